@@ -1,0 +1,279 @@
+//! The tactile image: what one reading of the covering sensor is (Sec. IV: "viewing tactile sensor
+//! readings as images").
+//!
+//! Layout: row-major, `rows x cols`; row 0 is the pad's `+up` edge, column 0 its left edge seen from
+//! behind the pad (looking along the pad normal, into the covering). Values are fractions of the
+//! sensing range, in [0, 1]: 0 is no penetration, 1 is the covering pushed through completely.
+
+use std::fmt;
+use std::io::Write;
+use std::path::Path;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// Where the pad was when it took a reading, in world coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PadPose {
+    /// Centre of the pad surface (the back of the covering), metres.
+    pub center_m: DVec3,
+    /// Unit normal pointing from the pad into the covering, toward the object.
+    pub normal: DVec3,
+    /// Unit vector in the pad plane toward image row 0.
+    pub up: DVec3,
+}
+
+impl PadPose {
+    /// Builds a pose from any normal and a hint for `up`; `up` is made orthogonal to the normal
+    /// (Gram-Schmidt). Returns `None` when the normal is zero or not finite, or `up` is parallel to it.
+    pub fn new(center_m: DVec3, normal: DVec3, up_hint: DVec3) -> Option<Self> {
+        let normal = normal.try_normalize()?;
+        let up = (up_hint - normal * up_hint.dot(normal)).try_normalize()?;
+        center_m.is_finite().then_some(Self { center_m, normal, up })
+    }
+
+    /// Unit vector in the pad plane toward the last image column: `normal x up`, so (right, up,
+    /// normal) is right-handed, as for a camera looking along the normal.
+    pub fn right(&self) -> DVec3 {
+        self.normal.cross(self.up)
+    }
+}
+
+/// Errors from building or reading a tactile image; each names the offending place.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("a tactile image needs at least one row and one column, got {rows}x{cols}")]
+    Empty { rows: usize, cols: usize },
+    #[error("a {rows}x{cols} tactile image needs {} values, got {got}", rows * cols)]
+    WrongLength { rows: usize, cols: usize, got: usize },
+    #[error("taxel (row {row}, col {col}) is {value}: values must be finite and within [0, 1]")]
+    OutOfRange { row: usize, col: usize, value: f64 },
+    #[error("{path}: line {line}: {what}")]
+    Parse { path: String, line: usize, what: String },
+    #[error("{path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: cannot encode PNG: {what}")]
+    Png { path: String, what: String },
+}
+
+/// One tactile reading, `rows x cols` fractions of the sensing range (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TactileImage {
+    rows: usize,
+    cols: usize,
+    values: Vec<f64>,
+    /// The pad pose the reading was taken at, when known (simulation knows it; recorded data may not).
+    pose: Option<PadPose>,
+}
+
+impl TactileImage {
+    /// An image from row-major values; every value must be finite and in [0, 1].
+    pub fn new(rows: usize, cols: usize, values: Vec<f64>) -> Result<Self, ImageError> {
+        if rows == 0 || cols == 0 {
+            return Err(ImageError::Empty { rows, cols });
+        }
+        if values.len() != rows * cols {
+            return Err(ImageError::WrongLength { rows, cols, got: values.len() });
+        }
+        if let Some((i, &value)) =
+            values.iter().enumerate().find(|(_, v)| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+        {
+            return Err(ImageError::OutOfRange { row: i / cols, col: i % cols, value });
+        }
+        Ok(Self { rows, cols, values, pose: None })
+    }
+
+    /// An all-zero image (no contact).
+    pub fn zeros(rows: usize, cols: usize) -> Result<Self, ImageError> {
+        Self::new(rows, cols, vec![0.0; rows * cols])
+    }
+
+    /// The same image tagged with the pad pose it was taken at.
+    pub fn with_pose(mut self, pose: PadPose) -> Self {
+        self.pose = Some(pose);
+        self
+    }
+
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// Row-major values, row 0 first.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    pub fn pose(&self) -> Option<&PadPose> {
+        self.pose.as_ref()
+    }
+
+    /// The value at (`row`, `col`); panics only on an index outside the image, a programming error.
+    pub fn get(&self, row: usize, col: usize) -> f64 {
+        assert!(row < self.rows && col < self.cols, "taxel ({row}, {col}) outside {}x{}", self.rows, self.cols);
+        self.values[row * self.cols + col]
+    }
+
+    /// Mean taxel value: the "average pressure of all sensor elements" of Sec. III-B.
+    pub fn mean(&self) -> f64 {
+        self.values.iter().sum::<f64>() / self.values.len() as f64
+    }
+
+    /// Largest taxel value.
+    pub fn max(&self) -> f64 {
+        self.values.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// Writes `rows` lines of `cols` comma-separated values (the format `taction sense` writes and
+    /// `taction describe` reads).
+    pub fn write_csv(&self, path: &Path) -> Result<(), ImageError> {
+        let io = |source| ImageError::Io { path: path.display().to_string(), source };
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+        write!(out, "{}", self.to_csv_string()).map_err(io)?;
+        out.flush().map_err(io)
+    }
+
+    /// The CSV text of [`write_csv`](Self::write_csv); values in shortest round-trip form.
+    pub fn to_csv_string(&self) -> String {
+        let mut s = String::new();
+        for row in self.values.chunks(self.cols) {
+            let line: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+            s.push_str(&line.join(","));
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Reads an image written by [`write_csv`](Self::write_csv); errors name the file and line.
+    pub fn read_csv(path: &Path) -> Result<Self, ImageError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ImageError::Io { path: path.display().to_string(), source })?;
+        Self::parse_csv(&text, &path.display().to_string())
+    }
+
+    /// Parses CSV text; `origin` names the source in errors.
+    pub fn parse_csv(text: &str, origin: &str) -> Result<Self, ImageError> {
+        let parse = |line: usize, what: String| ImageError::Parse { path: origin.to_string(), line, what };
+        let mut values = Vec::new();
+        let mut cols = None;
+        let mut rows = 0;
+        for (i, line) in text.lines().enumerate() {
+            let line_no = i + 1;
+            if line.trim().is_empty() {
+                continue;
+            }
+            let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+            match cols {
+                None => cols = Some(fields.len()),
+                Some(c) if c != fields.len() => {
+                    return Err(parse(line_no, format!("{} values, but earlier rows have {c}", fields.len())));
+                }
+                Some(_) => {}
+            }
+            for (j, field) in fields.iter().enumerate() {
+                let v: f64 =
+                    field.parse().map_err(|_| parse(line_no, format!("column {}: '{field}' is not a number", j + 1)))?;
+                if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                    return Err(parse(line_no, format!("column {}: {v} is not a finite value in [0, 1]", j + 1)));
+                }
+                values.push(v);
+            }
+            rows += 1;
+        }
+        let cols = cols.ok_or_else(|| parse(0, "no values".to_string()))?;
+        Self::new(rows, cols, values)
+    }
+
+    /// Writes an 8-bit grayscale PNG, each taxel a `scale x scale` block (nearest neighbour), so a
+    /// 6x6 image is visible; white is full penetration. `scale` 0 picks one making the long side >= 192 px.
+    pub fn write_png(&self, path: &Path, scale: usize) -> Result<(), ImageError> {
+        let scale = if scale == 0 { 192usize.div_ceil(self.rows.max(self.cols)) } else { scale };
+        let (w, h) = (self.cols * scale, self.rows * scale);
+        let mut pixels = vec![0u8; w * h];
+        for (y, row) in pixels.chunks_mut(w).enumerate() {
+            for (x, p) in row.iter_mut().enumerate() {
+                *p = to_gray(self.get(y / scale, x / scale));
+            }
+        }
+        write_gray_png(path, w, h, &pixels)
+    }
+}
+
+/// A value in [0, 1] as an 8-bit gray level.
+pub fn to_gray(value: f64) -> u8 {
+    (value.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Writes an 8-bit grayscale PNG of `width x height` row-major pixels.
+pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -> Result<(), ImageError> {
+    let name = || path.display().to_string();
+    let file = std::fs::File::create(path).map_err(|source| ImageError::Io { path: name(), source })?;
+    let dims = |v: usize| u32::try_from(v).map_err(|_| ImageError::Png { path: name(), what: "too large".into() });
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), dims(width)?, dims(height)?);
+    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_depth(png::BitDepth::Eight);
+    let png_err = |e: png::EncodingError| ImageError::Png { path: name(), what: e.to_string() };
+    let mut writer = encoder.write_header().map_err(png_err)?;
+    writer.write_image_data(pixels).map_err(png_err)?;
+    writer.finish().map_err(png_err)
+}
+
+impl fmt::Display for TactileImage {
+    /// A compact text rendering, one line per row, for terminals.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        const SHADES: &[u8] = b" .:-=+*#%@";
+        for row in self.values.chunks(self.cols) {
+            let line: String = row
+                .iter()
+                .map(|v| SHADES[((v * (SHADES.len() - 1) as f64).round() as usize).min(SHADES.len() - 1)] as char)
+                .collect();
+            writeln!(f, "{line}")?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_shapes_and_values() {
+        assert!(matches!(TactileImage::new(0, 3, vec![]), Err(ImageError::Empty { .. })));
+        assert!(matches!(TactileImage::new(2, 2, vec![0.0; 3]), Err(ImageError::WrongLength { got: 3, .. })));
+        let e = TactileImage::new(2, 2, vec![0.0, 0.5, f64::NAN, 1.0]).unwrap_err();
+        assert!(matches!(e, ImageError::OutOfRange { row: 1, col: 0, .. }), "{e}");
+        assert!(TactileImage::new(1, 2, vec![0.0, 1.5]).is_err());
+    }
+
+    #[test]
+    fn csv_round_trip_is_exact() {
+        let values: Vec<f64> = (0..12).map(|i| (i as f64 / 11.0).powf(1.3)).collect();
+        let image = TactileImage::new(3, 4, values).unwrap();
+        let back = TactileImage::parse_csv(&image.to_csv_string(), "mem").unwrap();
+        assert_eq!(image, back);
+    }
+
+    #[test]
+    fn csv_errors_name_the_line() {
+        let e = TactileImage::parse_csv("0,0.5\n0.1,x\n", "f.csv").unwrap_err().to_string();
+        assert!(e.contains("f.csv: line 2") && e.contains("'x'"), "{e}");
+        let e = TactileImage::parse_csv("0,0.5\n0.1\n", "f.csv").unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+        let e = TactileImage::parse_csv("0,NaN\n", "f.csv").unwrap_err().to_string();
+        assert!(e.contains("line 1"), "{e}");
+    }
+
+    #[test]
+    fn pad_frame_is_right_handed() {
+        let pose = PadPose::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0), DVec3::new(0.0, 1.0, 0.3)).unwrap();
+        assert!((pose.normal - DVec3::NEG_Z).length() < 1e-12);
+        assert!((pose.up - DVec3::Y).length() < 1e-12);
+        // Looking down -z with +y up, the right of the image is +x.
+        assert!((pose.right() - DVec3::X).length() < 1e-12);
+        assert!(PadPose::new(DVec3::ZERO, DVec3::Z, DVec3::Z).is_none());
+    }
+}

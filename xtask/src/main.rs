@@ -1,0 +1,188 @@
+//! `cargo xtask`: the project's own set-up, so that the README's two commands work on a fresh machine.
+//!
+//! MuJoCo is a C library; `mujoco-rs` links it dynamically from `MUJOCO_DYNAMIC_LINK_DIR`, which
+//! `.cargo/config.toml` points at `.runtime/mujoco/lib`. This task fills that folder from the official
+//! PyPI wheel `mujoco==3.17.0` (fetched with pip, the library inside checked against a pinned sha256),
+//! then runs cargo. It has no MuJoCo dependency itself, so it builds before the runtime exists
+//! (matklad's xtask pattern). A second run finds the checked library and does no network work.
+
+use std::ffi::OsString;
+use std::fs;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+use sha2::{Digest, Sha256};
+
+const MUJOCO_VERSION: &str = "3.17.0";
+const LIBRARY_IN_WHEEL: &str = "mujoco/libmujoco.so.3.17.0";
+const LIBRARY_FILE: &str = "libmujoco.so.3.17.0";
+/// sha256 of `libmujoco.so.3.17.0` for x86_64 Linux; identical in the cp311 and cp312 wheels
+/// (the wheels' own hashes differ per Python version, the library inside does not).
+const LIBRARY_SHA256: &str = "23496b023ee80fb61ab71167e94bc649f9941710fde96b18bb8204fb332523ad";
+
+const USAGE: &str = "\
+usage: cargo xtask <task> [args...]
+
+tasks:
+  setup          fetch and check the MuJoCo runtime (and the object meshes) if missing
+  demo [args]    setup, then `cargo run --release -- demo [args]`
+  test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`)
+  bench [args]   setup, then `cargo bench [args]`
+  run [args]     setup, then `cargo run --release -- [args]` (any taction subcommand)";
+
+fn main() -> ExitCode {
+    let mut args = std::env::args_os().skip(1);
+    let task = args.next().and_then(|t| t.into_string().ok());
+    let rest: Vec<OsString> = args.collect();
+    let result = match task.as_deref() {
+        Some("setup") => setup(),
+        Some("demo") => setup().and_then(|()| {
+            let mut a = os(&["run", "--release", "--quiet", "--package", "taction", "--", "demo"]);
+            a.extend(rest);
+            cargo(&a)
+        }),
+        Some("run") => setup().and_then(|()| {
+            let mut a = os(&["run", "--release", "--quiet", "--package", "taction", "--"]);
+            a.extend(rest);
+            cargo(&a)
+        }),
+        Some("test") => setup().and_then(|()| {
+            let mut a = os(&["test", "--workspace"]);
+            a.extend(rest);
+            cargo(&a)
+        }),
+        Some("bench") => setup().and_then(|()| {
+            let mut a = os(&["bench", "--package", "taction"]);
+            a.extend(rest);
+            cargo(&a)
+        }),
+        Some("help") | Some("--help") | Some("-h") => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        _ => Err(format!("unknown or missing task\n{USAGE}")),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("xtask: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn os(items: &[&str]) -> Vec<OsString> {
+    items.iter().map(OsString::from).collect()
+}
+
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+fn setup() -> Result<(), String> {
+    ensure_mujoco_runtime(&project_root().join(".runtime"))
+}
+
+fn cargo(args: &[OsString]) -> Result<(), String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| OsString::from("cargo"));
+    let status = Command::new(&cargo)
+        .args(args)
+        .current_dir(project_root())
+        .status()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo {} failed ({status})", display_args(args)))
+    }
+}
+
+fn display_args(args: &[OsString]) -> String {
+    args.iter().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" ")
+}
+
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Makes `<runtime>/mujoco/lib/{libmujoco.so.3.17.0, libmujoco.so}` exist and match the pin.
+fn ensure_mujoco_runtime(runtime: &Path) -> Result<(), String> {
+    let lib_dir = runtime.join("mujoco").join("lib");
+    let library = lib_dir.join(LIBRARY_FILE);
+    let link = lib_dir.join("libmujoco.so");
+    if let Ok(bytes) = fs::read(&library) {
+        if sha256_hex(&bytes) == LIBRARY_SHA256 && link.exists() {
+            return Ok(());
+        }
+        eprintln!("xtask: {} does not match the pinned sha256; fetching it again", library.display());
+    }
+    fs::create_dir_all(&lib_dir).map_err(|e| format!("cannot create {}: {e}", lib_dir.display()))?;
+    let download = runtime.join("download");
+    fs::create_dir_all(&download).map_err(|e| format!("cannot create {}: {e}", download.display()))?;
+
+    let wheel = match find_wheel(&download) {
+        Some(w) => w,
+        None => {
+            eprintln!("xtask: fetching MuJoCo {MUJOCO_VERSION} from PyPI (wheel mujoco=={MUJOCO_VERSION})");
+            let status = Command::new("python3")
+                .args(["-m", "pip", "download", "--no-deps", "--only-binary=:all:"])
+                .args(["--disable-pip-version-check", "--quiet", "--dest"])
+                .arg(&download)
+                .arg(format!("mujoco=={MUJOCO_VERSION}"))
+                .status()
+                .map_err(|e| format!("cannot run `python3 -m pip` (python3 with pip is required): {e}"))?;
+            if !status.success() {
+                return Err(format!("`python3 -m pip download mujoco=={MUJOCO_VERSION}` failed ({status})"));
+            }
+            find_wheel(&download).ok_or_else(|| format!("pip left no mujoco wheel in {}", download.display()))?
+        }
+    };
+
+    let bytes = read_library_from_wheel(&wheel)?;
+    let digest = sha256_hex(&bytes);
+    if digest != LIBRARY_SHA256 {
+        let _ = fs::remove_file(&wheel);
+        return Err(format!(
+            "{LIBRARY_IN_WHEEL} in {} has sha256 {digest}, expected {LIBRARY_SHA256}; the wheel was removed, run again",
+            wheel.display()
+        ));
+    }
+    let partial = lib_dir.join(format!("{LIBRARY_FILE}.partial"));
+    fs::write(&partial, &bytes).map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+    fs::rename(&partial, &library).map_err(|e| format!("cannot write {}: {e}", library.display()))?;
+    let _ = fs::remove_file(&link);
+    std::os::unix::fs::symlink(LIBRARY_FILE, &link).map_err(|e| format!("cannot link {}: {e}", link.display()))?;
+    eprintln!("xtask: MuJoCo {MUJOCO_VERSION} runtime ready in {}", lib_dir.display());
+    Ok(())
+}
+
+fn find_wheel(dir: &Path) -> Option<PathBuf> {
+    let mut wheels: Vec<PathBuf> = fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with(&format!("mujoco-{MUJOCO_VERSION}-")) && n.ends_with(".whl"))
+        })
+        .collect();
+    wheels.sort();
+    wheels.pop()
+}
+
+fn read_library_from_wheel(wheel: &Path) -> Result<Vec<u8>, String> {
+    let file = fs::File::open(wheel).map_err(|e| format!("cannot open {}: {e}", wheel.display()))?;
+    let mut archive = zip::ZipArchive::new(file).map_err(|e| format!("{} is not a valid wheel: {e}", wheel.display()))?;
+    let mut entry = archive
+        .by_name(LIBRARY_IN_WHEEL)
+        .map_err(|e| format!("{} holds no {LIBRARY_IN_WHEEL}: {e}", wheel.display()))?;
+    let mut bytes = Vec::new();
+    entry
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read {LIBRARY_IN_WHEEL} from {}: {e}", wheel.display()))?;
+    Ok(bytes)
+}
