@@ -1,1 +1,5 @@
-//! mesh (in progress)
+//! Objects as triangle meshes: the shapes the arm explores.
+
+pub mod trimesh;
+
+pub use trimesh::TriMesh;
