@@ -1,6 +1,34 @@
 //! The MuJoCo world (Sec. V-A1): the articulated arm with the sensor pad on its end, a table, and
 //! the object under exploration, free to be perturbed between readings (Sec. V-B4).
 
+pub mod arm;
+pub mod ik;
+pub mod mjcf;
+pub mod object;
+pub mod perturb;
 pub mod pose;
+pub mod scene;
 
+pub use arm::{Arm, Collision, MoveOptions, MoveOutcome};
+pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
+pub use object::{ObjectMount, ObjectSpec};
+pub use perturb::{Perturbation, PerturbationBounds};
 pub use pose::Pose;
+pub use scene::{Scene, SceneBuilder};
+
+/// Errors of the simulated world; each says which part and what is wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    #[error("MJCF ({origin}): {message}")]
+    Mjcf { origin: String, message: String },
+    #[error("object '{name}': {message}")]
+    Object { name: String, message: String },
+    #[error("the scene has no object")]
+    NoObject,
+    #[error("the scene has no arm")]
+    NoArm,
+    #[error("physics: {message}")]
+    Physics { message: String },
+    #[error("{message}")]
+    BadConfiguration { message: String },
+}

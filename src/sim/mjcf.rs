@@ -1,0 +1,123 @@
+//! Assembling MJCF documents from the world files in `mjcf/`.
+//!
+//! The files in `mjcf/` are complete MJCF models so that MuJoCo's own viewer opens them unchanged;
+//! `world.xml` combines them with `<include>`. MuJoCo's include inserts the children of the included
+//! `<mujoco>` element; [`inner`] does the same textually, so scenes built here are the same model as
+//! the files, with the object slot filled by a mesh and extra parts (sensor plugins) added.
+
+use crate::sim::SimError;
+
+/// `mjcf/arm.xml`: the arm of Sec. V-A1 with the sensor pad site.
+pub const ARM_XML: &str = include_str!("../../mjcf/arm.xml");
+/// `mjcf/table.xml`: the table, its top at z = 0.
+pub const TABLE_XML: &str = include_str!("../../mjcf/table.xml");
+
+/// The children of the root `<mujoco>` element of `xml` (what `<include>` would insert).
+pub fn inner(xml: &str, origin: &str) -> Result<String, SimError> {
+    let missing = |what: &str| SimError::Mjcf { origin: origin.to_string(), message: what.to_string() };
+    let open = xml.find("<mujoco").ok_or_else(|| missing("no <mujoco> root element"))?;
+    let body_start = xml[open..].find('>').map(|i| open + i + 1).ok_or_else(|| missing("unterminated <mujoco>"))?;
+    let close = xml.rfind("</mujoco>").ok_or_else(|| missing("no closing </mujoco>"))?;
+    if close < body_start {
+        return Err(missing("</mujoco> before the root element's content"));
+    }
+    Ok(xml[body_start..close].to_string())
+}
+
+/// Where a piece of XML goes in the assembled document.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Section {
+    Asset,
+    Worldbody,
+    Extension,
+    Sensor,
+    Contact,
+}
+
+impl Section {
+    fn tag(self) -> &'static str {
+        match self {
+            Self::Asset => "asset",
+            Self::Worldbody => "worldbody",
+            Self::Extension => "extension",
+            Self::Sensor => "sensor",
+            Self::Contact => "contact",
+        }
+    }
+}
+
+/// An MJCF document under construction: whole included models plus extra section content.
+#[derive(Debug, Clone, Default)]
+pub struct Document {
+    includes: Vec<String>,
+    sections: Vec<(Section, String)>,
+}
+
+impl Document {
+    /// Inserts the children of a complete `<mujoco>` model, as `<include>` would.
+    pub fn include(&mut self, xml: &str, origin: &str) -> Result<&mut Self, SimError> {
+        self.includes.push(inner(xml, origin)?);
+        Ok(self)
+    }
+
+    /// Adds raw elements to a section.
+    pub fn add(&mut self, section: Section, xml: impl Into<String>) -> &mut Self {
+        self.sections.push((section, xml.into()));
+        self
+    }
+
+    /// The assembled document. MJCF merges repeated top-level sections, so each part keeps its own.
+    pub fn to_xml(&self, model_name: &str) -> String {
+        let mut xml = format!("<mujoco model=\"{}\">\n", escape_attr(model_name));
+        for part in &self.includes {
+            xml.push_str(part);
+            xml.push('\n');
+        }
+        for (section, content) in &self.sections {
+            let tag = section.tag();
+            xml.push_str(&format!("<{tag}>\n{content}\n</{tag}>\n"));
+        }
+        xml.push_str("</mujoco>\n");
+        xml
+    }
+}
+
+/// Escapes a string for use inside a double-quoted XML attribute.
+pub fn escape_attr(value: &str) -> String {
+    value
+        .replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Space-separated numbers in shortest round-trip form, so the compiled model holds exactly these values.
+pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
+    let mut s = String::new();
+    for (i, v) in values.into_iter().enumerate() {
+        if i > 0 {
+            s.push(' ');
+        }
+        s.push_str(&v.to_string());
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inner_strips_the_root_and_keeps_content() {
+        let xml = "<!-- c --><mujoco model=\"m\">\n<worldbody/>\n</mujoco>\n";
+        assert_eq!(inner(xml, "t").unwrap().trim(), "<worldbody/>");
+        assert!(inner("<x/>", "t").unwrap_err().to_string().contains("no <mujoco>"));
+    }
+
+    #[test]
+    fn world_files_are_complete_models() {
+        for (xml, name) in [(ARM_XML, "arm.xml"), (TABLE_XML, "table.xml")] {
+            assert!(inner(xml, name).is_ok(), "{name}");
+        }
+    }
+}

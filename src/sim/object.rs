@@ -1,0 +1,90 @@
+//! The object under exploration as MJCF: a mesh asset and a body in the object slot.
+//!
+//! The body is named `object`, its geom `object`, as in `mjcf/example_object.xml`. The body frame is
+//! the mesh's own frame (vertices are written as given, metres), so the object's pose in MuJoCo is
+//! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
+
+use crate::mesh::TriMesh;
+use crate::sim::mjcf::{Document, Section, escape_attr, numbers};
+use crate::sim::{Pose, SimError};
+
+/// Body, geom and joint names of the object slot.
+pub const OBJECT_BODY: &str = "object";
+pub const OBJECT_GEOM: &str = "object";
+pub const OBJECT_JOINT: &str = "object_free";
+
+/// How the object is held in the world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ObjectMount {
+    /// A mocap body: it stays exactly where it is put (contacts do not move it); perturbations
+    /// teleport it. The default for exploration, since the paper's object is "relatively stable while
+    /// taking a sensor measurement" (Sec. I).
+    #[default]
+    Mocap,
+    /// A free joint: gravity and contacts act on it; it rests on the table.
+    Free,
+}
+
+/// An object to place in the scene.
+#[derive(Debug, Clone)]
+pub struct ObjectSpec {
+    /// Display name (for messages); the MJCF names are fixed.
+    pub name: String,
+    /// The shape in its own frame, metres.
+    pub mesh: TriMesh,
+    /// Initial pose of the mesh frame in the world.
+    pub pose: Pose,
+    pub mount: ObjectMount,
+    /// Mass of the object (free mount only), kilograms.
+    pub mass_kg: f64,
+}
+
+impl ObjectSpec {
+    /// An object resting at the origin as given (its coordinates are already world metres).
+    pub fn new(name: impl Into<String>, mesh: TriMesh) -> Self {
+        Self { name: name.into(), mesh, pose: Pose::IDENTITY, mount: ObjectMount::Mocap, mass_kg: 0.2 }
+    }
+
+    /// Adds the mesh asset and the object body to `doc`.
+    ///
+    /// The geom collides with the arm and the table (MuJoCo uses the mesh's convex hull for these
+    /// contacts; the tactile sensor raycasts the exact triangles). The body gets an explicit inertia (a
+    /// solid sphere of the mesh's bounding radius), so that open or thin user meshes, whose volume
+    /// MuJoCo cannot compute, still load.
+    pub fn add_to(&self, doc: &mut Document) -> Result<(), SimError> {
+        let (lo, hi) = self.mesh.bounds().ok_or_else(|| SimError::Object {
+            name: self.name.clone(),
+            message: "the mesh has no vertices".into(),
+        })?;
+        if self.mesh.triangles.is_empty() {
+            return Err(SimError::Object { name: self.name.clone(), message: "the mesh has no triangles".into() });
+        }
+        let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
+        let face = self.mesh.triangles.iter().flatten().map(|i| i.to_string()).collect::<Vec<_>>().join(" ");
+        doc.add(Section::Asset, format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"));
+
+        let center = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1e-3);
+        let inertia = 0.4 * self.mass_kg * radius * radius;
+        let pos = numbers(self.pose.position_m.to_array());
+        let quat = numbers(self.pose.mujoco_quat());
+        let (mount_attr, joint) = match self.mount {
+            ObjectMount::Mocap => (" mocap=\"true\"", String::new()),
+            ObjectMount::Free => ("", format!("<freejoint name=\"{OBJECT_JOINT}\"/>")),
+        };
+        doc.add(
+            Section::Worldbody,
+            format!(
+                "<body name=\"{OBJECT_BODY}\" pos=\"{pos}\" quat=\"{quat}\"{mount_attr}>\n\
+                 <!-- {} -->\n{joint}\n\
+                 <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>\n\
+                 <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"object\" rgba=\"0.8 0.5 0.3 1\" friction=\"0.6\"/>\n\
+                 </body>",
+                escape_attr(&self.name).replace("--", "- -"),
+                numbers(center.to_array()),
+                self.mass_kg
+            ),
+        );
+        Ok(())
+    }
+}

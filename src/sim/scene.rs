@@ -1,0 +1,247 @@
+//! A compiled MuJoCo world and its state: the one place that owns `MjModel` and `MjData`.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use mujoco_rs::prelude::*;
+
+use crate::mesh::TriMesh;
+use crate::sim::arm::Arm;
+use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML};
+use crate::sim::object::{OBJECT_BODY, ObjectMount, ObjectSpec};
+use crate::sim::{Pose, SimError};
+
+/// What goes into a scene. The arm and table come from `mjcf/`; the object and any extra parts (a
+/// sensor plugin, a free-floating pad) are added by the caller.
+#[derive(Debug, Clone, Default)]
+pub struct SceneBuilder {
+    arm: bool,
+    table: bool,
+    object: Option<ObjectSpec>,
+    extra: Vec<(Section, String)>,
+    timestep_s: Option<f64>,
+}
+
+impl SceneBuilder {
+    /// An empty world.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The world of Sec. V-A1: arm and table.
+    pub fn with_arm_and_table() -> Self {
+        Self { arm: true, table: true, ..Self::default() }
+    }
+
+    pub fn table(mut self, yes: bool) -> Self {
+        self.table = yes;
+        self
+    }
+
+    pub fn object(mut self, object: ObjectSpec) -> Self {
+        self.object = Some(object);
+        self
+    }
+
+    /// Extra MJCF elements for a section (e.g. a sensor plugin instance).
+    pub fn add(mut self, section: Section, xml: impl Into<String>) -> Self {
+        self.extra.push((section, xml.into()));
+        self
+    }
+
+    /// Overrides the simulation timestep, seconds.
+    pub fn timestep_s(mut self, dt: f64) -> Self {
+        self.timestep_s = Some(dt);
+        self
+    }
+
+    /// The MJCF document this builder compiles.
+    pub fn to_xml(&self) -> Result<String, SimError> {
+        let mut doc = Document::default();
+        if self.arm {
+            doc.include(ARM_XML, "mjcf/arm.xml")?;
+        } else {
+            doc.include("<mujoco><compiler angle=\"degree\" autolimits=\"true\"/></mujoco>", "compiler")?;
+        }
+        if let Some(dt) = self.timestep_s {
+            doc.include(&format!("<mujoco><option timestep=\"{dt}\"/></mujoco>"), "option")?;
+        }
+        if self.table {
+            doc.include(TABLE_XML, "mjcf/table.xml")?;
+        }
+        if let Some(object) = &self.object {
+            object.add_to(&mut doc)?;
+        }
+        for (section, xml) in &self.extra {
+            doc.add(*section, xml.clone());
+        }
+        Ok(doc.to_xml("taction scene"))
+    }
+
+    /// Compiles the scene and runs `mj_forward` once.
+    pub fn build(&self) -> Result<Scene, SimError> {
+        let xml = self.to_xml()?;
+        let model = MjModel::from_xml_string(&xml)
+            .map_err(|e| SimError::Mjcf { origin: "assembled scene".into(), message: mujoco_message(&e) })?;
+        Scene::new(model, self.object.as_ref())
+    }
+}
+
+/// The text of a MuJoCo load error.
+pub fn mujoco_message(e: &MjModelError) -> String {
+    match e {
+        MjModelError::LoadFailed(m) => m.clone(),
+        other => format!("{other:?}"),
+    }
+}
+
+/// The object slot of a compiled scene.
+#[derive(Debug, Clone)]
+pub struct SceneObject {
+    pub name: String,
+    pub body: usize,
+    pub mount: ObjectMount,
+    /// Address of the free joint's 7 qpos values (free mount).
+    qpos_adr: Option<usize>,
+    /// Index into mocap arrays (mocap mount).
+    mocap: Option<usize>,
+    /// The mesh in the body frame, for resting it on the table after a perturbation.
+    pub mesh: TriMesh,
+}
+
+/// A compiled world and its simulation state.
+pub struct Scene {
+    model: Arc<MjModel>,
+    data: MjData<Arc<MjModel>>,
+    object: Option<SceneObject>,
+    arm: Option<Arm>,
+}
+
+impl Scene {
+    /// Wraps a compiled model (any model: the arm and object slot are found by name if present).
+    pub fn new(model: MjModel, object: Option<&ObjectSpec>) -> Result<Self, SimError> {
+        let model = Arc::new(model);
+        let data = MjData::try_new(model.clone()).map_err(|e| SimError::Physics { message: format!("{e:?}") })?;
+        let object = match (object, model.name_to_id(MjtObjBase::mjOBJ_BODY, OBJECT_BODY)) {
+            (Some(spec), Some(body)) => {
+                let mocap_id = model.body_mocapid()[body];
+                let jnt = model.body_jntadr()[body];
+                Some(SceneObject {
+                    name: spec.name.clone(),
+                    body,
+                    mount: spec.mount,
+                    qpos_adr: (jnt >= 0).then(|| model.jnt_qposadr()[jnt as usize] as usize),
+                    mocap: (mocap_id >= 0).then_some(mocap_id as usize),
+                    mesh: spec.mesh.clone(),
+                })
+            }
+            _ => None,
+        };
+        let arm = Arm::find(&model)?;
+        let mut scene = Self { model, data, object, arm };
+        scene.data.forward();
+        Ok(scene)
+    }
+
+    pub fn model(&self) -> &MjModel {
+        &self.model
+    }
+
+    /// The shared model, for a second `MjData` (e.g. scratch data for inverse kinematics).
+    pub fn model_arc(&self) -> Arc<MjModel> {
+        self.model.clone()
+    }
+
+    pub fn data(&self) -> &MjData<Arc<MjModel>> {
+        &self.data
+    }
+
+    pub fn data_mut(&mut self) -> &mut MjData<Arc<MjModel>> {
+        &mut self.data
+    }
+
+    pub fn arm(&self) -> Option<&Arm> {
+        self.arm.as_ref()
+    }
+
+    pub fn object(&self) -> Option<&SceneObject> {
+        self.object.as_ref()
+    }
+
+    /// Recomputes everything derived from the state (kinematics, contacts, sensors) without advancing time.
+    pub fn forward(&mut self) {
+        self.data.forward();
+    }
+
+    /// One physics step; an unstable state (non-finite positions or velocities) is an error naming the time.
+    pub fn step(&mut self) -> Result<(), SimError> {
+        self.data.step();
+        let finite = self.data.qpos().iter().chain(self.data.qvel().iter()).all(|v| v.is_finite());
+        if finite {
+            Ok(())
+        } else {
+            Err(SimError::Physics { message: format!("non-finite state at t = {} s", self.data.time()) })
+        }
+    }
+
+    /// Name of body `id` (or `body <id>` when unnamed).
+    pub fn body_name(&self, id: usize) -> String {
+        self.model
+            .id_to_name(MjtObjBase::mjOBJ_BODY, id)
+            .map(str::to_string)
+            .unwrap_or_else(|| if id == 0 { "world".into() } else { format!("body {id}") })
+    }
+
+    /// Contacts currently detected, as body pairs (after `forward` or `step`).
+    pub fn contact_bodies(&self) -> Vec<(usize, usize)> {
+        let geom_body = self.model.geom_bodyid();
+        self.data
+            .contact()
+            .iter()
+            .map(|c| (geom_body[c.geom1 as usize] as usize, geom_body[c.geom2 as usize] as usize))
+            .collect()
+    }
+
+    /// The object's current pose (its mesh frame in the world).
+    pub fn object_pose(&self) -> Option<Pose> {
+        let object = self.object.as_ref()?;
+        let b = object.body;
+        Some(Pose::from_mujoco(self.data.xpos()[b], self.data.xquat()[b]))
+    }
+
+    /// Puts the object at `pose` (mesh frame in the world), at rest, and runs `mj_forward`.
+    pub fn set_object_pose(&mut self, pose: Pose) -> Result<(), SimError> {
+        let object = self.object.as_ref().ok_or(SimError::NoObject)?;
+        let pos = pose.position_m.to_array();
+        let quat = pose.mujoco_quat();
+        match (object.qpos_adr, object.mocap) {
+            (Some(adr), _) => {
+                let qpos = self.data.qpos_mut();
+                qpos[adr..adr + 3].copy_from_slice(&pos);
+                qpos[adr + 3..adr + 7].copy_from_slice(&quat);
+                let dof = self.model.jnt_dofadr()[self.model.body_jntadr()[object.body] as usize] as usize;
+                self.data.qvel_mut()[dof..dof + 6].fill(0.0);
+            }
+            (None, Some(m)) => {
+                self.data.mocap_pos_mut()[m] = pos;
+                self.data.mocap_quat_mut()[m] = quat;
+            }
+            (None, None) => return Err(SimError::NoObject),
+        }
+        self.data.forward();
+        Ok(())
+    }
+
+    /// Lowest world z of the object's mesh at `pose`.
+    pub fn object_lowest_z(&self, pose: &Pose) -> Option<f64> {
+        let object = self.object.as_ref()?;
+        object.mesh.vertices.iter().map(|&v| pose.transform_point(v).z).reduce(f64::min)
+    }
+
+    /// Centre of the object's bounding box in the world, at its current pose.
+    pub fn object_center(&self) -> Option<DVec3> {
+        let object = self.object.as_ref()?;
+        let (lo, hi) = object.mesh.bounds()?;
+        Some(self.object_pose()?.transform_point((lo + hi) * 0.5))
+    }
+}
