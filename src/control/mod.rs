@@ -1,6 +1,17 @@
 //! Surface contact control (Sec. III-B, Fig. 3, Algorithm 1): Approach, Press and Orient settle the
 //! sensor on the surface so that a patch of surface gives a consistent tactile image.
 
+pub mod approach;
+pub mod carrier;
+pub mod config;
+pub mod orient;
+pub mod press;
 pub mod status;
+pub mod surface_contact;
+pub mod trace;
 
+pub use carrier::{ControlError, PadCarrier, PadMotion};
+pub use config::ControlConfig;
 pub use status::ContactStatus;
+pub use surface_contact::{ContactOutcome, ContactReport, settle};
+pub use trace::{Command, Trace};

@@ -1,0 +1,159 @@
+//! Every threshold and gain of the surface contact controllers, with units.
+
+use serde::{Deserialize, Serialize};
+
+/// Configuration of Approach, Press and Orient (Sec. III-B). Pressures are fractions of the sensing
+/// range (taxel values in [0, 1]); lengths are metres or multiples of the covering thickness t.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlConfig {
+    /// A taxel above this value (fraction of range) is in contact ("significantly above zero",
+    /// Approach, Fig. 3c), on top of the noise allowance below.
+    pub contact_threshold: f64,
+    /// Additive noise amplitude the controllers should expect (fraction of range, as the sensor's
+    /// `noise_fraction`): contact needs a taxel above `contact_threshold + noise_fraction / 2`, the
+    /// largest value noise alone can produce, and tolerances widen with it.
+    pub expected_noise_fraction: f64,
+    /// Approach step as a fraction of t: small enough that first contact does not push through.
+    pub approach_step_thickness: f64,
+    /// Distance Approach travels before giving up with `NoContact`, metres.
+    pub approach_max_distance_m: f64,
+    /// Press target: the mean taxel value ("the average pressure of all sensor elements", Sec. III-B).
+    pub target_mean_pressure: f64,
+    /// Press stops commanding when |target - mean| is below this (fraction of range).
+    pub pressure_tolerance: f64,
+    /// Press proportional gain: metres per unit pressure error, in multiples of t.
+    pub press_kp: f64,
+    /// Press derivative gain: metres per unit change of pressure error, in multiples of t.
+    pub press_kd: f64,
+    /// Largest Press step, in multiples of t.
+    pub press_max_step_thickness: f64,
+    /// Press steps allowed in one Press phase.
+    pub press_max_steps: usize,
+    /// Press's second termination: a taxel at or above this value is "close to fully saturated".
+    pub saturation_threshold: f64,
+    /// Orient rotates the pad normal this fraction of the way to the fitted surface normal
+    /// (Algorithm 1, line 11: step = 0.3).
+    pub orient_step: f64,
+    /// Orient issues no command when pad and surface normals agree within this angle, radians.
+    pub orient_tolerance_rad: f64,
+    /// Largest rotation of one Orient command, radians.
+    pub orient_max_step_rad: f64,
+    /// Press/Orient alternations before `MaxIterations`.
+    pub max_iterations: usize,
+}
+
+impl Default for ControlConfig {
+    fn default() -> Self {
+        Self {
+            contact_threshold: 0.05,
+            expected_noise_fraction: 0.0,
+            approach_step_thickness: 0.25,
+            approach_max_distance_m: 0.05,
+            target_mean_pressure: 0.3,
+            pressure_tolerance: 0.01,
+            press_kp: 0.8,
+            press_kd: 0.1,
+            press_max_step_thickness: 0.5,
+            press_max_steps: 40,
+            saturation_threshold: 0.95,
+            orient_step: 0.3,
+            orient_tolerance_rad: 1.0_f64.to_radians(),
+            orient_max_step_rad: 15.0_f64.to_radians(),
+            max_iterations: 40,
+        }
+    }
+}
+
+/// A configuration value outside its allowed range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("control config: {field} = {value} is outside {allowed}")]
+pub struct ControlConfigError {
+    pub field: &'static str,
+    pub value: f64,
+    pub allowed: &'static str,
+}
+
+impl ControlConfig {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<(), ControlConfigError> {
+        let checks: [(&'static str, f64, bool, &'static str); 14] = [
+            ("contact_threshold", self.contact_threshold, (0.0..1.0).contains(&self.contact_threshold), "[0, 1)"),
+            (
+                "expected_noise_fraction",
+                self.expected_noise_fraction,
+                (0.0..=2.0).contains(&self.expected_noise_fraction),
+                "[0, 2]",
+            ),
+            (
+                "approach_step_thickness",
+                self.approach_step_thickness,
+                self.approach_step_thickness > 0.0 && self.approach_step_thickness <= 1.0,
+                "(0, 1]",
+            ),
+            ("approach_max_distance_m", self.approach_max_distance_m, self.approach_max_distance_m > 0.0, "(0, inf)"),
+            (
+                "target_mean_pressure",
+                self.target_mean_pressure,
+                self.target_mean_pressure > 0.0 && self.target_mean_pressure < 1.0,
+                "(0, 1)",
+            ),
+            ("pressure_tolerance", self.pressure_tolerance, self.pressure_tolerance > 0.0, "(0, inf)"),
+            ("press_kp", self.press_kp, self.press_kp > 0.0 && self.press_kp <= 2.0, "(0, 2]"),
+            ("press_kd", self.press_kd, (0.0..=2.0).contains(&self.press_kd), "[0, 2]"),
+            ("press_max_step_thickness", self.press_max_step_thickness, self.press_max_step_thickness > 0.0, "(0, inf)"),
+            ("press_max_steps", self.press_max_steps as f64, self.press_max_steps > 0, "1 or more"),
+            (
+                "saturation_threshold",
+                self.saturation_threshold,
+                self.saturation_threshold > self.target_mean_pressure && self.saturation_threshold <= 1.0,
+                "(target_mean_pressure, 1]",
+            ),
+            ("orient_step", self.orient_step, self.orient_step > 0.0 && self.orient_step <= 1.0, "(0, 1]"),
+            ("orient_tolerance_rad", self.orient_tolerance_rad, self.orient_tolerance_rad > 0.0, "(0, inf)"),
+            ("max_iterations", self.max_iterations as f64, self.max_iterations > 0, "1 or more"),
+        ];
+        for (field, value, ok, allowed) in checks {
+            if !ok || !value.is_finite() {
+                return Err(ControlConfigError { field, value, allowed });
+            }
+        }
+        Ok(())
+    }
+
+    /// The taxel value that counts as contact: the threshold above the largest value noise alone gives.
+    pub fn effective_contact_threshold(&self) -> f64 {
+        (self.contact_threshold + self.expected_noise_fraction * 0.5).min(0.99)
+    }
+
+    /// Pressure tolerance widened by the noise on the mean of `taxels` values (its standard deviation,
+    /// `a / sqrt(3 n)` for uniform noise of half-width `a`, times 3).
+    pub fn effective_pressure_tolerance(&self, taxels: usize) -> f64 {
+        let half_width = self.expected_noise_fraction * 0.5;
+        self.pressure_tolerance + 3.0 * half_width / (3.0 * taxels.max(1) as f64).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert_eq!(ControlConfig::default().validate(), Ok(()));
+        let bad = ControlConfig { orient_step: 1.5, ..ControlConfig::default() };
+        let e = bad.validate().unwrap_err();
+        assert_eq!(e.field, "orient_step");
+        assert!(e.to_string().contains("(0, 1]"));
+        let bad = ControlConfig { saturation_threshold: 0.2, ..ControlConfig::default() };
+        assert_eq!(bad.validate().unwrap_err().field, "saturation_threshold");
+    }
+
+    #[test]
+    fn unknown_json_fields_are_rejected() {
+        let e = serde_json::from_str::<ControlConfig>("{\"orient_stp\": 0.3}").unwrap_err().to_string();
+        assert!(e.contains("orient_stp"), "{e}");
+        let c: ControlConfig = serde_json::from_str("{\"orient_step\": 0.5}").unwrap();
+        assert_eq!(c.orient_step, 0.5);
+    }
+}
