@@ -2,8 +2,10 @@
 //! sensor on the surface so that a patch of surface gives a consistent tactile image.
 
 pub mod approach;
+pub mod arm_pad;
 pub mod carrier;
 pub mod config;
+pub mod free_pad;
 pub mod orient;
 pub mod press;
 pub mod status;

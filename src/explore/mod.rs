@@ -1,8 +1,14 @@
 //! Exploration (Sec. III-A) and training-data collection (Sec. V-A3).
 
 pub mod grid;
+pub mod planner;
+pub mod reading;
+pub mod sampler;
 pub mod strategy;
 pub mod surface_sampling;
 pub mod tree;
 
+pub use planner::{Planner, PlannerConfig};
+pub use reading::{ExplorationReport, Reading};
+pub use sampler::{SamplerConfig, sample_readings};
 pub use strategy::Strategy;

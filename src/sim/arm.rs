@@ -180,7 +180,8 @@ impl Arm {
 
     /// Drives the position servos toward `target` in small interpolated steps while MuJoCo steps,
     /// stopping at the first contact of the arm (or the pad's rigid back) with anything, or when
-    /// `observer` returns `true` (it runs after every control interval, e.g. to read the sensor).
+    /// `observer` returns `true` (it runs after every control interval with the scene, e.g. to read
+    /// the sensor).
     pub fn move_to<F>(
         &self,
         scene: &mut Scene,
@@ -189,7 +190,7 @@ impl Arm {
         mut observer: F,
     ) -> Result<MoveOutcome, SimError>
     where
-        F: FnMut(&Scene) -> bool,
+        F: FnMut(&mut Scene) -> bool,
     {
         if target.len() != self.dof() || target.iter().any(|v| !v.is_finite()) {
             return Err(SimError::BadConfiguration { message: format!("{target:?} is not an arm configuration") });

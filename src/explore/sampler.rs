@@ -1,0 +1,110 @@
+//! The training sampler (Sec. V-A3): the object's pose and mesh are known, so readings come from
+//! area-weighted random surface points, approached by the free-floating pad.
+//!
+//! "First a triangle is selected from the triangular mesh with probability proportional to its area. A
+//! point p is then sampled uniformly at random inside the selected triangle and the point p is then moved
+//! back some distance in the direction opposite the triangle normal. The sensor is then placed at this
+//! location facing toward the triangle. A small perturbation is applied to the sensor orientation and then
+//! the local controllers are used to approach the surface and take a measurement."
+//!
+//! The pad's rotation about its normal is drawn uniformly: the controllers leave it free (Sec. IV), so
+//! training sees every in-plane orientation.
+
+use glam::{DQuat, DVec3};
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+
+use crate::control::{ControlConfig, ControlError, settle};
+use crate::control::free_pad::FreePad;
+use crate::explore::reading::{ExplorationReport, Reading};
+use crate::explore::strategy::Strategy;
+use crate::explore::surface_sampling::SurfaceSampler;
+use crate::mesh::TriMesh;
+use crate::rng::Rng;
+use crate::sim::{PerturbationBounds, Scene, SimError};
+use crate::tactile::{PadPose, SensorConfig, TactileImage};
+
+/// The sampler's parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SamplerConfig {
+    /// Distance the pad starts from the surface point, along the triangle normal, metres.
+    pub back_off_m: f64,
+    /// Largest tilt of the pad normal away from the triangle's inward normal, degrees.
+    pub orientation_noise_deg: f64,
+    /// Approach only from above (the raised letters, Sec. V-D): only faces whose normal points up
+    /// (z > cos 30°) are sampled, and the pad looks straight down before the tilt.
+    pub from_above_only: bool,
+    /// Draws allowed per requested converged reading before giving up.
+    pub max_attempts_per_reading: usize,
+}
+
+impl Default for SamplerConfig {
+    fn default() -> Self {
+        Self { back_off_m: 0.006, orientation_noise_deg: 10.0, from_above_only: false, max_attempts_per_reading: 20 }
+    }
+}
+
+/// A uniformly random unit vector perpendicular to `n`.
+fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
+    let (a, b) = n.any_orthonormal_pair();
+    let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+    a * phi.cos() + b * phi.sin()
+}
+
+/// Collects `converged_target` converged readings of the object in `scene` (which holds the object and
+/// a free-floating pad), perturbing the object after each reading if `perturbation` allows.
+#[allow(clippy::too_many_arguments)]
+pub fn sample_readings<R>(
+    scene: &mut Scene,
+    object: &str,
+    sensor: SensorConfig,
+    control: &ControlConfig,
+    config: &SamplerConfig,
+    perturbation: PerturbationBounds,
+    converged_target: usize,
+    rng: &mut Rng,
+    reader: R,
+) -> Result<ExplorationReport, ControlError>
+where
+    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+{
+    let mesh: TriMesh = scene.object().ok_or(SimError::NoObject)?.mesh.clone();
+    let up_only = config.from_above_only;
+    let surface = SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
+        SimError::Object { name: object.to_string(), message: "no surface area to sample".into() }
+    })?;
+    let mut pad = FreePad::new(scene, sensor, reader)?;
+    let mut report = ExplorationReport::default();
+    let max_attempts = converged_target.saturating_mul(config.max_attempts_per_reading).max(1);
+    let tilt_max = config.orientation_noise_deg.to_radians();
+    while report.converged() < converged_target && report.iterations < max_attempts {
+        report.iterations += 1;
+        let object_pose = pad.scene().object_pose().ok_or(SimError::NoObject)?;
+        let local = surface.sample(&mesh, rng);
+        let point = object_pose.transform_point(local.point_m);
+        let outward = if up_only { DVec3::Z } else { object_pose.transform_vector(local.normal) };
+        let tilt_axis = random_perpendicular(outward, rng);
+        let tilt = DQuat::from_axis_angle(tilt_axis, rng.random_range(0.0..=1.0) * tilt_max);
+        let normal = (tilt * -outward).normalize();
+        let up = random_perpendicular(normal, rng);
+        let start = PadPose { center_m: point + outward * config.back_off_m, normal, up };
+        pad.place(&start);
+        let outcome = settle(&mut pad, control)?;
+        report.readings.push(Reading {
+            image: outcome.image,
+            object: object.to_string(),
+            object_pose,
+            status: outcome.status,
+            iterations: outcome.iterations,
+            strategy: Strategy::Sampler,
+        });
+        if !perturbation.is_none() {
+            let scene = pad.scene();
+            let width = scene.object_width_m().ok_or(SimError::NoObject)?;
+            let p = perturbation.draw(width, rng);
+            scene.perturb_object(&p)?;
+        }
+    }
+    Ok(report)
+}
