@@ -1,5 +1,7 @@
 //! The `taction` command line: thin; parses and validates flags, then calls the library.
 
+mod cli;
+
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -12,9 +14,21 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Train on a small object set, explore an unknown object with the arm, recognise it touch by touch.
+    Demo(cli::demo::DemoArgs),
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {}
+    let result = match &cli.command {
+        Command::Demo(args) => cli::demo::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("taction: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
