@@ -22,8 +22,10 @@ pub enum PadMotion {
 pub enum ControlError {
     #[error(transparent)]
     Sim(#[from] SimError),
-    #[error("sensor: {0}")]
-    Sensor(String),
+    #[error(transparent)]
+    Tactile(#[from] crate::tactile::sensor::TactileError),
+    #[error("cannot start the worker threads: {0}")]
+    ThreadPool(String),
     #[error(transparent)]
     Config(#[from] crate::control::config::ControlConfigError),
 }

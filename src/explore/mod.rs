@@ -1,5 +1,6 @@
 //! Exploration (Sec. III-A) and training-data collection (Sec. V-A3).
 
+pub mod collect;
 pub mod grid;
 pub mod planner;
 pub mod reading;

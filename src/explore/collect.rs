@@ -1,0 +1,102 @@
+//! Collecting readings of a set of objects, in parallel and reproducibly.
+//!
+//! Each object is an independent run in its own MuJoCo scene, seeded from the run's seed and the
+//! object's index ([`crate::rng::stream`]); the sensor's noise stream likewise. Runs go to a rayon pool
+//! of the requested size and come back in object order, so the readings do not depend on the number of
+//! threads or on scheduling.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::control::{ControlConfig, ControlError};
+use crate::explore::planner::{Planner, PlannerConfig};
+use crate::explore::reading::ExplorationReport;
+use crate::explore::sampler::{SamplerConfig, sample_readings};
+use crate::rng;
+use crate::sim::arm::PAD_SITE;
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
+use crate::tactile::free_floating::FreeFloatingSensor;
+use crate::tactile::sensor::{CoveringSensor, add_sensor};
+use crate::tactile::{SensorConfig, TactileImage};
+
+/// Which procedure collects the readings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "mode")]
+pub enum CollectMode {
+    /// The training sampler with the free-floating pad (Sec. V-A3).
+    Sampler(SamplerConfig),
+    /// The exploration planner with the arm (Sec. III-A).
+    Planner(PlannerConfig),
+}
+
+/// Everything that determines a collection run (besides the objects).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CollectPlan {
+    pub mode: CollectMode,
+    pub sensor: SensorConfig,
+    pub control: ControlConfig,
+    pub perturbation: PerturbationBounds,
+    /// Converged readings wanted per object.
+    pub readings_per_object: usize,
+    pub seed: u64,
+}
+
+/// A reading function for a scene's covering sensor: runs `mj_forward` (the plugin computes at the
+/// sensor stage) and returns the image.
+pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> {
+    move |scene: &mut Scene| {
+        scene.forward();
+        Ok(sensor.read(scene.data())?)
+    }
+}
+
+impl CollectPlan {
+    /// The sensor of object `index`: the noise stream is the object's own.
+    pub fn sensor_for(&self, index: usize) -> SensorConfig {
+        SensorConfig { noise_seed: rng::substream(self.sensor.noise_seed ^ self.seed, index as u64), ..self.sensor }
+    }
+
+    /// Collects the readings of object `index` (its name is the object's name).
+    pub fn collect_object(&self, object: &ObjectSpec, index: usize) -> Result<ExplorationReport, ControlError> {
+        let sensor = self.sensor_for(index);
+        let mut rng = rng::stream(self.seed, index as u64);
+        match self.mode {
+            CollectMode::Sampler(config) => {
+                let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
+                let reader = sensor_reader(free.sensor().clone());
+                sample_readings(
+                    free.scene_mut(),
+                    &object.name,
+                    sensor,
+                    &self.control,
+                    &config,
+                    self.perturbation,
+                    self.readings_per_object,
+                    &mut rng,
+                    reader,
+                )
+            }
+            CollectMode::Planner(config) => {
+                let builder = SceneBuilder::with_arm_and_table().object(object.clone());
+                let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
+                    .map_err(crate::tactile::sensor::TactileError::from)?
+                    .build()?;
+                let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+                let mut planner =
+                    Planner::new(&scene, config, self.control, sensor, self.perturbation, rng, reader)?;
+                planner.explore(&mut scene, &object.name, self.readings_per_object)
+            }
+        }
+    }
+
+    /// Collects every object on a pool of `threads` threads (0: all cores), results in object order.
+    pub fn collect(&self, objects: &[ObjectSpec], threads: usize) -> Result<Vec<ExplorationReport>, ControlError> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| ControlError::ThreadPool(format!("{threads} threads: {e}")))?;
+        pool.install(|| {
+            objects.par_iter().enumerate().map(|(i, object)| self.collect_object(object, i)).collect()
+        })
+    }
+}
