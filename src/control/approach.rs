@@ -30,8 +30,10 @@ pub fn approach<C: PadCarrier + ?Sized>(
         return Ok(ApproachOutcome::Contact(image));
     }
     let step_m = config.approach_step_thickness * carrier.sensor().thickness_m;
-    let steps = (config.approach_max_distance_m / step_m).ceil() as usize;
-    for _ in 0..steps {
+    let mut travelled_m = 0.0;
+    while travelled_m < config.approach_max_distance_m {
+        let step_m = step_m.min(config.approach_max_distance_m - travelled_m);
+        travelled_m += step_m;
         let mut pose = carrier.pad_pose();
         pose.center_m += pose.normal * step_m;
         trace.push(Command::Approach, pose);

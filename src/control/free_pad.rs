@@ -1,19 +1,14 @@
 //! The free-floating pad as a [`PadCarrier`]: the pad site on a mocap body with no arm, moved by
 //! writing the mocap pose (the training sampler of Sec. V-A3, and `taction touch`).
 
-use glam::{DMat3, DQuat};
 use mujoco_rs::prelude::*;
 
 use crate::control::arm_pad::pad_pose_of_site;
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
 use crate::sim::arm::{PAD_SITE, site_pose};
 use crate::sim::{Pose, Scene, SimError};
+use crate::tactile::free_floating::pad_rotation;
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
-
-/// The world rotation of a pad frame: columns right, up, normal (site x, y, z).
-pub fn pad_rotation(pose: &PadPose) -> DQuat {
-    DQuat::from_mat3(&DMat3::from_cols(pose.right(), pose.up, pose.normal)).normalize()
-}
 
 /// A pad on a mocap body, read by `reader`.
 pub struct FreePad<'s, R> {
