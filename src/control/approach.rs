@@ -39,6 +39,7 @@ pub fn approach<C: PadCarrier + ?Sized>(
         trace.push(Command::Approach, pose);
         match carrier.move_pad(&pose)? {
             PadMotion::Moved => {}
+            PadMotion::RigidContact => return Ok(ApproachOutcome::Contact(carrier.read()?)),
             blocked => return Ok(ApproachOutcome::Blocked(blocked)),
         }
         let image = carrier.read()?;

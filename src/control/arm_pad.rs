@@ -51,6 +51,25 @@ where
     }
 }
 
+impl<R> ArmPad<'_, R> {
+    /// Whether a collision is the pad's own body (the rigid back) against something outside the arm.
+    fn is_pad_contact(&self, c: &crate::sim::Collision) -> bool {
+        let model = self.scene.model();
+        let pad_body = model.site_bodyid()[self.arm.site()] as usize;
+        let pad_name = self.scene.body_name(pad_body);
+        let other = if c.body_a == pad_name {
+            &c.body_b
+        } else if c.body_b == pad_name {
+            &c.body_a
+        } else {
+            return false;
+        };
+        (0..model.ffi().nbody as usize)
+            .find(|&b| &self.scene.body_name(b) == other)
+            .is_some_and(|b| !self.arm.owns_body(model, b))
+    }
+}
+
 impl<R> PadCarrier for ArmPad<'_, R>
 where
     R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
@@ -76,6 +95,12 @@ where
         };
         match self.arm.move_to(self.scene, &q, &self.motion, |_| false)? {
             MoveOutcome::Reached | MoveOutcome::Stopped => Ok(PadMotion::Moved),
+            MoveOutcome::Collided(c) if self.is_pad_contact(&c) => {
+                // A controller command pressed the pad's rigid back onto the surface: back off to the
+                // last pose, which was free of contact (the servo's retreat, not simulated step by step).
+                self.arm.teleport(self.scene, &start);
+                Ok(PadMotion::RigidContact)
+            }
             MoveOutcome::Collided(c) => Ok(PadMotion::Collided(c)),
         }
     }

@@ -11,6 +11,9 @@ use crate::tactile::{PadPose, SensorConfig, TactileImage};
 pub enum PadMotion {
     /// The pad is at the commanded pose.
     Moved,
+    /// The pad's own rigid back touched the surface it is pressing (the covering is fully compressed
+    /// somewhere under the pad); the carrier backed off to its previous pose.
+    RigidContact,
     /// The carrier touched something with a rigid part on the way and stopped.
     Collided(Collision),
     /// The pose cannot be reached (inverse kinematics failed within the joint limits).

@@ -52,11 +52,17 @@ pub fn press<C: PadCarrier + ?Sized>(
         let mut pose = carrier.pad_pose();
         pose.center_m += pose.normal * step_m;
         trace.push(Command::Press, pose);
+        commanded = true;
         match carrier.move_pad(&pose)? {
             PadMotion::Moved => {}
+            PadMotion::RigidContact => {
+                // The covering is fully compressed under part of the pad: the strongest form of the
+                // "close to fully saturated" termination.
+                image = carrier.read()?;
+                break;
+            }
             blocked => return Ok(PressOutcome::Blocked(blocked)),
         }
-        commanded = true;
         image = carrier.read()?;
     }
     Ok(PressOutcome::Done { image, commanded })

@@ -40,6 +40,7 @@ pub fn settle<C: PadCarrier + ?Sized>(carrier: &mut C, config: &ControlConfig) -
     };
     let blocked_status = |motion: &PadMotion| match motion {
         PadMotion::Collided(c) => (ContactStatus::Collision, Some(c.clone())),
+        PadMotion::RigidContact => (ContactStatus::Saturated, None),
         PadMotion::Unreachable | PadMotion::Moved => (ContactStatus::Unreachable, None),
     };
 
@@ -76,6 +77,7 @@ pub fn settle<C: PadCarrier + ?Sized>(carrier: &mut C, config: &ControlConfig) -
                 trace.push(Command::Orient, target);
                 match carrier.move_pad(&target)? {
                     PadMotion::Moved => {}
+                    PadMotion::RigidContact => {}
                     motion => {
                         let (status, collision) = blocked_status(&motion);
                         let image = carrier.read()?;

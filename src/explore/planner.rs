@@ -51,6 +51,10 @@ pub struct PlannerConfig {
     pub grid_cell_m: f64,
     /// Distance the pad is lifted off the surface after a reading, metres.
     pub lift_off_m: f64,
+    /// Largest turn of the pad normal toward the direction of motion per global expansion step,
+    /// radians: the pad comes to lead the motion (so it meets the object with its covering) without
+    /// demanding a wrist flip in one step.
+    pub max_turn_per_step_rad: f64,
     /// Iterations allowed before giving up on reaching the requested number of readings.
     pub max_iterations: usize,
 }
@@ -66,6 +70,7 @@ impl Default for PlannerConfig {
             local_radius_m: 0.025,
             grid_cell_m: 0.03,
             lift_off_m: 0.01,
+            max_turn_per_step_rad: 30f64.to_radians(),
             max_iterations: 20_000,
         }
     }
@@ -100,8 +105,12 @@ pub struct Planner<R> {
     control: ControlConfig,
     sensor: SensorConfig,
     perturbation: PerturbationBounds,
+    /// Precise solver for the controllers' small commands.
     ik: InverseKinematics,
+    /// Solver for expansion steps, where a fraction of a millimetre does not matter.
+    expansion_ik: InverseKinematics,
     motion: MoveOptions,
+    expansion_motion: MoveOptions,
     tree: ExplorationTree,
     grid: ReadingGrid,
     rng: Rng,
@@ -136,6 +145,7 @@ where
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let (ik_options, motion) = precise_motion();
         let ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
+        let expansion_ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
         let q = arm.q(scene.data());
         let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
         Ok(Self {
@@ -144,7 +154,9 @@ where
             sensor,
             perturbation,
             ik,
+            expansion_ik,
             motion,
+            expansion_motion: MoveOptions::default(),
             tree: ExplorationTree::new(q, pad.center_m, pad.normal),
             grid: ReadingGrid::new(config.workspace_min_m, config.grid_cell_m),
             rng,
@@ -208,17 +220,17 @@ where
                 let next = pad.center_m + direction * distance.min(self.config.step_m);
                 let normal = match strategy {
                     Strategy::Local => facing,
-                    _ => direction,
+                    _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
                 };
                 let start = arm.q(scene.data());
-                let Ok(q) = self.ik.solve(&PadTarget { center_m: next, normal }, &start) else {
+                let Ok(q) = self.expansion_ik.solve(&PadTarget { center_m: next, normal }, &start) else {
                     report.unreachable_steps += 1;
                     break;
                 };
                 let reader = &mut self.reader;
                 let mut sensed = false;
                 let mut read_error = None;
-                let outcome = arm.move_to(scene, &q, &self.motion, |s| match reader(s) {
+                let outcome = arm.move_to(scene, &q, &self.expansion_motion, |s| match reader(s) {
                     Ok(image) => {
                         sensed = image.max() > threshold;
                         sensed
@@ -247,7 +259,7 @@ where
                     self.grid.add(pose.center_m);
                     let lifted = PadTarget { center_m: pose.center_m - pose.normal * self.config.lift_off_m, normal: pose.normal };
                     let start = arm.q(scene.data());
-                    if let Ok(q_lift) = self.ik.solve(&lifted, &start) {
+                    if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start) {
                         self.tree.add(vertex, q_lift, lifted.center_m, lifted.normal);
                     }
                 }
@@ -278,4 +290,14 @@ where
             strategy,
         })
     }
+}
+
+/// `from` turned toward `to` (both unit) by at most `max_rad`.
+pub fn turn_toward(from: DVec3, to: DVec3, max_rad: f64) -> DVec3 {
+    let angle = from.angle_between(to);
+    if angle <= max_rad {
+        return to;
+    }
+    let axis = from.cross(to).try_normalize().unwrap_or_else(|| from.any_orthonormal_vector());
+    glam::DQuat::from_axis_angle(axis, max_rad) * from
 }
