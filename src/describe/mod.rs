@@ -1,9 +1,41 @@
 //! Tactile image descriptors (Sec. IV-B): each turns a [`TactileImage`] into one or more feature
 //! vectors, ideally invariant to rotation about the pad normal, which the controllers leave free.
+//!
+//! One file per descriptor (`vectorize`, `sift`, `mr8`, `moment_normalized`, `polar_fourier`,
+//! `mnti`), and the helpers they share: [`Plane`] (centred coordinates, bilinear sampling),
+//! [`InscribedDisc`] (the mask), [`CentredMoments`] and [`FftPlans`] (cached FFT plans). Every
+//! descriptor works on images of any size, is deterministic, `Send + Sync`, and returns finite values
+//! for every valid image; each module documents its output for all-zero and saturated images.
+//! Descriptors that are built once and reused (as [`DescriptorKind::build`] gives them) plan their
+//! FFTs and filter banks once per image size.
+
+pub mod disc;
+pub mod fft;
+pub mod mnti;
+pub mod moment_normalized;
+pub mod moments;
+pub mod mr8;
+pub mod params;
+pub mod plane;
+pub mod polar_fourier;
+pub mod sift;
+pub mod vectorize;
 
 use serde::{Deserialize, Serialize};
 
 use crate::tactile::TactileImage;
+
+pub use disc::InscribedDisc;
+pub use fft::FftPlans;
+pub use mnti::{Mnti, MntiParams};
+pub use moment_normalized::{MomentNormalized, MomentNormalizedParams};
+pub use moments::CentredMoments;
+pub use mr8::{Mr8, Mr8Params};
+pub use params::{DescriptorParams, ParamsError};
+pub use plane::Plane;
+pub use polar_fourier::{PolarFourier, PolarFourierParams};
+pub use sift::{Sift, SiftParams};
+pub use vectorize::Vectorize;
 
 /// One feature vector.
 pub type Feature = Vec<f64>;
@@ -13,6 +45,8 @@ pub type Feature = Vec<f64>;
 pub trait Descriptor: Send + Sync {
     /// Which descriptor this is.
     fn kind(&self) -> DescriptorKind;
+    /// The parameters it was built with: `self.params().build()` describes images identically.
+    fn params(&self) -> DescriptorParams;
     /// The features of `image`; every value finite, for every input including all-zero and
     /// saturated images.
     fn describe(&self, image: &TactileImage) -> Vec<Feature>;
@@ -61,5 +95,56 @@ impl DescriptorKind {
     /// Parses [`name`](Self::name).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Its documented default parameters.
+    pub fn default_params(self) -> DescriptorParams {
+        DescriptorParams::default_for(self)
+    }
+
+    /// The descriptor with its documented default parameters.
+    pub fn build(self) -> Box<dyn Descriptor> {
+        match self {
+            Self::Vectorize => Box::new(Vectorize),
+            Self::Sift => Box::new(Sift::default()),
+            Self::Mr8 => Box::new(Mr8::default()),
+            Self::MomentNormalized => Box::new(MomentNormalized::default()),
+            Self::PolarFourier => Box::new(PolarFourier::default()),
+            Self::Mnti => Box::new(Mnti::default()),
+        }
+    }
+
+    /// The descriptor `params` define (their kind included), after checking them.
+    pub fn build_with(params: &DescriptorParams) -> Result<Box<dyn Descriptor>, ParamsError> {
+        params.build()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_defaults_build_the_named_descriptor() {
+        for kind in DescriptorKind::ALL {
+            assert_eq!(DescriptorKind::from_name(kind.name()), Some(kind));
+            let built = kind.build();
+            assert_eq!(built.kind(), kind);
+            assert_eq!(built.params(), kind.default_params());
+            assert_eq!(
+                DescriptorKind::build_with(&kind.default_params()).unwrap().kind(),
+                kind
+            );
+        }
+        assert_eq!(DescriptorKind::from_name("hog"), None);
+    }
+
+    #[test]
+    fn descriptors_are_shareable_across_threads() {
+        fn shareable<T: Send + Sync + ?Sized>() {}
+        shareable::<dyn Descriptor>();
+        shareable::<Mr8>();
+        shareable::<Mnti>();
+        shareable::<PolarFourier>();
     }
 }

@@ -1,5 +1,36 @@
 //! Objects as triangle meshes: the shapes the arm explores.
+//!
+//! - loading OBJ, OFF and STL with validation ([`load`], [`ValidationReport`]), writing OBJ;
+//! - geometry: bounds, area, signed volume, normalisation to a common size ([`normalise_to_diagonal`]),
+//!   and the edge topology behind watertightness and orientation checks ([`EdgeTopology`]);
+//! - the objects: ten real meshes fetched from Debian ([`cgal`]), chess pieces as surfaces of
+//!   revolution ([`chess`], [`revolution`]), raised letters from a font ([`letters`], [`glyph`]);
+//! - object sets: named, versioned manifests that datasets and models refer to ([`ObjectSet`]).
 
+pub mod cgal;
+pub mod checksum;
+pub mod chess;
+pub mod error;
+pub mod glyph;
+pub mod letters;
+pub mod load;
+pub mod normalise;
+pub mod obj;
+pub mod object_set;
+mod off;
+pub mod revolution;
+mod stl;
+pub mod topology;
+pub mod triangulate;
 pub mod trimesh;
+pub mod validate;
 
+pub use cgal::{CGAL_MESHES, CgalMesh, ObjectCache, ensure_fetched};
+pub use error::{Location, MeshError};
+pub use load::{LoadedMesh, MeshFormat, load, parse};
+pub use normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
+pub use obj::{to_obj_string, write_obj};
+pub use object_set::{BuildOptions, BuiltObject, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
+pub use topology::{EdgeTopology, connected_components};
 pub use trimesh::TriMesh;
+pub use validate::ValidationReport;

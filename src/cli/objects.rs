@@ -1,0 +1,196 @@
+//! `taction objects list|fetch|letters|export`: the object sets the arm explores.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand};
+use taction::mesh::cgal::{CGAL_MESHES, ObjectCache};
+use taction::mesh::glyph::Font;
+use taction::mesh::letters::LetterStyle;
+use taction::mesh::object_set::BUILTIN_SETS;
+use taction::mesh::{BuildOptions, MeshError, ObjectSet, ObjectSource, write_obj};
+
+#[derive(Debug, Args)]
+pub struct ObjectsArgs {
+    #[command(subcommand)]
+    pub command: ObjectsCommand,
+    /// Cache of fetched meshes [default: $TACTION_OBJECTS_DIR, or .runtime/objects].
+    #[arg(long, global = true, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ObjectsCommand {
+    /// List the built-in sets (name, version, id) and their objects.
+    List {
+        /// Font of the letters set [default: DejaVu Sans].
+        #[arg(long, value_name = "FILE.ttf")]
+        font: Option<PathBuf>,
+    },
+    /// Fetch the ten CGAL meshes of the `shapes` set (Debian's libcgal-demo 5.5.1-2) into the cache.
+    Fetch {
+        /// Use this already downloaded libcgal-demo_5.5.1-2_all.deb instead of apt-get download.
+        #[arg(long, value_name = "FILE.deb")]
+        deb: Option<PathBuf>,
+    },
+    /// Write the 52 raised letters as OBJ (metres): upper_A.obj ... lower_z.obj, plus manifest.json.
+    Letters {
+        /// TrueType/OpenType font [default: DejaVu Sans, Debian's fonts-dejavu-core].
+        #[arg(long, value_name = "FILE.ttf")]
+        font: Option<PathBuf>,
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// Write every object of a set as OBJ (metres, normalised as the set says), plus manifest.json.
+    Export {
+        /// A built-in set (shapes, chess, letters), a manifest .json, a folder of meshes, or mesh files.
+        #[arg(required = true, value_name = "SET")]
+        set: Vec<PathBuf>,
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Font of the letters set [default: DejaVu Sans].
+        #[arg(long, value_name = "FILE.ttf")]
+        font: Option<PathBuf>,
+        /// Rescale user meshes to this bounding-box diagonal, metres (centred, resting on z = 0).
+        #[arg(long, value_name = "M")]
+        diagonal_m: Option<f64>,
+        /// Fetch the CGAL meshes first if the cache lacks them.
+        #[arg(long)]
+        fetch: bool,
+    },
+}
+
+pub fn run(args: &ObjectsArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let cache = args
+        .cache
+        .clone()
+        .map(ObjectCache::new)
+        .unwrap_or_else(ObjectCache::from_env);
+    match &args.command {
+        ObjectsCommand::List { font } => list(&cache, font.as_deref()),
+        ObjectsCommand::Fetch { deb } => {
+            let fresh = deb.is_some() || cache.verify().is_err();
+            if fresh {
+                cache.fetch(deb.as_deref())?;
+            }
+            let verb = if fresh { "fetched" } else { "already present" };
+            println!(
+                "{} CGAL meshes {verb} in {} (checksums verified)",
+                CGAL_MESHES.len(),
+                cache.mesh_dir().display()
+            );
+            Ok(())
+        }
+        ObjectsCommand::Letters { font, out } => {
+            let font = match font {
+                Some(path) => Font::load(path)?,
+                None => Font::load_default()?,
+            };
+            let set = ObjectSet::letters(&font, LetterStyle::default());
+            export(&set, &BuildOptions { cache, fetch: false }, out)
+        }
+        ObjectsCommand::Export {
+            set,
+            out,
+            font,
+            diagonal_m,
+            fetch,
+        } => {
+            let set = ObjectSet::resolve(set, font.as_deref(), *diagonal_m)?;
+            export(&set, &BuildOptions { cache, fetch: *fetch }, out)
+        }
+    }
+}
+
+/// Sets with more objects than this are listed by their first and last object.
+const LIST_IN_FULL: usize = 20;
+
+fn list(cache: &ObjectCache, font: Option<&Path>) -> Result<(), Box<dyn std::error::Error>> {
+    let cached = cache.verify();
+    for name in BUILTIN_SETS {
+        let set = match ObjectSet::builtin(name, font) {
+            Ok(set) => set,
+            Err(e) => {
+                println!("{name}: unavailable: {e}\n");
+                continue;
+            }
+        };
+        let size = set
+            .diagonal_m
+            .map(|d| format!(", {} m diagonal", d))
+            .unwrap_or_default();
+        println!(
+            "{} v{} (id {}): {} objects{size}",
+            set.name,
+            set.version,
+            set.id(),
+            set.objects.len()
+        );
+        if let Some(first) = set.objects.first().filter(|_| set.objects.len() > LIST_IN_FULL) {
+            let summary = match &first.source {
+                ObjectSource::Letter { font, style, .. } => format!(
+                    "raised letters in {} (capitals {} mm tall, raised {} mm on a {} mm plate)",
+                    font.path.display(),
+                    style.cap_height_m * 1e3,
+                    style.raise_m * 1e3,
+                    style.plate_thickness_m * 1e3
+                ),
+                other => other.to_string(),
+            };
+            println!(
+                "  {} ... {}: {summary}",
+                first.name,
+                set.objects[set.objects.len() - 1].name
+            );
+        } else {
+            for object in &set.objects {
+                let note = match (&object.source, &cached) {
+                    (ObjectSource::Cgal { .. }, Err(MeshError::NotFetched { .. })) => "  [not fetched]",
+                    (ObjectSource::Cgal { .. }, Err(_)) => "  [cache damaged: fetch again]",
+                    _ => "",
+                };
+                println!("  {:14} {}{note}", object.name, object.source);
+            }
+        }
+        println!();
+    }
+    if let Err(e) = cached {
+        println!("{e}");
+    }
+    Ok(())
+}
+
+fn export(set: &ObjectSet, options: &BuildOptions, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(out).map_err(|source| MeshError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let id = set.id();
+    for object in set.build(options)? {
+        let path = out.join(format!("{}.obj", object.name));
+        let comment = format!(
+            "taction object '{}' of set {} v{} (id {id})",
+            object.name, set.name, set.version
+        );
+        write_obj(&object.mesh, &path, &comment)?;
+        let flipped = if object.flipped {
+            ", flipped to face outward"
+        } else {
+            ""
+        };
+        println!(
+            "{} ({} triangles; {}{flipped})",
+            path.display(),
+            object.mesh.triangles.len(),
+            object.warnings
+        );
+    }
+    set.save_manifest(&out.join("manifest.json"))?;
+    println!(
+        "{} v{} (id {id}): {} objects in {}",
+        set.name,
+        set.version,
+        set.objects.len(),
+        out.display()
+    );
+    Ok(())
+}

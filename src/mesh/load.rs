@@ -1,0 +1,171 @@
+//! Loading a mesh file: the format from the extension, then the format's parser, then validation.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::error::{Location, MeshError};
+use super::validate::ValidationReport;
+use super::{TriMesh, obj, off, stl};
+
+/// The mesh file formats `load` reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ (`v` and `f` records; other records ignored).
+    Obj,
+    /// Object File Format (`OFF`/`COFF` header, counts, vertices, polygon faces).
+    Off,
+    /// STL, ASCII or binary (told apart by content).
+    Stl,
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<Self, MeshError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => Ok(Self::Obj),
+            Some("off") => Ok(Self::Off),
+            Some("stl") => Ok(Self::Stl),
+            _ => Err(MeshError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+}
+
+/// A mesh as loaded, with the validation warnings it raised.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedMesh {
+    pub mesh: TriMesh,
+    pub warnings: ValidationReport,
+}
+
+/// Loads an OBJ, OFF or STL file (coordinates taken as they are, no unit conversion) and validates
+/// it. Polygons with more than three vertices are fan-triangulated.
+pub fn load(path: impl AsRef<Path>) -> Result<LoadedMesh, MeshError> {
+    let path = path.as_ref();
+    let format = MeshFormat::from_path(path)?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&bytes, format, path)
+}
+
+/// Parses the bytes of a mesh file of `format`; `path` only names the file in messages.
+pub fn parse(bytes: &[u8], format: MeshFormat, path: &Path) -> Result<LoadedMesh, MeshError> {
+    let mesh = match format {
+        MeshFormat::Obj => obj::parse(&String::from_utf8_lossy(bytes), path)?,
+        MeshFormat::Off => off::parse(&String::from_utf8_lossy(bytes), path)?,
+        MeshFormat::Stl => stl::parse(bytes, path)?,
+    };
+    let warnings = ValidationReport::of(&mesh);
+    Ok(LoadedMesh { mesh, warnings })
+}
+
+/// Collects vertices and polygons while a file is parsed, checking what makes a mesh unusable:
+/// non-finite coordinates and vertex indices out of range (errors at the offending place), and an
+/// empty result.
+pub(crate) struct MeshBuilder {
+    path: PathBuf,
+    vertices: Vec<DVec3>,
+    /// Polygons as resolved 0-based indices, with where they were read; checked in `finish`, since
+    /// an OBJ face may name a vertex defined further down.
+    polygons: Vec<(Location, Vec<i64>)>,
+}
+
+impl MeshBuilder {
+    pub(crate) fn new(path: &Path) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            vertices: Vec::new(),
+            polygons: Vec::new(),
+        }
+    }
+
+    pub(crate) fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub(crate) fn parse_error(&self, at: Location, what: impl Into<String>) -> MeshError {
+        MeshError::Parse {
+            path: self.path.clone(),
+            at,
+            what: what.into(),
+        }
+    }
+
+    /// Parses a coordinate token; a token that is not a number is a parse error, a non-finite
+    /// number (`nan`, `inf`) a [`MeshError::NonFinite`].
+    pub(crate) fn coordinate(&self, at: Location, token: &str) -> Result<f64, MeshError> {
+        let value: f64 = token
+            .parse()
+            .map_err(|_| self.parse_error(at, format!("'{token}' is not a number")))?;
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(MeshError::NonFinite {
+                path: self.path.clone(),
+                at,
+                value,
+            })
+        }
+    }
+
+    pub(crate) fn push_vertex(&mut self, v: DVec3) -> u32 {
+        self.vertices.push(v);
+        (self.vertices.len() - 1) as u32
+    }
+
+    /// Adds a polygon of 0-based indices (possibly out of range: checked in `finish`).
+    pub(crate) fn push_polygon(&mut self, at: Location, indices: Vec<i64>) -> Result<(), MeshError> {
+        if indices.len() < 3 {
+            return Err(self.parse_error(
+                at,
+                format!("a face needs at least 3 vertices, got {}", indices.len()),
+            ));
+        }
+        self.polygons.push((at, indices));
+        Ok(())
+    }
+
+    /// Checks indices, fan-triangulates polygons (v0, v_i, v_i+1) and returns the mesh.
+    pub(crate) fn finish(self) -> Result<TriMesh, MeshError> {
+        if self.vertices.is_empty() {
+            return Err(MeshError::NoVertices { path: self.path });
+        }
+        if self.polygons.is_empty() {
+            return Err(MeshError::NoFaces { path: self.path });
+        }
+        let count = self.vertices.len();
+        let mut triangles = Vec::with_capacity(self.polygons.len());
+        for (at, polygon) in &self.polygons {
+            if let Some(&index) = polygon.iter().find(|&&i| i < 0 || i >= count as i64) {
+                return Err(MeshError::IndexOutOfRange {
+                    path: self.path,
+                    at: *at,
+                    index,
+                    count,
+                });
+            }
+            let p: Vec<u32> = polygon.iter().map(|&i| i as u32).collect();
+            triangles.extend((1..p.len() - 1).map(|i| [p[0], p[i], p[i + 1]]));
+        }
+        Ok(TriMesh {
+            vertices: self.vertices,
+            triangles,
+        })
+    }
+}
+
+/// The non-empty lines of a text file with their 1-based numbers, comments (from `#`) removed.
+pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines().enumerate().filter_map(|(i, line)| {
+        let line = line.split('#').next().unwrap_or("").trim();
+        (!line.is_empty()).then_some((i + 1, line))
+    })
+}

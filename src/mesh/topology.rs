@@ -1,0 +1,153 @@
+//! Edge topology of a triangle mesh: which edges are shared by how many triangles, and in which
+//! directions. Watertightness, orientation and the Euler characteristic all come from here.
+//!
+//! A closed, consistently oriented 2-manifold uses every undirected edge {a, b} exactly twice, once
+//! as a -> b and once as b -> a. An edge used once lies on an open boundary; an edge used more than
+//! twice is non-manifold; an edge used twice in the same direction joins two triangles of opposite
+//! orientation.
+
+use std::collections::HashMap;
+
+use super::TriMesh;
+
+/// How the triangles of a mesh use each undirected edge.
+#[derive(Debug, Clone)]
+pub struct EdgeTopology {
+    /// Undirected edge (low, high) -> (uses as low -> high, uses as high -> low).
+    uses: HashMap<(u32, u32), (u32, u32)>,
+    vertex_count: usize,
+    triangle_count: usize,
+}
+
+impl EdgeTopology {
+    /// Counts the edge uses of `mesh`. Edges from a vertex to itself (in triangles that repeat a
+    /// vertex) are not edges and are skipped.
+    pub fn new(mesh: &TriMesh) -> Self {
+        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(mesh.triangles.len() * 2);
+        for &[a, b, c] in &mesh.triangles {
+            for (p, q) in [(a, b), (b, c), (c, a)] {
+                if p == q {
+                    continue;
+                }
+                let entry = uses.entry((p.min(q), p.max(q))).or_default();
+                if p < q {
+                    entry.0 += 1;
+                } else {
+                    entry.1 += 1;
+                }
+            }
+        }
+        Self {
+            uses,
+            vertex_count: mesh.vertices.len(),
+            triangle_count: mesh.triangles.len(),
+        }
+    }
+
+    /// Number of distinct undirected edges.
+    pub fn edge_count(&self) -> usize {
+        self.uses.len()
+    }
+
+    /// Edges used by exactly one triangle: the open boundary.
+    pub fn boundary_edges(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.uses.iter().filter(|(_, (f, b))| f + b == 1).map(|(&e, _)| e)
+    }
+
+    /// Number of edges used by more than two triangles.
+    pub fn non_manifold_edge_count(&self) -> usize {
+        self.uses.values().filter(|(f, b)| f + b > 2).count()
+    }
+
+    /// Number of two-triangle edges traversed twice in the same direction: their triangles have
+    /// opposite orientations.
+    pub fn misoriented_edge_count(&self) -> usize {
+        self.uses.values().filter(|&&(f, b)| f + b == 2 && f != 1).count()
+    }
+
+    /// Number of closed loops the boundary edges form (connected components of the boundary graph).
+    pub fn boundary_loop_count(&self) -> usize {
+        let mut parent: HashMap<u32, u32> = HashMap::new();
+        fn find(parent: &mut HashMap<u32, u32>, v: u32) -> u32 {
+            let mut root = v;
+            while let Some(&p) = parent.get(&root) {
+                if p == root {
+                    break;
+                }
+                root = p;
+            }
+            let mut cur = v;
+            while cur != root {
+                let next = parent[&cur];
+                parent.insert(cur, root);
+                cur = next;
+            }
+            root
+        }
+        let edges: Vec<(u32, u32)> = self.boundary_edges().collect();
+        for &(a, b) in &edges {
+            parent.entry(a).or_insert(a);
+            parent.entry(b).or_insert(b);
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            if ra != rb {
+                parent.insert(ra.max(rb), ra.min(rb));
+            }
+        }
+        let vertices: Vec<u32> = parent.keys().copied().collect();
+        vertices
+            .into_iter()
+            .filter(|&v| find(&mut parent, v) == v)
+            .count()
+    }
+
+    /// True when every edge is shared by exactly two triangles (closed, manifold at edges).
+    pub fn is_closed(&self) -> bool {
+        self.uses.values().all(|(f, b)| f + b == 2)
+    }
+
+    /// True when the mesh is closed and each edge is traversed once in each direction, i.e. all
+    /// triangles of each connected shell wind the same way.
+    pub fn is_consistently_oriented(&self) -> bool {
+        self.uses.values().all(|&(f, b)| f == 1 && b == 1)
+    }
+
+    /// Euler characteristic chi = V - E + F, counting only vertices that some triangle uses. For a
+    /// closed orientable surface of c shells with total genus g, chi = 2c - 2g.
+    pub fn euler_characteristic(&self, mesh: &TriMesh) -> i64 {
+        let mut used = vec![false; self.vertex_count];
+        for t in &mesh.triangles {
+            for &i in t {
+                used[i as usize] = true;
+            }
+        }
+        let v = used.iter().filter(|&&u| u).count() as i64;
+        v - self.uses.len() as i64 + self.triangle_count as i64
+    }
+}
+
+/// Number of connected components of `mesh`, triangles being connected when they share a vertex.
+pub fn connected_components(mesh: &TriMesh) -> usize {
+    let mut parent: Vec<u32> = (0..mesh.vertices.len() as u32).collect();
+    fn find(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            parent[v as usize] = parent[parent[v as usize] as usize];
+            v = parent[v as usize];
+        }
+        v
+    }
+    let mut used = vec![false; mesh.vertices.len()];
+    for &[a, b, c] in &mesh.triangles {
+        for (p, q) in [(a, b), (b, c)] {
+            let (rp, rq) = (find(&mut parent, p), find(&mut parent, q));
+            if rp != rq {
+                parent[rp.max(rq) as usize] = rp.min(rq);
+            }
+        }
+        for i in [a, b, c] {
+            used[i as usize] = true;
+        }
+    }
+    (0..mesh.vertices.len() as u32)
+        .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+        .count()
+}

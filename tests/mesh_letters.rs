@@ -1,0 +1,160 @@
+//! Raised letters from the default font (DejaVu Sans, Debian's fonts-dejavu-core): every letter is a
+//! closed, consistently oriented solid with the glyph's holes, the right heights and volume.
+
+use std::collections::BTreeMap;
+
+use taction::mesh::glyph::Font;
+use taction::mesh::letters::{LetterStyle, alphabet, letter_from_name, letter_name, raised_letter};
+use taction::mesh::{EdgeTopology, MeshError, TriMesh, ValidationReport, connected_components};
+
+/// Counters of DejaVu Sans' letters (its 'g' is single-storey).
+fn expected_holes(ch: char) -> usize {
+    match ch {
+        'B' => 2,
+        'A' | 'D' | 'O' | 'P' | 'Q' | 'R' | 'a' | 'b' | 'd' | 'e' | 'g' | 'o' | 'p' | 'q' => 1,
+        _ => 0,
+    }
+}
+
+/// The triangles lying in the plane z = `z` as their own mesh.
+fn faces_at(mesh: &TriMesh, z: f64) -> TriMesh {
+    TriMesh {
+        vertices: mesh.vertices.clone(),
+        triangles: mesh
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t.iter().all(|&i| mesh.vertices[i as usize].z == z))
+            .collect(),
+    }
+}
+
+#[test]
+fn all_52_letters_are_closed_oriented_solids_with_their_holes() {
+    let font = Font::load_default().unwrap();
+    let style = LetterStyle::default();
+    let z_top = style.plate_thickness_m + style.raise_m;
+    let mut meshes = BTreeMap::new();
+    for ch in alphabet() {
+        let mesh = raised_letter(&font, ch, &style).unwrap_or_else(|e| panic!("{ch}: {e}"));
+        let report = ValidationReport::of(&mesh);
+        assert!(report.is_clean(), "{ch}: {report}");
+        let topology = EdgeTopology::new(&mesh);
+        assert!(
+            topology.is_closed() && topology.is_consistently_oriented(),
+            "{ch}"
+        );
+        assert_eq!(
+            topology.euler_characteristic(&mesh),
+            2,
+            "{ch} is not one sphere-like shell"
+        );
+        assert_eq!(connected_components(&mesh), 1, "{ch}");
+
+        let (lo, hi) = mesh.bounds().unwrap();
+        assert_eq!((lo.z, hi.z), (0.0, z_top), "{ch}: plate bottom and raised top");
+        assert!(
+            (lo.x + hi.x).abs() < 1e-12 && (lo.y + hi.y).abs() < 1e-12,
+            "{ch} is not centred"
+        );
+
+        let top = faces_at(&mesh, z_top);
+        let top_topology = EdgeTopology::new(&top);
+        let components = connected_components(&top) as i64;
+        let holes = components - top_topology.euler_characteristic(&top);
+        assert_eq!(holes, expected_holes(ch) as i64, "{ch}: holes in the raised face");
+        assert_eq!(
+            components,
+            if matches!(ch, 'i' | 'j') { 2 } else { 1 },
+            "{ch}: pieces"
+        );
+
+        // Volume = plate area * plate thickness + glyph area * raise height, exactly.
+        let plate_area = (hi.x - lo.x) * (hi.y - lo.y);
+        let expected = plate_area * style.plate_thickness_m + top.total_area() * style.raise_m;
+        assert!(
+            (mesh.signed_volume() - expected).abs() < 1e-9 * expected,
+            "{ch}: volume"
+        );
+        assert!(
+            (faces_at(&mesh, style.plate_thickness_m).total_area() + top.total_area() - plate_area).abs()
+                < 1e-12
+        );
+        meshes.insert(ch, mesh);
+    }
+    let letters: Vec<char> = meshes.keys().copied().collect();
+    for (i, a) in letters.iter().enumerate() {
+        for b in &letters[i + 1..] {
+            assert_ne!(meshes[a], meshes[b], "{a} and {b} are the same mesh");
+        }
+    }
+}
+
+#[test]
+fn capitals_are_about_25_mm_and_letters_repeat_bit_for_bit() {
+    let font = Font::load_default().unwrap();
+    let style = LetterStyle::default();
+    let h = raised_letter(&font, 'H', &style).unwrap();
+    let top = faces_at(&h, style.plate_thickness_m + style.raise_m);
+    let (lo, hi) = top.bounds().unwrap();
+    let ys: Vec<f64> = top
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| top.vertices[i as usize].y)
+        .collect();
+    let height = ys.iter().cloned().fold(f64::MIN, f64::max) - ys.iter().cloned().fold(f64::MAX, f64::min);
+    assert!((height - 0.025).abs() < 1e-9, "H is {height} m tall");
+    assert!(hi.x - lo.x > 0.01);
+    assert_eq!(raised_letter(&font, 'H', &style).unwrap(), h);
+
+    let taller = LetterStyle {
+        raise_m: 0.005,
+        ..style
+    };
+    let t = raised_letter(&font, 'H', &taller).unwrap();
+    assert_eq!(t.bounds().unwrap().1.z, 0.007);
+    assert!(t.signed_volume() > h.signed_volume());
+}
+
+#[test]
+fn bad_fonts_styles_and_glyphs_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let not_a_font = dir.path().join("notes.ttf");
+    std::fs::write(&not_a_font, b"not a font").unwrap();
+    let e = Font::load(&not_a_font).unwrap_err();
+    assert!(
+        matches!(e, MeshError::Font { .. }) && e.to_string().contains("notes.ttf"),
+        "{e}"
+    );
+    let missing = Font::load(&dir.path().join("missing.ttf")).unwrap_err();
+    assert!(missing.to_string().contains("missing.ttf"));
+
+    let font = Font::load_default().unwrap();
+    let bad = LetterStyle {
+        raise_m: 0.0,
+        ..LetterStyle::default()
+    };
+    assert!(matches!(
+        raised_letter(&font, 'A', &bad),
+        Err(MeshError::InvalidParameter { field: "raise_m", .. })
+    ));
+    // A character the font draws nothing for.
+    assert!(matches!(
+        raised_letter(&font, ' ', &LetterStyle::default()),
+        Err(MeshError::Glyph { .. })
+    ));
+}
+
+#[test]
+fn letter_names_round_trip() {
+    let names: Vec<String> = alphabet().map(letter_name).collect();
+    assert_eq!(names.len(), 52);
+    assert_eq!((names[0].as_str(), names[51].as_str()), ("upper_A", "lower_z"));
+    for (ch, name) in alphabet().zip(&names) {
+        assert_eq!(letter_from_name(name), Some(ch));
+    }
+    assert_eq!(letter_from_name("upper_a"), None);
+    assert_eq!(letter_from_name("lower_ab"), None);
+    assert_eq!(letter_from_name("pawn"), None);
+}
