@@ -27,5 +27,9 @@ pub mod tactile;
 pub mod control;
 pub mod explore;
 
+pub mod dataset;
+
 pub mod describe;
 pub mod recognize;
+
+pub mod experiment;

@@ -15,14 +15,38 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Collect readings of objects with the training sampler or the exploring arm; write a dataset.
+    Collect(cli::collect::CollectArgs),
     /// Train on a small object set, explore an unknown object with the arm, recognise it touch by touch.
     Demo(cli::demo::DemoArgs),
+    /// Print the feature vectors of one tactile image (Sec. IV-B), one per line, comma-separated.
+    Describe(cli::describe::DescribeArgs),
+    /// Combine the output directories of sharded experiment runs (`--shard k/n`) into one.
+    Merge(cli::merge::MergeArgs),
+    /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
+    Objects(cli::objects::ObjectsArgs),
+    /// One raw reading of the free-floating tactile sensor on a mesh, written as CSV or PNG.
+    Sense(cli::sense::SenseArgs),
+    /// Show what a dataset file holds: objects, readings per object and status, sensor configuration.
+    Dataset(cli::dataset::DatasetArgs),
+    /// Recognise a test dataset touch by touch with a saved model; write posterior, accuracy, confusion CSVs.
+    Recognize(cli::recognize::RecognizeArgs),
+    /// Train a bag-of-features model (PCA, k-means or GMM codebook, object histograms) on a dataset.
+    Train(cli::train::TrainArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Collect(args) => cli::collect::run(args),
         Command::Demo(args) => cli::demo::run(args),
+        Command::Describe(args) => cli::describe::run(args),
+        Command::Merge(args) => cli::merge::run(args),
+        Command::Objects(args) => cli::objects::run(args),
+        Command::Sense(args) => cli::sense::run(args),
+        Command::Dataset(args) => cli::dataset::run(args),
+        Command::Recognize(args) => cli::recognize::run(args),
+        Command::Train(args) => cli::train::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,62 +1,201 @@
-//! `taction demo`: the product in one run.
+//! `taction demo`: the product in one run. Trains a recogniser on the 3D object set from sampler
+//! readings (or reuses the model it cached), then lets the arm explore one object whose identity and
+//! pose it does not know, printing after every converged touch the best guess, its probability and
+//! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
+//! the posterior over touches and a contact sheet of the tactile images.
+
+use std::io::Write;
+use std::path::PathBuf;
 
 use clap::Args;
-use glam::DVec3;
-
-use taction::sim::{IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget, SceneBuilder};
+use rand::RngExt;
+use taction::control::{ContactStatus, ControlConfig};
+use taction::dataset::{Dataset, DatasetHeader};
+use taction::describe::DescriptorKind;
+use taction::experiment::figure::{Figure, Panel, Series};
+use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
+use taction::explore::{Planner, PlannerConfig, SamplerConfig};
+use taction::mesh::{BuildOptions, ObjectSet};
+use taction::recognize::labelled::LabelledFeatures;
+use taction::recognize::model::{TrainedModel, TrainingProvenance};
+use taction::recognize::selection::{TrainConfig, train};
+use taction::recognize::OnlinePosterior;
+use taction::rng;
+use taction::sim::arm::PAD_SITE;
+use taction::sim::{ObjectSpec, PerturbationBounds, SceneBuilder};
+use taction::tactile::image::write_contact_sheet;
+use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 
 #[derive(Debug, Args)]
-pub struct DemoArgs {}
+pub struct DemoArgs {
+    /// The object set to learn (a built-in set, a folder of meshes, or mesh files).
+    #[arg(long, default_value = "shapes")]
+    pub objects: PathBuf,
+    /// The object to explore [default: one drawn with the seed].
+    #[arg(long)]
+    pub object: Option<String>,
+    /// Sampler readings per object for training.
+    #[arg(long, default_value_t = 150)]
+    pub training_readings: usize,
+    /// Converged touches of the unknown object.
+    #[arg(long, default_value_t = 20)]
+    pub touches: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output folder.
+    #[arg(long, default_value = "results/demo")]
+    pub out: PathBuf,
+}
 
-/// Loads the world, brings the pad above the object with inverse kinematics, lowers it until it
-/// touches, and prints what happened.
-pub fn run(_args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let mesh = taction::mesh::TriMesh {
-        vertices: (0..8)
-            .map(|i| {
-                DVec3::new(
-                    if i & 1 == 0 { -0.04 } else { 0.04 },
-                    if i & 2 == 0 { -0.03 } else { 0.03 },
-                    if i & 4 == 0 { 0.0 } else { 0.1 },
-                )
-            })
-            .collect(),
-        triangles: vec![
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ],
-    };
-    let mut scene = SceneBuilder::with_arm_and_table().object(ObjectSpec::new("box", mesh)).build()?;
-    let arm = scene.arm().cloned().ok_or("the world has no arm")?;
-    let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
-    println!("world loaded: arm with {} joints, a 8 x 6 x 10 cm box on the table", arm.dof());
-    let mut z = 0.16;
-    loop {
-        let target = PadTarget { center_m: DVec3::new(0.0, 0.0, z), normal: -DVec3::Z };
-        let q = ik.solve(&target, &arm.q(scene.data()))?;
-        match arm.move_to(&mut scene, &q, &MoveOptions::default(), |_| false)? {
-            MoveOutcome::Reached => {
-                println!("pad at z = {:.3} m, looking down", arm.pad_pose(scene.data()).position_m.z);
-            }
-            MoveOutcome::Collided(c) => {
-                println!("touched: {c} at pad height z = {:.4} m", arm.pad_pose(scene.data()).position_m.z);
-                return Ok(());
-            }
-            MoveOutcome::Stopped => {}
+pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if args.touches == 0 || args.training_readings < 11 {
+        return Err("--touches must be 1 or more and --training-readings 11 or more".into());
+    }
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
+    let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, None)?;
+    let built = set.build(&BuildOptions { fetch: true, ..BuildOptions::default() })?;
+    let objects: Vec<ObjectSpec> = built.into_iter().map(|b| ObjectSpec::new(b.name, b.mesh)).collect();
+    let descriptor_kind = DescriptorKind::PolarFourier;
+    let descriptor = descriptor_kind.build();
+
+    // 1. The model: cached per (object set, readings, seed), else trained now.
+    let model_path = args.out.join(format!("model-{}-{}-{}.json", set.id(), args.training_readings, args.seed));
+    let model = match TrainedModel::load(&model_path) {
+        Ok(model) if model.check_sensor(&sensor).is_ok() => {
+            println!("using the model trained before: {}", model_path.display());
+            model
         }
-        z -= 0.01;
-        if z < 0.0 {
-            return Err("the pad reached the table without touching the object".into());
+        _ => {
+            println!(
+                "training: {} sampler readings of each of {} objects ({})",
+                args.training_readings,
+                objects.len(),
+                objects.iter().map(|o| o.name.as_str()).collect::<Vec<_>>().join(", ")
+            );
+            let plan = CollectPlan {
+                mode: CollectMode::Sampler(SamplerConfig::default()),
+                sensor,
+                control: ControlConfig::default(),
+                perturbation: PerturbationBounds::NONE,
+                readings_per_object: args.training_readings,
+                seed: args.seed,
+            };
+            let readings = plan.collect(&objects, 0)?.into_iter().flat_map(|r| r.readings).collect();
+            let names = objects.iter().map(|o| o.name.clone()).collect();
+            let dataset = Dataset::new(DatasetHeader::new(sensor, set.id(), names, "sampler", args.seed), readings)?;
+            let features = LabelledFeatures::from_dataset(&dataset.converged_only(), descriptor.as_ref());
+            let config = TrainConfig { ks: vec![10, 20], restarts: 1, seed: args.seed, ..TrainConfig::default() };
+            let trained = train(&features, None, &config, &mut |_| {})?;
+            let provenance = TrainingProvenance {
+                object_set: set.id(),
+                generator: "sampler".into(),
+                dataset_seed: args.seed,
+                config,
+            };
+            let model = TrainedModel::new(descriptor.params(), sensor, trained.bag, trained.selection, provenance);
+            model.save(&model_path)?;
+            model
+        }
+    };
+    let names = model.bag.objects().to_vec();
+
+    // 2. The unknown object, at a pose the planner is not told.
+    let mut r = rng::stream(args.seed, 0xDE30);
+    let index = match &args.object {
+        Some(name) => objects.iter().position(|o| &o.name == name).ok_or_else(|| {
+            format!("--object: '{name}' is not in the set ({})", names.join(", "))
+        })?,
+        None => r.random_range(0..objects.len()),
+    };
+    let unknown = objects[index].clone();
+    let mut scene = add_sensor(SceneBuilder::with_arm_and_table().object(unknown.clone()), &sensor, "covering", PAD_SITE)?
+        .build()?;
+    let width = scene.object_width_m().unwrap_or(0.1);
+    let shuffle = PerturbationBounds::new(180.0, 0.1)?.draw(width, &mut r);
+    scene.perturb_object(&shuffle)?;
+    println!("exploring an unknown object with the arm (it is '{}'; the planner is not told)", unknown.name);
+
+    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+    let mut planner = Planner::new(
+        &scene,
+        PlannerConfig { local_probability: 0.8, ..PlannerConfig::default() },
+        ControlConfig::default(),
+        sensor,
+        PerturbationBounds::NONE,
+        rng::stream(args.seed, 0xE7),
+        reader,
+    )?;
+    let mut posterior = OnlinePosterior::new(&model.bag);
+    let mut csv = String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n");
+    let mut images = Vec::new();
+    let mut p_true_series = Vec::new();
+    println!("{:>5}  {:<12} {:>8} {:>8} {:>9}", "touch", "best guess", "p(guess)", "p(true)", "entropy");
+    let mut attempts = 0;
+    while images.len() < args.touches {
+        let report = planner.explore(&mut scene, &unknown.name, 1)?;
+        attempts += report.readings.len();
+        if report.converged() == 0 {
+            return Err(format!(
+                "the planner found no converged reading after {attempts} attempts ({} iterations, {} collisions, {} unreachable steps)",
+                report.iterations, report.collisions, report.unreachable_steps
+            )
+            .into());
+        }
+        for reading in report.readings.into_iter().filter(|r| r.status == ContactStatus::Converged) {
+            let belief = posterior.observe(&descriptor.describe(&reading.image))?;
+            let guess = belief.guess();
+            let p = belief.probabilities();
+            let touch = images.len() + 1;
+            println!(
+                "{touch:>5}  {:<12} {:>8.3} {:>8.3} {:>9.3}",
+                names[guess],
+                p[guess],
+                p[index],
+                belief.entropy_nats()
+            );
+            csv.push_str(&format!(
+                "{touch},{},{},{},{},{}\n",
+                unknown.name,
+                names[guess],
+                p[guess],
+                p[index],
+                belief.entropy_nats()
+            ));
+            p_true_series.push((touch as f64, p[index]));
+            images.push(reading.image);
         }
     }
+    std::io::stdout().flush()?;
+
+    // 3. Outputs.
+    let csv_path = args.out.join("touches.csv");
+    std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    let figure = Figure {
+        title: format!("Posterior of the true object ({}) over touches", unknown.name),
+        panels: vec![Panel {
+            title: String::new(),
+            x_label: "touches (converged readings)".into(),
+            y_label: "p(true object)".into(),
+            x_range: (1.0, images.len().max(2) as f64),
+            y_range: (0.0, 1.0),
+            series: vec![Series { label: unknown.name.clone(), points: p_true_series }],
+            markers: true,
+            legend: false,
+        }],
+    };
+    figure.write_svg(&args.out.join("posterior.svg"))?;
+    figure.write_png(&args.out.join("posterior.png"))?;
+    write_contact_sheet(&images, 10, 12, &args.out.join("contact_sheet.png"))?;
+    let belief = posterior.belief();
+    println!(
+        "after {} touches ({} attempts): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png}}",
+        images.len(),
+        attempts,
+        names[belief.guess()],
+        belief.probabilities()[belief.guess()],
+        unknown.name,
+        args.out.display()
+    );
+    Ok(())
 }

@@ -73,14 +73,29 @@ impl TactileImage {
             return Err(ImageError::Empty { rows, cols });
         }
         if values.len() != rows * cols {
-            return Err(ImageError::WrongLength { rows, cols, got: values.len() });
+            return Err(ImageError::WrongLength {
+                rows,
+                cols,
+                got: values.len(),
+            });
         }
-        if let Some((i, &value)) =
-            values.iter().enumerate().find(|(_, v)| !(v.is_finite() && (0.0..=1.0).contains(*v)))
+        if let Some((i, &value)) = values
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && (0.0..=1.0).contains(*v)))
         {
-            return Err(ImageError::OutOfRange { row: i / cols, col: i % cols, value });
+            return Err(ImageError::OutOfRange {
+                row: i / cols,
+                col: i % cols,
+                value,
+            });
         }
-        Ok(Self { rows, cols, values, pose: None })
+        Ok(Self {
+            rows,
+            cols,
+            values,
+            pose: None,
+        })
     }
 
     /// An all-zero image (no contact).
@@ -113,7 +128,12 @@ impl TactileImage {
 
     /// The value at (`row`, `col`); panics only on an index outside the image, a programming error.
     pub fn get(&self, row: usize, col: usize) -> f64 {
-        assert!(row < self.rows && col < self.cols, "taxel ({row}, {col}) outside {}x{}", self.rows, self.cols);
+        assert!(
+            row < self.rows && col < self.cols,
+            "taxel ({row}, {col}) outside {}x{}",
+            self.rows,
+            self.cols
+        );
         self.values[row * self.cols + col]
     }
 
@@ -130,7 +150,10 @@ impl TactileImage {
     /// Writes `rows` lines of `cols` comma-separated values (the format `taction sense` writes and
     /// `taction describe` reads).
     pub fn write_csv(&self, path: &Path) -> Result<(), ImageError> {
-        let io = |source| ImageError::Io { path: path.display().to_string(), source };
+        let io = |source| ImageError::Io {
+            path: path.display().to_string(),
+            source,
+        };
         let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
         write!(out, "{}", self.to_csv_string()).map_err(io)?;
         out.flush().map_err(io)
@@ -149,14 +172,20 @@ impl TactileImage {
 
     /// Reads an image written by [`write_csv`](Self::write_csv); errors name the file and line.
     pub fn read_csv(path: &Path) -> Result<Self, ImageError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ImageError::Io { path: path.display().to_string(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| ImageError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
         Self::parse_csv(&text, &path.display().to_string())
     }
 
     /// Parses CSV text; `origin` names the source in errors.
     pub fn parse_csv(text: &str, origin: &str) -> Result<Self, ImageError> {
-        let parse = |line: usize, what: String| ImageError::Parse { path: origin.to_string(), line, what };
+        let parse = |line: usize, what: String| ImageError::Parse {
+            path: origin.to_string(),
+            line,
+            what,
+        };
         let mut values = Vec::new();
         let mut cols = None;
         let mut rows = 0;
@@ -169,15 +198,22 @@ impl TactileImage {
             match cols {
                 None => cols = Some(fields.len()),
                 Some(c) if c != fields.len() => {
-                    return Err(parse(line_no, format!("{} values, but earlier rows have {c}", fields.len())));
+                    return Err(parse(
+                        line_no,
+                        format!("{} values, but earlier rows have {c}", fields.len()),
+                    ));
                 }
                 Some(_) => {}
             }
             for (j, field) in fields.iter().enumerate() {
-                let v: f64 =
-                    field.parse().map_err(|_| parse(line_no, format!("column {}: '{field}' is not a number", j + 1)))?;
+                let v: f64 = field
+                    .parse()
+                    .map_err(|_| parse(line_no, format!("column {}: '{field}' is not a number", j + 1)))?;
                 if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
-                    return Err(parse(line_no, format!("column {}: {v} is not a finite value in [0, 1]", j + 1)));
+                    return Err(parse(
+                        line_no,
+                        format!("column {}: {v} is not a finite value in [0, 1]", j + 1),
+                    ));
                 }
                 values.push(v);
             }
@@ -190,7 +226,11 @@ impl TactileImage {
     /// Writes an 8-bit grayscale PNG, each taxel a `scale x scale` block (nearest neighbour), so a
     /// 6x6 image is visible; white is full penetration. `scale` 0 picks one making the long side >= 192 px.
     pub fn write_png(&self, path: &Path, scale: usize) -> Result<(), ImageError> {
-        let scale = if scale == 0 { 192usize.div_ceil(self.rows.max(self.cols)) } else { scale };
+        let scale = if scale == 0 {
+            192usize.div_ceil(self.rows.max(self.cols))
+        } else {
+            scale
+        };
         let (w, h) = (self.cols * scale, self.rows * scale);
         let mut pixels = vec![0u8; w * h];
         for (y, row) in pixels.chunks_mut(w).enumerate() {
@@ -202,6 +242,41 @@ impl TactileImage {
     }
 }
 
+/// Writes `images` (all of one shape) as a grid `columns` wide, each taxel `scale x scale` pixels with a
+/// 2-pixel dark gutter between images: a contact sheet like the strips of the paper's Fig. 1 and Fig. 5.
+pub fn write_contact_sheet(
+    images: &[TactileImage],
+    columns: usize,
+    scale: usize,
+    path: &Path,
+) -> Result<(), ImageError> {
+    let Some(first) = images.first() else {
+        return Err(ImageError::Empty { rows: 0, cols: 0 });
+    };
+    let (rows, cols) = (first.rows(), first.cols());
+    if let Some(other) = images.iter().find(|i| i.rows() != rows || i.cols() != cols) {
+        return Err(ImageError::WrongLength {
+            rows,
+            cols,
+            got: other.values().len(),
+        });
+    }
+    let (columns, scale, gutter) = (columns.max(1), scale.max(1), 2);
+    let grid_rows = images.len().div_ceil(columns);
+    let (cell_w, cell_h) = (cols * scale + gutter, rows * scale + gutter);
+    let (w, h) = (columns * cell_w + gutter, grid_rows * cell_h + gutter);
+    let mut pixels = vec![40u8; w * h];
+    for (k, image) in images.iter().enumerate() {
+        let (x0, y0) = (gutter + (k % columns) * cell_w, gutter + (k / columns) * cell_h);
+        for y in 0..rows * scale {
+            for x in 0..cols * scale {
+                pixels[(y0 + y) * w + x0 + x] = to_gray(image.get(y / scale, x / scale));
+            }
+        }
+    }
+    write_gray_png(path, w, h, &pixels)
+}
+
 /// A value in [0, 1] as an 8-bit gray level.
 pub fn to_gray(value: f64) -> u8 {
     (value.clamp(0.0, 1.0) * 255.0).round() as u8
@@ -211,11 +286,19 @@ pub fn to_gray(value: f64) -> u8 {
 pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -> Result<(), ImageError> {
     let name = || path.display().to_string();
     let file = std::fs::File::create(path).map_err(|source| ImageError::Io { path: name(), source })?;
-    let dims = |v: usize| u32::try_from(v).map_err(|_| ImageError::Png { path: name(), what: "too large".into() });
+    let dims = |v: usize| {
+        u32::try_from(v).map_err(|_| ImageError::Png {
+            path: name(),
+            what: "too large".into(),
+        })
+    };
     let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), dims(width)?, dims(height)?);
     encoder.set_color(png::ColorType::Grayscale);
     encoder.set_depth(png::BitDepth::Eight);
-    let png_err = |e: png::EncodingError| ImageError::Png { path: name(), what: e.to_string() };
+    let png_err = |e: png::EncodingError| ImageError::Png {
+        path: name(),
+        what: e.to_string(),
+    };
     let mut writer = encoder.write_header().map_err(png_err)?;
     writer.write_image_data(pixels).map_err(png_err)?;
     writer.finish().map_err(png_err)
@@ -228,7 +311,9 @@ impl fmt::Display for TactileImage {
         for row in self.values.chunks(self.cols) {
             let line: String = row
                 .iter()
-                .map(|v| SHADES[((v * (SHADES.len() - 1) as f64).round() as usize).min(SHADES.len() - 1)] as char)
+                .map(|v| {
+                    SHADES[((v * (SHADES.len() - 1) as f64).round() as usize).min(SHADES.len() - 1)] as char
+                })
                 .collect();
             writeln!(f, "{line}")?;
         }
@@ -242,8 +327,14 @@ mod tests {
 
     #[test]
     fn rejects_bad_shapes_and_values() {
-        assert!(matches!(TactileImage::new(0, 3, vec![]), Err(ImageError::Empty { .. })));
-        assert!(matches!(TactileImage::new(2, 2, vec![0.0; 3]), Err(ImageError::WrongLength { got: 3, .. })));
+        assert!(matches!(
+            TactileImage::new(0, 3, vec![]),
+            Err(ImageError::Empty { .. })
+        ));
+        assert!(matches!(
+            TactileImage::new(2, 2, vec![0.0; 3]),
+            Err(ImageError::WrongLength { got: 3, .. })
+        ));
         let e = TactileImage::new(2, 2, vec![0.0, 0.5, f64::NAN, 1.0]).unwrap_err();
         assert!(matches!(e, ImageError::OutOfRange { row: 1, col: 0, .. }), "{e}");
         assert!(TactileImage::new(1, 2, vec![0.0, 1.5]).is_err());
@@ -259,11 +350,17 @@ mod tests {
 
     #[test]
     fn csv_errors_name_the_line() {
-        let e = TactileImage::parse_csv("0,0.5\n0.1,x\n", "f.csv").unwrap_err().to_string();
+        let e = TactileImage::parse_csv("0,0.5\n0.1,x\n", "f.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("f.csv: line 2") && e.contains("'x'"), "{e}");
-        let e = TactileImage::parse_csv("0,0.5\n0.1\n", "f.csv").unwrap_err().to_string();
+        let e = TactileImage::parse_csv("0,0.5\n0.1\n", "f.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 2"), "{e}");
-        let e = TactileImage::parse_csv("0,NaN\n", "f.csv").unwrap_err().to_string();
+        let e = TactileImage::parse_csv("0,NaN\n", "f.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 1"), "{e}");
     }
 

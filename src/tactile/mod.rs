@@ -1,10 +1,37 @@
 //! The covering sensor (Sec. V-A2, DESIGN.md §4): an orthographic depth camera looking through a
 //! soft covering of thickness t, blurred by a point-spread, averaged to taxels, with optional noise.
 //! It is a MuJoCo sensor plugin (`taction.covering`), so any MuJoCo user reads it from `sensordata`.
+//!
+//! ```text
+//! config      SensorConfig: the <config> keys, their ranges, the PSF law
+//! plugin      registration with MuJoCo and the C callbacks
+//! covering    one instance's state: sensed geoms, BVHs, the per-reading pass
+//! mesh_bvh    one obvhs BVH per mesh, queried with the pad's slab
+//! raster      parallel rays as an orthographic z-buffer, and the inside test
+//! primitive   planes, spheres, capsules, ellipsoids, cylinders, boxes cut analytically
+//! grid        where the (supersampled) rays pierce the pad
+//! formation   penetration -> PSF -> taxels -> [0, 1] -> noise
+//! sensor      the Rust handle (read an image from sensordata) and the MJCF helpers
+//! free_floating  the pad on a mocap body, no arm (Sec. V-A3, `taction sense`)
+//! image       TactileImage and PadPose
+//! ```
 
 pub mod config;
+pub mod covering;
+pub mod formation;
+pub mod free_floating;
+pub mod grid;
 pub mod image;
+pub mod mesh_bvh;
+pub mod model_view;
 pub mod plugin;
+pub mod primitive;
+pub mod raster;
+pub mod sensor;
 
-pub use config::SensorConfig;
+pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
+pub use covering::{CoveringError, CoveringStats};
+pub use free_floating::{FreeFloatingSensor, free_floating_builder};
 pub use image::{ImageError, PadPose, TactileImage};
+pub use plugin::{PLUGIN_NAME, ensure_registered, register};
+pub use sensor::{CoveringSensor, TactileError, add_sensor, extension_xml, sensor_xml};

@@ -1,4 +1,255 @@
-//! Registration of the `taction.covering` sensor plugin with MuJoCo.
+//! Registration of the `taction.covering` sensor plugin with MuJoCo, and its callbacks.
+//!
+//! MJCF:
+//!
+//! ```xml
+//! <extension><plugin plugin="taction.covering"/></extension>
+//! <sensor>
+//!   <plugin name="tactile" plugin="taction.covering" objtype="site" objname="pad">
+//!     <config key="rows" value="6"/> ...   (keys: see ConfigKey)
+//!   </plugin>
+//! </sensor>
+//! ```
+//!
+//! The sensor writes `rows * cols` values in [0, 1] (row-major, row 0 = the pad's `+up` edge) at
+//! the position stage, so any MuJoCo user reads the image from `sensordata`. Each instance keeps a
+//! reading counter in its `plugin_state` (one number): it numbers the noise streams, is copied
+//! by `mj_copyData` and zeroed by `mj_resetData`, so a copied or reset `mjData` continues or restarts
+//! the same noise sequence. Everything else (BVHs, buffers) lives in a [`Covering`] behind
+//! `plugin_data`, built in `init` and freed in `destroy`.
+//!
+//! A bad config value fails compilation: `init` raises `mju_error` with a message naming the key
+//! and its allowed range, which MuJoCo's compiler turns into the load error (as MuJoCo's own
+//! plugins do).
 
-/// Registers the plugin with MuJoCo, once per process.
-pub fn register() {}
+use std::ffi::{CStr, c_char, c_int, c_void};
+use std::sync::Once;
+
+use mujoco_rs::mujoco_c::{
+    mj_getPluginConfig, mjData, mjModel, mjp_defaultPlugin, mjp_getPluginAtSlot, mjp_registerPlugin,
+    mjpPlugin, mjtNum, mjtPluginCapabilityBit, mjtSensor, mjtStage, mju_error, mju_warning,
+};
+
+use crate::tactile::config::{ConfigKey, SensorConfig};
+use crate::tactile::covering::Covering;
+use crate::tactile::model_view::{ModelView, PoseView};
+
+/// The plugin's registered name.
+pub const PLUGIN_NAME: &str = "taction.covering";
+const PLUGIN_NAME_C: &CStr = c"taction.covering";
+
+/// The config keys as C strings, in [`ConfigKey::ALL`] order.
+struct Attributes([*const c_char; 9]);
+// SAFETY: the pointers refer to 'static string literals, never written.
+unsafe impl Sync for Attributes {}
+
+static ATTRIBUTES: Attributes = Attributes([
+    c"rows".as_ptr(),
+    c"cols".as_ptr(),
+    c"pad_width_m".as_ptr(),
+    c"pad_height_m".as_ptr(),
+    c"thickness_m".as_ptr(),
+    c"psf_sigma_m".as_ptr(),
+    c"rays_per_taxel".as_ptr(),
+    c"noise_fraction".as_ptr(),
+    c"noise_seed".as_ptr(),
+]);
+
+static REGISTER: Once = Once::new();
+
+/// Registers the plugin with MuJoCo, once per process (later calls do nothing). Must run before
+/// any model using `taction.covering` is compiled; [`ensure_registered`] is the same call under
+/// the name scene builders use.
+pub fn register() {
+    REGISTER.call_once(|| {
+        // SAFETY: mjp_defaultPlugin fills a plain C struct; every pointer stored in it is 'static
+        // and every callback has the signature MuJoCo declares. mjp_registerPlugin copies it.
+        unsafe {
+            let mut plugin: mjpPlugin = std::mem::zeroed();
+            mjp_defaultPlugin(&mut plugin);
+            plugin.name = PLUGIN_NAME_C.as_ptr();
+            plugin.nattribute = ATTRIBUTES.0.len() as c_int;
+            plugin.attributes = ATTRIBUTES.0.as_ptr();
+            plugin.capabilityflags = mjtPluginCapabilityBit::mjPLUGIN_SENSOR as c_int;
+            plugin.needstage = mjtStage::mjSTAGE_POS as c_int;
+            plugin.nstate = Some(nstate);
+            plugin.nsensordata = Some(nsensordata);
+            plugin.init = Some(init);
+            plugin.destroy = Some(destroy);
+            plugin.reset = Some(reset);
+            plugin.compute = Some(compute);
+            mjp_registerPlugin(&plugin);
+        }
+    });
+}
+
+/// Makes sure the plugin is registered before compiling a model that uses it.
+pub fn ensure_registered() {
+    register();
+}
+
+/// Whether plugin instance `instance` of `m` is a `taction.covering` instance.
+pub fn is_covering_instance(m: &mjModel, instance: usize) -> bool {
+    if instance as i64 >= m.nplugin || m.plugin.is_null() {
+        return false;
+    }
+    // SAFETY: m.plugin has nplugin slots; mjp_getPluginAtSlot returns null or a registered plugin.
+    unsafe {
+        let slot = *m.plugin.add(instance);
+        let plugin = mjp_getPluginAtSlot(slot);
+        !plugin.is_null() && !(*plugin).name.is_null() && CStr::from_ptr((*plugin).name) == PLUGIN_NAME_C
+    }
+}
+
+/// The config of plugin instance `instance`, parsed and validated.
+pub fn instance_config(m: &mjModel, instance: usize) -> Result<SensorConfig, crate::tactile::ConfigError> {
+    let values: Vec<Option<String>> = ConfigKey::ALL
+        .iter()
+        .zip(ATTRIBUTES.0.iter())
+        .map(|(_, &attr)| {
+            // SAFETY: m is a compiled (or compiling) model and attr a NUL-terminated key; MuJoCo
+            // returns null or a NUL-terminated string owned by the model.
+            unsafe {
+                let value = mj_getPluginConfig(m, instance as c_int, attr);
+                (!value.is_null()).then(|| CStr::from_ptr(value).to_string_lossy().into_owned())
+            }
+        })
+        .collect();
+    SensorConfig::from_key_values(|key| {
+        let i = ConfigKey::ALL.iter().position(|k| *k == key)?;
+        values[i].as_deref()
+    })
+}
+
+/// The sensors of `m` that use plugin instance `instance`.
+pub fn instance_sensors(model: &ModelView, instance: usize) -> Vec<usize> {
+    (0..model.sensor_type.len())
+        .filter(|&s| {
+            model.sensor_type[s] == mjtSensor::mjSENS_PLUGIN as i32
+                && model.sensor_plugin[s] == instance as i32
+        })
+        .collect()
+}
+
+/// Copies `message` into a fixed buffer as a NUL-terminated string, truncated if needed.
+fn c_message(message: &str) -> [u8; 1024] {
+    let mut buffer = [0u8; 1024];
+    let bytes = message.as_bytes();
+    let n = bytes.len().min(buffer.len() - 1);
+    buffer[..n].copy_from_slice(&bytes[..n]);
+    // Interior NULs would cut the message short; replace them.
+    for b in &mut buffer[..n] {
+        if *b == 0 {
+            *b = b' ';
+        }
+    }
+    buffer
+}
+
+unsafe extern "C" fn nstate(_m: *const mjModel, _instance: c_int) -> c_int {
+    1
+}
+
+/// Sets up the instance; on failure returns the message. The callers turn it into plain bytes and
+/// drop it before raising `mju_error` (which does not return), so that they hold no destructors
+/// when MuJoCo's error handler jumps out of them.
+fn set_up(m: &mjModel, d: &mut mjData, instance: c_int) -> Result<(), String> {
+    let config = instance_config(m, instance as usize).map_err(|e| e.to_string())?;
+    // SAFETY: m is the model being compiled or used, with all arrays allocated.
+    let model = unsafe { ModelView::new(m) };
+    let sensors = instance_sensors(&model, instance as usize);
+    let covering = Covering::new(&model, config, &sensors).map_err(|e| e.to_string())?;
+    // SAFETY: plugin_data has nplugin entries; the pointer is reclaimed in `destroy`.
+    unsafe { *d.plugin_data.add(instance as usize) = Box::into_raw(Box::new(covering)) as usize };
+    Ok(())
+}
+
+unsafe extern "C" fn nsensordata(m: *const mjModel, instance: c_int, _sensor_id: c_int) -> c_int {
+    // SAFETY: MuJoCo passes the model being compiled.
+    let m = unsafe { &*m };
+    let message = match instance_config(m, instance as usize) {
+        Ok(config) => return config.taxel_count() as c_int,
+        Err(e) => c_message(&e.to_string()),
+    };
+    // SAFETY: the format is a literal and its argument NUL-terminated; no value with a destructor
+    // is alive in this frame (mju_error unwinds by longjmp to the compiler).
+    unsafe { mju_error(c"%s".as_ptr(), message.as_ptr()) };
+    0
+}
+
+unsafe extern "C" fn init(m: *const mjModel, d: *mut mjData, instance: c_int) -> c_int {
+    // SAFETY: MuJoCo passes valid model and data pointers.
+    let (m, d) = unsafe { (&*m, &mut *d) };
+    let message = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| set_up(m, d, instance))) {
+        Ok(Ok(())) => return 0,
+        Ok(Err(message)) => c_message(&message),
+        Err(_) => c_message("taction.covering: internal error while setting up the sensor"),
+    };
+    // SAFETY: as in `nsensordata`: only plain bytes are alive here.
+    unsafe { mju_error(c"%s".as_ptr(), message.as_ptr()) };
+    -1
+}
+
+unsafe extern "C" fn destroy(d: *mut mjData, instance: c_int) {
+    // SAFETY: plugin_data[instance] is 0 or the pointer `set_up` leaked from a Box<Covering>.
+    unsafe {
+        let slot = (*d).plugin_data.add(instance as usize);
+        if *slot != 0 {
+            drop(Box::from_raw(*slot as *mut Covering));
+            *slot = 0;
+        }
+    }
+}
+
+unsafe extern "C" fn reset(
+    _m: *const mjModel,
+    plugin_state: *mut mjtNum,
+    _plugin_data: *mut c_void,
+    _instance: c_int,
+) {
+    // SAFETY: MuJoCo passes this instance's state, of the size `nstate` returned.
+    unsafe { *plugin_state = 0.0 };
+}
+
+unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int, _capability: c_int) {
+    // SAFETY: MuJoCo passes valid pointers; plugin_data[instance] is our Covering (set in init);
+    // the state address comes from the model; sensordata has nsensordata entries.
+    unsafe {
+        let (m, d) = (&*m, &mut *d);
+        let covering = *d.plugin_data.add(instance as usize) as *mut Covering;
+        if covering.is_null() {
+            return;
+        }
+        let state = d
+            .plugin_state
+            .add(*m.plugin_stateadr.add(instance as usize) as usize);
+        let reading = *state as u64;
+        let poses = PoseView::new(m, d);
+        let sensordata = std::slice::from_raw_parts_mut(d.sensordata, m.nsensordata as usize);
+        let computed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            (*covering).compute(&poses, reading, sensordata)
+        }));
+        if computed.is_err() {
+            mju_warning(
+                c"%s".as_ptr(),
+                c"taction.covering: internal error while computing a reading".as_ptr(),
+            );
+        }
+        *state = (reading + 1) as mjtNum;
+    }
+}
+
+/// The instance state behind plugin instance `instance` of `d`, when it is a covering instance.
+///
+/// # Safety
+/// `d` must be data made for `m` by MuJoCo, with plugins initialised.
+pub unsafe fn instance_state<'d>(m: &mjModel, d: &'d mjData, instance: usize) -> Option<&'d Covering> {
+    if !is_covering_instance(m, instance) || d.plugin_data.is_null() {
+        return None;
+    }
+    // SAFETY: plugin_data[instance] of a covering instance is null or a live Covering.
+    unsafe {
+        let ptr = *d.plugin_data.add(instance) as *const Covering;
+        ptr.as_ref()
+    }
+}

@@ -1,0 +1,64 @@
+//! `taction recognize`: run a saved model over a test dataset touch by touch and write the
+//! per-touch posterior, accuracy against the number of readings, and the confusion matrix.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use indicatif::ProgressBar;
+use taction::dataset::Dataset;
+use taction::recognize::{LabelledFeatures, ReadingRange, TrainedModel, evaluate, make_trials};
+
+#[derive(Debug, Args)]
+pub struct RecognizeArgs {
+    /// A model written by `taction train`.
+    #[arg(long, value_name = "FILE")]
+    pub model: PathBuf,
+    /// Test dataset; each object's converged readings, in order, are split into trials of as many
+    /// readings as the end of `--readings`.
+    #[arg(long, value_name = "FILE")]
+    pub dataset: PathBuf,
+    /// Reading counts to report, `A..B` (both included) or `N` (= `1..N`).
+    #[arg(long, default_value = "1..100", value_name = "A..B")]
+    pub readings: ReadingRange,
+    /// Directory for posterior.csv, accuracy.csv and confusion.csv.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let model = TrainedModel::load(&args.model)?;
+    let test = Dataset::read(&args.dataset)?;
+    model
+        .check_sensor(&test.header().sensor)
+        .map_err(|e| format!("{}: {e}", args.dataset.display()))?;
+    let descriptor = model.build_descriptor()?;
+    let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let features = LabelledFeatures::from_dataset(&test, descriptor.as_ref());
+    let trials = make_trials(&features, model.bag.objects(), args.readings.last())?;
+    let evaluation = evaluate(&model.bag, &trials, args.readings)?;
+    spinner.finish_and_clear();
+    let paths = evaluation.write_csvs(&args.out)?;
+    println!(
+        "{} trials of up to {} readings over {} objects (model k = {}, {})",
+        trials.len(),
+        args.readings.last(),
+        features.objects().len(),
+        model.selection.chosen_k,
+        model.descriptor.kind().name()
+    );
+    for n in [1, 10, 30, 100] {
+        if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {
+            println!(
+                "accuracy at {n:>3} readings: {:.3} ({}/{} trials, mean p(true) {:.3})",
+                row.accuracy(),
+                row.correct,
+                row.trials,
+                row.mean_p_true
+            );
+        }
+    }
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    Ok(())
+}

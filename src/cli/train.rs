@@ -1,0 +1,166 @@
+//! `taction train`: fit a bag-of-features model (Sec. IV-A) on a dataset, choosing the number of
+//! clusters on validation data (Sec. V-B1), and save it.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use taction::dataset::Dataset;
+use taction::describe::DescriptorKind;
+use taction::recognize::{
+    CodebookKind, LabelledFeatures, PseudoCount, TrainConfig, TrainProgress, TrainedModel,
+    TrainingProvenance, VarianceFraction, check_same_sensor, train,
+};
+
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    /// Training dataset (the format of `taction::dataset`); only converged readings are used.
+    #[arg(long, value_name = "FILE")]
+    pub dataset: PathBuf,
+    /// Validation dataset for model selection; without it the last 1/11 of each object's
+    /// training readings are held out.
+    #[arg(long, value_name = "FILE")]
+    pub validation: Option<PathBuf>,
+    /// vectorize | sift | mr8 | moment-normalized | polar-fourier | mnti (default parameters)
+    #[arg(long, value_name = "NAME", value_parser = parse_descriptor)]
+    pub descriptor: DescriptorKind,
+    /// gmm (soft membership) | kmeans (hard membership)
+    #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
+    pub codebook: CodebookKind,
+    /// Cluster counts to try, comma-separated.
+    #[arg(long = "k", value_name = "K,...", value_delimiter = ',', default_values_t = [10, 20, 50])]
+    pub ks: Vec<usize>,
+    /// Seeded restarts per cluster count.
+    #[arg(long, default_value_t = 3)]
+    pub restarts: usize,
+    /// Seed of the codebook fits.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Fraction of the training variance the kept principal components explain.
+    #[arg(long, default_value_t = 0.9, value_name = "FRACTION")]
+    pub variance_kept: f64,
+    /// Pseudo-count added to every cluster bin of every object histogram.
+    #[arg(long, default_value_t = 1.0, value_name = "ALPHA")]
+    pub pseudo_count: f64,
+    /// Readings per validation trial.
+    #[arg(long, default_value_t = 10, value_name = "N")]
+    pub trial_readings: usize,
+    /// Where to write the model (JSON).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+}
+
+fn parse_descriptor(name: &str) -> Result<DescriptorKind, String> {
+    DescriptorKind::from_name(name).ok_or_else(|| {
+        let known: Vec<&str> = DescriptorKind::ALL.iter().map(|k| k.name()).collect();
+        format!(
+            "unknown descriptor '{name}'; expected one of {}",
+            known.join(", ")
+        )
+    })
+}
+
+fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
+    CodebookKind::from_name(name).ok_or_else(|| format!("unknown codebook '{name}'; expected gmm or kmeans"))
+}
+
+pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let config = TrainConfig {
+        codebook: args.codebook,
+        ks: args.ks.clone(),
+        restarts: args.restarts,
+        seed: args.seed,
+        variance_kept: VarianceFraction::new(args.variance_kept)?,
+        pseudo_count: PseudoCount::new(args.pseudo_count)?,
+        trial_readings: args.trial_readings,
+        ..TrainConfig::default()
+    };
+    let training = Dataset::read(&args.dataset)?;
+    let validation = args.validation.as_deref().map(Dataset::read).transpose()?;
+    if let (Some(v), Some(path)) = (&validation, &args.validation) {
+        check_same_sensor(&training.header().sensor, &v.header().sensor)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    let descriptor = args.descriptor.build();
+
+    let spinner =
+        ProgressBar::new_spinner().with_message(format!("describing readings ({})", args.descriptor.name()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let train_features = LabelledFeatures::from_dataset(&training, descriptor.as_ref());
+    let validation_features = validation
+        .as_ref()
+        .map(|v| LabelledFeatures::from_dataset(v, descriptor.as_ref()));
+    spinner.finish_and_clear();
+
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} candidates  {msg}  [{elapsed}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut on_progress = |event: TrainProgress| match event {
+        TrainProgress::PcaFitted { total, .. } => bar.set_length(total as u64),
+        TrainProgress::Fitting { k, restart, .. } => {
+            bar.set_message(format!("fitting k={k} restart={restart}"))
+        }
+        TrainProgress::Scored(_) => bar.inc(1),
+    };
+    let trained = train(
+        &train_features,
+        validation_features.as_ref(),
+        &config,
+        &mut on_progress,
+    )?;
+    bar.finish_and_clear();
+
+    let header = training.header();
+    let model = TrainedModel::new(
+        descriptor.params(),
+        header.sensor,
+        trained.bag,
+        trained.selection,
+        TrainingProvenance {
+            object_set: header.object_set.clone(),
+            generator: header.generator.clone(),
+            dataset_seed: header.seed,
+            config,
+        },
+    );
+    model.save(&args.out)?;
+    let s = &model.selection;
+    println!(
+        "trained on {} readings ({} features) of {} objects; validation: {}",
+        s.training_readings,
+        s.training_features,
+        model.bag.objects().len(),
+        s.validation
+    );
+    println!(
+        "PCA: {} components explain {:.1}% of the variance",
+        s.pca_components,
+        s.pca_variance_ratio * 100.0
+    );
+    for c in &s.candidates {
+        match &c.failure {
+            Some(why) => println!("  k={:<4} restart={}  failed: {why}", c.k, c.restart),
+            None => println!(
+                "  k={:<4} restart={}  validation accuracy {:.3} ({}/{})  reliability {:.3}",
+                c.k,
+                c.restart,
+                c.accuracy(),
+                c.correct,
+                c.trials,
+                c.reliability
+            ),
+        }
+    }
+    let chosen = s.chosen().map_or(String::new(), |c| {
+        format!(
+            " (validation accuracy {:.3}, reliability {:.3})",
+            c.accuracy(),
+            c.reliability
+        )
+    });
+    println!("chosen k = {}, restart {}{chosen}", s.chosen_k, s.chosen_restart);
+    println!("model written to {}", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,91 @@
+//! The tidy accuracy table of the paper's recognition figures (Fig. 7-13, 16, 17): one row per
+//! observation, i.e. per (setting, trial, number of readings).
+
+use serde::{Deserialize, Serialize};
+
+/// One point of one recognition curve.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment` | the experiment's name, e.g. `noise` |
+/// | `descriptor` | the descriptor's command-line name, e.g. `polar-fourier` |
+/// | `parameter` | the setting the experiment varies, e.g. `noise_fraction`, `local_probability`, `object` (`fixed`/`perturbed`), `data` (`validation`/`exploration`); empty when nothing but the descriptor varies |
+/// | `value` | that setting's value, as text: `0.1`, `perturbed` |
+/// | `trial` | the repetition (0-based); the plot averages over trials |
+/// | `n_readings` | number of readings of the unknown object used so far (1-based) |
+/// | `accuracy` | fraction of test objects whose most probable identity after `n_readings` readings is correct, in [0, 1] (the "empirical probability of correctly identifying any unknown object", Sec. V-B2) |
+/// | `reliability` | mean posterior probability given to the correct object, in [0, 1] (Sec. V-B1) |
+/// | `seed` | the seed the trial's randomness was drawn from |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub parameter: String,
+    pub value: String,
+    pub trial: u32,
+    pub n_readings: u32,
+    pub accuracy: f64,
+    pub reliability: f64,
+    pub seed: u64,
+}
+
+/// Everything an [`AccuracyRow`] holds but the point itself: one curve of one trial.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AccuracyCurve {
+    pub experiment: String,
+    pub descriptor: String,
+    pub parameter: String,
+    pub value: String,
+    pub trial: u32,
+    pub seed: u64,
+}
+
+impl AccuracyCurve {
+    /// The rows of this curve from `(accuracy, reliability)` after 1, 2, 3, ... readings.
+    pub fn rows(&self, points: impl IntoIterator<Item = (f64, f64)>) -> Vec<AccuracyRow> {
+        points
+            .into_iter()
+            .zip(1u32..)
+            .map(|((accuracy, reliability), n_readings)| AccuracyRow {
+                experiment: self.experiment.clone(),
+                descriptor: self.descriptor.clone(),
+                parameter: self.parameter.clone(),
+                value: self.value.clone(),
+                trial: self.trial,
+                n_readings,
+                accuracy,
+                reliability,
+                seed: self.seed,
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curve_rows_count_readings_from_one() {
+        let curve = AccuracyCurve {
+            experiment: "noise".into(),
+            descriptor: "mnti".into(),
+            parameter: "noise_fraction".into(),
+            value: "0.1".into(),
+            trial: 2,
+            seed: 9,
+        };
+        let rows = curve.rows([(0.2, 0.3), (0.4, 0.5)]);
+        assert_eq!(rows.len(), 2);
+        assert_eq!((rows[0].n_readings, rows[0].accuracy), (1, 0.2));
+        assert_eq!(
+            (
+                rows[1].n_readings,
+                rows[1].reliability,
+                rows[1].trial,
+                rows[1].seed
+            ),
+            (2, 0.5, 2, 9)
+        );
+    }
+}

@@ -1,0 +1,130 @@
+//! Finishing an experiment: unit files -> `<experiment>.csv` -> plots. It works on the files alone,
+//! not on the row type, so a single run and a merge of shards produce the same bytes.
+
+use std::path::{Path, PathBuf};
+
+use super::atomic::{read, write_if_changed};
+use super::error::ExperimentError;
+use super::layout::ExperimentDir;
+use super::name::UnitKey;
+use super::plot::render_plot;
+use super::spec::Manifest;
+
+/// A unit file checked at the CSV level: a header, at least one record, every record as wide as the
+/// header, UTF-8 throughout.
+#[derive(Debug)]
+pub(crate) struct UnitTable {
+    /// The header line, with its terminator.
+    pub header: Vec<u8>,
+    pub columns: csv::StringRecord,
+    /// Every line after the header, ending in a newline.
+    pub body: Vec<u8>,
+}
+
+impl UnitTable {
+    pub fn read(path: &Path) -> Result<Self, ExperimentError> {
+        Self::parse(read(path)?, path)
+    }
+
+    pub fn parse(bytes: Vec<u8>, path: &Path) -> Result<Self, ExperimentError> {
+        let corrupt = |what: String| ExperimentError::CorruptUnit {
+            path: path.to_path_buf(),
+            what,
+        };
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .from_reader(&bytes[..]);
+        let columns = reader.headers().map_err(|e| corrupt(e.to_string()))?.clone();
+        if columns.is_empty() || columns.iter().all(str::is_empty) {
+            return Err(corrupt("no header".to_string()));
+        }
+        let body_start = reader.position().byte() as usize;
+        let mut records = 0usize;
+        for record in reader.records() {
+            record.map_err(|e| corrupt(e.to_string()))?;
+            records += 1;
+        }
+        if records == 0 {
+            return Err(corrupt("no rows".to_string()));
+        }
+        let (header, body) = bytes.split_at(body_start.min(bytes.len()));
+        let mut body = body.to_vec();
+        if body.last() != Some(&b'\n') {
+            body.push(b'\n');
+        }
+        Ok(Self {
+            header: header.to_vec(),
+            columns,
+            body,
+        })
+    }
+}
+
+/// The keys of `manifest` whose unit file is not in `dir`.
+pub fn missing_units<'m>(dir: &ExperimentDir, manifest: &'m Manifest) -> Vec<&'m UnitKey> {
+    manifest
+        .units
+        .iter()
+        .filter(|key| !dir.unit_csv(key).is_file())
+        .collect()
+}
+
+/// The files an assembled experiment has.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finished {
+    pub csv: PathBuf,
+    pub config: PathBuf,
+    pub plots: Vec<PathBuf>,
+}
+
+/// Assembles `<experiment>.csv` from every unit file in manifest order (one header; every unit must
+/// have the same header) and draws the manifest's plots from it. Fails with
+/// [`ExperimentError::Incomplete`] when a unit file is missing.
+pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, ExperimentError> {
+    let missing = missing_units(dir, manifest);
+    if let Some(first) = missing.first() {
+        return Err(ExperimentError::Incomplete {
+            experiment: dir.name().to_string(),
+            dir: dir.root().to_path_buf(),
+            missing: missing.len(),
+            total: manifest.units.len(),
+            first_missing: (*first).clone(),
+        });
+    }
+    let mut out: Vec<u8> = Vec::new();
+    let mut first: Option<(UnitTable, PathBuf)> = None;
+    for key in &manifest.units {
+        let path = dir.unit_csv(key);
+        let table = UnitTable::read(&path)?;
+        match &first {
+            None => {
+                out.extend_from_slice(&table.header);
+                out.extend_from_slice(&table.body);
+                first = Some((table, path));
+            }
+            Some((head, head_path)) if head.columns != table.columns => {
+                return Err(ExperimentError::CorruptUnit {
+                    path,
+                    what: format!(
+                        "header '{}' differs from '{}' of {}",
+                        table.columns.iter().collect::<Vec<_>>().join(","),
+                        head.columns.iter().collect::<Vec<_>>().join(","),
+                        head_path.display()
+                    ),
+                });
+            }
+            Some(_) => out.extend_from_slice(&table.body),
+        }
+    }
+    let csv = dir.csv();
+    write_if_changed(&csv, &out)?;
+    let mut plots = Vec::new();
+    for spec in &manifest.spec.plots {
+        plots.extend(render_plot(spec, &csv, dir)?);
+    }
+    Ok(Finished {
+        csv,
+        config: dir.config(),
+        plots,
+    })
+}

@@ -1,0 +1,100 @@
+//! What can go wrong running, merging, assembling and plotting experiments; every variant names the
+//! file, directory, unit or column concerned.
+
+use std::path::PathBuf;
+
+use super::name::{NameError, UnitKey};
+
+/// One unit that failed, with its error text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UnitFailure {
+    pub key: UnitKey,
+    pub what: String,
+}
+
+/// Errors of the experiment framework.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: {what}", path.display())]
+    Json { path: PathBuf, what: String },
+    #[error(transparent)]
+    Name(#[from] NameError),
+    #[error("experiment '{experiment}' has no work units")]
+    NoUnits { experiment: String },
+    #[error("experiment '{experiment}' lists unit '{key}' twice")]
+    DuplicateUnit { experiment: String, key: UnitKey },
+    #[error(
+        "{} was written by an earlier run with different {what}; resuming would mix results: \
+         use another --out or delete {}",
+        path.display(),
+        dir.display()
+    )]
+    ChangedSinceLastRun {
+        path: PathBuf,
+        dir: PathBuf,
+        what: &'static str,
+    },
+    #[error("{}: corrupt unit file ({what}); delete it to rerun that unit", path.display())]
+    CorruptUnit { path: PathBuf, what: String },
+    #[error("{} of the units failed (finished units are saved; a rerun resumes): {}",
+        failures.len(),
+        failures.iter().map(|f| format!("{}: {}", f.key, f.what)).collect::<Vec<_>>().join("; "))]
+    UnitsFailed { failures: Vec<UnitFailure> },
+    #[error("cannot start {threads} worker threads: {what}")]
+    ThreadPool { threads: usize, what: String },
+    #[error("{}: {what}", path.display())]
+    Csv { path: PathBuf, what: String },
+    #[error("{}: no column '{column}' (columns: {available})", path.display())]
+    MissingColumn {
+        path: PathBuf,
+        column: String,
+        available: String,
+    },
+    #[error("{}: cannot draw the plot: {what}", path.display())]
+    Plot { path: PathBuf, what: String },
+    #[error(
+        "no TrueType font for plot text: set TACTION_FONT to a .ttf file or install fonts-dejavu-core \
+         (tried {})",
+        tried.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    NoFont { tried: Vec<PathBuf> },
+    #[error(
+        "experiment '{experiment}': {file} differs between {} and {}; shards of one run must share it",
+        first.display(),
+        second.display()
+    )]
+    ShardMismatch {
+        experiment: String,
+        file: &'static str,
+        first: PathBuf,
+        second: PathBuf,
+    },
+    #[error("unit '{key}' differs between {} and {}", first.display(), second.display())]
+    UnitConflict {
+        key: UnitKey,
+        first: PathBuf,
+        second: PathBuf,
+    },
+    #[error(
+        "experiment '{experiment}' in {} is incomplete: {missing} of {total} units missing (first: {first_missing})",
+        dir.display()
+    )]
+    Incomplete {
+        experiment: String,
+        dir: PathBuf,
+        missing: usize,
+        total: usize,
+        first_missing: UnitKey,
+    },
+    #[error("{}: no experiment output here (no <experiment>/manifest.json)", dir.display())]
+    NoExperiments { dir: PathBuf },
+}
+
+impl ExperimentError {
+    pub(crate) fn io(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.into();
+        move |source| Self::Io { path, source }
+    }
+}

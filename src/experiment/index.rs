@@ -1,0 +1,127 @@
+//! The results index: `<out>/README.md` lists every experiment directory under the output root
+//! with its description, CSV, plots and headline numbers. Rewritten by every run and merge, from
+//! the files alone.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::assemble::missing_units;
+use super::atomic::write_if_changed;
+use super::error::ExperimentError;
+use super::figure::{Panel, format_number as number};
+use super::layout::ExperimentDir;
+use super::merge::experiments_in;
+use super::plot::{PlotKind, build_figure};
+use super::spec::Manifest;
+
+/// The numbers of readings at which the index quotes accuracy.
+pub const HEADLINE_READINGS: [u32; 4] = [10, 30, 60, 100];
+
+/// The most x values a line plot's headline table shows (evenly spaced, ends included).
+const MAX_LINE_COLUMNS: usize = 8;
+
+/// (Re)writes `<out>/README.md`; returns its path.
+pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
+    let mut text = String::from(
+        "# Results\n\nOne directory per experiment: `<name>.csv` (tidy, one row per observation), its plots \
+         (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
+         per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
+    );
+    for dir in experiments_in(out)? {
+        let manifest = Manifest::read(&dir.manifest())?;
+        section(&mut text, &dir, &manifest)?;
+    }
+    let path = out.join("README.md");
+    write_if_changed(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Result<(), ExperimentError> {
+    let name = dir.name();
+    let _ = write!(text, "\n## {name}\n\n{}\n\n", manifest.spec.description);
+    let missing = missing_units(dir, manifest).len();
+    let csv = dir.csv();
+    if missing > 0 || !csv.is_file() {
+        let total = manifest.units.len();
+        let _ = writeln!(text, "Incomplete: {} of {total} units done.", total - missing);
+        return Ok(());
+    }
+    let _ = writeln!(text, "Data: [{name}.csv]({name}/{name}.csv)");
+    for spec in &manifest.spec.plots {
+        let stem = &spec.stem;
+        let _ = write!(
+            text,
+            "\n![{}]({name}/{stem}.svg)\n([PNG]({name}/{stem}.png))\n\n",
+            spec.title
+        );
+        let figure = build_figure(spec, &csv)?;
+        for panel in &figure.panels {
+            match spec.kind {
+                PlotKind::Accuracy => accuracy_table(text, panel),
+                PlotKind::Lines { .. } => line_table(text, panel),
+            }
+        }
+    }
+    Ok(())
+}
+
+fn table_title(text: &mut String, panel: &Panel) {
+    if !panel.title.is_empty() {
+        let _ = write!(text, "\n{}:\n\n", panel.title);
+    }
+}
+
+fn accuracy_table(text: &mut String, panel: &Panel) {
+    table_title(text, panel);
+    let _ = write!(text, "| accuracy (%) at n readings |");
+    for n in HEADLINE_READINGS {
+        let _ = write!(text, " {n} |");
+    }
+    let _ = write!(text, "\n|---|{}\n", "---:|".repeat(HEADLINE_READINGS.len()));
+    for series in &panel.series {
+        let _ = write!(text, "| {} |", series.label);
+        for n in HEADLINE_READINGS {
+            match series.points.iter().find(|(x, _)| *x == n as f64) {
+                Some((_, y)) => {
+                    let _ = write!(text, " {y:.1} |");
+                }
+                None => text.push_str(" - |"),
+            }
+        }
+        text.push('\n');
+    }
+}
+
+fn line_table(text: &mut String, panel: &Panel) {
+    text.push('\n');
+    let mut xs: Vec<f64> = panel
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    if xs.len() > MAX_LINE_COLUMNS {
+        let last = xs.len() - 1;
+        xs = (0..MAX_LINE_COLUMNS)
+            .map(|i| xs[i * last / (MAX_LINE_COLUMNS - 1)])
+            .collect();
+    }
+    let _ = write!(text, "| {} \\ {} |", panel.y_label, panel.x_label);
+    for x in &xs {
+        let _ = write!(text, " {} |", number(*x));
+    }
+    let _ = write!(text, "\n|---|{}\n", "---:|".repeat(xs.len()));
+    for series in &panel.series {
+        let _ = write!(text, "| {} |", series.label);
+        for x in &xs {
+            match series.points.iter().find(|p| p.0 == *x) {
+                Some((_, y)) => {
+                    let _ = write!(text, " {} |", number(*y));
+                }
+                None => text.push_str(" - |"),
+            }
+        }
+        text.push('\n');
+    }
+}

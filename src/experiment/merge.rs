@@ -1,0 +1,157 @@
+//! Combining shard outputs: `taction merge DIRS... --out DIR` gives exactly the files one unsharded
+//! run would have written.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use super::assemble::{Finished, UnitTable, finish};
+use super::atomic::{create_dir_all, read, remove_stale_temporaries, write_atomic};
+use super::error::ExperimentError;
+use super::index::write_index;
+use super::layout::ExperimentDir;
+use super::name::{ExperimentName, SafeName};
+use super::spec::{Manifest, write_manifest, write_or_check};
+
+/// What a merge produced, per experiment in name order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MergeReport {
+    pub experiments: Vec<(ExperimentName, Finished)>,
+    /// Unit files copied into the output (units already there with identical bytes are not counted).
+    pub copied: usize,
+}
+
+/// Merges the output roots `inputs` (each the `--out` of one or more shard runs) into `out`, which
+/// may be one of them.
+///
+/// For every experiment found (a directory holding `manifest.json`): its `manifest.json` and
+/// `config.json` must be byte-identical in every input that has it (else
+/// [`ExperimentError::ShardMismatch`] names the two directories); every unit file is checked and
+/// copied (a unit present in several inputs must be identical, else
+/// [`ExperimentError::UnitConflict`]); then the experiment is assembled and plotted, which fails with
+/// [`ExperimentError::Incomplete`] if some unit is in no input. Finally the index is rewritten.
+pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport, ExperimentError> {
+    let mut experiments: BTreeMap<ExperimentName, Vec<ExperimentDir>> = BTreeMap::new();
+    for input in inputs {
+        let found = experiments_in(input)?;
+        if found.is_empty() {
+            return Err(ExperimentError::NoExperiments { dir: input.clone() });
+        }
+        for dir in found {
+            experiments.entry(dir.name().clone()).or_default().push(dir);
+        }
+    }
+    let mut report = MergeReport {
+        experiments: Vec::new(),
+        copied: 0,
+    };
+    for (name, sources) in &experiments {
+        let (finished, copied) = merge_experiment(name, sources, out)?;
+        report.experiments.push((name.clone(), finished));
+        report.copied += copied;
+    }
+    write_index(out)?;
+    Ok(report)
+}
+
+/// The experiment directories directly under `root`, in name order.
+pub(crate) fn experiments_in(root: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(root).map_err(ExperimentError::io(root))? {
+        let entry = entry.map_err(ExperimentError::io(root))?;
+        let file_name = entry.file_name();
+        let Some(name) = file_name.to_str().and_then(|n| SafeName::new(n).ok()) else {
+            continue;
+        };
+        if entry.path().join("manifest.json").is_file() {
+            names.push(name);
+        }
+    }
+    names.sort();
+    Ok(names.iter().map(|name| ExperimentDir::new(root, name)).collect())
+}
+
+fn merge_experiment(
+    name: &ExperimentName,
+    sources: &[ExperimentDir],
+    out: &Path,
+) -> Result<(Finished, usize), ExperimentError> {
+    let first = &sources[0];
+    let manifest_bytes = read(&first.manifest())?;
+    let config_bytes = read(&first.config())?;
+    let manifest = Manifest::read(&first.manifest())?;
+    if &manifest.spec.name != name {
+        return Err(ExperimentError::Json {
+            path: first.manifest(),
+            what: format!(
+                "names experiment '{}' but lies in directory '{name}'",
+                manifest.spec.name
+            ),
+        });
+    }
+    for other in &sources[1..] {
+        for (file, path, bytes) in [
+            ("manifest.json", other.manifest(), &manifest_bytes),
+            ("config.json", other.config(), &config_bytes),
+        ] {
+            if &read(&path)? != bytes {
+                return Err(ExperimentError::ShardMismatch {
+                    experiment: name.to_string(),
+                    file,
+                    first: first.root().to_path_buf(),
+                    second: other.root().to_path_buf(),
+                });
+            }
+        }
+    }
+
+    let target = ExperimentDir::new(out, name);
+    create_dir_all(&target.units_dir())?;
+    for stale in [out, target.root(), &target.units_dir()] {
+        remove_stale_temporaries(stale)?;
+    }
+    write_manifest(&target.manifest(), &manifest, &manifest_bytes, target.root())?;
+    write_or_check(&target.config(), &config_bytes, target.root(), "configuration")?;
+    let mut copied = 0;
+    for key in &manifest.units {
+        let mut chosen: Option<(Vec<u8>, PathBuf)> = None;
+        for source in sources {
+            let path = source.unit_csv(key);
+            if !path.is_file() {
+                continue;
+            }
+            let bytes = read(&path)?;
+            match &chosen {
+                Some((kept, kept_path)) if kept != &bytes => {
+                    return Err(ExperimentError::UnitConflict {
+                        key: key.clone(),
+                        first: kept_path.clone(),
+                        second: path,
+                    });
+                }
+                Some(_) => {}
+                None => {
+                    UnitTable::parse(bytes.clone(), &path)?;
+                    chosen = Some((bytes, path));
+                }
+            }
+        }
+        let Some((bytes, path)) = chosen else { continue };
+        let dest = target.unit_csv(key);
+        match std::fs::read(&dest) {
+            Ok(existing) if existing == bytes => {}
+            Ok(_) => {
+                return Err(ExperimentError::UnitConflict {
+                    key: key.clone(),
+                    first: path,
+                    second: dest,
+                });
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                write_atomic(&dest, &bytes)?;
+                copied += 1;
+            }
+            Err(source) => return Err(ExperimentError::Io { path: dest, source }),
+        }
+    }
+    Ok((finish(&target, &manifest)?, copied))
+}

@@ -1,0 +1,48 @@
+//! The experiments of Sec. V as resumable, parallel, shardable runs writing tidy CSV and plots, and
+//! the import of recorded real-sensor data (Sec. V-E, V-F).
+//!
+//! An experiment is a list of [`Unit`]s, each a stable [`UnitKey`] and a deterministic function
+//! producing rows (any serde record; [`AccuracyRow`] for the recognition curves). [`run`] executes
+//! the units of one [`Shard`] on a thread pool, writing each unit's rows atomically to
+//! `<out>/<experiment>/units/<key>.csv`, so a killed run resumes where it stopped and never
+//! duplicates a row; once every unit is present it assembles `<experiment>.csv`, draws the
+//! experiment's plots and rewrites the index `<out>/README.md`. [`merge`] combines the outputs of
+//! separate shards into exactly the files of one unsharded run. The on-disk layout is in
+//! [`layout`].
+//!
+//! The framework knows nothing of MuJoCo or recognition: the experiments themselves build the units.
+
+pub mod accuracy;
+pub mod assemble;
+pub mod atomic;
+pub mod error;
+pub mod figure;
+pub mod font;
+pub mod index;
+pub mod layout;
+pub mod merge;
+pub mod name;
+pub mod plot;
+pub mod real_data;
+pub mod runner;
+pub mod shard;
+pub mod sim_to_real;
+pub mod spec;
+pub mod split;
+pub mod unit;
+
+pub use accuracy::{AccuracyCurve, AccuracyRow};
+pub use assemble::Finished;
+pub use error::{ExperimentError, UnitFailure};
+pub use index::write_index;
+pub use layout::ExperimentDir;
+pub use merge::{MergeReport, merge};
+pub use name::{ExperimentName, NameError, SafeName, UnitKey};
+pub use plot::{Axis, PlotKind, PlotSpec};
+pub use real_data::{Normalisation, RealData, RealDataError, RealImport, RealReading, import_real_csv};
+pub use runner::{Experiment, RunOptions, RunReport, run};
+pub use shard::{Shard, ShardError};
+pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};
+pub use spec::{ExperimentSpec, Manifest};
+pub use split::{Split, SplitSizes, split_per_label};
+pub use unit::{BoxError, Unit};

@@ -1,0 +1,354 @@
+//! What each experiment plots, read back from its assembled CSV so that a merge can plot without the
+//! experiment's code. Two kinds: the paper's recognition curves (accuracy vs readings, Fig. 7-13,
+//! 16, 17) and a generic line plot (e.g. Fig. 14, controller convergence vs noise).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::accuracy::AccuracyRow;
+use super::error::ExperimentError;
+use super::figure::{Figure, Panel, Series};
+use super::layout::ExperimentDir;
+use super::name::SafeName;
+
+/// One axis of a line plot: the CSV column it reads and its label (with units).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    pub column: String,
+    pub label: String,
+}
+
+impl Axis {
+    pub fn new(column: &str, label: &str) -> Self {
+        Self {
+            column: column.to_string(),
+            label: label.to_string(),
+        }
+    }
+}
+
+/// What to draw from the assembled CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlotKind {
+    /// Accuracy (%) against the number of readings from [`AccuracyRow`] columns: one line per
+    /// (descriptor, value), the mean over trials at each `n_readings`. When both the descriptor
+    /// and the value vary, one panel per descriptor with one line per value (the layout of Fig.
+    /// 11-13); otherwise one panel.
+    Accuracy,
+    /// `y` against `x` from named columns: one line per distinct combination of the `series`
+    /// columns (one line if none), the mean of `y` over rows sharing (series, x), with a marker per
+    /// point; one panel per `y` axis.
+    Lines {
+        x: Axis,
+        y: Vec<Axis>,
+        series: Vec<String>,
+    },
+}
+
+/// One plot of an experiment, written as `<stem>.svg` and `<stem>.png` beside its CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlotSpec {
+    pub stem: SafeName,
+    pub title: String,
+    pub kind: PlotKind,
+}
+
+impl PlotSpec {
+    pub fn accuracy(stem: SafeName, title: &str) -> Self {
+        Self {
+            stem,
+            title: title.to_string(),
+            kind: PlotKind::Accuracy,
+        }
+    }
+
+    pub fn lines(stem: SafeName, title: &str, x: Axis, y: Vec<Axis>, series: &[&str]) -> Self {
+        let series = series.iter().map(|s| s.to_string()).collect();
+        Self {
+            stem,
+            title: title.to_string(),
+            kind: PlotKind::Lines { x, y, series },
+        }
+    }
+}
+
+/// Draws `spec` from the assembled `csv` into `dir`; returns the SVG and PNG paths.
+pub fn render_plot(
+    spec: &PlotSpec,
+    csv: &Path,
+    dir: &ExperimentDir,
+) -> Result<Vec<PathBuf>, ExperimentError> {
+    let figure = build_figure(spec, csv)?;
+    let svg = dir.plot(&spec.stem, "svg");
+    let png = dir.plot(&spec.stem, "png");
+    figure.write_svg(&svg)?;
+    figure.write_png(&png)?;
+    Ok(vec![svg, png])
+}
+
+/// The figure `spec` describes, from the rows of `csv`.
+pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentError> {
+    let panels = match &spec.kind {
+        PlotKind::Accuracy => accuracy_panels(csv)?,
+        PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series)?,
+    };
+    Ok(Figure {
+        title: spec.title.clone(),
+        panels,
+    })
+}
+
+/// Means of `y` per x (keyed by the bits of x, which come from the same text for the same setting).
+#[derive(Default)]
+struct Means {
+    sums: BTreeMap<u64, (f64, f64, usize)>,
+}
+
+impl Means {
+    fn add(&mut self, x: f64, y: f64) {
+        let entry = self.sums.entry(x.to_bits()).or_insert((x, 0.0, 0));
+        entry.1 += y;
+        entry.2 += 1;
+    }
+
+    fn points(&self) -> Vec<(f64, f64)> {
+        let mut points: Vec<(f64, f64)> = self
+            .sums
+            .values()
+            .map(|&(x, sum, n)| (x, sum / n as f64))
+            .collect();
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        points
+    }
+}
+
+/// Items in order of first appearance, each with its accumulator.
+struct Ordered<K, V> {
+    items: Vec<(K, V)>,
+}
+
+impl<K: PartialEq, V: Default> Ordered<K, V> {
+    fn new() -> Self {
+        Self { items: Vec::new() }
+    }
+
+    fn entry(&mut self, key: K) -> &mut V {
+        let i = match self.items.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                self.items.push((key, V::default()));
+                self.items.len() - 1
+            }
+        };
+        &mut self.items[i].1
+    }
+}
+
+fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
+    ExperimentError::Csv {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    }
+}
+
+fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
+    let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
+    // (descriptor, parameter, value) -> means of accuracy (%) per n_readings
+    let mut curves: Ordered<(String, String, String), Means> = Ordered::new();
+    let mut max_n = 1u32;
+    for (i, row) in reader.deserialize::<AccuracyRow>().enumerate() {
+        let row = row.map_err(|e| csv_error(csv, e))?;
+        let line = i + 2;
+        for (name, v) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
+            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                return Err(csv_error(
+                    csv,
+                    format!("line {line}: {name} {v} is not a fraction in [0, 1]"),
+                ));
+            }
+        }
+        if row.n_readings == 0 {
+            return Err(csv_error(
+                csv,
+                format!("line {line}: n_readings must be at least 1"),
+            ));
+        }
+        max_n = max_n.max(row.n_readings);
+        curves
+            .entry((row.descriptor, row.parameter, row.value))
+            .add(row.n_readings as f64, 100.0 * row.accuracy);
+    }
+    if curves.items.is_empty() {
+        return Err(csv_error(csv, "no rows to plot"));
+    }
+    let mut descriptors: Vec<&str> = Vec::new();
+    let mut values: Vec<&str> = Vec::new();
+    for ((d, _, v), _) in &curves.items {
+        if !descriptors.contains(&d.as_str()) {
+            descriptors.push(d);
+        }
+        if !values.contains(&v.as_str()) {
+            values.push(v);
+        }
+    }
+    let setting = |parameter: &str, value: &str| {
+        if parameter.is_empty() {
+            value.to_string()
+        } else {
+            format!("{parameter} = {value}")
+        }
+    };
+    let panel = |title: String, series: Vec<Series>| Panel {
+        title,
+        x_label: "number of readings".to_string(),
+        y_label: "accuracy (%)".to_string(),
+        x_range: if max_n > 1 {
+            (1.0, max_n as f64)
+        } else {
+            (0.5, 1.5)
+        },
+        y_range: (0.0, 100.0),
+        series,
+        markers: max_n <= 12,
+        legend: true,
+    };
+    if descriptors.len() > 1 && values.len() > 1 {
+        Ok(descriptors
+            .iter()
+            .map(|&descriptor| {
+                let series = curves
+                    .items
+                    .iter()
+                    .filter(|((d, _, _), _)| d == descriptor)
+                    .map(|((_, p, v), m)| Series {
+                        label: setting(p, v),
+                        points: m.points(),
+                    })
+                    .collect();
+                panel(descriptor.to_string(), series)
+            })
+            .collect())
+    } else {
+        let series = curves
+            .items
+            .iter()
+            .map(|((d, p, v), m)| Series {
+                label: if values.len() > 1 {
+                    setting(p, v)
+                } else {
+                    d.clone()
+                },
+                points: m.points(),
+            })
+            .collect();
+        Ok(vec![panel(String::new(), series)])
+    }
+}
+
+fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<Vec<Panel>, ExperimentError> {
+    let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
+    let headers = reader.headers().map_err(|e| csv_error(csv, e))?.clone();
+    let column = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| ExperimentError::MissingColumn {
+                path: csv.to_path_buf(),
+                column: name.to_string(),
+                available: headers.iter().collect::<Vec<_>>().join(", "),
+            })
+    };
+    let x_col = column(&x.column)?;
+    let y_cols = ys
+        .iter()
+        .map(|y| column(&y.column))
+        .collect::<Result<Vec<_>, _>>()?;
+    let series_cols = series.iter().map(|s| column(s)).collect::<Result<Vec<_>, _>>()?;
+    // one accumulator per y axis, per series label
+    let mut curves: Vec<Ordered<String, Means>> = ys.iter().map(|_| Ordered::new()).collect();
+    for (i, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| csv_error(csv, e))?;
+        let line = i + 2;
+        let number = |col: usize, name: &str| {
+            let text = record.get(col).unwrap_or("");
+            text.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    csv_error(
+                        csv,
+                        format!("line {line}: column '{name}': '{text}' is not a finite number"),
+                    )
+                })
+        };
+        let xv = number(x_col, &x.column)?;
+        let label = match series_cols.as_slice() {
+            [] => String::new(),
+            [one] => record.get(*one).unwrap_or("").to_string(),
+            many => many
+                .iter()
+                .zip(series)
+                .map(|(&c, name)| format!("{name} = {}", record.get(c).unwrap_or("")))
+                .collect::<Vec<_>>()
+                .join(", "),
+        };
+        for ((y, &col), acc) in ys.iter().zip(&y_cols).zip(curves.iter_mut()) {
+            acc.entry(label.clone()).add(xv, number(col, &y.column)?);
+        }
+    }
+    if curves.first().is_none_or(|c| c.items.is_empty()) {
+        return Err(csv_error(csv, "no rows to plot"));
+    }
+    Ok(ys
+        .iter()
+        .zip(curves)
+        .map(|(y, acc)| {
+            let series: Vec<Series> = acc
+                .items
+                .into_iter()
+                .map(|(label, m)| Series {
+                    label: if label.is_empty() { y.label.clone() } else { label },
+                    points: m.points(),
+                })
+                .collect();
+            let all = || series.iter().flat_map(|s| s.points.iter());
+            let (xmin, xmax) = bounds(all().map(|p| p.0));
+            let (ymin, ymax) = bounds(all().map(|p| p.1));
+            Panel {
+                title: if ys.len() > 1 {
+                    y.label.clone()
+                } else {
+                    String::new()
+                },
+                x_label: x.label.clone(),
+                y_label: y.label.clone(),
+                x_range: padded(xmin, xmax, false),
+                y_range: padded(ymin.min(0.0), ymax.max(0.0), true),
+                series,
+                markers: true,
+                legend: !series_cols.is_empty(),
+            }
+        })
+        .collect())
+}
+
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    })
+}
+
+/// A drawable range around `[lo, hi]`: 5 % margins (only above zero-anchored ranges when
+/// `from_zero`), and a unit width when all values are equal.
+fn padded(lo: f64, hi: f64, from_zero: bool) -> (f64, f64) {
+    if hi <= lo {
+        return (lo - 0.5, hi + 0.5);
+    }
+    let pad = 0.05 * (hi - lo);
+    let lo = if from_zero && lo == 0.0 { 0.0 } else { lo - pad };
+    (lo, hi + pad)
+}

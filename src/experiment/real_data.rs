@@ -1,0 +1,349 @@
+//! Recorded readings of a real tactile sensor (Sec. V-E, V-F), imported from CSV.
+//!
+//! # Format
+//!
+//! One frame per line. The first line that is not a comment is the header: `label` followed by one
+//! column per taxel, named `r<row>c<col>` (0-based) in row-major order, which fixes the frame size:
+//!
+//! ```text
+//! # comment lines start with '#'
+//! label,r0c0,r0c1,...,r0c5,r1c0,...,r5c5
+//! A,0,12,873,901,15,0,...
+//! ```
+//!
+//! - `label`: the object the frame was taken from (e.g. `A`); non-empty. When the importer is given
+//!   a set of allowed labels, any other label is an error.
+//! - taxel values: raw sensor units (any scale), finite and non-negative; row 0 is the pad's `up`
+//!   edge, column 0 its left edge, as in [`TactileImage`].
+//! - lines are frames in collection order (Fig. 17b uses that order); fields are separated by commas
+//!   and trimmed, without quoting; blank lines and lines starting with `#` are skipped.
+//!
+//! Import divides every value by one number so that frames land in [0, 1] of the sensing range
+//! ([`Normalisation`]): the largest value in the file, or a given range (`--range`), above which a
+//! value is an error. Errors name the file, the line and the column.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use crate::tactile::TactileImage;
+
+/// How raw sensor units become fractions of the sensing range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Normalisation {
+    /// Divide by the largest value in the file (the file's strongest reading becomes 1).
+    FileMax,
+    /// Divide by this full-scale value, in raw units; it must be finite and positive.
+    Range(f64),
+}
+
+impl std::str::FromStr for Normalisation {
+    type Err = String;
+
+    /// `max` for [`Normalisation::FileMax`], or a full-scale value in raw units for
+    /// [`Normalisation::Range`] (the `--range` flag).
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim() == "max" {
+            return Ok(Self::FileMax);
+        }
+        match s.trim().parse::<f64>() {
+            Ok(range) if range.is_finite() && range > 0.0 => Ok(Self::Range(range)),
+            _ => Err(format!(
+                "'{s}' is neither 'max' nor a finite positive full-scale value"
+            )),
+        }
+    }
+}
+
+/// Import settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealImport {
+    pub normalisation: Normalisation,
+    /// When set, the only labels accepted.
+    pub allowed_labels: Option<BTreeSet<String>>,
+}
+
+impl Default for RealImport {
+    fn default() -> Self {
+        Self {
+            normalisation: Normalisation::FileMax,
+            allowed_labels: None,
+        }
+    }
+}
+
+/// One imported frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealReading {
+    pub label: String,
+    /// The line of the file it came from (1-based).
+    pub line: u64,
+    /// Values normalised to [0, 1]; no pad pose (a recording has none).
+    pub image: TactileImage,
+}
+
+/// An imported file: frames of `rows x cols` taxels in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealData {
+    pub rows: usize,
+    pub cols: usize,
+    pub readings: Vec<RealReading>,
+}
+
+impl RealData {
+    /// The distinct labels, sorted.
+    pub fn labels(&self) -> BTreeSet<&str> {
+        self.readings.iter().map(|r| r.label.as_str()).collect()
+    }
+}
+
+/// What is wrong with a real-data file; `origin` is its path, `line` 1-based.
+#[derive(Debug, thiserror::Error)]
+pub enum RealDataError {
+    #[error("{origin}: {source}")]
+    Io { origin: String, source: std::io::Error },
+    #[error("{origin}: line {line}: {what}")]
+    Invalid { origin: String, line: u64, what: String },
+    #[error("{origin}: line {line}: bad header: {what}")]
+    Header { origin: String, line: u64, what: String },
+    #[error("{origin}: no header line (label,r0c0,...)")]
+    NoHeader { origin: String },
+    #[error("{origin}: line {line}: {got} columns, expected {expected} (label + {rows}x{cols} taxels)")]
+    ColumnCount {
+        origin: String,
+        line: u64,
+        got: usize,
+        expected: usize,
+        rows: usize,
+        cols: usize,
+    },
+    #[error("{origin}: line {line}: empty label")]
+    EmptyLabel { origin: String, line: u64 },
+    #[error("{origin}: line {line}: unknown label '{label}' (allowed: {allowed})")]
+    UnknownLabel {
+        origin: String,
+        line: u64,
+        label: String,
+        allowed: String,
+    },
+    #[error("{origin}: line {line}: column {column}: '{text}' is not a number")]
+    NotANumber {
+        origin: String,
+        line: u64,
+        column: String,
+        text: String,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} is not finite")]
+    NotFinite {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} is negative")]
+    Negative {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} exceeds the range {range}")]
+    AboveRange {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+        range: f64,
+    },
+    #[error("{origin}: the range must be finite and positive, got {range}")]
+    BadRange { origin: String, range: f64 },
+    #[error("{origin}: no frames")]
+    NoFrames { origin: String },
+    #[error("{origin}: every value is zero; nothing to normalise by")]
+    AllZero { origin: String },
+}
+
+/// Reads and normalises a real-data file (format in the module docs).
+pub fn import_real_csv(path: &Path, options: &RealImport) -> Result<RealData, RealDataError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| RealDataError::Io {
+        origin: origin.clone(),
+        source,
+    })?;
+    parse_real_csv(&text, &origin, options)
+}
+
+/// Parses real-data CSV text; `origin` names the source in errors.
+pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<RealData, RealDataError> {
+    let origin_s = || origin.to_string();
+    if let Normalisation::Range(range) = options.normalisation
+        && !(range.is_finite() && range > 0.0)
+    {
+        return Err(RealDataError::BadRange {
+            origin: origin_s(),
+            range,
+        });
+    }
+    let mut header: Option<(usize, usize, Vec<String>)> = None;
+    let mut raw: Vec<(String, u64, Vec<f64>)> = Vec::new();
+    for (i, text_line) in text.lines().enumerate() {
+        let line = i as u64 + 1;
+        let trimmed = text_line.trim();
+        if trimmed.is_empty() || trimmed.starts_with('#') {
+            continue;
+        }
+        let record: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+        let Some((rows, cols, names)) = &header else {
+            header = Some(parse_header(&record, line, origin)?);
+            continue;
+        };
+        let expected = 1 + rows * cols;
+        if record.len() != expected {
+            return Err(RealDataError::ColumnCount {
+                origin: origin_s(),
+                line,
+                got: record.len(),
+                expected,
+                rows: *rows,
+                cols: *cols,
+            });
+        }
+        let label = record[0].to_string();
+        if label.is_empty() {
+            return Err(RealDataError::EmptyLabel {
+                origin: origin_s(),
+                line,
+            });
+        }
+        if let Some(allowed) = &options.allowed_labels
+            && !allowed.contains(&label)
+        {
+            let allowed = allowed.iter().cloned().collect::<Vec<_>>().join(", ");
+            return Err(RealDataError::UnknownLabel {
+                origin: origin_s(),
+                line,
+                label,
+                allowed,
+            });
+        }
+        let mut values = Vec::with_capacity(rows * cols);
+        for (text, column) in record[1..].iter().zip(names) {
+            let column = column.clone();
+            let value: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
+                origin: origin_s(),
+                line,
+                column: column.clone(),
+                text: text.to_string(),
+            })?;
+            if !value.is_finite() {
+                return Err(RealDataError::NotFinite {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value,
+                });
+            }
+            if value < 0.0 {
+                return Err(RealDataError::Negative {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value,
+                });
+            }
+            if let Normalisation::Range(range) = options.normalisation
+                && value > range
+            {
+                return Err(RealDataError::AboveRange {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value,
+                    range,
+                });
+            }
+            values.push(value);
+        }
+        raw.push((label, line, values));
+    }
+    let Some((rows, cols, _)) = header else {
+        return Err(RealDataError::NoHeader { origin: origin_s() });
+    };
+    if raw.is_empty() {
+        return Err(RealDataError::NoFrames { origin: origin_s() });
+    }
+    let scale = match options.normalisation {
+        Normalisation::Range(range) => range,
+        Normalisation::FileMax => raw
+            .iter()
+            .flat_map(|(_, _, v)| v.iter().copied())
+            .fold(0.0, f64::max),
+    };
+    if scale == 0.0 {
+        return Err(RealDataError::AllZero { origin: origin_s() });
+    }
+    let readings = raw
+        .into_iter()
+        .map(|(label, line, values)| {
+            let values = values.into_iter().map(|v| v / scale).collect();
+            TactileImage::new(rows, cols, values)
+                .map(|image| RealReading { label, line, image })
+                .map_err(|e| RealDataError::Invalid {
+                    origin: origin_s(),
+                    line,
+                    what: e.to_string(),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(RealData { rows, cols, readings })
+}
+
+/// Reads `label,r0c0,...`: the taxel columns must be `r<i>c<j>` in row-major order and fill a grid.
+fn parse_header(
+    record: &[&str],
+    line: u64,
+    origin: &str,
+) -> Result<(usize, usize, Vec<String>), RealDataError> {
+    let bad = |what: String| RealDataError::Header {
+        origin: origin.to_string(),
+        line,
+        what,
+    };
+    if record[0] != "label" {
+        return Err(bad(format!(
+            "the first column must be 'label', got '{}'",
+            record[0]
+        )));
+    }
+    let names: Vec<String> = record[1..].iter().map(|s| s.to_string()).collect();
+    if names.is_empty() {
+        return Err(bad("no taxel columns".to_string()));
+    }
+    let cells = names
+        .iter()
+        .map(|name| {
+            name.strip_prefix('r')
+                .and_then(|rest| rest.split_once('c'))
+                .and_then(|(r, c)| Some((r.parse::<usize>().ok()?, c.parse::<usize>().ok()?)))
+                .ok_or_else(|| bad(format!("taxel column '{name}' is not r<row>c<col>")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let rows = cells.iter().map(|c| c.0).max().unwrap_or(0) + 1;
+    let cols = cells.iter().map(|c| c.1).max().unwrap_or(0) + 1;
+    for (k, (&cell, name)) in cells.iter().zip(&names).enumerate() {
+        if cell != (k / cols, k % cols) {
+            return Err(bad(format!(
+                "taxel column {} is '{name}', expected r{}c{} (row-major, {rows}x{cols})",
+                k + 2,
+                k / cols,
+                k % cols
+            )));
+        }
+    }
+    if cells.len() != rows * cols {
+        return Err(bad(format!(
+            "{} taxel columns do not fill a {rows}x{cols} grid",
+            cells.len()
+        )));
+    }
+    Ok((rows, cols, names))
+}

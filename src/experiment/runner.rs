@@ -1,0 +1,272 @@
+//! The runner: an experiment's units, resumable, parallel and shardable.
+
+use std::collections::HashSet;
+use std::fmt;
+use std::num::NonZeroUsize;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+use super::assemble::{Finished, finish, missing_units};
+use super::atomic::{create_dir_all, remove_stale_temporaries, write_atomic};
+use super::error::{ExperimentError, UnitFailure};
+use super::index::write_index;
+use super::layout::ExperimentDir;
+use super::shard::Shard;
+use super::spec::{ExperimentSpec, Manifest, to_json, write_manifest, write_or_check};
+use super::unit::{Unit, parse_rows, read_rows, rows_to_csv};
+
+/// Where and how to run: the flags every experiment command shares.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct RunOptions {
+    /// Output root; the experiment writes into `<out>/<experiment>/`.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Worker threads; results do not depend on it. Default: one per core.
+    #[arg(long)]
+    pub threads: Option<NonZeroUsize>,
+    /// Run only the k-th of n disjoint slices of the units (`1 <= k <= n`), e.g. `2/3`; combine the
+    /// shards' output directories with `taction merge`.
+    #[arg(long, default_value = "1/1")]
+    pub shard: Shard,
+}
+
+impl RunOptions {
+    /// The whole experiment into `out`, one thread per core.
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Self {
+            out: out.into(),
+            threads: None,
+            shard: Shard::WHOLE,
+        }
+    }
+
+    fn thread_count(&self) -> usize {
+        self.threads
+            .or_else(|| std::thread::available_parallelism().ok())
+            .map_or(1, NonZeroUsize::get)
+    }
+}
+
+/// An experiment ready to run: what it is, its full configuration (written to `config.json`; it
+/// should hold everything the rows depend on, such as the seed, and nothing they do not, such as
+/// the thread count) and its units in their fixed order.
+pub struct Experiment<'a, R, C> {
+    pub spec: ExperimentSpec,
+    pub config: C,
+    pub units: Vec<Unit<'a, R>>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunReport {
+    pub dir: PathBuf,
+    pub shard: Shard,
+    /// Units in the whole experiment.
+    pub total: usize,
+    /// Units in this shard.
+    pub in_shard: usize,
+    /// Units of this shard found complete on disk and not rerun.
+    pub reused: usize,
+    /// Units run now.
+    pub ran: usize,
+    /// Units of the whole experiment still missing (other shards' work, or none).
+    pub missing: usize,
+    /// The assembled files, once every unit is present.
+    pub finished: Option<Finished>,
+}
+
+impl fmt::Display for RunReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: shard {}: ran {} and reused {} of its {} units; {} of {} units of the experiment done",
+            self.dir.display(),
+            self.shard,
+            self.ran,
+            self.reused,
+            self.in_shard,
+            self.total - self.missing,
+            self.total
+        )?;
+        match &self.finished {
+            Some(done) => {
+                write!(f, "\nwrote {}", done.csv.display())?;
+                for plot in &done.plots {
+                    write!(f, ", {}", plot.display())?;
+                }
+                Ok(())
+            }
+            None => write!(
+                f,
+                "\nrun the other shards, then `taction merge` their output directories"
+            ),
+        }
+    }
+}
+
+/// Runs `experiment` as `options` say.
+///
+/// 1. Removes temporaries left by killed runs; writes `manifest.json` and `config.json`. A resumed
+///    run must have the same units in the same order and the same configuration, or it would mix
+///    results; its description and plots may change.
+/// 2. Takes this shard's units; a unit whose `units/<key>.csv` exists and reads back as rows of `R`
+///    is reused, one that does not read back is an error naming the file.
+/// 3. Runs the rest on a pool of `--threads` workers, writing each unit's rows atomically as soon
+///    as it finishes, so a run killed at any point loses only the units in flight. After a unit
+///    fails no new unit starts; the finished ones are kept and the error names every failed unit.
+/// 4. When every unit of the experiment is present (from any shard), assembles the CSV and the
+///    plots, then rewrites the index `<out>/README.md`.
+pub fn run<R, C>(
+    experiment: &Experiment<'_, R, C>,
+    options: &RunOptions,
+) -> Result<RunReport, ExperimentError>
+where
+    R: Serialize + DeserializeOwned,
+    C: Serialize,
+{
+    let spec = &experiment.spec;
+    let units = &experiment.units;
+    if units.is_empty() {
+        return Err(ExperimentError::NoUnits {
+            experiment: spec.name.to_string(),
+        });
+    }
+    let mut seen = HashSet::new();
+    if let Some(dup) = units.iter().find(|u| !seen.insert(u.key())) {
+        return Err(ExperimentError::DuplicateUnit {
+            experiment: spec.name.to_string(),
+            key: dup.key().clone(),
+        });
+    }
+    let dir = ExperimentDir::new(&options.out, &spec.name);
+    create_dir_all(&dir.units_dir())?;
+    for stale in [options.out.as_path(), dir.root(), &dir.units_dir()] {
+        remove_stale_temporaries(stale)?;
+    }
+    let manifest = Manifest {
+        spec: spec.clone(),
+        units: units.iter().map(|u| u.key().clone()).collect(),
+    };
+    write_manifest(
+        &dir.manifest(),
+        &manifest,
+        &manifest.to_json(&dir.manifest())?,
+        dir.root(),
+    )?;
+    write_or_check(
+        &dir.config(),
+        &to_json(&experiment.config, &dir.config())?,
+        dir.root(),
+        "configuration",
+    )?;
+
+    let mut in_shard = 0;
+    let mut pending = Vec::new();
+    for (_, unit) in units
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| options.shard.contains(*i))
+    {
+        in_shard += 1;
+        let path = dir.unit_csv(unit.key());
+        if path.exists() {
+            read_rows::<R>(&path)?;
+        } else {
+            pending.push(unit);
+        }
+    }
+    let reused = in_shard - pending.len();
+
+    let threads = options.thread_count();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| ExperimentError::ThreadPool {
+            threads,
+            what: e.to_string(),
+        })?;
+    let progress = progress_bar(pending.len(), &spec.name.to_string());
+    let stop = AtomicBool::new(false);
+    let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
+        pending
+            .par_iter()
+            .map(|unit| {
+                if stop.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let outcome = run_unit(unit, &dir);
+                if outcome.is_err() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                progress.inc(1);
+                Some(outcome)
+            })
+            .collect()
+    });
+    progress.finish_and_clear();
+    let ran = outcomes.iter().filter(|o| matches!(o, Some(Ok(())))).count();
+    let failures: Vec<UnitFailure> = outcomes.into_iter().flatten().filter_map(Result::err).collect();
+    if !failures.is_empty() {
+        return Err(ExperimentError::UnitsFailed { failures });
+    }
+
+    let missing = missing_units(&dir, &manifest).len();
+    let finished = if missing == 0 {
+        Some(finish(&dir, &manifest)?)
+    } else {
+        None
+    };
+    write_index(&options.out)?;
+    Ok(RunReport {
+        dir: dir.root().to_path_buf(),
+        shard: options.shard,
+        total: units.len(),
+        in_shard,
+        reused,
+        ran,
+        missing,
+        finished,
+    })
+}
+
+/// Runs one unit and saves its rows, after checking they read back as they will on resume: a
+/// header and every row (so rows must be structs with named fields, not tuples or scalars).
+fn run_unit<R: Serialize + DeserializeOwned>(
+    unit: &Unit<'_, R>,
+    dir: &ExperimentDir,
+) -> Result<(), UnitFailure> {
+    let fail = |what: String| UnitFailure {
+        key: unit.key().clone(),
+        what,
+    };
+    let rows = unit.run().map_err(fail)?;
+    let path = dir.unit_csv(unit.key());
+    let bytes = rows_to_csv(&rows, &path).map_err(|e| fail(e.to_string()))?;
+    match parse_rows::<R>(&bytes, &path) {
+        Ok(back) if back.len() == rows.len() => {}
+        _ => {
+            return Err(fail(
+                "its rows do not read back from CSV: rows must be structs of plain fields (names become the header)"
+                    .to_string(),
+            ));
+        }
+    }
+    write_atomic(&path, &bytes).map_err(|e| fail(e.to_string()))
+}
+
+/// A progress bar with ETA on stderr; indicatif hides it when stderr is not a terminal.
+fn progress_bar(len: usize, name: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{prefix} [{bar:30}] {pos}/{len} units, {elapsed_precise} elapsed, ETA {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_prefix(name.to_string());
+    bar
+}

@@ -1,0 +1,97 @@
+//! What an experiment is on disk, apart from its rows: [`ExperimentSpec`] (name, description,
+//! plots) and the [`Manifest`] that adds the ordered unit keys, so that `merge` and the index can
+//! finish an experiment without its code.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::atomic::{read, write_atomic, write_if_changed};
+use super::error::ExperimentError;
+use super::name::{ExperimentName, UnitKey};
+use super::plot::PlotSpec;
+
+/// The name, a one-line description (shown in the results index) and the plots of an experiment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExperimentSpec {
+    pub name: ExperimentName,
+    pub description: String,
+    pub plots: Vec<PlotSpec>,
+}
+
+/// `manifest.json`: the spec plus every unit key of the whole experiment (all shards), in the
+/// experiment's order, which is the order of the assembled CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    #[serde(flatten)]
+    pub spec: ExperimentSpec,
+    pub units: Vec<UnitKey>,
+}
+
+impl Manifest {
+    pub fn read(path: &Path) -> Result<Self, ExperimentError> {
+        let bytes = read(path)?;
+        serde_json::from_slice(&bytes).map_err(|e| ExperimentError::Json {
+            path: path.to_path_buf(),
+            what: e.to_string(),
+        })
+    }
+
+    /// Pretty JSON with a final newline; the same manifest always gives the same bytes.
+    pub fn to_json(&self, path: &Path) -> Result<Vec<u8>, ExperimentError> {
+        to_json(self, path)
+    }
+}
+
+/// `value` as pretty JSON with a final newline; `path` names the destination in errors.
+pub fn to_json<T: Serialize + ?Sized>(value: &T, path: &Path) -> Result<Vec<u8>, ExperimentError> {
+    let mut bytes = serde_json::to_vec_pretty(value).map_err(|e| ExperimentError::Json {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })?;
+    bytes.push(b'\n');
+    Ok(bytes)
+}
+
+/// Writes `bytes` to `path` unless the file exists; an existing file must hold exactly `bytes`,
+/// because a resumed run that changed its units or configuration would mix results.
+/// `what` says what differs ("configuration"); `dir` is what to delete instead.
+pub fn write_or_check(
+    path: &Path,
+    bytes: &[u8],
+    dir: &Path,
+    what: &'static str,
+) -> Result<(), ExperimentError> {
+    match std::fs::read(path) {
+        Ok(existing) if existing == bytes => Ok(()),
+        Ok(_) => Err(ExperimentError::ChangedSinceLastRun {
+            path: path.to_path_buf(),
+            dir: dir.to_path_buf(),
+            what,
+        }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_atomic(path, bytes),
+        Err(source) => Err(ExperimentError::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// Writes `manifest` (serialised as `bytes`) to `path`. An existing manifest must list the same
+/// units in the same order, since the unit files on disk belong to it; its description and plots
+/// may change, and are replaced.
+pub fn write_manifest(
+    path: &Path,
+    manifest: &Manifest,
+    bytes: &[u8],
+    dir: &Path,
+) -> Result<(), ExperimentError> {
+    if path.exists() && Manifest::read(path)?.units != manifest.units {
+        return Err(ExperimentError::ChangedSinceLastRun {
+            path: path.to_path_buf(),
+            dir: dir.to_path_buf(),
+            what: "units",
+        });
+    }
+    write_if_changed(path, bytes)
+}

@@ -1,0 +1,99 @@
+//! Work units: the resumable pieces of an experiment, and their row files.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+use super::error::ExperimentError;
+use super::name::UnitKey;
+
+/// Any error a unit's work can return.
+pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
+
+type Work<'a, R> = dyn Fn() -> Result<Vec<R>, BoxError> + Send + Sync + 'a;
+
+/// One resumable piece of an experiment: a stable key and the work producing its rows.
+///
+/// The rows must be a deterministic function of what the closure captured (settings and a seed
+/// derived from the run seed, e.g. with [`crate::rng::stream`]), never of the thread or the order in
+/// which units run: that is what makes `--threads`, `--shard` and resuming give identical files.
+/// `R` is a struct whose field names become the CSV header.
+pub struct Unit<'a, R> {
+    key: UnitKey,
+    work: Box<Work<'a, R>>,
+}
+
+impl<'a, R> Unit<'a, R> {
+    pub fn new(key: UnitKey, work: impl Fn() -> Result<Vec<R>, BoxError> + Send + Sync + 'a) -> Self {
+        Self {
+            key,
+            work: Box::new(work),
+        }
+    }
+
+    pub fn key(&self) -> &UnitKey {
+        &self.key
+    }
+
+    /// Runs the work; a panic inside it becomes an error naming the unit, so one bad unit does not
+    /// take down the units running beside it.
+    pub(crate) fn run(&self) -> Result<Vec<R>, String> {
+        match catch_unwind(AssertUnwindSafe(|| (self.work)())) {
+            Ok(Ok(rows)) if rows.is_empty() => Err("produced no rows".to_string()),
+            Ok(Ok(rows)) => Ok(rows),
+            Ok(Err(e)) => Err(e.to_string()),
+            Err(panic) => Err(format!(
+                "panicked: {}",
+                panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "(no message)".to_string())
+            )),
+        }
+    }
+}
+
+/// `rows` as CSV: a header line of field names, then one line per row; floats in shortest
+/// round-trip form, so reading them back gives the same values bit for bit.
+pub fn rows_to_csv<R: Serialize>(rows: &[R], path: &Path) -> Result<Vec<u8>, ExperimentError> {
+    let csv_err = |e: csv::Error| ExperimentError::Csv {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    };
+    let mut writer = csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(Vec::new());
+    for row in rows {
+        writer.serialize(row).map_err(csv_err)?;
+    }
+    writer.into_inner().map_err(|e| ExperimentError::Csv {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })
+}
+
+/// Reads a unit file as rows of `R`; any problem makes it a corrupt file, named with the line.
+pub fn read_rows<R: DeserializeOwned>(path: &Path) -> Result<Vec<R>, ExperimentError> {
+    let bytes = std::fs::read(path).map_err(ExperimentError::io(path))?;
+    parse_rows(&bytes, path)
+}
+
+/// Parses unit-file bytes as rows of `R` (header first, at least one row); `path` names them in errors.
+pub fn parse_rows<R: DeserializeOwned>(bytes: &[u8], path: &Path) -> Result<Vec<R>, ExperimentError> {
+    let corrupt = |what: String| ExperimentError::CorruptUnit {
+        path: path.to_path_buf(),
+        what,
+    };
+    let mut reader = csv::Reader::from_reader(bytes);
+    let rows = reader
+        .deserialize()
+        .collect::<Result<Vec<R>, _>>()
+        .map_err(|e| corrupt(e.to_string()))?;
+    if rows.is_empty() {
+        return Err(corrupt("no rows".to_string()));
+    }
+    Ok(rows)
+}

@@ -1,0 +1,360 @@
+//! The covering sensor's computation for one plugin instance: what it senses, the BVHs it built at
+//! init, and the per-reading pass from geom poses to the taxel image (Sec. V-A2, DESIGN.md §4).
+//!
+//! The computation runs in the pad site's frame (x, y, z) = (site x, up, normal), right-handed.
+//! The image's columns run the other way, along `PadPose::right() = normal x up = -site x` (column
+//! 0 is the left edge seen from behind the pad, looking along the normal), so the finished
+//! per-sample map is mirrored left-right before image formation; the grid is exactly symmetric, so
+//! this is a relabelling of samples.
+//!
+//! For each sample `s` of the pad grid, the ray is the line through the sample along the pad
+//! normal. With `z(s)` the pad-frame depth of the nearest surface of any sensed solid in front of
+//! the pad (`-inf` when the pad point is inside a solid, `+inf` when nothing is hit), the
+//! penetration is `p(s) = clamp(t - z(s), 0, t)`: an object that pushed through the covering, or
+//! through the pad itself, reads full penetration, never NaN.
+//!
+//! Sensed: every geom except those of the kinematic tree the pad is mounted on (same
+//! `body_rootid` as the pad site's body; when that root is the world body, only the geoms of the
+//! site's own body are skipped). Meshes are rasterised from their BVH's candidate faces;
+//! primitives are cut analytically ([`crate::tactile::primitive`]).
+
+use glam::{DMat3, DVec3};
+use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
+
+use crate::tactile::SensorConfig;
+use crate::tactile::config::ConfigError;
+use crate::tactile::formation::ImageFormation;
+use crate::tactile::grid::SampleGrid;
+use crate::tactile::mesh_bvh::{MeshBvh, MeshBvhError, OrientedBox};
+use crate::tactile::model_view::{ModelView, PoseView};
+use crate::tactile::primitive::Solid;
+use crate::tactile::raster::{Behind, rasterise_triangle};
+
+/// Why a plugin instance cannot be set up; each names the offending part of the model, briefly
+/// (MuJoCo keeps about 80 characters of a plugin's compile error).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CoveringError {
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("taction.covering: sensor '{sensor}' must be on a site (objtype=\"site\")")]
+    NotASite { sensor: String, objtype: i32 },
+    #[error("taction.covering: sensor '{sensor}' has dim {got}, not rows*cols = {expected}")]
+    Dimension {
+        sensor: String,
+        got: i32,
+        expected: usize,
+    },
+    #[error("taction.covering: cannot sense geom '{geom}', a {kind}")]
+    UnsupportedGeom { geom: String, kind: &'static str },
+    #[error("taction.covering: mesh '{mesh}': {source}")]
+    Mesh { mesh: String, source: MeshBvhError },
+}
+
+/// How one sensed geom is cut by the rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Shape {
+    /// Index into `Covering::meshes`.
+    Mesh(usize),
+    Solid(Solid),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SensedGeom {
+    geom: usize,
+    shape: Shape,
+    /// Bounding-sphere radius about the geom origin; 0 for unbounded (planes).
+    rbound_m: f64,
+}
+
+/// One `<sensor><plugin>` element using the instance.
+#[derive(Debug, Clone)]
+struct PadSensor {
+    adr: usize,
+    site: usize,
+    /// Noise stream seed of this sensor.
+    noise_seed: u64,
+    sensed: Vec<SensedGeom>,
+}
+
+/// Counters for diagnostics and tests.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CoveringStats {
+    /// BVHs built (all at init; compute never builds one).
+    pub bvh_builds: usize,
+    /// Triangles over all BVHs.
+    pub bvh_triangles: usize,
+    /// Readings computed since init.
+    pub readings: u64,
+    /// Mesh faces rasterised in the last reading (the BVH's candidates near the pad).
+    pub last_faces: usize,
+}
+
+/// A plugin instance's state (stored behind MuJoCo's `plugin_data`).
+#[derive(Debug)]
+pub struct Covering {
+    config: SensorConfig,
+    grid: SampleGrid,
+    formation: ImageFormation,
+    sensors: Vec<PadSensor>,
+    meshes: Vec<MeshBvh>,
+    // Scratch space, reused by every reading.
+    nearest_m: Vec<f64>,
+    behind: Behind,
+    candidates: Vec<u32>,
+    stack: Vec<usize>,
+    stats: CoveringStats,
+}
+
+/// The world rotation of row-major `xmat` (its columns are the frame's axes).
+#[inline]
+fn rotation(xmat: &[f64]) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(xmat[0], xmat[3], xmat[6]),
+        DVec3::new(xmat[1], xmat[4], xmat[7]),
+        DVec3::new(xmat[2], xmat[5], xmat[8]),
+    )
+}
+
+impl Covering {
+    /// Sets up the instance whose sensors are `sensor_ids` (the model's sensors using it): checks
+    /// each is on a site with the right dimension, chooses the sensed geoms, and builds one BVH per
+    /// mesh they use.
+    pub fn new(model: &ModelView, config: SensorConfig, sensor_ids: &[usize]) -> Result<Self, CoveringError> {
+        config.validate()?;
+        let grid = SampleGrid::new(&config);
+        let formation = ImageFormation::new(&config, &grid);
+        let mut meshes: Vec<MeshBvh> = Vec::new();
+        let mut mesh_slot: Vec<Option<usize>> = vec![None; model.mesh_vertadr.len()];
+        let mut stats = CoveringStats::default();
+        let mut sensors = Vec::with_capacity(sensor_ids.len());
+        for (k, &sensor) in sensor_ids.iter().enumerate() {
+            let sensor_name = || model.name(mjtObj::mjOBJ_SENSOR, sensor);
+            let objtype = model.sensor_objtype[sensor];
+            if objtype != mjtObj::mjOBJ_SITE as i32 {
+                return Err(CoveringError::NotASite {
+                    sensor: sensor_name(),
+                    objtype,
+                });
+            }
+            if model.sensor_dim[sensor] as i64 != config.taxel_count() as i64 {
+                return Err(CoveringError::Dimension {
+                    sensor: sensor_name(),
+                    got: model.sensor_dim[sensor],
+                    expected: config.taxel_count(),
+                });
+            }
+            let site = model.sensor_objid[sensor] as usize;
+            let body = model.site_bodyid[site] as usize;
+            let root = model.body_rootid[body] as usize;
+            let mut sensed = Vec::new();
+            for geom in 0..model.ngeom() {
+                let geom_body = model.geom_bodyid[geom] as usize;
+                let own = if root == 0 {
+                    geom_body == body
+                } else {
+                    model.body_rootid[geom_body] as usize == root
+                };
+                if own {
+                    continue;
+                }
+                let size = &model.geom_size[3 * geom..3 * geom + 3];
+                let unsupported = |kind| CoveringError::UnsupportedGeom {
+                    geom: model.name(mjtObj::mjOBJ_GEOM, geom),
+                    kind,
+                };
+                let t = model.geom_type[geom];
+                let shape = if t == mjtGeom::mjGEOM_PLANE as i32 {
+                    Shape::Solid(Solid::HalfSpace)
+                } else if t == mjtGeom::mjGEOM_SPHERE as i32 {
+                    Shape::Solid(Solid::Sphere { radius_m: size[0] })
+                } else if t == mjtGeom::mjGEOM_CAPSULE as i32 {
+                    Shape::Solid(Solid::Capsule {
+                        radius_m: size[0],
+                        half_length_m: size[1],
+                    })
+                } else if t == mjtGeom::mjGEOM_ELLIPSOID as i32 {
+                    Shape::Solid(Solid::Ellipsoid {
+                        radii_m: DVec3::from_slice(size),
+                    })
+                } else if t == mjtGeom::mjGEOM_CYLINDER as i32 {
+                    Shape::Solid(Solid::Cylinder {
+                        radius_m: size[0],
+                        half_length_m: size[1],
+                    })
+                } else if t == mjtGeom::mjGEOM_BOX as i32 {
+                    Shape::Solid(Solid::Box {
+                        half_m: DVec3::from_slice(size),
+                    })
+                } else if t == mjtGeom::mjGEOM_MESH as i32 {
+                    let mesh = model.geom_dataid[geom] as usize;
+                    let slot = match mesh_slot[mesh] {
+                        Some(slot) => slot,
+                        None => {
+                            let (va, vn) = (
+                                model.mesh_vertadr[mesh] as usize,
+                                model.mesh_vertnum[mesh] as usize,
+                            );
+                            let (fa, fnum) = (
+                                model.mesh_faceadr[mesh] as usize,
+                                model.mesh_facenum[mesh] as usize,
+                            );
+                            let bvh = MeshBvh::new(
+                                &model.mesh_vert[3 * va..3 * (va + vn)],
+                                &model.mesh_face[3 * fa..3 * (fa + fnum)],
+                            )
+                            .map_err(|source| CoveringError::Mesh {
+                                mesh: model.name(mjtObj::mjOBJ_MESH, mesh),
+                                source,
+                            })?;
+                            stats.bvh_builds += 1;
+                            stats.bvh_triangles += bvh.triangle_count();
+                            meshes.push(bvh);
+                            mesh_slot[mesh] = Some(meshes.len() - 1);
+                            meshes.len() - 1
+                        }
+                    };
+                    Shape::Mesh(slot)
+                } else if t == mjtGeom::mjGEOM_HFIELD as i32 {
+                    return Err(unsupported("height field"));
+                } else {
+                    return Err(unsupported("signed distance field"));
+                };
+                let rbound_m = if t == mjtGeom::mjGEOM_PLANE as i32 {
+                    0.0
+                } else {
+                    model.geom_rbound[geom]
+                };
+                sensed.push(SensedGeom {
+                    geom,
+                    shape,
+                    rbound_m,
+                });
+            }
+            let noise_seed = if k == 0 {
+                config.noise_seed
+            } else {
+                crate::rng::substream(config.noise_seed, k as u64)
+            };
+            sensors.push(PadSensor {
+                adr: model.sensor_adr[sensor] as usize,
+                site,
+                noise_seed,
+                sensed,
+            });
+        }
+        let samples = grid.len();
+        Ok(Self {
+            config,
+            grid,
+            formation,
+            sensors,
+            meshes,
+            nearest_m: vec![f64::INFINITY; samples],
+            behind: Behind::new(samples),
+            candidates: Vec::new(),
+            stack: Vec::new(),
+            stats,
+        })
+    }
+
+    pub fn config(&self) -> &SensorConfig {
+        &self.config
+    }
+
+    pub fn stats(&self) -> CoveringStats {
+        self.stats
+    }
+
+    /// Writes the images of all the instance's sensors into `sensordata` at their addresses;
+    /// `reading` numbers the reading for the noise streams.
+    pub fn compute(&mut self, poses: &PoseView, reading: u64, sensordata: &mut [f64]) {
+        self.stats.last_faces = 0;
+        for k in 0..self.sensors.len() {
+            self.penetration(k, poses);
+            let sensor = &self.sensors[k];
+            let n = self.config.taxel_count();
+            let out = &mut sensordata[sensor.adr..sensor.adr + n];
+            self.formation
+                .form(&mut self.nearest_m, sensor.noise_seed, reading, out);
+        }
+        self.stats.readings += 1;
+    }
+
+    /// Fills `nearest_m` with the per-sample penetration (metres) seen by sensor `k`.
+    fn penetration(&mut self, k: usize, poses: &PoseView) {
+        let sensor = &self.sensors[k];
+        let t = self.config.thickness_m;
+        let pad_origin = DVec3::from_slice(&poses.site_xpos[3 * sensor.site..3 * sensor.site + 3]);
+        let pad_rotation = rotation(&poses.site_xmat[9 * sensor.site..9 * sensor.site + 9]);
+        let to_pad = pad_rotation.transpose();
+        let (hw, hh) = (self.grid.half_width_m, self.grid.half_height_m);
+        self.nearest_m.fill(f64::INFINITY);
+        for g in &sensor.sensed {
+            let geom_origin = DVec3::from_slice(&poses.geom_xpos[3 * g.geom..3 * g.geom + 3]);
+            let geom_rotation = rotation(&poses.geom_xmat[9 * g.geom..9 * g.geom + 9]);
+            // Geom frame -> pad frame: p_pad = m p_geom + o.
+            let m = to_pad * geom_rotation;
+            let o = to_pad * (geom_origin - pad_origin);
+            let r = g.rbound_m;
+            if r > 0.0 && (o.z - r > t || o.z + r < 0.0 || o.x.abs() - r > hw || o.y.abs() - r > hh) {
+                continue;
+            }
+            match g.shape {
+                Shape::Mesh(slot) => {
+                    let z_lo = (o.z - r).min(0.0);
+                    let centre_pad = DVec3::new(0.0, 0.0, 0.5 * (z_lo + t));
+                    let margin = 1e-6 * (hw + hh + t - z_lo);
+                    let to_geom = m.transpose();
+                    let region = OrientedBox {
+                        centre: to_geom * (centre_pad - o),
+                        axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
+                        half: DVec3::new(hw, hh, 0.5 * (t - z_lo)) + margin,
+                    };
+                    let mesh = &self.meshes[slot];
+                    self.candidates.clear();
+                    mesh.faces_near(&region, &mut self.stack, &mut self.candidates);
+                    self.stats.last_faces += self.candidates.len();
+                    for &face in &self.candidates {
+                        let corners = mesh.corners(face, &m, o);
+                        rasterise_triangle(&self.grid, corners, t, &mut self.nearest_m, &mut self.behind);
+                    }
+                    self.behind.resolve_into(&self.grid, &mut self.nearest_m);
+                }
+                Shape::Solid(solid) => {
+                    let to_geom = m.transpose();
+                    let (right, up, dir) = (to_geom.x_axis, to_geom.y_axis, to_geom.z_axis);
+                    let base = -(to_geom * o);
+                    let (rows, cols) = if r > 0.0 {
+                        (
+                            self.grid.row_range(o.y - r, o.y + r),
+                            self.grid.col_range(o.x - r, o.x + r),
+                        )
+                    } else {
+                        (0..self.grid.rows, 0..self.grid.cols)
+                    };
+                    for i in rows {
+                        let row_origin = base + up * self.grid.y(i);
+                        for j in cols.clone() {
+                            let origin = row_origin + right * self.grid.x(j);
+                            if let Some((s_in, s_out)) = solid.line_interval(origin, dir)
+                                && s_out >= 0.0
+                            {
+                                let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
+                                let s = i * self.grid.cols + j;
+                                if z < self.nearest_m[s] {
+                                    self.nearest_m[s] = z;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for row in self.nearest_m.chunks_exact_mut(self.grid.cols) {
+            row.reverse();
+            for z in row {
+                *z = (t - *z).clamp(0.0, t);
+            }
+        }
+    }
+}

@@ -1,0 +1,246 @@
+//! One `obvhs` BVH per mesh of the compiled model, built once, queried with the pad's slab.
+//!
+//! The pad's rays are parallel and only depths in a thin range matter, so instead of traversing
+//! the BVH once per ray, the BVH is traversed once per image with the oriented box that contains
+//! every ray segment of interest (the pad rectangle swept along the normal over `[z_lo, t]`).
+//! The few triangles whose leaves overlap that box are then rasterised onto the sample grid
+//! ([`crate::tactile::raster`]), which gives exactly the ray-casting depths.
+//!
+//! Vertices are read from the compiled model's `mesh_vert` (MuJoCo re-centres and re-orients them
+//! into the mesh's inertial frame, which is the geom frame), so together with `geom_xpos` and
+//! `geom_xmat` they give world positions with no further bookkeeping.
+
+use std::time::Duration;
+
+use glam::{DMat3, DVec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::bvh2::Bvh2;
+use obvhs::bvh2::builder::build_bvh2_from_tris;
+use obvhs::triangle::Triangle;
+
+/// An oriented box in a mesh's frame: `centre + sum_i u_i axes[i]`, `|u_i| <= half[i]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientedBox {
+    pub centre: DVec3,
+    /// Orthonormal axes.
+    pub axes: [DVec3; 3],
+    pub half: DVec3,
+}
+
+impl OrientedBox {
+    /// Whether the box may overlap the axis-aligned box `[lo, hi]`: the separating-axis test on
+    /// the three coordinate axes and the three box axes (conservative: the nine edge-cross axes are
+    /// skipped, so rare non-overlapping pairs pass, never the reverse).
+    #[inline]
+    pub fn may_overlap(&self, lo: DVec3, hi: DVec3) -> bool {
+        let c = (lo + hi) * 0.5;
+        let e = (hi - lo) * 0.5;
+        let t = self.centre - c;
+        let [a0, a1, a2] = self.axes;
+        let h = self.half;
+        for k in 0..3 {
+            let r = h.x * a0[k].abs() + h.y * a1[k].abs() + h.z * a2[k].abs();
+            if t[k].abs() > r + e[k] {
+                return false;
+            }
+        }
+        for (i, a) in self.axes.iter().enumerate() {
+            let r = e.x * a.x.abs() + e.y * a.y.abs() + e.z * a.z.abs();
+            if t.dot(*a).abs() > h[i] + r {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// A mesh of the model with its BVH.
+#[derive(Clone)]
+pub struct MeshBvh {
+    /// Vertices in the mesh (geom) frame, metres.
+    vertices: Vec<DVec3>,
+    faces: Vec<[u32; 3]>,
+    bvh: Bvh2,
+}
+
+impl std::fmt::Debug for MeshBvh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MeshBvh")
+            .field("vertices", &self.vertices.len())
+            .field("faces", &self.faces.len())
+            .field("nodes", &self.bvh.nodes.len())
+            .finish()
+    }
+}
+
+/// Why a mesh cannot be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshBvhError {
+    #[error("face {face} refers to vertex {vertex}, but the mesh has {count} vertices")]
+    IndexOutOfRange { face: usize, vertex: i64, count: usize },
+    #[error("vertex {vertex} is not finite")]
+    NonFinite { vertex: usize },
+}
+
+impl MeshBvh {
+    /// Builds the BVH of a mesh given as flat `xyz` vertex coordinates and vertex-index triples.
+    pub fn new(vertex_xyz: &[f32], face_indices: &[i32]) -> Result<Self, MeshBvhError> {
+        let vertices: Vec<DVec3> = vertex_xyz
+            .chunks_exact(3)
+            .map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+            .collect();
+        if let Some(vertex) = vertices.iter().position(|v| !v.is_finite()) {
+            return Err(MeshBvhError::NonFinite { vertex });
+        }
+        let mut faces = Vec::with_capacity(face_indices.len() / 3);
+        for (face, f) in face_indices.chunks_exact(3).enumerate() {
+            let mut tri = [0u32; 3];
+            for (slot, &v) in tri.iter_mut().zip(f) {
+                if v < 0 || v as usize >= vertices.len() {
+                    return Err(MeshBvhError::IndexOutOfRange {
+                        face,
+                        vertex: v as i64,
+                        count: vertices.len(),
+                    });
+                }
+                *slot = v as u32;
+            }
+            faces.push(tri);
+        }
+        let triangles: Vec<Triangle> = faces
+            .iter()
+            .map(|f| {
+                let p = |i: u32| Vec3A::from(vertices[i as usize].as_vec3());
+                Triangle {
+                    v0: p(f[0]),
+                    v1: p(f[1]),
+                    v2: p(f[2]),
+                }
+            })
+            .collect();
+        let bvh = if triangles.is_empty() {
+            Bvh2::default()
+        } else {
+            build_bvh2_from_tris(&triangles, BvhBuildParams::fast_build(), &mut Duration::default())
+        };
+        Ok(Self { vertices, faces, bvh })
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// The corners of face `f` mapped by `x -> rotation x + offset`.
+    #[inline]
+    pub fn corners(&self, f: u32, rotation: &DMat3, offset: DVec3) -> [DVec3; 3] {
+        let [a, b, c] = self.faces[f as usize];
+        let map = |i: u32| *rotation * self.vertices[i as usize] + offset;
+        [map(a), map(b), map(c)]
+    }
+
+    /// Appends to `out` every face whose BVH leaf may overlap `region` (a superset of the faces
+    /// that intersect it). `stack` is scratch space, reused across calls.
+    pub fn faces_near(&self, region: &OrientedBox, stack: &mut Vec<usize>, out: &mut Vec<u32>) {
+        let nodes = &self.bvh.nodes;
+        if nodes.is_empty() {
+            return;
+        }
+        let bounds = |i: usize| {
+            let aabb = nodes[i].aabb;
+            (
+                DVec3::from(aabb.min.to_array().map(f64::from)),
+                DVec3::from(aabb.max.to_array().map(f64::from)),
+            )
+        };
+        stack.clear();
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let (lo, hi) = bounds(i);
+            if !region.may_overlap(lo, hi) {
+                continue;
+            }
+            let node = &nodes[i];
+            if node.prim_count > 0 {
+                let first = node.first_index as usize;
+                out.extend_from_slice(&self.bvh.primitive_indices[first..first + node.prim_count as usize]);
+            } else {
+                let child = node.first_index as usize;
+                stack.push(child + 1);
+                stack.push(child);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed 10 x 10 grid-tessellated unit square pair: many small faces in the plane z = 0.
+    fn square_grid(n: usize) -> (Vec<f32>, Vec<i32>) {
+        let mut v = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                v.extend_from_slice(&[j as f32 / n as f32, i as f32 / n as f32, 0.0]);
+            }
+        }
+        let mut f = Vec::new();
+        let id = |i: usize, j: usize| (i * (n + 1) + j) as i32;
+        for i in 0..n {
+            for j in 0..n {
+                f.extend_from_slice(&[id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
+                f.extend_from_slice(&[id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
+            }
+        }
+        (v, f)
+    }
+
+    #[test]
+    fn query_returns_every_face_in_the_box_and_few_others() {
+        let (v, f) = square_grid(40);
+        let mesh = MeshBvh::new(&v, &f).unwrap();
+        assert_eq!(mesh.triangle_count(), 3200);
+        let angle = 0.3f64;
+        let axes = [
+            DVec3::new(angle.cos(), angle.sin(), 0.0),
+            DVec3::new(-angle.sin(), angle.cos(), 0.0),
+            DVec3::Z,
+        ];
+        let region = OrientedBox {
+            centre: DVec3::new(0.5, 0.5, 0.0),
+            axes,
+            half: DVec3::new(0.1, 0.05, 0.01),
+        };
+        let mut near = Vec::new();
+        mesh.faces_near(&region, &mut Vec::new(), &mut near);
+        // Every face with a corner strictly inside the box must be found.
+        let inside = |p: DVec3| {
+            let d = p - region.centre;
+            (0..3).all(|i| d.dot(axes[i]).abs() < region.half[i])
+        };
+        for face in 0..mesh.triangle_count() as u32 {
+            if mesh
+                .corners(face, &DMat3::IDENTITY, DVec3::ZERO)
+                .into_iter()
+                .any(inside)
+            {
+                assert!(near.contains(&face), "face {face} missed");
+            }
+        }
+        assert!(near.len() < 400, "{} candidates", near.len());
+    }
+
+    #[test]
+    fn bad_indices_are_errors() {
+        let e = MeshBvh::new(&[0.0; 9], &[0, 1, 3]).unwrap_err();
+        assert_eq!(
+            e,
+            MeshBvhError::IndexOutOfRange {
+                face: 0,
+                vertex: 3,
+                count: 3
+            }
+        );
+        assert!(MeshBvh::new(&[0.0, 0.0, f32::NAN], &[]).is_err());
+    }
+}

@@ -1,0 +1,177 @@
+//! The Rust side of a `taction.covering` sensor in a compiled model: find it, read its image from
+//! `sensordata` together with the pad pose, and write the MJCF that inserts it into a scene.
+
+use glam::DVec3;
+use mujoco_rs::mujoco_c::mjtObj;
+use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::mj_model::traits::ModelType;
+
+use crate::sim::SceneBuilder;
+use crate::sim::mjcf::{Section, escape_attr};
+use crate::tactile::config::{ConfigError, ConfigKey, SensorConfig};
+use crate::tactile::covering::CoveringStats;
+use crate::tactile::image::{ImageError, PadPose, TactileImage};
+use crate::tactile::model_view::ModelView;
+use crate::tactile::plugin::{
+    PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state, is_covering_instance,
+};
+
+/// Errors of the tactile module; each names the sensor, site or key concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum TactileError {
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("no taction.covering sensor is attached to site '{site}'")]
+    NoSensorOnSite { site: String },
+    #[error("the model has no taction.covering sensor")]
+    NoSensor,
+    #[error("sensor '{sensor}': {source}")]
+    Image { sensor: String, source: ImageError },
+    #[error("sensor '{sensor}': the pad frame of site '{site}' is degenerate (mj_forward not run?)")]
+    BadPadFrame { sensor: String, site: String },
+    #[error(transparent)]
+    Sim(#[from] crate::sim::SimError),
+}
+
+/// One covering sensor of a compiled model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoveringSensor {
+    name: String,
+    sensor: usize,
+    instance: usize,
+    site: usize,
+    site_name: String,
+    adr: usize,
+    config: SensorConfig,
+}
+
+impl CoveringSensor {
+    /// Every covering sensor of `model`, in sensor order.
+    pub fn all(model: &MjModel) -> Result<Vec<Self>, TactileError> {
+        let raw = model.ffi();
+        // SAFETY: a compiled model has all its arrays.
+        let view = unsafe { ModelView::new(raw) };
+        let mut found = Vec::new();
+        for instance in 0..raw.nplugin.max(0) as usize {
+            if !is_covering_instance(raw, instance) {
+                continue;
+            }
+            let config = instance_config(raw, instance)?;
+            for sensor in instance_sensors(&view, instance) {
+                let site = view.sensor_objid[sensor].max(0) as usize;
+                found.push(Self {
+                    name: view.name(mjtObj::mjOBJ_SENSOR, sensor),
+                    sensor,
+                    instance,
+                    site,
+                    site_name: view.name(mjtObj::mjOBJ_SITE, site),
+                    adr: view.sensor_adr[sensor] as usize,
+                    config,
+                });
+            }
+        }
+        Ok(found)
+    }
+
+    /// The covering sensor attached to site `site`.
+    pub fn on_site(model: &MjModel, site: &str) -> Result<Self, TactileError> {
+        Self::all(model)?
+            .into_iter()
+            .find(|s| s.site_name == site)
+            .ok_or_else(|| TactileError::NoSensorOnSite {
+                site: site.to_string(),
+            })
+    }
+
+    /// The model's only (or first) covering sensor.
+    pub fn first(model: &MjModel) -> Result<Self, TactileError> {
+        Self::all(model)?.into_iter().next().ok_or(TactileError::NoSensor)
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn config(&self) -> &SensorConfig {
+        &self.config
+    }
+
+    /// The sensor's index among the model's sensors.
+    pub fn sensor_id(&self) -> usize {
+        self.sensor
+    }
+
+    /// The pad site's index.
+    pub fn site_id(&self) -> usize {
+        self.site
+    }
+
+    /// The pad frame of the site, from `site_xpos` / `site_xmat` (valid after kinematics).
+    pub fn pad_pose<M: ModelType>(&self, data: &MjData<M>) -> Result<PadPose, TactileError> {
+        let m = data.site_xmat()[self.site];
+        let center = DVec3::from_array(data.site_xpos()[self.site]);
+        PadPose::new(center, DVec3::new(m[2], m[5], m[8]), DVec3::new(m[1], m[4], m[7])).ok_or_else(|| {
+            TactileError::BadPadFrame {
+                sensor: self.name.clone(),
+                site: self.site_name.clone(),
+            }
+        })
+    }
+
+    /// The image in `sensordata` (as of the last `mj_forward`/`mj_step`), tagged with the pad pose.
+    pub fn read<M: ModelType>(&self, data: &MjData<M>) -> Result<TactileImage, TactileError> {
+        let n = self.config.taxel_count();
+        let values = data.sensordata()[self.adr..self.adr + n].to_vec();
+        let image = TactileImage::new(self.config.rows, self.config.cols, values).map_err(|source| {
+            TactileError::Image {
+                sensor: self.name.clone(),
+                source,
+            }
+        })?;
+        Ok(image.with_pose(self.pad_pose(data)?))
+    }
+
+    /// The instance's counters (BVHs built, readings computed) in `data`.
+    pub fn stats<M: ModelType>(&self, model: &MjModel, data: &MjData<M>) -> Option<CoveringStats> {
+        // SAFETY: `data` was made by MuJoCo for `model` (mujoco-rs ties them together).
+        unsafe { instance_state(model.ffi(), data.ffi(), self.instance).map(|c| c.stats()) }
+    }
+}
+
+/// The `<extension>` content that declares the plugin (once per model).
+pub fn extension_xml() -> String {
+    format!("<plugin plugin=\"{PLUGIN_NAME}\"/>")
+}
+
+/// The `<sensor>` content of a covering sensor named `name` on site `site` with every config key.
+pub fn sensor_xml(config: &SensorConfig, name: &str, site: &str) -> Result<String, ConfigError> {
+    config.validate()?;
+    let mut xml = format!(
+        "<plugin name=\"{}\" plugin=\"{PLUGIN_NAME}\" objtype=\"site\" objname=\"{}\">\n",
+        escape_attr(name),
+        escape_attr(site)
+    );
+    for key in ConfigKey::ALL {
+        xml.push_str(&format!(
+            "  <config key=\"{key}\" value=\"{}\"/>\n",
+            config.value_text(key)
+        ));
+    }
+    xml.push_str("</plugin>");
+    Ok(xml)
+}
+
+/// Adds the plugin declaration and a covering sensor on site `site` to a scene, and registers the
+/// plugin so the scene compiles.
+pub fn add_sensor(
+    builder: SceneBuilder,
+    config: &SensorConfig,
+    name: &str,
+    site: &str,
+) -> Result<SceneBuilder, ConfigError> {
+    ensure_registered();
+    let sensor = sensor_xml(config, name, site)?;
+    Ok(builder
+        .add(Section::Extension, extension_xml())
+        .add(Section::Sensor, sensor))
+}

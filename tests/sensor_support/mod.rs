@@ -1,0 +1,138 @@
+//! Shapes and scenes shared by the sensor tests and the sensor benchmark.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use taction::mesh::TriMesh;
+use taction::sim::SceneBuilder;
+use taction::sim::mjcf::Section;
+use taction::tactile::free_floating::free_pad_body_xml;
+use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
+
+/// An icosphere of radius `radius_m` about `center_m`: the icosahedron with every face split into
+/// four `subdivisions` times, vertices pushed onto the sphere; 20 * 4^subdivisions outward faces.
+pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
+    let p = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut vertices: Vec<DVec3> = [
+        (-1.0, p, 0.0),
+        (1.0, p, 0.0),
+        (-1.0, -p, 0.0),
+        (1.0, -p, 0.0),
+        (0.0, -1.0, p),
+        (0.0, 1.0, p),
+        (0.0, -1.0, -p),
+        (0.0, 1.0, -p),
+        (p, 0.0, -1.0),
+        (p, 0.0, 1.0),
+        (-p, 0.0, -1.0),
+        (-p, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut midpoint = |a: u32, b: u32, vertices: &mut Vec<DVec3>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                vertices.push(((vertices[a as usize] + vertices[b as usize]) * 0.5).normalize());
+                (vertices.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for [a, b, c] in faces {
+            let ab = midpoint(a, b, &mut vertices);
+            let bc = midpoint(b, c, &mut vertices);
+            let ca = midpoint(c, a, &mut vertices);
+            next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    TriMesh {
+        vertices: vertices.into_iter().map(|v| center_m + v * radius_m).collect(),
+        triangles: faces,
+    }
+}
+
+/// A closed axis-aligned box mesh between `lo` and `hi`, outward faces.
+pub fn box_between(lo: DVec3, hi: DVec3) -> TriMesh {
+    let vertices = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let triangles = vec![
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    TriMesh { vertices, triangles }
+}
+
+/// A free-floating sensor scene around arbitrary world MJCF (primitive geoms etc.).
+pub fn free_sensor_with(world_xml: &str, config: &SensorConfig) -> FreeFloatingSensor {
+    let builder = SceneBuilder::new()
+        .table(false)
+        .add(Section::Worldbody, world_xml)
+        .add(Section::Worldbody, free_pad_body_xml(config));
+    let builder = add_sensor(builder, config, "covering", "pad").unwrap();
+    FreeFloatingSensor::from_scene(builder.build().unwrap()).unwrap()
+}
+
+/// A pad at `center` looking straight down (-z), image up along +y.
+pub fn pad_looking_down(center_m: DVec3) -> PadPose {
+    PadPose::new(center_m, DVec3::NEG_Z, DVec3::Y).unwrap()
+}
+
+/// Centre of taxel (`row`, `col`) in the pad frame: (right, up), metres.
+pub fn taxel_centre(config: &SensorConfig, row: usize, col: usize) -> (f64, f64) {
+    let x = ((col as f64 + 0.5) / config.cols as f64 - 0.5) * config.pad_width_m;
+    let y = (0.5 - (row as f64 + 0.5) / config.rows as f64) * config.pad_height_m;
+    (x, y)
+}
+
+/// A sharp config: one ray per taxel, no point-spread, no noise.
+pub fn sharp(rows: usize, cols: usize) -> SensorConfig {
+    SensorConfig {
+        rows,
+        cols,
+        psf_sigma_m: 0.0,
+        rays_per_taxel: 1,
+        ..SensorConfig::default()
+    }
+}
