@@ -7,7 +7,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "taction", version, about = "Tactile object recognition from appearance information")]
+#[command(
+    name = "taction",
+    version,
+    about = "Tactile object recognition from appearance information"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -34,9 +34,18 @@ mod tests {
 
     #[test]
     fn same_seed_same_draws_and_streams_differ() {
-        let a: Vec<u64> = (0..8).map(|_| 0).scan(stream(7, 3), |r, _| Some(r.random::<u64>())).collect();
-        let b: Vec<u64> = (0..8).map(|_| 0).scan(stream(7, 3), |r, _| Some(r.random::<u64>())).collect();
-        let c: Vec<u64> = (0..8).map(|_| 0).scan(stream(7, 4), |r, _| Some(r.random::<u64>())).collect();
+        let a: Vec<u64> = (0..8)
+            .map(|_| 0)
+            .scan(stream(7, 3), |r, _| Some(r.random::<u64>()))
+            .collect();
+        let b: Vec<u64> = (0..8)
+            .map(|_| 0)
+            .scan(stream(7, 3), |r, _| Some(r.random::<u64>()))
+            .collect();
+        let c: Vec<u64> = (0..8)
+            .map(|_| 0)
+            .scan(stream(7, 4), |r, _| Some(r.random::<u64>()))
+            .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(substream(0, 0), substream(0, 1));

@@ -21,7 +21,11 @@ fn free_sensor(object: ObjectSpec) -> FreeFloatingSensor {
 }
 
 /// Runs the controllers from `start` and returns the outcome.
-fn settle_from(free: &mut FreeFloatingSensor, start: &PadPose, config: &ControlConfig) -> taction::control::ContactOutcome {
+fn settle_from(
+    free: &mut FreeFloatingSensor,
+    start: &PadPose,
+    config: &ControlConfig,
+) -> taction::control::ContactOutcome {
     let reader = sensor_reader(free.sensor().clone());
     let mut pad = FreePad::new(free.scene_mut(), sensor(), reader).unwrap();
     pad.place(start);
@@ -51,9 +55,17 @@ fn tilted_planes_converge_normal_and_pressure() {
         let normal = DQuat::from_axis_angle(off_axis, 30f64.to_radians()) * -surface_n;
         let start = PadPose::new(surface_n * 0.003, normal, normal.any_orthonormal_vector()).unwrap();
         let outcome = settle_from(&mut free, &start, &config);
-        assert_eq!(outcome.status, ContactStatus::Converged, "trial {trial}: {:?}", outcome.status);
+        assert_eq!(
+            outcome.status,
+            ContactStatus::Converged,
+            "trial {trial}: {:?}",
+            outcome.status
+        );
         let angle = outcome.pose.normal.angle_between(-surface_n).to_degrees();
-        assert!(angle <= 2.0, "trial {trial}: pad normal {angle:.2} deg off the surface normal");
+        assert!(
+            angle <= 2.0,
+            "trial {trial}: pad normal {angle:.2} deg off the surface normal"
+        );
         let mean = outcome.image.mean();
         assert!(
             (mean - config.target_mean_pressure).abs() <= 0.05 * config.target_mean_pressure,
@@ -65,8 +77,16 @@ fn tilted_planes_converge_normal_and_pressure() {
 #[test]
 fn sphere_converges_and_box_edge_reading_shows_the_edge() {
     let config = ControlConfig::default();
-    let mut free = free_sensor(ObjectSpec::new("sphere", common::sphere_mesh(0.03, DVec3::new(0.0, 0.0, 0.03), 24)));
-    let start = PadPose::new(DVec3::new(0.01, 0.0, 0.066), DVec3::new(-0.2, 0.0, -1.0), DVec3::Y).unwrap();
+    let mut free = free_sensor(ObjectSpec::new(
+        "sphere",
+        common::sphere_mesh(0.03, DVec3::new(0.0, 0.0, 0.03), 24),
+    ));
+    let start = PadPose::new(
+        DVec3::new(0.01, 0.0, 0.066),
+        DVec3::new(-0.2, 0.0, -1.0),
+        DVec3::Y,
+    )
+    .unwrap();
     let outcome = settle_from(&mut free, &start, &config);
     assert_eq!(outcome.status, ContactStatus::Converged);
     // On a sphere the settled pad faces the centre from where it touches: the line along the pad normal
@@ -86,10 +106,17 @@ fn sphere_converges_and_box_edge_reading_shows_the_edge() {
     let contact = pose.center_m + pose.right() * (wx / w) + pose.up * (wy / w);
     let to_center = (DVec3::new(0.0, 0.0, 0.03) - contact).normalize();
     let angle = pose.normal.angle_between(to_center).to_degrees();
-    assert!(angle < 2.0, "settled {angle} deg off the sphere's normal after {} iterations\n{image}", outcome.iterations);
+    assert!(
+        angle < 2.0,
+        "settled {angle} deg off the sphere's normal after {} iterations\n{image}",
+        outcome.iterations
+    );
 
     // A box edge along y at x = 0.04, z = 0.08; approach from the diagonal.
-    let mut free = free_sensor(ObjectSpec::new("box", common::box_mesh(DVec3::new(0.08, 0.08, 0.08))));
+    let mut free = free_sensor(ObjectSpec::new(
+        "box",
+        common::box_mesh(DVec3::new(0.08, 0.08, 0.08)),
+    ));
     let normal = DVec3::new(-1.0, 0.0, -1.0).normalize();
     let start = PadPose::new(DVec3::new(0.045, 0.0, 0.085), normal, DVec3::Y).unwrap();
     let outcome = settle_from(&mut free, &start, &config);
@@ -97,27 +124,43 @@ fn sphere_converges_and_box_edge_reading_shows_the_edge() {
     let image = &outcome.image;
     // The edge runs along the pad's up axis (world y): a ridge in the middle columns, a step to the sides.
     let column_mean = |c: usize| (0..6).map(|r| image.get(r, c)).sum::<f64>() / 6.0;
-    let (middle, side) = ((column_mean(2) + column_mean(3)) / 2.0, (column_mean(0) + column_mean(5)) / 2.0);
+    let (middle, side) = (
+        (column_mean(2) + column_mean(3)) / 2.0,
+        (column_mean(0) + column_mean(5)) / 2.0,
+    );
     assert!(middle > side + 0.2, "no edge in the reading:\n{image}");
 }
 
 #[test]
 fn approach_into_empty_space_reports_no_contact() {
-    let config = ControlConfig { approach_max_distance_m: 0.02, ..ControlConfig::default() };
+    let config = ControlConfig {
+        approach_max_distance_m: 0.02,
+        ..ControlConfig::default()
+    };
     let mut free = free_sensor(ObjectSpec::new("box", common::box_mesh(DVec3::splat(0.05))));
     let start = PadPose::new(DVec3::new(0.0, 0.0, 0.1), DVec3::Z, DVec3::Y).unwrap();
     let outcome = settle_from(&mut free, &start, &config);
     assert_eq!(outcome.status, ContactStatus::NoContact);
     let travelled = (outcome.pose.center_m - start.center_m).length();
-    assert!(travelled <= config.approach_max_distance_m + 1e-9 && travelled >= 0.019, "{travelled}");
+    assert!(
+        travelled <= config.approach_max_distance_m + 1e-9 && travelled >= 0.019,
+        "{travelled}"
+    );
     assert!(outcome.image.max() == 0.0);
 }
 
 #[test]
 fn same_seed_same_commands_and_readings() {
-    let config = ControlConfig { expected_noise_fraction: 0.2, ..ControlConfig::default() };
+    let config = ControlConfig {
+        expected_noise_fraction: 0.2,
+        ..ControlConfig::default()
+    };
     let run = |seed: u64| {
-        let sensor = SensorConfig { noise_fraction: 0.2, noise_seed: seed, ..sensor() };
+        let sensor = SensorConfig {
+            noise_fraction: 0.2,
+            noise_seed: seed,
+            ..sensor()
+        };
         let mut free = FreeFloatingSensor::new(tilted_plane(DQuat::from_rotation_x(0.3)), &sensor).unwrap();
         let start = PadPose::new(DVec3::new(0.0, 0.0, 0.004), -DVec3::Z, DVec3::Y).unwrap();
         let reader = sensor_reader(free.sensor().clone());

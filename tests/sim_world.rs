@@ -6,13 +6,16 @@ use glam::DVec3;
 use rand::RngExt;
 use taction::rng;
 use taction::sim::{
-    IkError, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget, PerturbationBounds,
-    SceneBuilder,
+    IkError, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget,
+    PerturbationBounds, SceneBuilder,
 };
 
 fn scene_with_box() -> taction::sim::Scene {
     let mesh = common::box_mesh(DVec3::new(0.10, 0.08, 0.12));
-    SceneBuilder::with_arm_and_table().object(ObjectSpec::new("box", mesh)).build().unwrap()
+    SceneBuilder::with_arm_and_table()
+        .object(ObjectSpec::new("box", mesh))
+        .build()
+        .unwrap()
 }
 
 #[test]
@@ -29,7 +32,10 @@ fn world_files_load_in_mujoco_unchanged() {
 #[test]
 fn malformed_mjcf_is_a_named_error() {
     let e = SceneBuilder::new()
-        .add(taction::sim::mjcf::Section::Worldbody, "<body name=\"x\"><geom type=\"sphere\" size=\"-1\"/></body>")
+        .add(
+            taction::sim::mjcf::Section::Worldbody,
+            "<body name=\"x\"><geom type=\"sphere\" size=\"-1\"/></body>",
+        )
         .build()
         .err()
         .map(|e| e.to_string())
@@ -42,7 +48,11 @@ fn initial_pad_pose_is_along_x_at_shoulder_height() {
     let scene = scene_with_box();
     let arm = scene.arm().unwrap();
     let pose = arm.pad_pose(scene.data());
-    assert!((pose.position_m - DVec3::new(0.34, 0.0, 0.30)).length() < 1e-9, "{:?}", pose.position_m);
+    assert!(
+        (pose.position_m - DVec3::new(0.34, 0.0, 0.30)).length() < 1e-9,
+        "{:?}",
+        pose.position_m
+    );
     assert!((pose.transform_vector(DVec3::Z) - DVec3::X).length() < 1e-9);
 }
 
@@ -61,15 +71,28 @@ fn ik_reaches_targets_around_the_object() {
     for _ in 0..200 {
         let elevation = r.random_range(0.0f64..=90.0).to_radians();
         let azimuth = r.random_range(0.0..std::f64::consts::TAU);
-        let dir = DVec3::new(elevation.cos() * azimuth.cos(), elevation.cos() * azimuth.sin(), elevation.sin());
-        let target = PadTarget { center_m: center + dir * r.random_range(0.10..0.13), normal: -dir };
+        let dir = DVec3::new(
+            elevation.cos() * azimuth.cos(),
+            elevation.cos() * azimuth.sin(),
+            elevation.sin(),
+        );
+        let target = PadTarget {
+            center_m: center + dir * r.random_range(0.10..0.13),
+            normal: -dir,
+        };
         match ik.solve(&target, &start) {
             Ok(q) => {
                 assert!(arm.within_limits(&q));
                 let pose = ik.forward(&q);
                 let dp = (pose.position_m - target.center_m).length();
-                let angle = pose.transform_vector(DVec3::Z).angle_between(target.normal).to_degrees();
-                assert!(dp <= 1e-3 && angle <= 1.0, "wrong pose returned: {dp} m, {angle} deg");
+                let angle = pose
+                    .transform_vector(DVec3::Z)
+                    .angle_between(target.normal)
+                    .to_degrees();
+                assert!(
+                    dp <= 1e-3 && angle <= 1.0,
+                    "wrong pose returned: {dp} m, {angle} deg"
+                );
                 solved += 1;
             }
             Err(IkError::Unreachable { .. }) => unreachable += 1,
@@ -87,17 +110,43 @@ fn move_through_the_object_reports_the_collision_and_a_free_path_completes() {
     let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
     let start = arm.q(scene.data());
     // A free path: above the object, looking down.
-    let above = ik.solve(&PadTarget { center_m: DVec3::new(0.0, 0.0, 0.25), normal: -DVec3::Z }, &start).unwrap();
-    let outcome = arm.move_to(&mut scene, &above, &MoveOptions::default(), |_| false).unwrap();
+    let above = ik
+        .solve(
+            &PadTarget {
+                center_m: DVec3::new(0.0, 0.0, 0.25),
+                normal: -DVec3::Z,
+            },
+            &start,
+        )
+        .unwrap();
+    let outcome = arm
+        .move_to(&mut scene, &above, &MoveOptions::default(), |_| false)
+        .unwrap();
     assert_eq!(outcome, MoveOutcome::Reached);
     assert!((arm.pad_pose(scene.data()).position_m - DVec3::new(0.0, 0.0, 0.25)).length() < 5e-3);
     // Straight down through the box (its top is at 0.12 m).
-    let inside = ik.solve(&PadTarget { center_m: DVec3::new(0.0, 0.0, 0.05), normal: -DVec3::Z }, &above).unwrap();
-    match arm.move_to(&mut scene, &inside, &MoveOptions::default(), |_| false).unwrap() {
+    let inside = ik
+        .solve(
+            &PadTarget {
+                center_m: DVec3::new(0.0, 0.0, 0.05),
+                normal: -DVec3::Z,
+            },
+            &above,
+        )
+        .unwrap();
+    match arm
+        .move_to(&mut scene, &inside, &MoveOptions::default(), |_| false)
+        .unwrap()
+    {
         MoveOutcome::Collided(c) => {
             let names = [c.body_a.as_str(), c.body_b.as_str()];
             assert!(names.contains(&"object"), "{c}");
-            assert!(names.iter().any(|n| ["sensor", "link4", "link3", "link2"].contains(n)), "{c}");
+            assert!(
+                names
+                    .iter()
+                    .any(|n| ["sensor", "link4", "link3", "link2"].contains(n)),
+                "{c}"
+            );
         }
         other => panic!("expected a collision, got {other:?}"),
     }
@@ -126,6 +175,9 @@ fn perturbations_stay_in_bounds_and_repeat_with_the_seed() {
     let before = scene.object_pose().unwrap();
     let after = scene.perturb_object(&a[0]).unwrap();
     assert_eq!(scene.object_pose().unwrap().position_m, after.position_m);
-    assert!(scene.object_lowest_z(&after).unwrap().abs() < 1e-12, "rests on the table");
+    assert!(
+        scene.object_lowest_z(&after).unwrap().abs() < 1e-12,
+        "rests on the table"
+    );
     assert!(before.rotation.angle_between(after.rotation) <= 10f64.to_radians() + 1e-9);
 }

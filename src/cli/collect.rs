@@ -68,16 +68,31 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed)?;
     let set = ObjectSet::resolve(&args.objects, None, args.object_size_m)?;
-    let built = set.build(&BuildOptions { fetch: true, ..BuildOptions::default() })?;
-    let objects: Vec<ObjectSpec> = built.into_iter().map(|b| ObjectSpec::new(b.name, b.mesh)).collect();
+    let built = set.build(&BuildOptions {
+        fetch: true,
+        ..BuildOptions::default()
+    })?;
+    let objects: Vec<ObjectSpec> = built
+        .into_iter()
+        .map(|b| ObjectSpec::new(b.name, b.mesh))
+        .collect();
     let (mode, generator) = match args.mode {
         Mode::Sampler => {
-            let config = SamplerConfig { from_above_only: args.from_above, ..SamplerConfig::default() };
+            let config = SamplerConfig {
+                from_above_only: args.from_above,
+                ..SamplerConfig::default()
+            };
             (CollectMode::Sampler(config), "sampler".to_string())
         }
         Mode::Planner => {
-            let config = PlannerConfig { local_probability: args.local_prob, ..PlannerConfig::default() };
-            (CollectMode::Planner(config), format!("planner L={}", args.local_prob))
+            let config = PlannerConfig {
+                local_probability: args.local_prob,
+                ..PlannerConfig::default()
+            };
+            (
+                CollectMode::Planner(config),
+                format!("planner L={}", args.local_prob),
+            )
         }
     };
     let plan = CollectPlan {

@@ -16,10 +16,10 @@ use taction::experiment::figure::{Figure, Panel, Series};
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
+use taction::recognize::OnlinePosterior;
 use taction::recognize::labelled::LabelledFeatures;
 use taction::recognize::model::{TrainedModel, TrainingProvenance};
 use taction::recognize::selection::{TrainConfig, train};
-use taction::recognize::OnlinePosterior;
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{ObjectSpec, PerturbationBounds, SceneBuilder};
@@ -54,13 +54,24 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, None)?;
-    let built = set.build(&BuildOptions { fetch: true, ..BuildOptions::default() })?;
-    let objects: Vec<ObjectSpec> = built.into_iter().map(|b| ObjectSpec::new(b.name, b.mesh)).collect();
+    let built = set.build(&BuildOptions {
+        fetch: true,
+        ..BuildOptions::default()
+    })?;
+    let objects: Vec<ObjectSpec> = built
+        .into_iter()
+        .map(|b| ObjectSpec::new(b.name, b.mesh))
+        .collect();
     let descriptor_kind = DescriptorKind::PolarFourier;
     let descriptor = descriptor_kind.build();
 
     // 1. The model: cached per (object set, readings, seed), else trained now.
-    let model_path = args.out.join(format!("model-{}-{}-{}.json", set.id(), args.training_readings, args.seed));
+    let model_path = args.out.join(format!(
+        "model-{}-{}-{}.json",
+        set.id(),
+        args.training_readings,
+        args.seed
+    ));
     let model = match TrainedModel::load(&model_path) {
         Ok(model) if model.check_sensor(&sensor).is_ok() => {
             println!("using the model trained before: {}", model_path.display());
@@ -71,7 +82,11 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 "training: {} sampler readings of each of {} objects ({})",
                 args.training_readings,
                 objects.len(),
-                objects.iter().map(|o| o.name.as_str()).collect::<Vec<_>>().join(", ")
+                objects
+                    .iter()
+                    .map(|o| o.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             );
             let plan = CollectPlan {
                 mode: CollectMode::Sampler(SamplerConfig::default()),
@@ -81,11 +96,23 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 readings_per_object: args.training_readings,
                 seed: args.seed,
             };
-            let readings = plan.collect(&objects, 0)?.into_iter().flat_map(|r| r.readings).collect();
+            let readings = plan
+                .collect(&objects, 0)?
+                .into_iter()
+                .flat_map(|r| r.readings)
+                .collect();
             let names = objects.iter().map(|o| o.name.clone()).collect();
-            let dataset = Dataset::new(DatasetHeader::new(sensor, set.id(), names, "sampler", args.seed), readings)?;
+            let dataset = Dataset::new(
+                DatasetHeader::new(sensor, set.id(), names, "sampler", args.seed),
+                readings,
+            )?;
             let features = LabelledFeatures::from_dataset(&dataset.converged_only(), descriptor.as_ref());
-            let config = TrainConfig { ks: vec![10, 20], restarts: 1, seed: args.seed, ..TrainConfig::default() };
+            let config = TrainConfig {
+                ks: vec![10, 20],
+                restarts: 1,
+                seed: args.seed,
+                ..TrainConfig::default()
+            };
             let trained = train(&features, None, &config, &mut |_| {})?;
             let provenance = TrainingProvenance {
                 object_set: set.id(),
@@ -93,7 +120,13 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 dataset_seed: args.seed,
                 config,
             };
-            let model = TrainedModel::new(descriptor.params(), sensor, trained.bag, trained.selection, provenance);
+            let model = TrainedModel::new(
+                descriptor.params(),
+                sensor,
+                trained.bag,
+                trained.selection,
+                provenance,
+            );
             model.save(&model_path)?;
             model
         }
@@ -103,23 +136,35 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     // 2. The unknown object, at a pose the planner is not told.
     let mut r = rng::stream(args.seed, 0xDE30);
     let index = match &args.object {
-        Some(name) => objects.iter().position(|o| &o.name == name).ok_or_else(|| {
-            format!("--object: '{name}' is not in the set ({})", names.join(", "))
-        })?,
+        Some(name) => objects
+            .iter()
+            .position(|o| &o.name == name)
+            .ok_or_else(|| format!("--object: '{name}' is not in the set ({})", names.join(", ")))?,
         None => r.random_range(0..objects.len()),
     };
     let unknown = objects[index].clone();
-    let mut scene = add_sensor(SceneBuilder::with_arm_and_table().object(unknown.clone()), &sensor, "covering", PAD_SITE)?
-        .build()?;
+    let mut scene = add_sensor(
+        SceneBuilder::with_arm_and_table().object(unknown.clone()),
+        &sensor,
+        "covering",
+        PAD_SITE,
+    )?
+    .build()?;
     let width = scene.object_width_m().unwrap_or(0.1);
     let shuffle = PerturbationBounds::new(180.0, 0.1)?.draw(width, &mut r);
     scene.perturb_object(&shuffle)?;
-    println!("exploring an unknown object with the arm (it is '{}'; the planner is not told)", unknown.name);
+    println!(
+        "exploring an unknown object with the arm (it is '{}'; the planner is not told)",
+        unknown.name
+    );
 
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
     let mut planner = Planner::new(
         &scene,
-        PlannerConfig { local_probability: 0.8, ..PlannerConfig::default() },
+        PlannerConfig {
+            local_probability: 0.8,
+            ..PlannerConfig::default()
+        },
         ControlConfig::default(),
         sensor,
         PerturbationBounds::NONE,
@@ -130,7 +175,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut csv = String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n");
     let mut images = Vec::new();
     let mut p_true_series = Vec::new();
-    println!("{:>5}  {:<12} {:>8} {:>8} {:>9}", "touch", "best guess", "p(guess)", "p(true)", "entropy");
+    println!(
+        "{:>5}  {:<12} {:>8} {:>8} {:>9}",
+        "touch", "best guess", "p(guess)", "p(true)", "entropy"
+    );
     let mut attempts = 0;
     while images.len() < args.touches {
         let report = planner.explore(&mut scene, &unknown.name, 1)?;
@@ -142,7 +190,11 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             )
             .into());
         }
-        for reading in report.readings.into_iter().filter(|r| r.status == ContactStatus::Converged) {
+        for reading in report
+            .readings
+            .into_iter()
+            .filter(|r| r.status == ContactStatus::Converged)
+        {
             let belief = posterior.observe(&descriptor.describe(&reading.image))?;
             let guess = belief.guess();
             let p = belief.probabilities();
@@ -179,7 +231,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             y_label: "p(true object)".into(),
             x_range: (1.0, images.len().max(2) as f64),
             y_range: (0.0, 1.0),
-            series: vec![Series { label: unknown.name.clone(), points: p_true_series }],
+            series: vec![Series {
+                label: unknown.name.clone(),
+                points: p_true_series,
+            }],
             markers: true,
             legend: false,
         }],

@@ -1,12 +1,12 @@
 //! One file per subcommand: its clap arguments and its `run` function. `main.rs` only dispatches.
 
-pub mod dataset;
 pub mod collect;
+pub mod dataset;
 pub mod demo;
 pub mod describe;
 pub mod merge;
 pub mod objects;
 pub mod recognize;
 pub mod sense;
-pub mod train;
 pub mod sensor_args;
+pub mod train;

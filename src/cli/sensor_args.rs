@@ -61,7 +61,9 @@ impl SensorArgs {
             pad_width_m: self.pad_m,
             pad_height_m: self.pad_m,
             thickness_m,
-            psf_sigma_m: self.psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
+            psf_sigma_m: self
+                .psf_sigma_m
+                .unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
             rays_per_taxel: self.rays_per_taxel,
             noise_fraction: self.noise,
             noise_seed,

@@ -39,7 +39,14 @@ where
         motion: MoveOptions,
     ) -> Result<Self, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
-        Ok(Self { scene, arm, ik, sensor, reader, motion })
+        Ok(Self {
+            scene,
+            arm,
+            ik,
+            sensor,
+            reader,
+            motion,
+        })
     }
 
     pub fn scene(&mut self) -> &mut Scene {
@@ -89,7 +96,13 @@ where
 
     fn move_pad(&mut self, target: &PadPose) -> Result<PadMotion, ControlError> {
         let start = self.arm.q(self.scene.data());
-        let q = match self.ik.solve(&PadTarget { center_m: target.center_m, normal: target.normal }, &start) {
+        let q = match self.ik.solve(
+            &PadTarget {
+                center_m: target.center_m,
+                normal: target.normal,
+            },
+            &start,
+        ) {
             Ok(q) => q,
             Err(IkError::Unreachable { .. } | IkError::BadTarget) => return Ok(PadMotion::Unreachable),
         };

@@ -78,7 +78,12 @@ impl ControlConfig {
     /// Checks every field's range.
     pub fn validate(&self) -> Result<(), ControlConfigError> {
         let checks: [(&'static str, f64, bool, &'static str); 14] = [
-            ("contact_threshold", self.contact_threshold, (0.0..1.0).contains(&self.contact_threshold), "[0, 1)"),
+            (
+                "contact_threshold",
+                self.contact_threshold,
+                (0.0..1.0).contains(&self.contact_threshold),
+                "[0, 1)",
+            ),
             (
                 "expected_noise_fraction",
                 self.expected_noise_fraction,
@@ -91,31 +96,80 @@ impl ControlConfig {
                 self.approach_step_thickness > 0.0 && self.approach_step_thickness <= 1.0,
                 "(0, 1]",
             ),
-            ("approach_max_distance_m", self.approach_max_distance_m, self.approach_max_distance_m > 0.0, "(0, inf)"),
+            (
+                "approach_max_distance_m",
+                self.approach_max_distance_m,
+                self.approach_max_distance_m > 0.0,
+                "(0, inf)",
+            ),
             (
                 "target_mean_pressure",
                 self.target_mean_pressure,
                 self.target_mean_pressure > 0.0 && self.target_mean_pressure < 1.0,
                 "(0, 1)",
             ),
-            ("pressure_tolerance", self.pressure_tolerance, self.pressure_tolerance > 0.0, "(0, inf)"),
-            ("press_kp", self.press_kp, self.press_kp > 0.0 && self.press_kp <= 2.0, "(0, 2]"),
-            ("press_kd", self.press_kd, (0.0..=2.0).contains(&self.press_kd), "[0, 2]"),
-            ("press_max_step_thickness", self.press_max_step_thickness, self.press_max_step_thickness > 0.0, "(0, inf)"),
-            ("press_max_steps", self.press_max_steps as f64, self.press_max_steps > 0, "1 or more"),
+            (
+                "pressure_tolerance",
+                self.pressure_tolerance,
+                self.pressure_tolerance > 0.0,
+                "(0, inf)",
+            ),
+            (
+                "press_kp",
+                self.press_kp,
+                self.press_kp > 0.0 && self.press_kp <= 2.0,
+                "(0, 2]",
+            ),
+            (
+                "press_kd",
+                self.press_kd,
+                (0.0..=2.0).contains(&self.press_kd),
+                "[0, 2]",
+            ),
+            (
+                "press_max_step_thickness",
+                self.press_max_step_thickness,
+                self.press_max_step_thickness > 0.0,
+                "(0, inf)",
+            ),
+            (
+                "press_max_steps",
+                self.press_max_steps as f64,
+                self.press_max_steps > 0,
+                "1 or more",
+            ),
             (
                 "saturation_threshold",
                 self.saturation_threshold,
                 self.saturation_threshold > self.target_mean_pressure && self.saturation_threshold <= 1.0,
                 "(target_mean_pressure, 1]",
             ),
-            ("orient_step", self.orient_step, self.orient_step > 0.0 && self.orient_step <= 1.0, "(0, 1]"),
-            ("orient_tolerance_rad", self.orient_tolerance_rad, self.orient_tolerance_rad > 0.0, "(0, inf)"),
-            ("max_iterations", self.max_iterations as f64, self.max_iterations > 0, "1 or more"),
+            (
+                "orient_step",
+                self.orient_step,
+                self.orient_step > 0.0 && self.orient_step <= 1.0,
+                "(0, 1]",
+            ),
+            (
+                "orient_tolerance_rad",
+                self.orient_tolerance_rad,
+                self.orient_tolerance_rad > 0.0,
+                "(0, inf)",
+            ),
+            (
+                "max_iterations",
+                self.max_iterations as f64,
+                self.max_iterations > 0,
+                "1 or more",
+            ),
         ];
         for (field, value, ok, allowed) in checks {
             if !ok || !value.is_finite() {
-                return Err(ControlConfigError { field, value, allowed });
+                return Err(ControlConfigError {
+                    field,
+                    value,
+                    allowed,
+                });
             }
         }
         Ok(())
@@ -141,17 +195,25 @@ mod tests {
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
         assert_eq!(ControlConfig::default().validate(), Ok(()));
-        let bad = ControlConfig { orient_step: 1.5, ..ControlConfig::default() };
+        let bad = ControlConfig {
+            orient_step: 1.5,
+            ..ControlConfig::default()
+        };
         let e = bad.validate().unwrap_err();
         assert_eq!(e.field, "orient_step");
         assert!(e.to_string().contains("(0, 1]"));
-        let bad = ControlConfig { saturation_threshold: 0.2, ..ControlConfig::default() };
+        let bad = ControlConfig {
+            saturation_threshold: 0.2,
+            ..ControlConfig::default()
+        };
         assert_eq!(bad.validate().unwrap_err().field, "saturation_threshold");
     }
 
     #[test]
     fn unknown_json_fields_are_rejected() {
-        let e = serde_json::from_str::<ControlConfig>("{\"orient_stp\": 0.3}").unwrap_err().to_string();
+        let e = serde_json::from_str::<ControlConfig>("{\"orient_stp\": 0.3}")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("orient_stp"), "{e}");
         let c: ControlConfig = serde_json::from_str("{\"orient_step\": 0.5}").unwrap();
         assert_eq!(c.orient_step, 0.5);

@@ -27,16 +27,28 @@ where
 {
     /// Finds the site `pad` and the mocap body carrying it.
     pub fn new(scene: &'s mut Scene, sensor: SensorConfig, reader: R) -> Result<Self, ControlError> {
-        let missing = |message: &str| SimError::Mjcf { origin: "free-floating pad".into(), message: message.into() };
+        let missing = |message: &str| SimError::Mjcf {
+            origin: "free-floating pad".into(),
+            message: message.into(),
+        };
         let model = scene.model();
-        let site = model.name_to_id(MjtObjBase::mjOBJ_SITE, PAD_SITE).ok_or_else(|| missing("no site 'pad'"))?;
+        let site = model
+            .name_to_id(MjtObjBase::mjOBJ_SITE, PAD_SITE)
+            .ok_or_else(|| missing("no site 'pad'"))?;
         let body = model.site_bodyid()[site] as usize;
         let mocap = model.body_mocapid()[body];
         if mocap < 0 {
             return Err(missing("the body carrying site 'pad' is not a mocap body").into());
         }
         let site_in_body = Pose::from_mujoco(model.site_pos()[site], model.site_quat()[site]);
-        Ok(Self { scene, site, mocap: mocap as usize, site_in_body, sensor, reader })
+        Ok(Self {
+            scene,
+            site,
+            mocap: mocap as usize,
+            site_in_body,
+            sensor,
+            reader,
+        })
     }
 
     pub fn scene(&mut self) -> &mut Scene {

@@ -30,9 +30,14 @@ pub fn fit_plane(points: &[DVec3]) -> PlaneFit {
         return PlaneFit::Degenerate;
     }
     let centroid = points.iter().copied().sum::<DVec3>() / points.len() as f64;
-    let centred = Matrix3xX::from_iterator(points.len(), points.iter().flat_map(|p| (*p - centroid).to_array()));
+    let centred = Matrix3xX::from_iterator(
+        points.len(),
+        points.iter().flat_map(|p| (*p - centroid).to_array()),
+    );
     let svd = SVD::new(centred, true, false);
-    let Some(u) = svd.u else { return PlaneFit::Degenerate };
+    let Some(u) = svd.u else {
+        return PlaneFit::Degenerate;
+    };
     let s = svd.singular_values;
     let mut order = [0usize, 1, 2];
     order.sort_by(|&a, &b| s[b].total_cmp(&s[a]));
@@ -103,12 +108,16 @@ const LINE_CONTACT_TILT_RAD: f64 = 0.35;
 /// fits no unique plane. If that line passes near the pad centre it is an edge under the pad, and the
 /// pad stays as it is; if it lies off-centre, the surface is closer on that side, so the stand-in normal
 /// leans toward the contact by [`LINE_CONTACT_TILT_RAD`], bringing the rest of the pad down onto it.
-pub fn surface_normal(image: &TactileImage, sensor: &SensorConfig, config: &ControlConfig) -> Option<(DVec3, DVec3)> {
+pub fn surface_normal(
+    image: &TactileImage,
+    sensor: &SensorConfig,
+    config: &ControlConfig,
+) -> Option<(DVec3, DVec3)> {
     let points = contact_points(image, sensor, config.effective_contact_threshold());
-    if let PlaneFit::Plane { normal, centroid } = fit_plane(&points) {
-        if !is_line_like(&points, sensor) {
-            return Some((normal, centroid));
-        }
+    if let PlaneFit::Plane { normal, centroid } = fit_plane(&points)
+        && !is_line_like(&points, sensor)
+    {
+        return Some((normal, centroid));
     }
     if points.is_empty() {
         return None;
@@ -126,7 +135,11 @@ pub fn surface_normal(image: &TactileImage, sensor: &SensorConfig, config: &Cont
 /// Whether the points' pad-plane positions lie along one line (spread across it below half a taxel).
 fn is_line_like(points: &[DVec3], sensor: &SensorConfig) -> bool {
     let n = points.len() as f64;
-    let mean = points.iter().map(|p| glam::DVec2::new(p.x, p.y)).sum::<glam::DVec2>() / n;
+    let mean = points
+        .iter()
+        .map(|p| glam::DVec2::new(p.x, p.y))
+        .sum::<glam::DVec2>()
+        / n;
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
     for p in points {
         let d = glam::DVec2::new(p.x, p.y) - mean;
@@ -163,7 +176,11 @@ pub fn orient_command(
     if angle > config.orient_max_step_rad {
         rotation = DQuat::from_axis_angle(axis, config.orient_max_step_rad);
     }
-    Some(OrientCommand { rotation, pivot_m: pose.center_m + to_world(centroid_pad), misalignment_rad })
+    Some(OrientCommand {
+        rotation,
+        pivot_m: pose.center_m + to_world(centroid_pad),
+        misalignment_rad,
+    })
 }
 
 #[cfg(test)]
@@ -177,7 +194,9 @@ mod tests {
             .flat_map(|i| (0..5).map(move |j| (i as f64 * 0.002, j as f64 * 0.002)))
             .map(|(x, y)| DVec3::new(x, y, 0.001 + 0.2 * x - 0.1 * y))
             .collect();
-        let PlaneFit::Plane { normal, .. } = fit_plane(&pts) else { panic!("degenerate") };
+        let PlaneFit::Plane { normal, .. } = fit_plane(&pts) else {
+            panic!("degenerate")
+        };
         let expected = DVec3::new(-0.2, 0.1, 1.0).normalize();
         assert!((normal - expected).length() < 1e-9, "{normal:?}");
     }
@@ -185,7 +204,9 @@ mod tests {
     #[test]
     fn degenerate_fits_are_reported() {
         assert_eq!(fit_plane(&[DVec3::ZERO, DVec3::X]), PlaneFit::Degenerate);
-        let line: Vec<DVec3> = (0..6).map(|i| DVec3::new(i as f64, 2.0 * i as f64, 0.5)).collect();
+        let line: Vec<DVec3> = (0..6)
+            .map(|i| DVec3::new(i as f64, 2.0 * i as f64, 0.5))
+            .collect();
         assert_eq!(fit_plane(&line), PlaneFit::Degenerate);
     }
 }

@@ -31,12 +31,22 @@ pub struct ContactOutcome {
 }
 
 /// Runs the controllers on `carrier` from its current pose, approaching along the pad normal.
-pub fn settle<C: PadCarrier + ?Sized>(carrier: &mut C, config: &ControlConfig) -> Result<ContactOutcome, ControlError> {
+pub fn settle<C: PadCarrier + ?Sized>(
+    carrier: &mut C,
+    config: &ControlConfig,
+) -> Result<ContactOutcome, ControlError> {
     config.validate()?;
     let mut trace = Trace::default();
     let finish = |carrier: &mut C, status, image: TactileImage, iterations, trace, collision| {
         let pose = carrier.pad_pose();
-        Ok(ContactOutcome { status, image: image.with_pose(pose), pose, iterations, trace, collision })
+        Ok(ContactOutcome {
+            status,
+            image: image.with_pose(pose),
+            pose,
+            iterations,
+            trace,
+            collision,
+        })
     };
     let blocked_status = |motion: &PadMotion| match motion {
         PadMotion::Collided(c) => (ContactStatus::Collision, Some(c.clone())),
@@ -59,7 +69,10 @@ pub fn settle<C: PadCarrier + ?Sized>(carrier: &mut C, config: &ControlConfig) -
 
     for iteration in 1..=config.max_iterations as u32 {
         let pressed = match press(carrier, config, &mut trace)? {
-            PressOutcome::Done { image: pressed_image, commanded } => {
+            PressOutcome::Done {
+                image: pressed_image,
+                commanded,
+            } => {
                 image = pressed_image;
                 commanded
             }
@@ -93,11 +106,22 @@ pub fn settle<C: PadCarrier + ?Sized>(carrier: &mut C, config: &ControlConfig) -
             return finish(carrier, ContactStatus::NoContact, image, iteration, trace, None);
         }
         if !pressed && !oriented {
-            let status = if image.max() >= CLIPPED { ContactStatus::Saturated } else { ContactStatus::Converged };
+            let status = if image.max() >= CLIPPED {
+                ContactStatus::Saturated
+            } else {
+                ContactStatus::Converged
+            };
             return finish(carrier, status, image, iteration, trace, None);
         }
     }
-    finish(carrier, ContactStatus::MaxIterations, image, config.max_iterations as u32, trace, None)
+    finish(
+        carrier,
+        ContactStatus::MaxIterations,
+        image,
+        config.max_iterations as u32,
+        trace,
+        None,
+    )
 }
 
 /// A controller outcome as one JSON-friendly record (for `taction touch`).
@@ -119,7 +143,12 @@ impl From<&ContactOutcome> for ContactReport {
             pad_center: o.pose.center_m.to_array(),
             pad_normal: o.pose.normal.to_array(),
             mean_pressure: o.image.mean(),
-            image: o.image.values().chunks(o.image.cols()).map(<[f64]>::to_vec).collect(),
+            image: o
+                .image
+                .values()
+                .chunks(o.image.cols())
+                .map(<[f64]>::to_vec)
+                .collect(),
         }
     }
 }

@@ -53,11 +53,18 @@ pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.
     pub fn sensor_for(&self, index: usize) -> SensorConfig {
-        SensorConfig { noise_seed: rng::substream(self.sensor.noise_seed ^ self.seed, index as u64), ..self.sensor }
+        SensorConfig {
+            noise_seed: rng::substream(self.sensor.noise_seed ^ self.seed, index as u64),
+            ..self.sensor
+        }
     }
 
     /// Collects the readings of object `index` (its name is the object's name).
-    pub fn collect_object(&self, object: &ObjectSpec, index: usize) -> Result<ExplorationReport, ControlError> {
+    pub fn collect_object(
+        &self,
+        object: &ObjectSpec,
+        index: usize,
+    ) -> Result<ExplorationReport, ControlError> {
         let sensor = self.sensor_for(index);
         let mut rng = rng::stream(self.seed, index as u64);
         match self.mode {
@@ -82,21 +89,36 @@ impl CollectPlan {
                     .map_err(crate::tactile::sensor::TactileError::from)?
                     .build()?;
                 let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-                let mut planner =
-                    Planner::new(&scene, config, self.control, sensor, self.perturbation, rng, reader)?;
+                let mut planner = Planner::new(
+                    &scene,
+                    config,
+                    self.control,
+                    sensor,
+                    self.perturbation,
+                    rng,
+                    reader,
+                )?;
                 planner.explore(&mut scene, &object.name, self.readings_per_object)
             }
         }
     }
 
     /// Collects every object on a pool of `threads` threads (0: all cores), results in object order.
-    pub fn collect(&self, objects: &[ObjectSpec], threads: usize) -> Result<Vec<ExplorationReport>, ControlError> {
+    pub fn collect(
+        &self,
+        objects: &[ObjectSpec],
+        threads: usize,
+    ) -> Result<Vec<ExplorationReport>, ControlError> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| ControlError::ThreadPool(format!("{threads} threads: {e}")))?;
         pool.install(|| {
-            objects.par_iter().enumerate().map(|(i, object)| self.collect_object(object, i)).collect()
+            objects
+                .par_iter()
+                .enumerate()
+                .map(|(i, object)| self.collect_object(object, i))
+                .collect()
         })
     }
 }

@@ -30,7 +30,12 @@ pub struct ReadingGrid {
 impl ReadingGrid {
     /// A grid of cubes of side `cell_m` anchored at `origin_m` (the workspace's lower corner).
     pub fn new(origin_m: DVec3, cell_m: f64) -> Self {
-        Self { origin_m, cell_m, index: HashMap::new(), cells: Vec::new() }
+        Self {
+            origin_m,
+            cell_m,
+            index: HashMap::new(),
+            cells: Vec::new(),
+        }
     }
 
     fn cell_of(&self, p: DVec3) -> IVec3 {
@@ -85,7 +90,11 @@ impl ReadingGrid {
 /// A point uniform in the ball of radius `r` about the origin (rejection from the cube).
 pub fn uniform_in_ball(r: f64, rng: &mut Rng) -> DVec3 {
     loop {
-        let p = DVec3::new(rng.random_range(-1.0..=1.0), rng.random_range(-1.0..=1.0), rng.random_range(-1.0..=1.0));
+        let p = DVec3::new(
+            rng.random_range(-1.0..=1.0),
+            rng.random_range(-1.0..=1.0),
+            rng.random_range(-1.0..=1.0),
+        );
         if p.length_squared() <= 1.0 {
             return p * r;
         }
@@ -138,6 +147,10 @@ mod tests {
             let p = grid.local_target(0.02, &mut r).unwrap();
             assert!(locations.iter().any(|l| (p - *l).length() <= 0.02 + 1e-12));
         }
-        assert!(ReadingGrid::new(DVec3::ZERO, 0.1).local_target(0.02, &mut r).is_none());
+        assert!(
+            ReadingGrid::new(DVec3::ZERO, 0.1)
+                .local_target(0.02, &mut r)
+                .is_none()
+        );
     }
 }

@@ -28,7 +28,9 @@ use crate::explore::reading::{ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::tree::ExplorationTree;
 use crate::rng::Rng;
-use crate::sim::{IkOptions, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, PerturbationBounds, Scene};
+use crate::sim::{
+    IkOptions, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, PerturbationBounds, Scene,
+};
 use crate::tactile::{SensorConfig, TactileImage};
 
 /// The planner's parameters.
@@ -80,7 +82,10 @@ impl PlannerConfig {
     /// Checks ranges; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
         if !(0.0..=1.0).contains(&self.local_probability) {
-            return Err(format!("local_probability {} is outside [0, 1]", self.local_probability));
+            return Err(format!(
+                "local_probability {} is outside [0, 1]",
+                self.local_probability
+            ));
         }
         if !(self.workspace_min_m.cmplt(self.workspace_max_m).all()) {
             return Err("workspace_min_m must be below workspace_max_m on every axis".into());
@@ -121,8 +126,16 @@ pub struct Planner<R> {
 /// to a few hundredths of a millimetre.
 pub fn precise_motion() -> (IkOptions, MoveOptions) {
     (
-        IkOptions { position_tolerance_m: 2e-5, angle_tolerance_rad: 0.02_f64.to_radians(), ..IkOptions::default() },
-        MoveOptions { tolerance_rad: 5e-5, settle_intervals: 300, ..MoveOptions::default() },
+        IkOptions {
+            position_tolerance_m: 2e-5,
+            angle_tolerance_rad: 0.02_f64.to_radians(),
+            ..IkOptions::default()
+        },
+        MoveOptions {
+            tolerance_rad: 5e-5,
+            settle_intervals: 300,
+            ..MoveOptions::default()
+        },
     )
 }
 
@@ -140,7 +153,9 @@ where
         rng: Rng,
         reader: R,
     ) -> Result<Self, ControlError> {
-        config.validate().map_err(|message| crate::sim::SimError::BadConfiguration { message })?;
+        config
+            .validate()
+            .map_err(|message| crate::sim::SimError::BadConfiguration { message })?;
         control.validate()?;
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let (ik_options, motion) = precise_motion();
@@ -223,7 +238,26 @@ where
                     _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
                 };
                 let start = arm.q(scene.data());
-                let Ok(q) = self.expansion_ik.solve(&PadTarget { center_m: next, normal }, &start) else {
+                // If the turned pad cannot be reached, try the step keeping the pad's orientation.
+                let solved = self
+                    .expansion_ik
+                    .solve(
+                        &PadTarget {
+                            center_m: next,
+                            normal,
+                        },
+                        &start,
+                    )
+                    .or_else(|_| {
+                        self.expansion_ik.solve(
+                            &PadTarget {
+                                center_m: next,
+                                normal: pad.normal,
+                            },
+                            &start,
+                        )
+                    });
+                let Ok(q) = solved else {
                     report.unreachable_steps += 1;
                     break;
                 };
@@ -249,7 +283,9 @@ where
                 }
                 if !sensed {
                     let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-                    vertex = self.tree.add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
+                    vertex = self
+                        .tree
+                        .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
                     continue;
                 }
                 let reading = self.settle_here(scene, object, strategy)?;
@@ -257,7 +293,10 @@ where
                 if converged {
                     let pose = reading.image.pose().copied().unwrap_or(pad);
                     self.grid.add(pose.center_m);
-                    let lifted = PadTarget { center_m: pose.center_m - pose.normal * self.config.lift_off_m, normal: pose.normal };
+                    let lifted = PadTarget {
+                        center_m: pose.center_m - pose.normal * self.config.lift_off_m,
+                        normal: pose.normal,
+                    };
                     let start = arm.q(scene.data());
                     if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start) {
                         self.tree.add(vertex, q_lift, lifted.center_m, lifted.normal);
@@ -276,9 +315,21 @@ where
     }
 
     /// Hands over to surface contact control at the current pose and packages the outcome.
-    fn settle_here(&mut self, scene: &mut Scene, object: &str, strategy: Strategy) -> Result<Reading, ControlError> {
+    fn settle_here(
+        &mut self,
+        scene: &mut Scene,
+        object: &str,
+        strategy: Strategy,
+    ) -> Result<Reading, ControlError> {
         let object_pose = scene.object_pose().unwrap_or_default();
-        let Self { ik, reader, sensor, control, motion, .. } = self;
+        let Self {
+            ik,
+            reader,
+            sensor,
+            control,
+            motion,
+            ..
+        } = self;
         let mut carrier = ArmPad::new(scene, ik, *sensor, |s: &mut Scene| reader(s), *motion)?;
         let outcome = settle(&mut carrier, control)?;
         Ok(Reading {
@@ -298,6 +349,9 @@ pub fn turn_toward(from: DVec3, to: DVec3, max_rad: f64) -> DVec3 {
     if angle <= max_rad {
         return to;
     }
-    let axis = from.cross(to).try_normalize().unwrap_or_else(|| from.any_orthonormal_vector());
+    let axis = from
+        .cross(to)
+        .try_normalize()
+        .unwrap_or_else(|| from.any_orthonormal_vector());
     glam::DQuat::from_axis_angle(axis, max_rad) * from
 }

@@ -40,7 +40,10 @@ pub struct ExplorationReport {
 impl ExplorationReport {
     /// Number of converged readings.
     pub fn converged(&self) -> usize {
-        self.readings.iter().filter(|r| r.status == ContactStatus::Converged).count()
+        self.readings
+            .iter()
+            .filter(|r| r.status == ContactStatus::Converged)
+            .count()
     }
 
     /// Reading attempts by status.

@@ -14,8 +14,8 @@ use glam::{DQuat, DVec3};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use crate::control::{ControlConfig, ControlError, settle};
 use crate::control::free_pad::FreePad;
+use crate::control::{ControlConfig, ControlError, settle};
 use crate::explore::reading::{ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::surface_sampling::SurfaceSampler;
@@ -41,7 +41,12 @@ pub struct SamplerConfig {
 
 impl Default for SamplerConfig {
     fn default() -> Self {
-        Self { back_off_m: 0.006, orientation_noise_deg: 10.0, from_above_only: false, max_attempts_per_reading: 20 }
+        Self {
+            back_off_m: 0.006,
+            orientation_noise_deg: 10.0,
+            from_above_only: false,
+            max_attempts_per_reading: 20,
+        }
     }
 }
 
@@ -71,24 +76,38 @@ where
 {
     let mesh: TriMesh = scene.object().ok_or(SimError::NoObject)?.mesh.clone();
     let up_only = config.from_above_only;
-    let surface = SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
-        SimError::Object { name: object.to_string(), message: "no surface area to sample".into() }
-    })?;
+    let surface =
+        SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
+            SimError::Object {
+                name: object.to_string(),
+                message: "no surface area to sample".into(),
+            }
+        })?;
     let mut pad = FreePad::new(scene, sensor, reader)?;
     let mut report = ExplorationReport::default();
-    let max_attempts = converged_target.saturating_mul(config.max_attempts_per_reading).max(1);
+    let max_attempts = converged_target
+        .saturating_mul(config.max_attempts_per_reading)
+        .max(1);
     let tilt_max = config.orientation_noise_deg.to_radians();
     while report.converged() < converged_target && report.iterations < max_attempts {
         report.iterations += 1;
         let object_pose = pad.scene().object_pose().ok_or(SimError::NoObject)?;
         let local = surface.sample(&mesh, rng);
         let point = object_pose.transform_point(local.point_m);
-        let outward = if up_only { DVec3::Z } else { object_pose.transform_vector(local.normal) };
+        let outward = if up_only {
+            DVec3::Z
+        } else {
+            object_pose.transform_vector(local.normal)
+        };
         let tilt_axis = random_perpendicular(outward, rng);
         let tilt = DQuat::from_axis_angle(tilt_axis, rng.random_range(0.0..=1.0) * tilt_max);
         let normal = (tilt * -outward).normalize();
         let up = random_perpendicular(normal, rng);
-        let start = PadPose { center_m: point + outward * config.back_off_m, normal, up };
+        let start = PadPose {
+            center_m: point + outward * config.back_off_m,
+            normal,
+            up,
+        };
         pad.place(&start);
         let outcome = settle(&mut pad, control)?;
         report.readings.push(Reading {

@@ -36,14 +36,19 @@ impl SurfaceSampler {
         let mut total = 0.0;
         for t in 0..mesh.triangles.len() {
             let area = mesh.triangle_area(t);
-            let Some(normal) = triangle_normal(mesh, t) else { continue };
+            let Some(normal) = triangle_normal(mesh, t) else {
+                continue;
+            };
             if area > 0.0 && area.is_finite() && eligible(normal) {
                 total += area;
                 triangles.push(t);
                 cumulative_area.push(total);
             }
         }
-        (total > 0.0).then_some(Self { triangles, cumulative_area })
+        (total > 0.0).then_some(Self {
+            triangles,
+            cumulative_area,
+        })
     }
 
     /// Total eligible area, square metres.
@@ -54,14 +59,21 @@ impl SurfaceSampler {
     /// One area-weighted random surface point.
     pub fn sample(&self, mesh: &TriMesh, rng: &mut Rng) -> SurfacePoint {
         let u = rng.random_range(0.0..self.total_area());
-        let i = self.cumulative_area.partition_point(|&c| c <= u).min(self.triangles.len() - 1);
+        let i = self
+            .cumulative_area
+            .partition_point(|&c| c <= u)
+            .min(self.triangles.len() - 1);
         let triangle = self.triangles[i];
         let [a, b, c] = mesh.corners(triangle);
         let (r1, r2): (f64, f64) = (rng.random_range(0.0..=1.0), rng.random_range(0.0..=1.0));
         let s = r1.sqrt();
         let point_m = a * (1.0 - s) + b * (s * (1.0 - r2)) + c * (s * r2);
         let normal = triangle_normal(mesh, triangle).unwrap_or(DVec3::Z);
-        SurfacePoint { triangle, point_m, normal }
+        SurfacePoint {
+            triangle,
+            point_m,
+            normal,
+        }
     }
 }
 
@@ -99,7 +111,11 @@ mod tests {
             let p = sampler.sample(&mesh, &mut r);
             if p.triangle == 1 {
                 second += 1;
-                assert!(p.point_m.x >= 10.0 && p.point_m.y >= 0.0 && p.point_m.y <= 3.0 * (1.0 - (p.point_m.x - 10.0) / 2.0) + 1e-12);
+                assert!(
+                    p.point_m.x >= 10.0
+                        && p.point_m.y >= 0.0
+                        && p.point_m.y <= 3.0 * (1.0 - (p.point_m.x - 10.0) / 2.0) + 1e-12
+                );
             } else {
                 assert!(p.point_m.x >= 0.0 && p.point_m.x <= 2.0 * (1.0 - p.point_m.y) + 1e-12);
             }
@@ -107,7 +123,10 @@ mod tests {
         }
         let expected = 0.75 * n as f64;
         let sigma = (n as f64 * 0.75 * 0.25).sqrt();
-        assert!((second as f64 - expected).abs() < 5.0 * sigma, "{second} vs {expected}");
+        assert!(
+            (second as f64 - expected).abs() < 5.0 * sigma,
+            "{second} vs {expected}"
+        );
     }
 
     /// Points are uniform inside a triangle: the fraction in the sub-triangle of the midpoints (a quarter
@@ -126,7 +145,10 @@ mod tests {
             .filter(|p| p.x + p.y <= 0.5)
             .count();
         let sigma = (n as f64 * 0.25 * 0.75).sqrt();
-        assert!((inside_corner as f64 - 0.25 * n as f64).abs() < 5.0 * sigma, "{inside_corner}");
+        assert!(
+            (inside_corner as f64 - 0.25 * n as f64).abs() < 5.0 * sigma,
+            "{inside_corner}"
+        );
     }
 
     #[test]

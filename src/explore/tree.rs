@@ -24,7 +24,14 @@ pub struct ExplorationTree {
 
 impl ExplorationTree {
     pub fn new(root_q: Vec<f64>, pad_m: DVec3, pad_normal: DVec3) -> Self {
-        Self { vertices: vec![Vertex { q: root_q, pad_m, pad_normal, parent: None }] }
+        Self {
+            vertices: vec![Vertex {
+                q: root_q,
+                pad_m,
+                pad_normal,
+                parent: None,
+            }],
+        }
     }
 
     pub fn vertices(&self) -> &[Vertex] {
@@ -41,7 +48,12 @@ impl ExplorationTree {
 
     /// Adds a vertex reached from `parent`; returns its index.
     pub fn add(&mut self, parent: usize, q: Vec<f64>, pad_m: DVec3, pad_normal: DVec3) -> usize {
-        self.vertices.push(Vertex { q, pad_m, pad_normal, parent: Some(parent) });
+        self.vertices.push(Vertex {
+            q,
+            pad_m,
+            pad_normal,
+            parent: Some(parent),
+        });
         self.vertices.len() - 1
     }
 

@@ -1,1 +1,47 @@
-//! recognize (in progress)
+//! Bag-of-features recognition (Sec. IV-A, V-B1; Fig. 4).
+//!
+//! Training: descriptor features of every training image -> [`Pca`] keeping 90% of the variance ->
+//! a [`Codebook`] (k-means, hard membership, or a Gaussian mixture, soft membership) -> per object
+//! the smoothed histogram `p(c_i | O_j)` ([`ObjectModels`]); [`train`] repeats the codebook step
+//! over a grid of `k` and seeded restarts and keeps the best on validation data.
+//!
+//! Testing: the features of the unknown object's readings go through the same PCA and codebook
+//! into a histogram `p(c_i | U)`; the guess minimises the cross-entropy of Eq. 4, and the
+//! distribution over objects is the softmax of `n_U` times the average log-likelihood (Eq. 16).
+//! [`OnlinePosterior`] does this after every reading; [`evaluate`] over a whole test set.
+//!
+//! Everything here works on features (`Vec<Feature>` per reading), so it knows nothing of MuJoCo:
+//! recorded data from a real sensor can be fed in. A [`TrainedModel`] adds the descriptor, the
+//! sensor configuration and persistence.
+
+pub mod bag;
+pub mod codebook;
+pub mod confusion;
+pub mod decision;
+pub mod error;
+pub mod evaluate;
+pub mod features;
+pub mod gmm;
+pub mod kmeans;
+pub mod labelled;
+pub mod model;
+pub mod object_model;
+pub mod pca;
+pub mod posterior;
+pub mod selection;
+
+pub use bag::BagOfFeatures;
+pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
+pub use confusion::ConfusionMatrix;
+pub use decision::{Decision, cross_entropy, entropy_nats};
+pub use error::RecognizeError;
+pub use evaluate::{AccuracyRow, Evaluation, ReadingRange, TouchRow, Trial, evaluate, make_trials};
+pub use features::FeatureMatrix;
+pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
+pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
+pub use labelled::LabelledFeatures;
+pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
+pub use object_model::{ClusterHistogram, ObjectModels, PseudoCount};
+pub use pca::{Pca, VarianceFraction};
+pub use posterior::{Belief, OnlinePosterior};
+pub use selection::{CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, train};

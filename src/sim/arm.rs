@@ -11,8 +11,16 @@ use crate::sim::scene::Scene;
 use crate::sim::{Pose, SimError};
 
 /// The arm's joints, in chain order; each has a position actuator of the same name.
-pub const ARM_JOINTS: [&str; 8] =
-    ["shoulder_z", "shoulder_y", "elbow_z", "elbow_y", "forearm_z", "forearm_y", "wrist_y", "wrist_z"];
+pub const ARM_JOINTS: [&str; 8] = [
+    "shoulder_z",
+    "shoulder_y",
+    "elbow_z",
+    "elbow_y",
+    "forearm_z",
+    "forearm_y",
+    "wrist_y",
+    "wrist_z",
+];
 /// The site whose frame is the pad frame (+z the pad normal, +y image up).
 pub const PAD_SITE: &str = "pad";
 /// The arm's root body.
@@ -77,20 +85,36 @@ pub struct MoveOptions {
 impl Default for MoveOptions {
     /// 0.01 rad per 5 steps of 2 ms: a slow 1 rad/s, as the planner's "slowly move" asks (Sec. III-A).
     fn default() -> Self {
-        Self { max_step_rad: 0.01, steps_per_interval: 5, tolerance_rad: 2e-3, settle_intervals: 60 }
+        Self {
+            max_step_rad: 0.01,
+            steps_per_interval: 5,
+            tolerance_rad: 2e-3,
+            settle_intervals: 60,
+        }
     }
 }
 
 impl Arm {
     /// Finds the arm in `model`; `Ok(None)` when the model has no arm (e.g. a free-floating sensor).
     pub fn find(model: &MjModel) -> Result<Option<Arm>, SimError> {
-        let Some(site) = model.name_to_id(MjtObjBase::mjOBJ_SITE, PAD_SITE) else { return Ok(None) };
-        let Some(base) = model.name_to_id(MjtObjBase::mjOBJ_BODY, ARM_BASE) else { return Ok(None) };
+        let Some(site) = model.name_to_id(MjtObjBase::mjOBJ_SITE, PAD_SITE) else {
+            return Ok(None);
+        };
+        let Some(base) = model.name_to_id(MjtObjBase::mjOBJ_BODY, ARM_BASE) else {
+            return Ok(None);
+        };
         let mut joints = Vec::with_capacity(ARM_JOINTS.len());
         for name in ARM_JOINTS {
-            let missing = || SimError::Mjcf { origin: "arm".into(), message: format!("no joint or actuator '{name}'") };
-            let j = model.name_to_id(MjtObjBase::mjOBJ_JOINT, name).ok_or_else(missing)?;
-            let actuator = model.name_to_id(MjtObjBase::mjOBJ_ACTUATOR, name).ok_or_else(missing)?;
+            let missing = || SimError::Mjcf {
+                origin: "arm".into(),
+                message: format!("no joint or actuator '{name}'"),
+            };
+            let j = model
+                .name_to_id(MjtObjBase::mjOBJ_JOINT, name)
+                .ok_or_else(missing)?;
+            let actuator = model
+                .name_to_id(MjtObjBase::mjOBJ_ACTUATOR, name)
+                .ok_or_else(missing)?;
             joints.push(ArmJoint {
                 name,
                 qpos_adr: model.jnt_qposadr()[j] as usize,
@@ -99,7 +123,11 @@ impl Arm {
                 range_rad: model.jnt_range()[j],
             });
         }
-        Ok(Some(Arm { joints, site, root_body: model.body_rootid()[base] as usize }))
+        Ok(Some(Arm {
+            joints,
+            site,
+            root_body: model.body_rootid()[base] as usize,
+        }))
     }
 
     pub fn joints(&self) -> &[ArmJoint] {
@@ -141,7 +169,10 @@ impl Arm {
 
     /// Whether `q` is within the joint limits.
     pub fn within_limits(&self, q: &[f64]) -> bool {
-        self.joints.iter().zip(q).all(|(j, &v)| v >= j.range_rad[0] - 1e-12 && v <= j.range_rad[1] + 1e-12)
+        self.joints
+            .iter()
+            .zip(q)
+            .all(|(j, &v)| v >= j.range_rad[0] - 1e-12 && v <= j.range_rad[1] + 1e-12)
     }
 
     /// The pad frame in the world from the current kinematics (`site_xpos`, `site_xmat`).
@@ -173,8 +204,10 @@ impl Arm {
             let (arm_a, arm_b) = (self.owns_body(model, a), self.owns_body(model, b));
             let involved = arm_a || arm_b;
             let adjacent = model.body_parentid()[a] as usize == b || model.body_parentid()[b] as usize == a;
-            (involved && !(arm_a && arm_b && adjacent))
-                .then(|| Collision { body_a: scene.body_name(a), body_b: scene.body_name(b) })
+            (involved && !(arm_a && arm_b && adjacent)).then(|| Collision {
+                body_a: scene.body_name(a),
+                body_b: scene.body_name(b),
+            })
         })
     }
 
@@ -193,12 +226,22 @@ impl Arm {
         F: FnMut(&mut Scene) -> bool,
     {
         if target.len() != self.dof() || target.iter().any(|v| !v.is_finite()) {
-            return Err(SimError::BadConfiguration { message: format!("{target:?} is not an arm configuration") });
+            return Err(SimError::BadConfiguration {
+                message: format!("{target:?} is not an arm configuration"),
+            });
         }
         let mut target = target.to_vec();
         self.clamp(&mut target);
-        let start: Vec<f64> = self.joints.iter().map(|j| scene.data().ctrl()[j.actuator]).collect();
-        let span = start.iter().zip(&target).map(|(a, b)| (b - a).abs()).fold(0.0, f64::max);
+        let start: Vec<f64> = self
+            .joints
+            .iter()
+            .map(|j| scene.data().ctrl()[j.actuator])
+            .collect();
+        let span = start
+            .iter()
+            .zip(&target)
+            .map(|(a, b)| (b - a).abs())
+            .fold(0.0, f64::max);
         let intervals = (span / options.max_step_rad).ceil().max(1.0) as usize;
         let mut command = start.clone();
         for k in 1..=intervals + options.settle_intervals {
@@ -220,7 +263,11 @@ impl Arm {
             }
             if k >= intervals {
                 let q = self.q(scene.data());
-                let error = q.iter().zip(&target).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+                let error = q
+                    .iter()
+                    .zip(&target)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
                 if error <= options.tolerance_rad {
                     return Ok(MoveOutcome::Reached);
                 }

@@ -71,7 +71,10 @@ pub enum IkError {
     #[error(
         "pad target unreachable within the joint limits (best: {best_position_error_m:.4} m, {best_angle_deg:.2} deg off)"
     )]
-    Unreachable { best_position_error_m: f64, best_angle_deg: f64 },
+    Unreachable {
+        best_position_error_m: f64,
+        best_angle_deg: f64,
+    },
     #[error("pad target is not finite or its normal is zero")]
     BadTarget,
 }
@@ -86,7 +89,12 @@ pub struct InverseKinematics {
 
 impl InverseKinematics {
     pub fn new(model: Arc<MjModel>, arm: Arm, options: IkOptions) -> Self {
-        Self { arm, data: MjData::new(model), options, calls: 0 }
+        Self {
+            arm,
+            data: MjData::new(model),
+            options,
+            calls: 0,
+        }
     }
 
     pub fn options(&self) -> &IkOptions {
@@ -108,16 +116,23 @@ impl InverseKinematics {
             return Err(IkError::BadTarget);
         }
         self.calls += 1;
-        let target_bits = target.center_m.to_array().iter().chain(normal.to_array().iter()).fold(0u64, |h, v| {
-            rng::substream(h, v.to_bits())
-        });
+        let target_bits = target
+            .center_m
+            .to_array()
+            .iter()
+            .chain(normal.to_array().iter())
+            .fold(0u64, |h, v| rng::substream(h, v.to_bits()));
         let mut restarts = rng::stream(self.options.seed, target_bits);
         let mut best = (f64::INFINITY, f64::INFINITY);
         for attempt in 0..self.options.attempts {
             let mut q: Vec<f64> = if attempt == 0 {
                 start.to_vec()
             } else {
-                self.arm.joints().iter().map(|j| restarts.random_range(j.range_rad[0]..=j.range_rad[1])).collect()
+                self.arm
+                    .joints()
+                    .iter()
+                    .map(|j| restarts.random_range(j.range_rad[0]..=j.range_rad[1]))
+                    .collect()
             };
             self.arm.clamp(&mut q);
             match self.descend(&mut q, target.center_m, normal) {
@@ -131,7 +146,10 @@ impl InverseKinematics {
                 }
             }
         }
-        Err(IkError::Unreachable { best_position_error_m: best.0, best_angle_deg: best.1.to_degrees() })
+        Err(IkError::Unreachable {
+            best_position_error_m: best.0,
+            best_angle_deg: best.1.to_degrees(),
+        })
     }
 
     /// Damped least-squares descent from `q`; `Err` carries the final (position, angle) error.
@@ -154,7 +172,8 @@ impl InverseKinematics {
                 return Ok(());
             }
             let (jacp, jacr) = self.data.jac_site(true, true, self.arm.site());
-            let proj = nalgebra::Matrix3::identity() - nalgebra::Vector3::new(n.x, n.y, n.z) * nalgebra::RowVector3::new(n.x, n.y, n.z);
+            let proj = nalgebra::Matrix3::identity()
+                - nalgebra::Vector3::new(n.x, n.y, n.z) * nalgebra::RowVector3::new(n.x, n.y, n.z);
             let mut jac = DMatrix::<f64>::zeros(6, n_dof);
             for (c, joint) in self.arm.joints().iter().enumerate() {
                 let d = joint.dof_adr;
@@ -169,7 +188,9 @@ impl InverseKinematics {
             let e = Vector6::new(dp.x, dp.y, dp.z, rot.x, rot.y, rot.z);
             let jjt: Matrix6<f64> = (&jac * jac.transpose()).fixed_view::<6, 6>(0, 0).into_owned()
                 + Matrix6::identity() * lambda2;
-            let Some(y) = jjt.cholesky().map(|c| c.solve(&e)) else { return Err(error) };
+            let Some(y) = jjt.cholesky().map(|c| c.solve(&e)) else {
+                return Err(error);
+            };
             let dq: DVector<f64> = jac.transpose() * DVector::from_column_slice(y.as_slice());
             let scale = (0.3 / dq.amax().max(1e-12)).min(1.0);
             for (v, d) in q.iter_mut().zip(dq.iter()) {
@@ -185,6 +206,8 @@ impl InverseKinematics {
 pub fn rotation_between(from: DVec3, to: DVec3) -> (DVec3, f64) {
     let cross = from.cross(to);
     let angle = cross.length().atan2(from.dot(to));
-    let axis = cross.try_normalize().unwrap_or_else(|| from.any_orthonormal_vector());
+    let axis = cross
+        .try_normalize()
+        .unwrap_or_else(|| from.any_orthonormal_vector());
     (axis, angle)
 }

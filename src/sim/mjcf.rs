@@ -14,10 +14,20 @@ pub const TABLE_XML: &str = include_str!("../../mjcf/table.xml");
 
 /// The children of the root `<mujoco>` element of `xml` (what `<include>` would insert).
 pub fn inner(xml: &str, origin: &str) -> Result<String, SimError> {
-    let missing = |what: &str| SimError::Mjcf { origin: origin.to_string(), message: what.to_string() };
-    let open = xml.find("<mujoco").ok_or_else(|| missing("no <mujoco> root element"))?;
-    let body_start = xml[open..].find('>').map(|i| open + i + 1).ok_or_else(|| missing("unterminated <mujoco>"))?;
-    let close = xml.rfind("</mujoco>").ok_or_else(|| missing("no closing </mujoco>"))?;
+    let missing = |what: &str| SimError::Mjcf {
+        origin: origin.to_string(),
+        message: what.to_string(),
+    };
+    let open = xml
+        .find("<mujoco")
+        .ok_or_else(|| missing("no <mujoco> root element"))?;
+    let body_start = xml[open..]
+        .find('>')
+        .map(|i| open + i + 1)
+        .ok_or_else(|| missing("unterminated <mujoco>"))?;
+    let close = xml
+        .rfind("</mujoco>")
+        .ok_or_else(|| missing("no closing </mujoco>"))?;
     if close < body_start {
         return Err(missing("</mujoco> before the root element's content"));
     }
@@ -111,7 +121,12 @@ mod tests {
     fn inner_strips_the_root_and_keeps_content() {
         let xml = "<!-- c --><mujoco model=\"m\">\n<worldbody/>\n</mujoco>\n";
         assert_eq!(inner(xml, "t").unwrap().trim(), "<worldbody/>");
-        assert!(inner("<x/>", "t").unwrap_err().to_string().contains("no <mujoco>"));
+        assert!(
+            inner("<x/>", "t")
+                .unwrap_err()
+                .to_string()
+                .contains("no <mujoco>")
+        );
     }
 
     #[test]

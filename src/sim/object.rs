@@ -42,7 +42,13 @@ pub struct ObjectSpec {
 impl ObjectSpec {
     /// An object resting at the origin as given (its coordinates are already world metres).
     pub fn new(name: impl Into<String>, mesh: TriMesh) -> Self {
-        Self { name: name.into(), mesh, pose: Pose::IDENTITY, mount: ObjectMount::Mocap, mass_kg: 0.2 }
+        Self {
+            name: name.into(),
+            mesh,
+            pose: Pose::IDENTITY,
+            mount: ObjectMount::Mocap,
+            mass_kg: 0.2,
+        }
     }
 
     /// Adds the mesh asset and the object body to `doc`.
@@ -57,11 +63,24 @@ impl ObjectSpec {
             message: "the mesh has no vertices".into(),
         })?;
         if self.mesh.triangles.is_empty() {
-            return Err(SimError::Object { name: self.name.clone(), message: "the mesh has no triangles".into() });
+            return Err(SimError::Object {
+                name: self.name.clone(),
+                message: "the mesh has no triangles".into(),
+            });
         }
         let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
-        let face = self.mesh.triangles.iter().flatten().map(|i| i.to_string()).collect::<Vec<_>>().join(" ");
-        doc.add(Section::Asset, format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"));
+        let face = self
+            .mesh
+            .triangles
+            .iter()
+            .flatten()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(" ");
+        doc.add(
+            Section::Asset,
+            format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"),
+        );
 
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);

@@ -24,7 +24,10 @@ pub struct PerturbationBounds {
 
 impl PerturbationBounds {
     /// No perturbation.
-    pub const NONE: Self = Self { max_rotation_rad: 0.0, max_translation_fraction: 0.0 };
+    pub const NONE: Self = Self {
+        max_rotation_rad: 0.0,
+        max_translation_fraction: 0.0,
+    };
 
     /// Rotation at most `max_rotation_deg` (0..=180) and translation at most
     /// `max_translation_fraction` (0..=1) of the object's bounding width.
@@ -36,10 +39,15 @@ impl PerturbationBounds {
         }
         if !(0.0..=1.0).contains(&max_translation_fraction) {
             return Err(SimError::BadConfiguration {
-                message: format!("perturbation translation {max_translation_fraction} is outside [0, 1] of the object width"),
+                message: format!(
+                    "perturbation translation {max_translation_fraction} is outside [0, 1] of the object width"
+                ),
             });
         }
-        Ok(Self { max_rotation_rad: max_rotation_deg.to_radians(), max_translation_fraction })
+        Ok(Self {
+            max_rotation_rad: max_rotation_deg.to_radians(),
+            max_translation_fraction,
+        })
     }
 
     pub fn max_rotation_rad(&self) -> f64 {
@@ -63,7 +71,11 @@ impl PerturbationBounds {
         let angle_rad = rng.random_range(0.0..=1.0) * self.max_rotation_rad;
         let radius = self.max_translation_fraction * width_m * rng.random_range(0.0..=1.0f64).sqrt();
         let theta: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-        Perturbation { axis, angle_rad, translation_m: DVec3::new(radius * theta.cos(), radius * theta.sin(), 0.0) }
+        Perturbation {
+            axis,
+            angle_rad,
+            translation_m: DVec3::new(radius * theta.cos(), radius * theta.sin(), 0.0),
+        }
     }
 }
 
@@ -83,7 +95,10 @@ impl Scene {
         let pose = self.object_pose().ok_or(SimError::NoObject)?;
         let center = self.object_center().ok_or(SimError::NoObject)?;
         let rot = DQuat::from_axis_angle(p.axis, p.angle_rad);
-        let rotated = Pose::new(rot * (pose.position_m - center) + center + p.translation_m, rot * pose.rotation);
+        let rotated = Pose::new(
+            rot * (pose.position_m - center) + center + p.translation_m,
+            rot * pose.rotation,
+        );
         let lowest = self.object_lowest_z(&rotated).ok_or(SimError::NoObject)?;
         let rested = Pose::new(rotated.position_m - DVec3::Z * lowest, rotated.rotation);
         self.set_object_pose(rested)?;

@@ -17,10 +17,16 @@ impl Default for Pose {
 }
 
 impl Pose {
-    pub const IDENTITY: Self = Self { position_m: DVec3::ZERO, rotation: DQuat::IDENTITY };
+    pub const IDENTITY: Self = Self {
+        position_m: DVec3::ZERO,
+        rotation: DQuat::IDENTITY,
+    };
 
     pub fn new(position_m: DVec3, rotation: DQuat) -> Self {
-        Self { position_m, rotation: rotation.normalize() }
+        Self {
+            position_m,
+            rotation: rotation.normalize(),
+        }
     }
 
     /// A body point in world coordinates.
@@ -36,12 +42,18 @@ impl Pose {
     /// The inverse transform (world to body).
     pub fn inverse(&self) -> Self {
         let r = self.rotation.inverse();
-        Self { position_m: -(r * self.position_m), rotation: r }
+        Self {
+            position_m: -(r * self.position_m),
+            rotation: r,
+        }
     }
 
     /// `self` after `other`: first `other`, then `self` (`(self * other)(p) = self(other(p))`).
     pub fn compose(&self, other: &Pose) -> Self {
-        Self::new(self.transform_point(other.position_m), self.rotation * other.rotation)
+        Self::new(
+            self.transform_point(other.position_m),
+            self.rotation * other.rotation,
+        )
     }
 
     /// MuJoCo's quaternion order (w, x, y, z).
@@ -51,7 +63,10 @@ impl Pose {
 
     /// From MuJoCo's position and (w, x, y, z) quaternion.
     pub fn from_mujoco(pos: [f64; 3], quat: [f64; 4]) -> Self {
-        Self::new(DVec3::from_array(pos), DQuat::from_xyzw(quat[1], quat[2], quat[3], quat[0]))
+        Self::new(
+            DVec3::from_array(pos),
+            DQuat::from_xyzw(quat[1], quat[2], quat[3], quat[0]),
+        )
     }
 }
 
@@ -61,11 +76,16 @@ mod tests {
 
     #[test]
     fn inverse_and_compose_round_trip() {
-        let a = Pose::new(DVec3::new(0.1, -0.2, 0.3), DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1));
+        let a = Pose::new(
+            DVec3::new(0.1, -0.2, 0.3),
+            DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 1.1),
+        );
         let b = Pose::new(DVec3::new(-0.5, 0.05, 0.2), DQuat::from_rotation_z(0.4));
         let p = DVec3::new(0.7, 0.1, -0.9);
         assert!((a.inverse().transform_point(a.transform_point(p)) - p).length() < 1e-12);
-        assert!((a.compose(&b).transform_point(p) - a.transform_point(b.transform_point(p))).length() < 1e-12);
+        assert!(
+            (a.compose(&b).transform_point(p) - a.transform_point(b.transform_point(p))).length() < 1e-12
+        );
         let m = Pose::from_mujoco(a.position_m.to_array(), a.mujoco_quat());
         assert!((m.transform_point(p) - a.transform_point(p)).length() < 1e-12);
     }

@@ -30,7 +30,11 @@ impl SceneBuilder {
 
     /// The world of Sec. V-A1: arm and table.
     pub fn with_arm_and_table() -> Self {
-        Self { arm: true, table: true, ..Self::default() }
+        Self {
+            arm: true,
+            table: true,
+            ..Self::default()
+        }
     }
 
     pub fn table(mut self, yes: bool) -> Self {
@@ -61,7 +65,10 @@ impl SceneBuilder {
         if self.arm {
             doc.include(ARM_XML, "mjcf/arm.xml")?;
         } else {
-            doc.include("<mujoco><compiler angle=\"degree\" autolimits=\"true\"/></mujoco>", "compiler")?;
+            doc.include(
+                "<mujoco><compiler angle=\"degree\" autolimits=\"true\"/></mujoco>",
+                "compiler",
+            )?;
         }
         if let Some(dt) = self.timestep_s {
             doc.include(&format!("<mujoco><option timestep=\"{dt}\"/></mujoco>"), "option")?;
@@ -81,8 +88,10 @@ impl SceneBuilder {
     /// Compiles the scene and runs `mj_forward` once.
     pub fn build(&self) -> Result<Scene, SimError> {
         let xml = self.to_xml()?;
-        let model = MjModel::from_xml_string(&xml)
-            .map_err(|e| SimError::Mjcf { origin: "assembled scene".into(), message: mujoco_message(&e) })?;
+        let model = MjModel::from_xml_string(&xml).map_err(|e| SimError::Mjcf {
+            origin: "assembled scene".into(),
+            message: mujoco_message(&e),
+        })?;
         Scene::new(model, self.object.as_ref())
     }
 }
@@ -121,7 +130,9 @@ impl Scene {
     /// Wraps a compiled model (any model: the arm and object slot are found by name if present).
     pub fn new(model: MjModel, object: Option<&ObjectSpec>) -> Result<Self, SimError> {
         let model = Arc::new(model);
-        let data = MjData::try_new(model.clone()).map_err(|e| SimError::Physics { message: format!("{e:?}") })?;
+        let data = MjData::try_new(model.clone()).map_err(|e| SimError::Physics {
+            message: format!("{e:?}"),
+        })?;
         let object = match (object, model.name_to_id(MjtObjBase::mjOBJ_BODY, OBJECT_BODY)) {
             (Some(spec), Some(body)) => {
                 let mocap_id = model.body_mocapid()[body];
@@ -138,7 +149,12 @@ impl Scene {
             _ => None,
         };
         let arm = Arm::find(&model)?;
-        let mut scene = Self { model, data, object, arm };
+        let mut scene = Self {
+            model,
+            data,
+            object,
+            arm,
+        };
         scene.data.forward();
         Ok(scene)
     }
@@ -176,11 +192,18 @@ impl Scene {
     /// One physics step; an unstable state (non-finite positions or velocities) is an error naming the time.
     pub fn step(&mut self) -> Result<(), SimError> {
         self.data.step();
-        let finite = self.data.qpos().iter().chain(self.data.qvel().iter()).all(|v| v.is_finite());
+        let finite = self
+            .data
+            .qpos()
+            .iter()
+            .chain(self.data.qvel().iter())
+            .all(|v| v.is_finite());
         if finite {
             Ok(())
         } else {
-            Err(SimError::Physics { message: format!("non-finite state at t = {} s", self.data.time()) })
+            Err(SimError::Physics {
+                message: format!("non-finite state at t = {} s", self.data.time()),
+            })
         }
     }
 
@@ -189,7 +212,13 @@ impl Scene {
         self.model
             .id_to_name(MjtObjBase::mjOBJ_BODY, id)
             .map(str::to_string)
-            .unwrap_or_else(|| if id == 0 { "world".into() } else { format!("body {id}") })
+            .unwrap_or_else(|| {
+                if id == 0 {
+                    "world".into()
+                } else {
+                    format!("body {id}")
+                }
+            })
     }
 
     /// Contacts currently detected, as body pairs (after `forward` or `step`).
@@ -198,7 +227,12 @@ impl Scene {
         self.data
             .contact()
             .iter()
-            .map(|c| (geom_body[c.geom1 as usize] as usize, geom_body[c.geom2 as usize] as usize))
+            .map(|c| {
+                (
+                    geom_body[c.geom1 as usize] as usize,
+                    geom_body[c.geom2 as usize] as usize,
+                )
+            })
             .collect()
     }
 
@@ -235,7 +269,12 @@ impl Scene {
     /// Lowest world z of the object's mesh at `pose`.
     pub fn object_lowest_z(&self, pose: &Pose) -> Option<f64> {
         let object = self.object.as_ref()?;
-        object.mesh.vertices.iter().map(|&v| pose.transform_point(v).z).reduce(f64::min)
+        object
+            .mesh
+            .vertices
+            .iter()
+            .map(|&v| pose.transform_point(v).z)
+            .reduce(f64::min)
     }
 
     /// Centre of the object's bounding box in the world, at its current pose.

@@ -40,7 +40,8 @@ pub fn sphere_mesh(r: f64, center: DVec3, n: usize) -> TriMesh {
         let theta = std::f64::consts::PI * i as f64 / n as f64;
         for j in 0..2 * n {
             let phi = std::f64::consts::PI * j as f64 / n as f64;
-            vertices.push(center + r * DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()));
+            vertices
+                .push(center + r * DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()));
         }
     }
     vertices.push(center - DVec3::new(0.0, 0.0, r));

@@ -38,7 +38,15 @@ fn main() -> ExitCode {
     let result = match task.as_deref() {
         Some("setup") => setup(),
         Some("demo") => setup().and_then(|()| {
-            let mut a = os(&["run", "--release", "--quiet", "--package", "taction", "--", "demo"]);
+            let mut a = os(&[
+                "run",
+                "--release",
+                "--quiet",
+                "--package",
+                "taction",
+                "--",
+                "demo",
+            ]);
             a.extend(rest);
             cargo(&a)
         }),
@@ -102,7 +110,10 @@ fn cargo(args: &[OsString]) -> Result<(), String> {
 }
 
 fn display_args(args: &[OsString]) -> String {
-    args.iter().map(|a| a.to_string_lossy().into_owned()).collect::<Vec<_>>().join(" ")
+    args.iter()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
@@ -118,7 +129,10 @@ fn ensure_mujoco_runtime(runtime: &Path) -> Result<(), String> {
         if sha256_hex(&bytes) == LIBRARY_SHA256 && link.exists() {
             return Ok(());
         }
-        eprintln!("xtask: {} does not match the pinned sha256; fetching it again", library.display());
+        eprintln!(
+            "xtask: {} does not match the pinned sha256; fetching it again",
+            library.display()
+        );
     }
     fs::create_dir_all(&lib_dir).map_err(|e| format!("cannot create {}: {e}", lib_dir.display()))?;
     let download = runtime.join("download");
@@ -136,9 +150,12 @@ fn ensure_mujoco_runtime(runtime: &Path) -> Result<(), String> {
                 .status()
                 .map_err(|e| format!("cannot run `python3 -m pip` (python3 with pip is required): {e}"))?;
             if !status.success() {
-                return Err(format!("`python3 -m pip download mujoco=={MUJOCO_VERSION}` failed ({status})"));
+                return Err(format!(
+                    "`python3 -m pip download mujoco=={MUJOCO_VERSION}` failed ({status})"
+                ));
             }
-            find_wheel(&download).ok_or_else(|| format!("pip left no mujoco wheel in {}", download.display()))?
+            find_wheel(&download)
+                .ok_or_else(|| format!("pip left no mujoco wheel in {}", download.display()))?
         }
     };
 
@@ -155,8 +172,12 @@ fn ensure_mujoco_runtime(runtime: &Path) -> Result<(), String> {
     fs::write(&partial, &bytes).map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
     fs::rename(&partial, &library).map_err(|e| format!("cannot write {}: {e}", library.display()))?;
     let _ = fs::remove_file(&link);
-    std::os::unix::fs::symlink(LIBRARY_FILE, &link).map_err(|e| format!("cannot link {}: {e}", link.display()))?;
-    eprintln!("xtask: MuJoCo {MUJOCO_VERSION} runtime ready in {}", lib_dir.display());
+    std::os::unix::fs::symlink(LIBRARY_FILE, &link)
+        .map_err(|e| format!("cannot link {}: {e}", link.display()))?;
+    eprintln!(
+        "xtask: MuJoCo {MUJOCO_VERSION} runtime ready in {}",
+        lib_dir.display()
+    );
     Ok(())
 }
 
@@ -176,7 +197,8 @@ fn find_wheel(dir: &Path) -> Option<PathBuf> {
 
 fn read_library_from_wheel(wheel: &Path) -> Result<Vec<u8>, String> {
     let file = fs::File::open(wheel).map_err(|e| format!("cannot open {}: {e}", wheel.display()))?;
-    let mut archive = zip::ZipArchive::new(file).map_err(|e| format!("{} is not a valid wheel: {e}", wheel.display()))?;
+    let mut archive =
+        zip::ZipArchive::new(file).map_err(|e| format!("{} is not a valid wheel: {e}", wheel.display()))?;
     let mut entry = archive
         .by_name(LIBRARY_IN_WHEEL)
         .map_err(|e| format!("{} holds no {LIBRARY_IN_WHEEL}: {e}", wheel.display()))?;

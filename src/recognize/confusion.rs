@@ -1,0 +1,97 @@
+//! The confusion matrix over a test set.
+
+use serde::{Deserialize, Serialize};
+
+/// `counts[true][guess]`: how often an object was recognised as each object.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ConfusionMatrix {
+    objects: Vec<String>,
+    counts: Vec<Vec<u64>>,
+}
+
+impl ConfusionMatrix {
+    /// An all-zero matrix over `objects`.
+    pub fn new(objects: Vec<String>) -> Self {
+        let n = objects.len();
+        Self {
+            objects,
+            counts: vec![vec![0; n]; n],
+        }
+    }
+
+    /// Records one decision. Indices are object indices of the model, known to be in range.
+    pub fn add(&mut self, truth: usize, guess: usize) {
+        self.counts[truth][guess] += 1;
+    }
+
+    pub fn objects(&self) -> &[String] {
+        &self.objects
+    }
+
+    /// How often `truth` was recognised as `guess`.
+    pub fn count(&self, truth: usize, guess: usize) -> u64 {
+        self.counts[truth][guess]
+    }
+
+    pub fn total(&self) -> u64 {
+        self.counts.iter().flatten().sum()
+    }
+
+    /// Fraction on the diagonal; 0 for an empty matrix.
+    pub fn accuracy(&self) -> f64 {
+        let correct: u64 = (0..self.objects.len()).map(|i| self.counts[i][i]).sum();
+        let total = self.total();
+        if total == 0 {
+            0.0
+        } else {
+            correct as f64 / total as f64
+        }
+    }
+
+    /// Tidy CSV (`object_true,object_guess,count`, every pair including zeros).
+    pub fn to_csv_string(&self) -> String {
+        let mut out = String::from("object_true,object_guess,count\n");
+        for (i, t) in self.objects.iter().enumerate() {
+            for (j, g) in self.objects.iter().enumerate() {
+                out.push_str(&csv_row(&[t, g, &self.counts[i][j].to_string()]));
+            }
+        }
+        out
+    }
+}
+
+/// One CSV line, quoting fields that need it.
+pub(crate) fn csv_row(fields: &[&str]) -> String {
+    let quoted: Vec<String> = fields
+        .iter()
+        .map(|f| {
+            if f.contains([',', '"', '\n', '\r']) {
+                format!("\"{}\"", f.replace('"', "\"\""))
+            } else {
+                f.to_string()
+            }
+        })
+        .collect();
+    quoted.join(",") + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_and_accuracy() {
+        let mut m = ConfusionMatrix::new(vec!["a".into(), "b,c".into()]);
+        m.add(0, 0);
+        m.add(0, 1);
+        m.add(1, 1);
+        m.add(1, 1);
+        assert_eq!(m.count(0, 1), 1);
+        assert!((m.accuracy() - 0.75).abs() < 1e-15);
+        let csv = m.to_csv_string();
+        assert_eq!(
+            csv,
+            "object_true,object_guess,count\na,a,1\na,\"b,c\",1\n\"b,c\",a,0\n\"b,c\",\"b,c\",2\n"
+        );
+    }
+}

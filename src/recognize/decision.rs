@@ -1,0 +1,131 @@
+//! The decision rule (Sec. IV-A, Eq. 1-4) and the distribution over objects it implies
+//! (Appendix, Eq. 12-16).
+
+use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
+
+/// The cross-entropy of Eq. 4, `H(U, O_j) = -sum_i p(c_i | U) ln p(c_i | O_j)`: the KL divergence
+/// of Eq. 1-2 less the entropy of `p(c_i | U)`, which does not depend on `j`.
+pub fn cross_entropy(p_u: &[f64], log_p_o: &[f64]) -> f64 {
+    -p_u.iter().zip(log_p_o).map(|(p, l)| p * l).sum::<f64>()
+}
+
+/// Shannon entropy `-sum p ln p` in nats (`0 ln 0 = 0`).
+pub fn entropy_nats(p: &[f64]) -> f64 {
+    -p.iter().filter(|&&p| p > 0.0).map(|p| p * p.ln()).sum::<f64>()
+}
+
+/// What the models say about a set of features `U`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decision {
+    /// `D = argmin_j H(U, O_j)` (Eq. 4); ties go to the lower index, so with no features (every
+    /// `H` is 0) it is object 0.
+    pub guess: usize,
+    /// `H(U, O_j)` for every object, nats per feature.
+    pub cross_entropy: Vec<f64>,
+    /// `p(O_j | U)` under a uniform prior: the softmax of `ln p(U | O_j) = -n_U H(U, O_j)`
+    /// (Eq. 16); uniform when `n_U = 0`.
+    pub probabilities: Vec<f64>,
+    /// `n_U`.
+    pub features: usize,
+}
+
+impl Decision {
+    /// Entropy of [`probabilities`](Self::probabilities), nats: `ln n_O` when nothing is known,
+    /// 0 when one object has all the probability.
+    pub fn entropy_nats(&self) -> f64 {
+        entropy_nats(&self.probabilities)
+    }
+}
+
+impl ObjectModels {
+    /// Applies Eq. 4 and Eq. 16 to the histogram of the unknown object's features.
+    ///
+    /// With `s_i = n_U p(c_i | U)` the summed memberships, `ln p(U | O_j) = sum_i s_i ln p(c_i | O_j)`
+    /// (Eq. 15-16), so the guess and the distribution come from the same numbers:
+    /// `p(O_j | U) = exp(ln p(U | O_j) - ln sum_m p(U | O_m))`.
+    pub fn decide(&self, u: &ClusterHistogram) -> Decision {
+        debug_assert_eq!(u.clusters(), self.clusters());
+        let n_objects = self.objects().len();
+        let log_likelihood: Vec<f64> = (0..n_objects)
+            .map(|j| {
+                u.sums()
+                    .iter()
+                    .zip(self.log_probabilities(j))
+                    .map(|(s, l)| s * l)
+                    .sum()
+            })
+            .collect();
+        let n = u.features();
+        let cross_entropy: Vec<f64> = log_likelihood
+            .iter()
+            .map(|l| if n == 0 { 0.0 } else { -l / n as f64 })
+            .collect();
+        let guess = (0..n_objects).fold(0, |best, j| {
+            if log_likelihood[j] > log_likelihood[best] {
+                j
+            } else {
+                best
+            }
+        });
+        let lse = crate::recognize::gmm::log_sum_exp(&log_likelihood);
+        let probabilities = log_likelihood.iter().map(|l| (l - lse).exp()).collect();
+        Decision {
+            guess,
+            cross_entropy,
+            probabilities,
+            features: n,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recognize::object_model::PseudoCount;
+
+    fn models() -> ObjectModels {
+        let mut hist = Vec::new();
+        for counts in [[8.0, 1.0, 1.0], [1.0, 8.0, 1.0], [3.0, 3.0, 4.0]] {
+            let mut h = ClusterHistogram::new(3);
+            for (i, c) in counts.iter().enumerate() {
+                for _ in 0..*c as usize {
+                    let mut m = [0.0; 3];
+                    m[i] = 1.0;
+                    h.add(&m);
+                }
+            }
+            hist.push(h);
+        }
+        ObjectModels::fit(
+            vec!["a".into(), "b".into(), "c".into()],
+            &hist,
+            PseudoCount::LAPLACE,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn entropy_of_known_distributions() {
+        assert!((entropy_nats(&[0.5, 0.5]) - 2f64.ln()).abs() < 1e-15);
+        assert_eq!(entropy_nats(&[1.0, 0.0]), 0.0);
+    }
+
+    #[test]
+    fn no_features_gives_a_uniform_distribution() {
+        let d = models().decide(&ClusterHistogram::new(3));
+        assert!(d.probabilities.iter().all(|p| (p - 1.0 / 3.0).abs() < 1e-15));
+        assert!((d.entropy_nats() - 3f64.ln()).abs() < 1e-12);
+        assert_eq!(d.guess, 0);
+    }
+
+    #[test]
+    fn soft_memberships_weigh_in_proportionally() {
+        let m = models();
+        let mut u = ClusterHistogram::new(3);
+        u.add(&[0.1, 0.9, 0.0]);
+        let d = m.decide(&u);
+        assert_eq!(d.guess, 1);
+        let expected: f64 = -(0.1 * m.log_probabilities(1)[0] + 0.9 * m.log_probabilities(1)[1]);
+        assert!((d.cross_entropy[1] - expected).abs() < 1e-15);
+    }
+}

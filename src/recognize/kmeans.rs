@@ -1,0 +1,342 @@
+//! k-means clustering with k-means++ seeding (Sec. V-B1; the initialisation of the paper's [52],
+//! Arthur and Vassilvitskii 2007), used as a hard codebook and to initialise the Gaussian mixture.
+
+use rand::RngExt;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::recognize::{FeatureMatrix, RecognizeError};
+use crate::rng::Rng;
+
+/// How Lloyd's iterations stop.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KMeansConfig {
+    /// Upper bound on Lloyd iterations.
+    pub max_iterations: usize,
+    /// Stop when the summed squared centre shift falls below `tolerance` times the mean
+    /// per-dimension variance of the data (scikit-learn's convention), or when no label changes.
+    pub tolerance: f64,
+}
+
+impl Default for KMeansConfig {
+    fn default() -> Self {
+        Self {
+            max_iterations: 300,
+            tolerance: 1e-4,
+        }
+    }
+}
+
+/// How a fit went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KMeansFit {
+    pub iterations: usize,
+    /// Sum of squared distances of the features to their centres.
+    pub inertia: f64,
+}
+
+/// `k` centres; a feature's cluster is its nearest centre (Euclidean, ties to the lower index).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct KMeans {
+    centers: Vec<Vec<f64>>,
+}
+
+/// Squared Euclidean distance.
+#[inline]
+pub(crate) fn squared_distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+/// k-means++ seeding: the first centre is a uniformly drawn feature, each next one a feature drawn
+/// with probability proportional to `D(x)^2`, its squared distance to the nearest centre so far.
+/// Returns the indices of the `k` chosen features. When every remaining `D(x)^2` is 0 (fewer
+/// distinct features than `k`) the next centre is drawn uniformly.
+pub fn kmeans_plus_plus(data: &FeatureMatrix, k: usize, rng: &mut Rng) -> Vec<usize> {
+    let n = data.rows();
+    let mut chosen = Vec::with_capacity(k);
+    if k == 0 {
+        return chosen;
+    }
+    let first = rng.random_range(0..n);
+    chosen.push(first);
+    let mut d2: Vec<f64> = data
+        .iter_rows()
+        .map(|x| squared_distance(x, data.row(first)))
+        .collect();
+    while chosen.len() < k {
+        let total: f64 = d2.iter().sum();
+        let pick = if total > 0.0 {
+            let target = rng.random::<f64>() * total;
+            let mut cumulative = 0.0;
+            let mut pick = None;
+            for (i, &w) in d2.iter().enumerate() {
+                cumulative += w;
+                if w > 0.0 && cumulative > target {
+                    pick = Some(i);
+                    break;
+                }
+            }
+            // Rounding can leave `target` at the very top; take the last feature with weight.
+            pick.or_else(|| d2.iter().rposition(|&w| w > 0.0)).unwrap_or(0)
+        } else {
+            rng.random_range(0..n)
+        };
+        chosen.push(pick);
+        let c = data.row(pick);
+        for (d, x) in d2.iter_mut().zip(data.iter_rows()) {
+            *d = d.min(squared_distance(x, c));
+        }
+    }
+    chosen
+}
+
+impl KMeans {
+    /// Clusters `data` into `k` groups: k-means++ seeding from `rng`, then Lloyd's iterations. An
+    /// emptied cluster is re-seeded with the feature farthest from its centre. Deterministic for
+    /// a given `rng` state, whatever the thread count.
+    pub fn fit(
+        data: &FeatureMatrix,
+        k: usize,
+        config: &KMeansConfig,
+        rng: &mut Rng,
+    ) -> Result<(Self, KMeansFit), RecognizeError> {
+        let (n, d) = (data.rows(), data.dim());
+        if k == 0 {
+            return Err(RecognizeError::InvalidParameter {
+                name: "k",
+                what: "needs at least one cluster".into(),
+            });
+        }
+        if n < k {
+            return Err(RecognizeError::TooFewFeatures { k, n });
+        }
+        let mut centers: Vec<Vec<f64>> = kmeans_plus_plus(data, k, rng)
+            .into_iter()
+            .map(|i| data.row(i).to_vec())
+            .collect();
+        let threshold = config.tolerance * mean_variance(data);
+        let mut labels = vec![usize::MAX; n];
+        let mut distances = vec![0.0; n];
+        let mut iterations = 0;
+        while iterations < config.max_iterations {
+            iterations += 1;
+            let changed = assign(data, &centers, &mut labels, &mut distances);
+            let mut sums = vec![vec![0.0; d]; k];
+            let mut counts = vec![0usize; k];
+            for (x, &l) in data.iter_rows().zip(&labels) {
+                counts[l] += 1;
+                for (s, v) in sums[l].iter_mut().zip(x) {
+                    *s += v;
+                }
+            }
+            reseed_empty(data, &mut labels, &mut distances, &mut sums, &mut counts);
+            let mut shift = 0.0;
+            for ((center, sum), &count) in centers.iter_mut().zip(&sums).zip(&counts) {
+                for (c, s) in center.iter_mut().zip(sum) {
+                    let new = s / count as f64;
+                    shift += (new - *c) * (new - *c);
+                    *c = new;
+                }
+            }
+            if changed == 0 || shift <= threshold {
+                break;
+            }
+        }
+        let model = Self { centers };
+        let inertia = data
+            .iter_rows()
+            .map(|x| squared_distance(x, &model.centers[model.nearest(x)]))
+            .sum();
+        Ok((model, KMeansFit { iterations, inertia }))
+    }
+
+    /// Centres from explicit coordinates (all the same, non-zero length, finite).
+    pub fn from_centers(centers: Vec<Vec<f64>>) -> Result<Self, RecognizeError> {
+        let model = Self { centers };
+        model.check().map_err(|what| RecognizeError::InvalidParameter {
+            name: "centers",
+            what,
+        })?;
+        Ok(model)
+    }
+
+    pub fn centers(&self) -> &[Vec<f64>] {
+        &self.centers
+    }
+
+    pub fn k(&self) -> usize {
+        self.centers.len()
+    }
+
+    pub fn dim(&self) -> usize {
+        self.centers[0].len()
+    }
+
+    /// The index of the centre nearest to `x` (ties to the lower index).
+    pub fn nearest(&self, x: &[f64]) -> usize {
+        let mut best = (0, f64::INFINITY);
+        for (i, c) in self.centers.iter().enumerate() {
+            let d = squared_distance(x, c);
+            if d < best.1 {
+                best = (i, d);
+            }
+        }
+        best.0
+    }
+
+    /// The cluster of every feature.
+    pub fn labels(&self, data: &FeatureMatrix) -> Vec<usize> {
+        data.iter_rows().map(|x| self.nearest(x)).collect()
+    }
+
+    pub(crate) fn check(&self) -> Result<(), String> {
+        let d = self.centers.first().map_or(0, Vec::len);
+        if d == 0 {
+            return Err("k-means has no centres or centres of zero length".into());
+        }
+        if let Some(i) = self.centers.iter().position(|c| c.len() != d) {
+            return Err(format!(
+                "k-means centre {i} has {} values, expected {d}",
+                self.centers[i].len()
+            ));
+        }
+        if self.centers.iter().flatten().any(|v| !v.is_finite()) {
+            return Err("k-means has a non-finite centre".into());
+        }
+        Ok(())
+    }
+}
+
+/// Mean over dimensions of the per-dimension variance (population form).
+fn mean_variance(data: &FeatureMatrix) -> f64 {
+    let (n, d) = (data.rows() as f64, data.dim());
+    let mut mean = vec![0.0; d];
+    for x in data.iter_rows() {
+        mean.iter_mut().zip(x).for_each(|(m, v)| *m += v / n);
+    }
+    let total: f64 = data.iter_rows().map(|x| squared_distance(x, &mean)).sum();
+    total / (n * d as f64)
+}
+
+/// Labels every feature with its nearest centre, in parallel (each feature independently, so the
+/// result does not depend on the thread count); returns how many labels changed.
+fn assign(data: &FeatureMatrix, centers: &[Vec<f64>], labels: &mut [usize], distances: &mut [f64]) -> usize {
+    const CHUNK: usize = 512;
+    let d = data.dim();
+    data.as_slice()
+        .par_chunks(CHUNK * d)
+        .zip(labels.par_chunks_mut(CHUNK))
+        .zip(distances.par_chunks_mut(CHUNK))
+        .map(|((rows, labels), distances)| {
+            let mut changed = 0;
+            for ((x, label), dist) in rows
+                .chunks_exact(d)
+                .zip(labels.iter_mut())
+                .zip(distances.iter_mut())
+            {
+                let mut best = (0, f64::INFINITY);
+                for (i, c) in centers.iter().enumerate() {
+                    let dd = squared_distance(x, c);
+                    if dd < best.1 {
+                        best = (i, dd);
+                    }
+                }
+                if *label != best.0 {
+                    changed += 1;
+                    *label = best.0;
+                }
+                *dist = best.1;
+            }
+            changed
+        })
+        .sum()
+}
+
+/// Moves, into every empty cluster, the feature farthest from its current centre (ties to the
+/// lower index), updating the running sums and counts.
+fn reseed_empty(
+    data: &FeatureMatrix,
+    labels: &mut [usize],
+    distances: &mut [f64],
+    sums: &mut [Vec<f64>],
+    counts: &mut [usize],
+) {
+    for empty in 0..counts.len() {
+        if counts[empty] > 0 {
+            continue;
+        }
+        let far =
+            (0..labels.len())
+                .filter(|&i| counts[labels[i]] > 1)
+                .fold(None, |best: Option<usize>, i| match best {
+                    Some(b) if distances[b] >= distances[i] => Some(b),
+                    _ => Some(i),
+                });
+        let Some(i) = far else { continue };
+        let from = labels[i];
+        let x = data.row(i);
+        sums[from].iter_mut().zip(x).for_each(|(s, v)| *s -= v);
+        counts[from] -= 1;
+        sums[empty].copy_from_slice(x);
+        counts[empty] = 1;
+        labels[i] = empty;
+        distances[i] = 0.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::stream;
+
+    fn blobs() -> FeatureMatrix {
+        let mut rng = stream(1, 0);
+        let centers = [[0.0, 0.0], [100.0, 0.0], [0.0, 100.0]];
+        let features: Vec<Vec<f64>> = (0..90)
+            .map(|i| {
+                let c = centers[i % 3];
+                vec![c[0] + rng.random::<f64>() - 0.5, c[1] + rng.random::<f64>() - 0.5]
+            })
+            .collect();
+        FeatureMatrix::from_features(&features, "blobs").unwrap()
+    }
+
+    #[test]
+    fn separates_well_separated_blobs() {
+        let data = blobs();
+        let (km, fit) = KMeans::fit(&data, 3, &KMeansConfig::default(), &mut stream(5, 0)).unwrap();
+        let labels = km.labels(&data);
+        for i in 0..90 {
+            assert_eq!(labels[i], labels[i % 3], "feature {i}");
+        }
+        assert!(labels[0] != labels[1] && labels[1] != labels[2] && labels[0] != labels[2]);
+        // Each blob is uniform on a unit square: inertia ~ 90 * 2/12.
+        assert!(fit.inertia < 90.0 * 0.25, "{}", fit.inertia);
+    }
+
+    #[test]
+    fn plus_plus_spreads_seeds_over_distinct_blobs() {
+        let data = blobs();
+        for seed in 0..20 {
+            let seeds = kmeans_plus_plus(&data, 3, &mut stream(seed, 0));
+            let mut blobs: Vec<usize> = seeds.iter().map(|i| i % 3).collect();
+            blobs.sort();
+            blobs.dedup();
+            // D^2 weighting makes a second seed in the same blob ~(0.5/100)^2 as likely as a new blob.
+            assert_eq!(blobs.len(), 3, "seed {seed}: {seeds:?}");
+        }
+    }
+
+    #[test]
+    fn empty_clusters_are_reseeded() {
+        // Two distinct points repeated, k = 3: one cluster must take a duplicate.
+        let features: Vec<Vec<f64>> = (0..6).map(|i| vec![(i % 2) as f64]).collect();
+        let data = FeatureMatrix::from_features(&features, "t").unwrap();
+        let (km, _) = KMeans::fit(&data, 3, &KMeansConfig::default(), &mut stream(0, 0)).unwrap();
+        assert!(km.centers().iter().flatten().all(|v| v.is_finite()));
+        assert!(matches!(
+            KMeans::fit(&data, 7, &KMeansConfig::default(), &mut stream(0, 0)),
+            Err(RecognizeError::TooFewFeatures { k: 7, n: 6 })
+        ));
+    }
+}

@@ -1,0 +1,385 @@
+//! Training with model selection (Sec. V-B1): over a grid of cluster counts `k` and several seeded
+//! restarts, keep the model with the best validation accuracy, ties broken by reliability (the
+//! probability the posterior puts on the correct object).
+
+use serde::{Deserialize, Serialize};
+
+use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
+use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
+use crate::recognize::evaluate::{Trial, make_trials};
+use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
+use crate::recognize::pca::{Pca, VarianceFraction};
+use crate::recognize::{FeatureMatrix, RecognizeError};
+use crate::rng::{stream, substream};
+
+/// Everything that determines a trained model besides the data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainConfig {
+    pub codebook: CodebookKind,
+    /// The cluster counts to try.
+    pub ks: Vec<usize>,
+    /// Seeded restarts per `k`.
+    pub restarts: usize,
+    /// Restart `r` of `k` draws from `rng::stream(substream(seed, k), r)`, so adding values of
+    /// `k` or restarts leaves the other candidates unchanged.
+    pub seed: u64,
+    pub variance_kept: VarianceFraction,
+    pub pseudo_count: PseudoCount,
+    pub fitting: CodebookConfig,
+    /// Readings per validation trial: validation readings of each object are split into trials
+    /// of this many consecutive readings, each classified as one unknown object.
+    pub trial_readings: usize,
+    /// Without a separate validation set, the last `holdout` of each object's training readings
+    /// are held out for validation (1/11: the paper's 1000 + 100).
+    pub holdout: f64,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        Self {
+            codebook: CodebookKind::Gmm,
+            ks: vec![10, 20, 50],
+            restarts: 3,
+            seed: 0,
+            variance_kept: VarianceFraction::PAPER,
+            pseudo_count: PseudoCount::LAPLACE,
+            fitting: CodebookConfig::default(),
+            trial_readings: 10,
+            holdout: 1.0 / 11.0,
+        }
+    }
+}
+
+impl TrainConfig {
+    fn validate(&self) -> Result<(), RecognizeError> {
+        let bad = |name, what: &str| {
+            Err(RecognizeError::InvalidParameter {
+                name,
+                what: what.to_string(),
+            })
+        };
+        if self.ks.is_empty() {
+            return bad("k", "give at least one cluster count");
+        }
+        if self.ks.contains(&0) {
+            return bad("k", "cluster counts must be at least 1");
+        }
+        if self.restarts == 0 {
+            return bad("restarts", "must be at least 1");
+        }
+        if self.trial_readings == 0 {
+            return bad("trial_readings", "must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// One candidate's validation result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CandidateScore {
+    pub k: usize,
+    pub restart: usize,
+    /// Validation trials classified correctly, of `trials`.
+    pub correct: usize,
+    pub trials: usize,
+    /// Mean probability on the correct object over the validation trials.
+    pub reliability: f64,
+    /// Why the candidate could not be fitted (e.g. a singular covariance); then it is not chosen.
+    pub failure: Option<String>,
+}
+
+impl CandidateScore {
+    pub fn accuracy(&self) -> f64 {
+        if self.trials == 0 {
+            0.0
+        } else {
+            self.correct as f64 / self.trials as f64
+        }
+    }
+
+    /// Sec. V-B1's order: more correct, then higher reliability; a failed fit is never better.
+    pub fn is_better_than(&self, other: &CandidateScore) -> bool {
+        match (&self.failure, &other.failure) {
+            (Some(_), _) => false,
+            (None, Some(_)) => true,
+            (None, None) => {
+                self.correct > other.correct
+                    || (self.correct == other.correct && self.reliability > other.reliability)
+            }
+        }
+    }
+}
+
+/// What model selection tried and what it kept.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SelectionReport {
+    pub chosen_k: usize,
+    pub chosen_restart: usize,
+    /// Every candidate, in the order tried (`k` in the given order, restarts within).
+    pub candidates: Vec<CandidateScore>,
+    /// Where the validation data came from.
+    pub validation: String,
+    /// Training readings and features used (after any hold-out).
+    pub training_readings: usize,
+    pub training_features: usize,
+    /// Principal components kept, and the fraction of variance they explain.
+    pub pca_components: usize,
+    pub pca_variance_ratio: f64,
+}
+
+impl SelectionReport {
+    /// The chosen candidate's score.
+    pub fn chosen(&self) -> Option<&CandidateScore> {
+        self.candidates
+            .iter()
+            .find(|c| c.k == self.chosen_k && c.restart == self.chosen_restart)
+    }
+}
+
+/// What [`train`] reports while it runs (for progress bars).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrainProgress {
+    /// PCA is fitted; `total` candidates follow.
+    PcaFitted {
+        components: usize,
+        variance_ratio: f64,
+        total: usize,
+    },
+    /// Candidate `index` of `total` is being fitted.
+    Fitting {
+        index: usize,
+        total: usize,
+        k: usize,
+        restart: usize,
+    },
+    /// A candidate was scored.
+    Scored(CandidateScore),
+}
+
+/// A trained pipeline and how it was chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trained {
+    pub bag: BagOfFeatures,
+    pub selection: SelectionReport,
+}
+
+/// Trains on `training` (Fig. 4): PCA on all training features, then for every `k` and restart a
+/// codebook and the objects' histograms, scored on validation trials; keeps the best candidate.
+/// `validation` must name only training objects; without it, part of `training` is held out
+/// ([`TrainConfig::holdout`]).
+pub fn train(
+    training: &LabelledFeatures,
+    validation: Option<&LabelledFeatures>,
+    config: &TrainConfig,
+    progress: &mut dyn FnMut(TrainProgress),
+) -> Result<Trained, RecognizeError> {
+    config.validate()?;
+    let held_out;
+    let (training, validation, validation_origin) = match validation {
+        Some(v) => (training, v, "a separate validation set".to_string()),
+        None => {
+            held_out = training.split_validation(config.holdout)?;
+            (
+                &held_out.0,
+                &held_out.1,
+                format!(
+                    "the last {:.3} of each object's training readings",
+                    config.holdout
+                ),
+            )
+        }
+    };
+    let objects = training.objects().to_vec();
+    if let Some(j) = (0..objects.len()).find(|&j| training.readings(j).iter().all(Vec::is_empty)) {
+        return Err(RecognizeError::EmptyObject {
+            object: objects[j].clone(),
+        });
+    }
+    let raw = FeatureMatrix::from_features(training.features(), "the training set")?;
+    let pca = Pca::fit(&raw, config.variance_kept)?;
+    let reduced = pca.transform(&raw);
+    drop(raw);
+    // Rows of `reduced` are object by object; each object's block gives its histogram.
+    let mut blocks = Vec::with_capacity(objects.len());
+    let mut start = 0;
+    for j in 0..objects.len() {
+        let n: usize = training.readings(j).iter().map(Vec::len).sum();
+        blocks.push(FeatureMatrix::from_trusted(
+            n,
+            reduced.dim(),
+            reduced.as_slice()[start * reduced.dim()..(start + n) * reduced.dim()].to_vec(),
+        ));
+        start += n;
+    }
+    let trials = make_trials(validation, &objects, config.trial_readings)?;
+    let trials = reduce_trials(&pca, &trials)?;
+    let total = config.ks.len() * config.restarts;
+    progress(TrainProgress::PcaFitted {
+        components: pca.output_dim(),
+        variance_ratio: pca.kept_variance_ratio(),
+        total,
+    });
+
+    let mut best: Option<(CandidateScore, CodebookModel, ObjectModels)> = None;
+    let mut candidates = Vec::with_capacity(total);
+    let mut first_error = None;
+    for (ki, &k) in config.ks.iter().enumerate() {
+        for restart in 0..config.restarts {
+            progress(TrainProgress::Fitting {
+                index: ki * config.restarts + restart,
+                total,
+                k,
+                restart,
+            });
+            let mut rng = stream(substream(config.seed, k as u64), restart as u64);
+            let fitted = CodebookModel::fit(config.codebook, &reduced, k, &config.fitting, &mut rng)
+                .and_then(|cb| {
+                    let histograms: Vec<ClusterHistogram> =
+                        blocks.iter().map(|b| reduced_histogram(&cb, b)).collect();
+                    let models = ObjectModels::fit(objects.clone(), &histograms, config.pseudo_count)?;
+                    Ok((cb, models))
+                });
+            let (score, fitted) = match fitted {
+                Ok((cb, models)) => (
+                    score_candidate(&cb, &models, &trials, k, restart),
+                    Some((cb, models)),
+                ),
+                Err(e) => {
+                    let score = CandidateScore {
+                        k,
+                        restart,
+                        correct: 0,
+                        trials: trials.len(),
+                        reliability: 0.0,
+                        failure: Some(e.to_string()),
+                    };
+                    first_error.get_or_insert(e);
+                    (score, None)
+                }
+            };
+            progress(TrainProgress::Scored(score.clone()));
+            if let Some((cb, models)) = fitted
+                && best.as_ref().is_none_or(|(b, _, _)| score.is_better_than(b))
+            {
+                best = Some((score.clone(), cb, models));
+            }
+            candidates.push(score);
+        }
+    }
+    let Some((chosen, codebook, models)) = best else {
+        return Err(
+            first_error.unwrap_or_else(|| RecognizeError::NoFeatures("no candidate was fitted".into()))
+        );
+    };
+    let selection = SelectionReport {
+        chosen_k: chosen.k,
+        chosen_restart: chosen.restart,
+        candidates,
+        validation: validation_origin,
+        training_readings: training.reading_count(),
+        training_features: reduced.rows(),
+        pca_components: pca.output_dim(),
+        pca_variance_ratio: pca.kept_variance_ratio(),
+    };
+    Ok(Trained {
+        bag: BagOfFeatures::new(pca, codebook, models)?,
+        selection,
+    })
+}
+
+/// A validation trial with its features already PCA-reduced, one matrix per reading.
+struct ReducedTrial {
+    object: usize,
+    features: Vec<FeatureMatrix>,
+}
+
+fn reduce_trials(pca: &Pca, trials: &[Trial]) -> Result<Vec<ReducedTrial>, RecognizeError> {
+    trials
+        .iter()
+        .map(|t| {
+            let mut features = Vec::with_capacity(t.readings.len());
+            for (r, reading) in t.readings.iter().enumerate() {
+                if reading.is_empty() {
+                    continue;
+                }
+                let origin = format!("validation reading {r} of an object");
+                let m = FeatureMatrix::from_features(reading, &origin)?;
+                if m.dim() != pca.input_dim() {
+                    return Err(RecognizeError::FeatureDimension {
+                        origin,
+                        index: 0,
+                        got: m.dim(),
+                        expected: pca.input_dim(),
+                    });
+                }
+                features.push(pca.transform(&m));
+            }
+            Ok(ReducedTrial {
+                object: t.object,
+                features,
+            })
+        })
+        .collect()
+}
+
+/// Classifies every validation trial with all its readings.
+fn score_candidate(
+    codebook: &CodebookModel,
+    models: &ObjectModels,
+    trials: &[ReducedTrial],
+    k: usize,
+    restart: usize,
+) -> CandidateScore {
+    let mut correct = 0;
+    let mut reliability = 0.0;
+    let mut membership = vec![0.0; codebook.clusters()];
+    for t in trials {
+        let mut histogram = ClusterHistogram::new(codebook.clusters());
+        for m in &t.features {
+            for x in m.iter_rows() {
+                codebook.membership(x, &mut membership);
+                histogram.add(&membership);
+            }
+        }
+        let decision = models.decide(&histogram);
+        if decision.guess == t.object {
+            correct += 1;
+        }
+        reliability += decision.probabilities[t.object];
+    }
+    let n = trials.len();
+    CandidateScore {
+        k,
+        restart,
+        correct,
+        trials: n,
+        reliability: if n == 0 { 0.0 } else { reliability / n as f64 },
+        failure: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn score(correct: usize, reliability: f64, failure: bool) -> CandidateScore {
+        CandidateScore {
+            k: 1,
+            restart: 0,
+            correct,
+            trials: 10,
+            reliability,
+            failure: failure.then(|| "x".into()),
+        }
+    }
+
+    #[test]
+    fn accuracy_first_then_reliability_and_failures_last() {
+        assert!(score(8, 0.1, false).is_better_than(&score(7, 0.9, false)));
+        assert!(score(8, 0.6, false).is_better_than(&score(8, 0.5, false)));
+        assert!(!score(8, 0.5, false).is_better_than(&score(8, 0.5, false)));
+        assert!(score(0, 0.0, false).is_better_than(&score(9, 0.9, true)));
+        assert!(!score(9, 0.9, true).is_better_than(&score(0, 0.0, false)));
+    }
+}

@@ -1,0 +1,138 @@
+//! The `taction train`, `taction recognize` and `taction dataset show` commands end to end on the
+//! toy object set.
+
+mod recognize_toy;
+
+use std::process::Command;
+
+fn taction(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    recognize_toy::dataset(40, 1)
+        .write(dir.path().join("train.csv").as_path())
+        .unwrap();
+    recognize_toy::dataset(15, 2)
+        .write(dir.path().join("val.csv").as_path())
+        .unwrap();
+    recognize_toy::dataset(30, 3)
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+
+    let (ok, stdout, stderr) = taction(&["dataset", "show", &p("train.csv")]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("ridges") && stdout.contains("40") && stdout.contains("8x8 taxels"),
+        "{stdout}"
+    );
+
+    let (ok, stdout, stderr) = taction(&[
+        "train",
+        "--dataset",
+        &p("train.csv"),
+        "--validation",
+        &p("val.csv"),
+        "--descriptor",
+        "polar-fourier",
+        "--codebook",
+        "gmm",
+        "--k",
+        "3,5",
+        "--restarts",
+        "2",
+        "--out",
+        &p("model.json"),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("chosen k = "), "{stdout}");
+
+    let (ok, stdout, stderr) = taction(&[
+        "recognize",
+        "--model",
+        &p("model.json"),
+        "--dataset",
+        &p("test.csv"),
+        "--readings",
+        "1..30",
+        "--out",
+        &p("out"),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("accuracy at   1 readings") && stdout.contains("accuracy at  30 readings: 1.000"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("accuracy at 100"), "{stdout}");
+    let posterior = std::fs::read_to_string(dir.path().join("out/posterior.csv")).unwrap();
+    let mut lines = posterior.lines();
+    assert_eq!(
+        lines.next(),
+        Some("trial,object_true,n_readings,object_guess,p_true,entropy")
+    );
+    assert_eq!(lines.count(), 3 * 30);
+    let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
+    assert!(
+        accuracy.starts_with("n_readings,trials,correct,accuracy,mean_p_true\n1,3,"),
+        "{accuracy}"
+    );
+    let confusion = std::fs::read_to_string(dir.path().join("out/confusion.csv")).unwrap();
+    assert!(
+        confusion.contains("ridges,ridges,1\n") && confusion.contains("flat,ridges,0\n"),
+        "{confusion}"
+    );
+}
+
+#[test]
+fn bad_inputs_fail_with_a_message_naming_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let (ok, _, stderr) = taction(&["dataset", "show", &p("missing.csv")]);
+    assert!(!ok && stderr.contains("missing.csv"), "{stderr}");
+    recognize_toy::dataset(3, 1)
+        .write(dir.path().join("d.csv").as_path())
+        .unwrap();
+    let (ok, _, stderr) = taction(&[
+        "train",
+        "--dataset",
+        &p("d.csv"),
+        "--descriptor",
+        "hog",
+        "--out",
+        &p("m.json"),
+    ]);
+    assert!(!ok && stderr.contains("unknown descriptor 'hog'"), "{stderr}");
+    let (ok, _, stderr) = taction(&[
+        "recognize",
+        "--model",
+        &p("d.csv"),
+        "--dataset",
+        &p("d.csv"),
+        "--out",
+        &p("o"),
+    ]);
+    assert!(!ok && stderr.contains("not a taction model"), "{stderr}");
+    let (ok, _, stderr) = taction(&[
+        "recognize",
+        "--model",
+        &p("m.json"),
+        "--dataset",
+        &p("d.csv"),
+        "--readings",
+        "5..2",
+        "--out",
+        &p("o"),
+    ]);
+    assert!(!ok && stderr.contains("5..2"), "{stderr}");
+}

@@ -1,0 +1,177 @@
+//! Saved models (issue 7, item 7): save -> load gives identical predictions; every corrupt file
+//! gives its own named error.
+
+mod recognize_toy;
+
+use taction::describe::DescriptorKind;
+use taction::recognize::{
+    CodebookKind, LabelledFeatures, ReadingRange, RecognizeError, TrainConfig, TrainedModel,
+    TrainingProvenance, evaluate, make_trials, train,
+};
+
+fn model(kind: CodebookKind) -> TrainedModel {
+    let descriptor = DescriptorKind::PolarFourier.build();
+    let data = recognize_toy::dataset(30, 8);
+    let features = LabelledFeatures::from_dataset(&data, descriptor.as_ref());
+    let config = TrainConfig {
+        codebook: kind,
+        ks: vec![4],
+        restarts: 1,
+        seed: 3,
+        ..TrainConfig::default()
+    };
+    let trained = train(&features, None, &config, &mut |_| {}).unwrap();
+    TrainedModel::new(
+        descriptor.params(),
+        data.header().sensor,
+        trained.bag,
+        trained.selection,
+        TrainingProvenance {
+            object_set: data.header().object_set.clone(),
+            generator: data.header().generator.clone(),
+            dataset_seed: data.header().seed,
+            config,
+        },
+    )
+}
+
+#[test]
+fn save_then_load_gives_identical_predictions() {
+    let dir = tempfile::tempdir().unwrap();
+    let test = recognize_toy::dataset(10, 77);
+    for kind in [CodebookKind::Gmm, CodebookKind::Kmeans] {
+        let original = model(kind);
+        let path = dir.path().join(format!("{}.json", kind.name()));
+        original.save(&path).unwrap();
+        let loaded = TrainedModel::load(&path).unwrap();
+        assert_eq!(loaded, original);
+        loaded.check_sensor(&test.header().sensor).unwrap();
+        let descriptor = loaded.build_descriptor().unwrap();
+        let features = LabelledFeatures::from_dataset(&test, descriptor.as_ref());
+        let trials = make_trials(&features, loaded.bag.objects(), 5).unwrap();
+        let range = ReadingRange::new(1, 5).unwrap();
+        let before = evaluate(&original.bag, &trials, range).unwrap();
+        let after = evaluate(&loaded.bag, &trials, range).unwrap();
+        assert_eq!(before, after);
+        let bits = |e: &taction::recognize::Evaluation| -> Vec<u64> {
+            e.touches
+                .iter()
+                .flat_map(|t| [t.p_true.to_bits(), t.entropy_nats.to_bits()])
+                .collect()
+        };
+        assert_eq!(bits(&before), bits(&after));
+    }
+}
+
+fn saved() -> (tempfile::TempDir, std::path::PathBuf, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    model(CodebookKind::Gmm).save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    (dir, path, text)
+}
+
+fn load_text(path: &std::path::Path, text: &str) -> RecognizeError {
+    std::fs::write(path, text).unwrap();
+    TrainedModel::load(path).unwrap_err()
+}
+
+#[test]
+fn truncated_file() {
+    let (_dir, path, text) = saved();
+    for cut in [text.len() / 3, text.len() - 1] {
+        let e = load_text(&path, &text[..cut]);
+        assert!(matches!(e, RecognizeError::Truncated { .. }), "{e}");
+        assert!(
+            e.to_string().contains("m.json") && e.to_string().contains("truncated"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn file_from_another_version() {
+    let (_dir, path, text) = saved();
+    assert!(text.starts_with("{\"format_version\":1,"), "{}", &text[..40]);
+    let e = load_text(
+        &path,
+        &text.replacen("\"format_version\":1", "\"format_version\":2", 1),
+    );
+    assert!(
+        matches!(
+            e,
+            RecognizeError::Version {
+                found: 2,
+                expected: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = load_text(&path, &text.replacen("\"format_version\":1,", "", 1));
+    assert!(
+        matches!(e, RecognizeError::NotAModel { .. }) && e.to_string().contains("format_version"),
+        "{e}"
+    );
+}
+
+#[test]
+fn sensor_config_that_does_not_match_the_data() {
+    let m = model(CodebookKind::Kmeans);
+    let mut other = m.sensor;
+    other.noise_seed += 1;
+    m.check_sensor(&other).unwrap();
+    other.rows = 6;
+    other.thickness_m *= 2.0;
+    let e = m.check_sensor(&other).unwrap_err();
+    assert!(matches!(e, RecognizeError::SensorMismatch { .. }), "{e}");
+    let text = e.to_string();
+    assert!(
+        text.contains("rows 8 (model) vs 6 (data)") && text.contains("thickness_m"),
+        "{text}"
+    );
+}
+
+#[test]
+fn inconsistent_or_foreign_content() {
+    let (_dir, path, text) = saved();
+    let e = load_text(&path, "P5 not json");
+    assert!(matches!(e, RecognizeError::NotAModel { .. }), "{e}");
+    // A descriptor whose features do not fit the PCA.
+    let e = load_text(
+        &path,
+        &text.replacen(
+            "\"descriptor\":\"polar-fourier\"",
+            "\"descriptor\":\"vectorize\"",
+            1,
+        ),
+    );
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("PCA takes"),
+        "{e}"
+    );
+    // A histogram that is not a distribution.
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut broken = value.clone();
+    broken["bag"]["models"]["probabilities"][0][0] = serde_json::json!(0.9);
+    let e = load_text(&path, &broken.to_string());
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("sums to"),
+        "{e}"
+    );
+    // A covariance that is not positive definite.
+    let mut broken = value.clone();
+    let d = broken["bag"]["codebook"]["means"][0].as_array().unwrap().len();
+    broken["bag"]["codebook"]["covariances"][0][0] = serde_json::json!(-1.0);
+    assert!(d >= 1);
+    let e = load_text(&path, &broken.to_string());
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("positive definite"),
+        "{e}"
+    );
+    let e = TrainedModel::load(&path.with_file_name("missing.json")).unwrap_err();
+    assert!(
+        matches!(e, RecognizeError::Io { .. }) && e.to_string().contains("missing.json"),
+        "{e}"
+    );
+}
