@@ -116,9 +116,7 @@ impl GaussianMixture {
                 what: format!("{} is not a finite non-negative number", config.reg_covar),
             });
         }
-        let t0 = std::time::Instant::now();
-        let (kmeans, kfit) = KMeans::fit(data, k, &config.kmeans, rng)?;
-        eprintln!("PROFILE kmeans {:?} iters {}", t0.elapsed(), kfit.iterations);
+        let (kmeans, _) = KMeans::fit(data, k, &config.kmeans, rng)?;
         let responsibilities: Vec<Vec<f64>> = {
             let labels = kmeans.labels(data);
             (0..k)
@@ -133,13 +131,8 @@ impl GaussianMixture {
         for iteration in 1..=config.max_iterations {
             iterations = iteration;
             let previous = lower_bound;
-            let t1 = std::time::Instant::now();
             let (mean_ll, responsibilities) = model.e_step(&x);
-            let t2 = std::time::Instant::now();
             model = m_step(&x, &responsibilities, config.reg_covar)?;
-            if iteration % 25 == 1 {
-                eprintln!("PROFILE e {:?} m {:?}", t2 - t1, t2.elapsed());
-            }
             lower_bound = mean_ll;
             if (lower_bound - previous).abs() < config.tolerance {
                 converged = true;
@@ -333,49 +326,26 @@ fn m_step(
     responsibilities: &[Vec<f64>],
     reg_covar: f64,
 ) -> Result<GaussianMixture, RecognizeError> {
-    let d = x.ncols();
-    #[allow(clippy::type_complexity)]
-    let per_component: Vec<Result<(f64, Vec<f64>, Vec<f64>, DMatrix<f64>, f64), RecognizeError>> =
-        responsibilities
-            .par_iter()
-            .enumerate()
-            .map(|(i, resp)| {
-                let r = DVector::from_column_slice(resp);
-                let nk = r.sum() + 10.0 * f64::EPSILON;
-                let mean = x.tr_mul(&r) / nk;
-                let mut diff = x.clone();
-                for (j, mut column) in diff.column_iter_mut().enumerate() {
-                    column.add_scalar_mut(-mean[j]);
-                }
-                let mut weighted = diff.clone();
-                for mut column in weighted.column_iter_mut() {
-                    column.component_mul_assign(&r);
-                }
-                let mut sigma = diff.tr_mul(&weighted) / nk;
-                for a in 0..d {
-                    sigma[(a, a)] += reg_covar;
-                    for b in 0..a {
-                        sigma[(b, a)] = sigma[(a, b)];
-                    }
-                }
-                let covariance: Vec<f64> = sigma.transpose().as_slice().to_vec();
-                let (p, log_det) =
-                    precision_cholesky(sigma).ok_or(RecognizeError::SingularCovariance { component: i })?;
-                Ok((nk, mean.as_slice().to_vec(), covariance, p, log_det))
-            })
-            .collect();
-    let mut weights = Vec::with_capacity(responsibilities.len());
-    let mut means = Vec::with_capacity(responsibilities.len());
-    let mut covariances = Vec::with_capacity(responsibilities.len());
-    let mut precision_chol = Vec::with_capacity(responsibilities.len());
-    let mut log_det_precision = Vec::with_capacity(responsibilities.len());
-    for result in per_component {
-        let (nk, mean, covariance, p, log_det) = result?;
-        weights.push(nk);
-        means.push(mean);
-        covariances.push(covariance);
-        precision_chol.push(p);
-        log_det_precision.push(log_det);
+    let per_component: Vec<Result<Component, RecognizeError>> = responsibilities
+        .par_iter()
+        .enumerate()
+        .map(|(i, resp)| {
+            Component::estimate(x, resp, reg_covar).ok_or(RecognizeError::SingularCovariance { component: i })
+        })
+        .collect();
+    let k = responsibilities.len();
+    let mut weights = Vec::with_capacity(k);
+    let mut means = Vec::with_capacity(k);
+    let mut covariances = Vec::with_capacity(k);
+    let mut precision_chol = Vec::with_capacity(k);
+    let mut log_det_precision = Vec::with_capacity(k);
+    for component in per_component {
+        let c = component?;
+        weights.push(c.n);
+        means.push(c.mean);
+        covariances.push(c.covariance);
+        precision_chol.push(c.precision_chol);
+        log_det_precision.push(c.log_det_precision);
     }
     let total: f64 = weights.iter().sum();
     weights.iter_mut().for_each(|w| *w /= total);
@@ -390,6 +360,50 @@ fn m_step(
         log_det_precision,
         log_weights,
     })
+}
+
+/// One component's M-step result.
+struct Component {
+    /// `n_i`, the summed responsibilities (the unnormalised weight).
+    n: f64,
+    mean: Vec<f64>,
+    /// Row-major `d x d`.
+    covariance: Vec<f64>,
+    precision_chol: DMatrix<f64>,
+    log_det_precision: f64,
+}
+
+impl Component {
+    /// The M-step for the component with responsibilities `resp`; `None` when its covariance is not
+    /// positive definite.
+    fn estimate(x: &DMatrix<f64>, resp: &[f64], reg_covar: f64) -> Option<Self> {
+        let (n_rows, d) = x.shape();
+        let r = DVector::from_column_slice(resp);
+        let n = r.sum() + 10.0 * f64::EPSILON;
+        let mean = x.tr_mul(&r) / n;
+        let mut diff = x.clone();
+        for (j, mut column) in diff.column_iter_mut().enumerate() {
+            column.add_scalar_mut(-mean[j]);
+        }
+        // (D^T diag(r)) D as one blocked matrix product; D^T diag(r) is built transposed directly.
+        let weighted_t = DMatrix::from_fn(d, n_rows, |j, row| diff[(row, j)] * resp[row]);
+        let mut sigma = &weighted_t * &diff / n;
+        for a in 0..d {
+            sigma[(a, a)] += reg_covar;
+            for b in 0..a {
+                sigma[(b, a)] = sigma[(a, b)];
+            }
+        }
+        let covariance = sigma.transpose().as_slice().to_vec();
+        let (precision_chol, log_det_precision) = precision_cholesky(sigma)?;
+        Some(Self {
+            n,
+            mean: mean.as_slice().to_vec(),
+            covariance,
+            precision_chol,
+            log_det_precision,
+        })
+    }
 }
 
 /// `(P, sum_j ln P_jj)` with `P = L^-T` for `Sigma = L L^T`; `None` when `Sigma` is not positive
