@@ -32,8 +32,8 @@ impl PadPose {
         center_m.is_finite().then_some(Self { center_m, normal, up })
     }
 
-    /// Unit vector in the pad plane toward the last image column: `normal x up`, so (right, up,
-    /// normal) is right-handed, as for a camera looking along the normal.
+    /// Unit vector in the pad plane toward the last image column: `normal x up`: the image's right
+    /// as seen from behind the pad, looking along the normal ((right, up, -normal) is right-handed).
     pub fn right(&self) -> DVec3 {
         self.normal.cross(self.up)
     }
@@ -365,7 +365,7 @@ mod tests {
     }
 
     #[test]
-    fn pad_frame_is_right_handed() {
+    fn pad_right_is_the_image_right_seen_from_behind() {
         let pose = PadPose::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0), DVec3::new(0.0, 1.0, 0.3)).unwrap();
         assert!((pose.normal - DVec3::NEG_Z).length() < 1e-12);
         assert!((pose.up - DVec3::Y).length() < 1e-12);
