@@ -45,8 +45,19 @@ use serde::{Deserialize, Serialize};
 use crate::control::ContactStatus;
 pub use crate::explore::Reading;
 use crate::explore::Strategy;
+use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::sim::ObjectSpec;
 use crate::sim::Pose;
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
+
+/// What a dataset's header says produced it: `sampler` (or `sampler from above`), `planner L=0.5`.
+pub fn generator_name(mode: &CollectMode) -> String {
+    match mode {
+        CollectMode::Sampler(c) if c.from_above_only => "sampler from above".to_string(),
+        CollectMode::Sampler(_) => "sampler".to_string(),
+        CollectMode::Planner(c) => format!("planner L={}", c.local_probability),
+    }
+}
 
 /// The file format version this build writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -111,6 +122,8 @@ pub enum DatasetError {
     Csv { path: String, line: u64, what: String },
     #[error("invalid dataset: {0}")]
     Invalid(String),
+    #[error("collecting readings: {0}")]
+    Collect(#[from] crate::control::ControlError),
 }
 
 /// What a dataset holds and how it was made.
@@ -223,6 +236,25 @@ impl Dataset {
         }
         self.readings.push(reading);
         Ok(())
+    }
+
+    /// Collects `objects` (of the set with id `object_set`) as `plan` says on `threads` threads
+    /// (0: all cores) and gathers the readings, object by object, into a dataset.
+    pub fn collect(
+        plan: &CollectPlan,
+        object_set: &str,
+        objects: &[ObjectSpec],
+        threads: usize,
+    ) -> Result<Dataset, DatasetError> {
+        let reports = plan.collect(objects, threads)?;
+        let header = DatasetHeader::new(
+            plan.sensor,
+            object_set,
+            objects.iter().map(|o| o.name.clone()).collect(),
+            generator_name(&plan.mode),
+            plan.seed,
+        );
+        Dataset::new(header, reports.into_iter().flat_map(|r| r.readings).collect())
     }
 
     pub fn header(&self) -> &DatasetHeader {
@@ -706,7 +738,7 @@ impl fmt::Display for DatasetSummary {
         )?;
         writeln!(
             f,
-            "sensor: {}x{} taxels, pad {} x {} m, covering {} m, PSF sigma {} m, {}^2 rays/taxel, noise {} (seed {})",
+            "sensor: {}x{} taxels, pad {} x {} m, covering {} m, PSF sigma {} m, {} rays/taxel ({}), noise {} (seed {})",
             s.rows,
             s.cols,
             s.pad_width_m,
@@ -714,6 +746,10 @@ impl fmt::Display for DatasetSummary {
             s.thickness_m,
             s.psf_sigma_m,
             s.rays_per_taxel,
+            match crate::tactile::config::rays_per_side(s.rays_per_taxel) {
+                Some(k) => format!("{k}x{k} grid"),
+                None => "not a square grid".to_string(),
+            },
             s.noise_fraction,
             s.noise_seed
         )?;
@@ -883,6 +919,11 @@ mod tests {
             shown.contains("2x3 taxels") && shown.contains("no_contact") && shown.contains("local 2"),
             "{shown}"
         );
+        // rays_per_taxel 4 is a 2x2 supersampling grid (it once printed as "4^2").
+        assert!(shown.contains("4 rays/taxel (2x2 grid)"), "{shown}");
+        let mut nine = s.clone();
+        nine.header.sensor.rays_per_taxel = 9;
+        assert!(nine.to_string().contains("9 rays/taxel (3x3 grid)"));
     }
 
     #[test]

@@ -8,8 +8,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    CodebookKind, LabelledFeatures, PseudoCount, TrainConfig, TrainProgress, TrainedModel,
-    TrainingProvenance, VarianceFraction, check_same_sensor, train,
+    CodebookKind, PseudoCount, RecognizeError, TrainConfig, TrainProgress, TrainedModel, VarianceFraction,
 };
 
 #[derive(Debug, Args)]
@@ -77,26 +76,14 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     let training = Dataset::read(&args.dataset)?;
     let validation = args.validation.as_deref().map(Dataset::read).transpose()?;
-    if let (Some(v), Some(path)) = (&validation, &args.validation) {
-        check_same_sensor(&training.header().sensor, &v.header().sensor)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-    }
     let descriptor = args.descriptor.build();
-
-    let spinner =
-        ProgressBar::new_spinner().with_message(format!("describing readings ({})", args.descriptor.name()));
-    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-    let train_features = LabelledFeatures::from_dataset(&training, descriptor.as_ref());
-    let validation_features = validation
-        .as_ref()
-        .map(|v| LabelledFeatures::from_dataset(v, descriptor.as_ref()));
-    spinner.finish_and_clear();
 
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} candidates  {msg}  [{elapsed}]")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    bar.set_message(format!("describing readings ({})", args.descriptor.name()));
     let mut on_progress = |event: TrainProgress| match event {
         TrainProgress::PcaFitted { total, .. } => bar.set_length(total as u64),
         TrainProgress::Fitting { k, restart, .. } => {
@@ -104,27 +91,19 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
         TrainProgress::Scored(_) => bar.inc(1),
     };
-    let trained = train(
-        &train_features,
-        validation_features.as_ref(),
-        &config,
+    let model = TrainedModel::fit(
+        &training,
+        validation.as_ref(),
+        descriptor.as_ref(),
+        config,
         &mut on_progress,
-    )?;
+    )
+    .map_err(|e| match (&e, &args.validation) {
+        (RecognizeError::SensorMismatch { .. }, Some(path)) => format!("{}: {e}", path.display()),
+        _ => e.to_string(),
+    })?;
     bar.finish_and_clear();
 
-    let header = training.header();
-    let model = TrainedModel::new(
-        descriptor.params(),
-        header.sensor,
-        trained.bag,
-        trained.selection,
-        TrainingProvenance {
-            object_set: header.object_set.clone(),
-            generator: header.generator.clone(),
-            dataset_seed: header.seed,
-            config,
-        },
-    );
     model.save(&args.out)?;
     let s = &model.selection;
     println!(

@@ -12,11 +12,12 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::write_atomic;
+use crate::dataset::{Dataset, write_atomic};
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
-use crate::recognize::selection::{SelectionReport, TrainConfig};
+use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::selection::{SelectionReport, TrainConfig, TrainProgress, train};
 use crate::tactile::{SensorConfig, TactileImage};
 
 /// The model file format version this build writes and reads.
@@ -61,6 +62,38 @@ impl TrainedModel {
             selection,
             provenance,
         }
+    }
+
+    /// Trains a model on the converged readings of `training` (Fig. 4), choosing among the
+    /// candidates of `config` on `validation` (or on readings held out of `training`), and records
+    /// the sensor and provenance of the data. The one training path of the CLI, the demo and the
+    /// experiments.
+    pub fn fit(
+        training: &Dataset,
+        validation: Option<&Dataset>,
+        descriptor: &dyn Descriptor,
+        config: TrainConfig,
+        progress: &mut dyn FnMut(TrainProgress),
+    ) -> Result<Self, RecognizeError> {
+        let header = training.header();
+        if let Some(v) = validation {
+            check_same_sensor(&header.sensor, &v.header().sensor)?;
+        }
+        let train_features = LabelledFeatures::from_dataset(training, descriptor);
+        let validation_features = validation.map(|v| LabelledFeatures::from_dataset(v, descriptor));
+        let trained = train(&train_features, validation_features.as_ref(), &config, progress)?;
+        Ok(Self::new(
+            descriptor.params(),
+            header.sensor,
+            trained.bag,
+            trained.selection,
+            TrainingProvenance {
+                object_set: header.object_set.clone(),
+                generator: header.generator.clone(),
+                dataset_seed: header.seed,
+                config,
+            },
+        ))
     }
 
     /// Builds the descriptor the model was trained with.

@@ -1,0 +1,121 @@
+//! `taction experiment NAME|list` and `taction reproduce`: the paper's experiments (Sec. V).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use taction::experiment::RunOptions;
+use taction::experiment::paper::headline::headline_table;
+use taction::experiment::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
+use taction::mesh::ObjectSet;
+
+/// What every paper experiment takes.
+#[derive(Debug, Args)]
+pub struct PaperArgs {
+    /// Fraction of the paper's data sizes (1.0: 1000 + 100 training readings and 3 x 100 test
+    /// readings per object; 0.1 for a quick look).
+    #[arg(long, default_value = "1.0")]
+    pub scale: Scale,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[command(flatten)]
+    pub run: RunOptions,
+    /// The 3D objects: a built-in set, a folder of meshes, a manifest, or mesh files.
+    #[arg(long, num_args = 1.., default_value = "shapes", value_name = "SET")]
+    pub objects: Vec<PathBuf>,
+    /// The raised letters (Fig. 16a): the built-in `letters` or another set.
+    #[arg(long, num_args = 1.., default_value = "letters", value_name = "SET")]
+    pub letters: Vec<PathBuf>,
+    /// Recorded real frames for the sim-to-real experiment (format: `taction::experiment::real_data`)
+    /// [default: the shipped synthetic example].
+    #[arg(long, value_name = "CSV")]
+    pub real: Option<PathBuf>,
+}
+
+impl PaperArgs {
+    fn context(&self) -> Result<PaperContext, Box<dyn std::error::Error>> {
+        let shapes = ObjectSet::resolve(&self.objects, None, None).map_err(|e| format!("--objects: {e}"))?;
+        let letters = ObjectSet::resolve(&self.letters, None, None).map_err(|e| format!("--letters: {e}"))?;
+        let real = match &self.real {
+            Some(path) => RealRecording::read(path).map_err(|e| format!("--real: {e}"))?,
+            None => RealRecording::example(),
+        };
+        Ok(PaperContext::new(
+            self.scale,
+            self.seed,
+            self.run.clone(),
+            shapes,
+            letters,
+            real,
+        ))
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct ExperimentArgs {
+    /// The experiment (`list` shows them).
+    pub name: String,
+    #[command(flatten)]
+    pub paper: PaperArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    #[command(flatten)]
+    pub paper: PaperArgs,
+    /// Only these experiments, comma-separated [default: all].
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    pub only: Vec<String>,
+}
+
+fn parse_experiment(name: &str) -> Result<PaperExperiment, String> {
+    PaperExperiment::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = PaperExperiment::ALL.iter().map(|e| e.name()).collect();
+        format!(
+            "no experiment '{name}' (the experiments are {})",
+            names.join(", ")
+        )
+    })
+}
+
+pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if args.name == "list" {
+        for experiment in PaperExperiment::ALL {
+            println!("{:<14} {}", experiment.name(), experiment.description());
+        }
+        return Ok(());
+    }
+    let experiment = parse_experiment(&args.name)?;
+    let context = args.paper.context()?;
+    let report = experiment.run(&context).map_err(|e| e.to_string())?;
+    println!("{report}");
+    Ok(())
+}
+
+pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let experiments: Vec<PaperExperiment> = if args.only.is_empty() {
+        PaperExperiment::ALL.to_vec()
+    } else {
+        args.only
+            .iter()
+            .map(|n| parse_experiment(n.trim()))
+            .collect::<Result<_, _>>()?
+    };
+    let context = args.paper.context()?;
+    let started = Instant::now();
+    for experiment in &experiments {
+        let begun = Instant::now();
+        eprintln!("== {experiment}: {}", experiment.description());
+        let report = experiment.run(&context).map_err(|e| e.to_string())?;
+        println!("{report}");
+        eprintln!("== {experiment} done in {:.1} s", begun.elapsed().as_secs_f64());
+    }
+    let names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
+    let table = headline_table(&context.options.out, &names)?;
+    println!(
+        "\naccuracy (%) after n readings, mean over trials, scale {}:\n{table}\nreproduce took {:.1} s",
+        context.scale,
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,142 @@
+//! What every experiment of a run shares: the scale, the seed, where and how to run, the object
+//! sets, the real recording, and the store of datasets and models.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use super::data::{DataStore, Objects};
+use super::recognition::Family;
+use super::scale::Scale;
+use crate::experiment::real_data::{RealData, RealImport, parse_real_csv};
+use crate::experiment::runner::RunOptions;
+use crate::experiment::unit::BoxError;
+use crate::mesh::letters::letter_from_name;
+use crate::mesh::{ObjectSet, ObjectSource};
+
+/// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):
+/// the sim-to-real experiment's default input, so that its whole path runs without a recording.
+pub const EXAMPLE_REAL_CSV: &str = include_str!("../../../data/real_letters_example.csv");
+
+/// A recording of real sensor frames: its CSV text and where it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealRecording {
+    pub origin: String,
+    pub text: String,
+}
+
+impl RealRecording {
+    /// The shipped synthetic example.
+    pub fn example() -> Self {
+        Self {
+            origin: "data/real_letters_example.csv (built in)".into(),
+            text: EXAMPLE_REAL_CSV.into(),
+        }
+    }
+
+    pub fn read(path: &std::path::Path) -> Result<Self, BoxError> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(Self {
+            origin: path.display().to_string(),
+            text,
+        })
+    }
+}
+
+/// The shared state of a run of one or more paper experiments.
+pub struct PaperContext {
+    pub scale: Scale,
+    pub seed: u64,
+    pub options: RunOptions,
+    /// The 3D objects (Figs. 7-14).
+    pub shapes: ObjectSet,
+    /// The raised letters (Fig. 16a) and the source of the sim-to-real letters.
+    pub letters: ObjectSet,
+    pub real: RealRecording,
+    pub(crate) store: DataStore,
+    built: Mutex<HashMap<String, Arc<Objects>>>,
+}
+
+impl PaperContext {
+    pub fn new(
+        scale: Scale,
+        seed: u64,
+        options: RunOptions,
+        shapes: ObjectSet,
+        letters: ObjectSet,
+        real: RealRecording,
+    ) -> Self {
+        let threads = options.threads.map_or(0, std::num::NonZeroUsize::get);
+        Self {
+            store: DataStore::new(&options.out, threads),
+            scale,
+            seed,
+            options,
+            shapes,
+            letters,
+            real,
+            built: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// The built objects of `family`, built once per run.
+    pub fn objects(&self, family: Family) -> Result<Arc<Objects>, BoxError> {
+        let set = match family {
+            Family::Shapes => self.shapes.clone(),
+            Family::Letters => self.letters.clone(),
+            Family::RealLabels => self.real_letters()?,
+        };
+        let id = set.id();
+        if let Some(built) = self.lock().get(&id) {
+            return Ok(Arc::clone(built));
+        }
+        let built = Arc::new(Objects::build(set)?);
+        self.lock().insert(id, Arc::clone(&built));
+        Ok(built)
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Arc<Objects>>> {
+        self.built.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The real recording, normalised to the sensing range by its largest value.
+    pub fn real_data(&self) -> Result<Arc<RealData>, BoxError> {
+        Ok(Arc::new(parse_real_csv(
+            &self.real.text,
+            &self.real.origin,
+            &RealImport::default(),
+        )?))
+    }
+
+    /// The letters the recording's labels name, each named by its label: a label is a single
+    /// character (`A`) or a letter's object name (`upper_A`).
+    fn real_letters(&self) -> Result<ObjectSet, BoxError> {
+        let real = self.real_data()?;
+        let mut objects = Vec::new();
+        for label in real.labels() {
+            let mut chars = label.chars();
+            let glyph = match (chars.next(), chars.next()) {
+                (Some(c), None) => Some(c),
+                _ => letter_from_name(label),
+            };
+            let object = self
+                .letters
+                .objects
+                .iter()
+                .find(|o| matches!(o.source, ObjectSource::Letter { glyph: g, .. } if Some(g) == glyph))
+                .ok_or_else(|| {
+                    format!(
+                        "{}: label '{label}' names none of the letters (labels are single letters such as 'A' or names such as 'upper_A')",
+                        self.real.origin
+                    )
+                })?;
+            let mut object = object.clone();
+            object.name = label.to_string();
+            objects.push(object);
+        }
+        Ok(ObjectSet {
+            name: "real-letters".into(),
+            objects,
+            ..self.letters.clone()
+        })
+    }
+}

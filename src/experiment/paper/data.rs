@@ -1,0 +1,238 @@
+//! The readings and models the paper's experiments share, collected or trained once and kept on
+//! disk under the output root, so that experiments of one `reproduce` (and reruns after a kill)
+//! reuse them:
+//!
+//! ```text
+//! <out>/data/<set>-<generator>-<key>.csv     a dataset (format of `crate::dataset`)
+//! <out>/models/<descriptor>-<key>.json       a trained model (format of `crate::recognize::model`)
+//! ```
+//!
+//! `<key>` is a hash of everything the file's content depends on (the object set's id and the
+//! collection plan; for a model also the training and validation keys, the descriptor and the
+//! training configuration), so a file is reused exactly when it would be recomputed identically.
+//! Files are written atomically; a corrupt one is an error naming it.
+//!
+//! Datasets are collected in a preparation step before an experiment's units run ([`DataStore::
+//! prepare`]), each one in parallel over its objects; units then only read them. Collecting inside
+//! the units instead would make units that share a dataset wait on each other inside the thread
+//! pool.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::dataset::{Dataset, generator_name};
+use crate::describe::Descriptor;
+use crate::experiment::unit::BoxError;
+use crate::explore::collect::CollectPlan;
+use crate::mesh::checksum::sha256_hex;
+use crate::mesh::{BuildOptions, ObjectSet};
+use crate::recognize::{TrainConfig, TrainedModel};
+use crate::sim::ObjectSpec;
+
+/// An object set with its meshes built and placed, ready for collection.
+pub struct Objects {
+    pub set: ObjectSet,
+    pub specs: Vec<ObjectSpec>,
+}
+
+impl Objects {
+    /// Builds every object of `set` (fetching the CGAL meshes when missing).
+    pub fn build(set: ObjectSet) -> Result<Self, BoxError> {
+        let built = set.build(&BuildOptions {
+            fetch: true,
+            ..BuildOptions::default()
+        })?;
+        let specs = built
+            .into_iter()
+            .map(|b| ObjectSpec::new(b.name, b.mesh))
+            .collect();
+        Ok(Self { set, specs })
+    }
+
+    pub fn names(&self) -> Vec<String> {
+        self.specs.iter().map(|o| o.name.clone()).collect()
+    }
+}
+
+/// One dataset an experiment needs: the objects of a set, collected as a plan says.
+#[derive(Clone, Serialize)]
+pub struct DataRequest {
+    #[serde(skip)]
+    pub objects: Arc<Objects>,
+    pub object_set: String,
+    pub plan: CollectPlan,
+}
+
+impl DataRequest {
+    pub fn new(objects: &Arc<Objects>, plan: CollectPlan) -> Self {
+        Self {
+            object_set: objects.set.id(),
+            objects: Arc::clone(objects),
+            plan,
+        }
+    }
+
+    /// The hash of what the dataset's content depends on.
+    pub fn key(&self) -> String {
+        hash_of(self)
+    }
+
+    fn file_name(&self) -> String {
+        let generator: String = generator_name(&self.plan.mode)
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '.' {
+                    c
+                } else {
+                    '-'
+                }
+            })
+            .collect();
+        format!("{}-{generator}-{}.csv", self.objects.set.name, self.key())
+    }
+}
+
+/// The first 16 hex digits of the SHA-256 of `value`'s JSON.
+fn hash_of<T: Serialize>(value: &T) -> String {
+    let json = serde_json::to_string(value).unwrap_or_default();
+    sha256_hex(json.as_bytes())[..16].to_string()
+}
+
+/// The datasets and models of one output root.
+pub struct DataStore {
+    root: PathBuf,
+    threads: usize,
+    datasets: Mutex<HashMap<String, Arc<Dataset>>>,
+}
+
+impl DataStore {
+    /// A store under `out`; collections run on `threads` threads (0: all cores).
+    pub fn new(out: &Path, threads: usize) -> Self {
+        Self {
+            root: out.to_path_buf(),
+            threads,
+            datasets: Mutex::new(HashMap::new()),
+        }
+    }
+
+    fn dataset_path(&self, request: &DataRequest) -> PathBuf {
+        self.root.join("data").join(request.file_name())
+    }
+
+    /// Makes every requested dataset available: read from disk when an earlier run wrote it,
+    /// otherwise collected now (in parallel over its objects) and written. Requests are taken in
+    /// order, each distinct dataset once.
+    pub fn prepare(&self, requests: &[DataRequest]) -> Result<(), BoxError> {
+        let mut distinct = BTreeMap::new();
+        for r in requests {
+            distinct.entry(r.key()).or_insert(r);
+        }
+        let total = distinct.len();
+        for (i, (key, request)) in distinct.into_iter().enumerate() {
+            if self.lock().contains_key(&key) {
+                continue;
+            }
+            let path = self.dataset_path(request);
+            let dataset = if path.exists() {
+                Dataset::read(&path).map_err(|e| {
+                    format!("{e} (a dataset cached by an earlier run; delete the file to collect it again)")
+                })?
+            } else {
+                let started = Instant::now();
+                eprintln!(
+                    "collecting dataset {}/{total}: {} readings of each of {} objects ({}), {}x{} taxels",
+                    i + 1,
+                    request.plan.readings_per_object,
+                    request.objects.specs.len(),
+                    generator_name(&request.plan.mode),
+                    request.plan.sensor.rows,
+                    request.plan.sensor.cols,
+                );
+                let dataset = Dataset::collect(
+                    &request.plan,
+                    &request.object_set,
+                    &request.objects.specs,
+                    self.threads,
+                )?;
+                crate::experiment::atomic::create_dir_all(&self.root.join("data"))?;
+                dataset.write(&path)?;
+                eprintln!(
+                    "  {} readings ({} converged) in {:.1} s -> {}",
+                    dataset.len(),
+                    dataset.converged_only().len(),
+                    started.elapsed().as_secs_f64(),
+                    path.display()
+                );
+                dataset
+            };
+            self.lock().insert(key, Arc::new(dataset));
+        }
+        Ok(())
+    }
+
+    /// A dataset made available by [`prepare`](Self::prepare).
+    pub fn dataset(&self, request: &DataRequest) -> Result<Arc<Dataset>, BoxError> {
+        self.lock().get(&request.key()).cloned().ok_or_else(|| {
+            format!(
+                "internal: dataset {} was not prepared before the units ran",
+                request.file_name()
+            )
+            .into()
+        })
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Arc<Dataset>>> {
+        self.datasets.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The model trained with `descriptor` and `config` on `training`, chosen on `validation`:
+    /// read from `<out>/models/` when an earlier run trained it, otherwise trained and saved.
+    /// Two units needing the same model at once both train it (identically); nothing shares a
+    /// lock inside the thread pool.
+    pub fn model(
+        &self,
+        training: &DataRequest,
+        validation: &DataRequest,
+        descriptor: &dyn Descriptor,
+        config: &TrainConfig,
+    ) -> Result<TrainedModel, BoxError> {
+        #[derive(Serialize)]
+        struct ModelKey<'a> {
+            training: String,
+            validation: String,
+            descriptor: crate::describe::DescriptorParams,
+            config: &'a TrainConfig,
+        }
+        let key = hash_of(&ModelKey {
+            training: training.key(),
+            validation: validation.key(),
+            descriptor: descriptor.params(),
+            config,
+        });
+        let path = self
+            .root
+            .join("models")
+            .join(format!("{}-{key}.json", descriptor.kind().name()));
+        if path.exists() {
+            return TrainedModel::load(&path).map_err(|e| {
+                format!("{e} (a model cached by an earlier run; delete the file to train it again)").into()
+            });
+        }
+        let training_data = self.dataset(training)?;
+        let validation_data = self.dataset(validation)?;
+        let model = TrainedModel::fit(
+            &training_data,
+            Some(&validation_data),
+            descriptor,
+            config.clone(),
+            &mut |_| {},
+        )?;
+        crate::experiment::atomic::create_dir_all(&self.root.join("models"))?;
+        model.save(&path)?;
+        Ok(model)
+    }
+}

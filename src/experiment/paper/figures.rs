@@ -1,0 +1,277 @@
+//! The recognition figures of Sec. V as [`RecognitionSweep`]s, with the paper's settings.
+//!
+//! Shared defaults (the paper's "Princeton set at 6x6 resolution and 10% covering thickness"):
+//! 6x6 taxels on a 12 mm pad, covering 10% of the pad side (1.2 mm, see
+//! [`crate::tactile::config::DEFAULT_THICKNESS_M`]), no noise; training and validation by the sampler; test readings by
+//! the planner with L = 0.5, the middle of Fig. 8's range (the paper does not say which L its
+//! other figures used). The top three descriptors are PF, MNTI and MN (Sec. V-B2); Figs. 11-13 add
+//! Vectorize.
+
+use super::recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
+use crate::describe::DescriptorKind;
+use crate::explore::SamplerConfig;
+use crate::sim::PerturbationBounds;
+use crate::tactile::SensorConfig;
+use crate::tactile::config::DEFAULT_PAD_M;
+
+/// L of the test exploration in every figure but Fig. 8.
+pub const DEFAULT_LOCAL_PROBABILITY: f64 = 0.5;
+
+const TOP_THREE: [DescriptorKind; 3] = [
+    DescriptorKind::PolarFourier,
+    DescriptorKind::Mnti,
+    DescriptorKind::MomentNormalized,
+];
+
+const TOP_THREE_AND_VECTORIZE: [DescriptorKind; 4] = [
+    DescriptorKind::PolarFourier,
+    DescriptorKind::Mnti,
+    DescriptorKind::MomentNormalized,
+    DescriptorKind::Vectorize,
+];
+
+/// The 6x6 sensor with 10% covering.
+pub fn default_sensor() -> SensorConfig {
+    sensor(6, 0.1, 0.0)
+}
+
+/// `taxels x taxels` on the 12 mm pad, covering `thickness_fraction` of the pad side, uniform
+/// noise of `noise_fraction` of the range.
+fn sensor(taxels: usize, thickness_fraction: f64, noise_fraction: f64) -> SensorConfig {
+    SensorConfig {
+        noise_fraction,
+        ..SensorConfig::square(taxels, taxels, DEFAULT_PAD_M, thickness_fraction * DEFAULT_PAD_M)
+    }
+}
+
+fn explored(local_probability: f64) -> TestData {
+    TestData::Planner {
+        local_probability,
+        perturbation: PerturbationBounds::NONE,
+    }
+}
+
+/// Fig. 7: all six descriptors at the default settings.
+pub fn descriptors() -> RecognitionSweep {
+    RecognitionSweep {
+        name: "descriptors",
+        description: "Fig. 7: the six descriptors on the 3D set, 6x6 taxels, 10% covering, planner test data",
+        title: "Descriptors (6x6, 10% covering)",
+        parameter: "",
+        family: Family::Shapes,
+        descriptors: DescriptorKind::ALL.to_vec(),
+        settings: vec![Setting::single(
+            "6x6",
+            default_sensor(),
+            SamplerConfig::default(),
+            explored(DEFAULT_LOCAL_PROBABILITY),
+        )],
+    }
+}
+
+/// Fig. 8: the exploration strategy, L in {0, 0.5, 1}; one model per descriptor.
+pub fn strategy() -> RecognitionSweep {
+    RecognitionSweep {
+        name: "strategy",
+        description: "Fig. 8: exploration with local-strategy probability L = 0, 0.5, 1 (top three descriptors)",
+        title: "Exploration strategy (L = probability of the local strategy)",
+        parameter: "local_probability",
+        family: Family::Shapes,
+        descriptors: TOP_THREE.to_vec(),
+        settings: vec![Setting {
+            label: "0-0.5-1".into(),
+            sensor: default_sensor(),
+            sampler: SamplerConfig::default(),
+            curves: [0.0, 0.5, 1.0]
+                .into_iter()
+                .map(|l| Curve {
+                    value: l.to_string(),
+                    test: explored(l),
+                })
+                .collect(),
+        }],
+    }
+}
+
+/// Fig. 9: validation (sampler) against exploration (planner) test data, MN and PF, at 6x6 and
+/// 26x26.
+pub fn validation() -> RecognitionSweep {
+    let setting = |taxels: usize| {
+        let size = format!("{taxels}x{taxels}");
+        Setting {
+            label: size.clone(),
+            sensor: sensor(taxels, 0.1, 0.0),
+            sampler: SamplerConfig::default(),
+            curves: vec![
+                Curve {
+                    value: format!("validation {size}"),
+                    test: TestData::Validation,
+                },
+                Curve {
+                    value: format!("exploration {size}"),
+                    test: explored(DEFAULT_LOCAL_PROBABILITY),
+                },
+            ],
+        }
+    };
+    RecognitionSweep {
+        name: "validation",
+        description: "Fig. 9: sampler validation data against planner exploration data (MN, PF; 6x6 and 26x26)",
+        title: "Validation (sampler) vs exploration (planner) test data",
+        parameter: "data",
+        family: Family::Shapes,
+        descriptors: vec![DescriptorKind::MomentNormalized, DescriptorKind::PolarFourier],
+        settings: vec![setting(6), setting(26)],
+    }
+}
+
+/// Fig. 10: the object fixed, or perturbed after every reading by up to 10 degrees and 10% of its
+/// width (Sec. V-B4).
+pub fn perturbation() -> RecognitionSweep {
+    let perturbed = PerturbationBounds::new(10.0, 0.1).unwrap_or(PerturbationBounds::NONE);
+    RecognitionSweep {
+        name: "perturbation",
+        description: "Fig. 10: object fixed vs perturbed (<= 10 deg, <= 10% of its width) after every reading",
+        title: "Fixed vs perturbed object",
+        parameter: "object",
+        family: Family::Shapes,
+        descriptors: TOP_THREE.to_vec(),
+        settings: vec![Setting {
+            label: "fixed-perturbed".into(),
+            sensor: default_sensor(),
+            sampler: SamplerConfig::default(),
+            curves: vec![
+                Curve {
+                    value: "fixed".into(),
+                    test: explored(DEFAULT_LOCAL_PROBABILITY),
+                },
+                Curve {
+                    value: "perturbed".into(),
+                    test: TestData::Planner {
+                        local_probability: DEFAULT_LOCAL_PROBABILITY,
+                        perturbation: perturbed,
+                    },
+                },
+            ],
+        }],
+    }
+}
+
+/// A sweep of Figs. 11-13: one setting per value, the top three descriptors and Vectorize.
+fn sensor_sweep(
+    name: &'static str,
+    description: &'static str,
+    title: &'static str,
+    parameter: &'static str,
+    values: Vec<(String, SensorConfig)>,
+) -> RecognitionSweep {
+    RecognitionSweep {
+        name,
+        description,
+        title,
+        parameter,
+        family: Family::Shapes,
+        descriptors: TOP_THREE_AND_VECTORIZE.to_vec(),
+        settings: values
+            .into_iter()
+            .map(|(value, sensor)| {
+                Setting::single(
+                    value,
+                    sensor,
+                    SamplerConfig::default(),
+                    explored(DEFAULT_LOCAL_PROBABILITY),
+                )
+            })
+            .collect(),
+    }
+}
+
+/// Fig. 11: covering thickness 5, 10, 20, 30% of the pad side (0.6 to 3.6 mm); the PSF widens with
+/// it ([`crate::tactile::config::PSF_SIGMA_PER_THICKNESS`]).
+pub fn thickness() -> RecognitionSweep {
+    sensor_sweep(
+        "thickness",
+        "Fig. 11: covering thickness 5, 10, 20, 30% of the pad side (top three descriptors and Vectorize)",
+        "Covering thickness (fraction of the pad side)",
+        "thickness_fraction",
+        [0.05, 0.1, 0.2, 0.3]
+            .into_iter()
+            .map(|t| (t.to_string(), sensor(6, t, 0.0)))
+            .collect(),
+    )
+}
+
+/// Fig. 12: 6x6 (the PPS sensor), 14x14 (a fingertip's Merkel receptors) and 26x26 (a Tekscan
+/// sensor) on the same pad.
+pub fn resolution() -> RecognitionSweep {
+    sensor_sweep(
+        "resolution",
+        "Fig. 12: sensor resolution 6x6, 14x14, 26x26 on the 12 mm pad (top three descriptors and Vectorize)",
+        "Sensor resolution (taxels per side)",
+        "resolution",
+        [6, 14, 26]
+            .into_iter()
+            .map(|n| (format!("{n}x{n}"), sensor(n, 0.1, 0.0)))
+            .collect(),
+    )
+}
+
+/// Fig. 13: uniform additive noise of 0, 10, 20, 40% of the sensing range, in training and test.
+pub fn noise() -> RecognitionSweep {
+    sensor_sweep(
+        "noise",
+        "Fig. 13: additive noise 0, 10, 20, 40% of the range in training and test (top three descriptors and Vectorize)",
+        "Additive noise (fraction of the sensing range)",
+        "noise_fraction",
+        [0.0, 0.1, 0.2, 0.4]
+            .into_iter()
+            .map(|f| (f.to_string(), sensor(6, 0.1, f)))
+            .collect(),
+    )
+}
+
+/// Fig. 16a: the 52 raised letters, every reading by the sampler from above (Sec. V-D).
+pub fn letters() -> RecognitionSweep {
+    let from_above = SamplerConfig {
+        from_above_only: true,
+        ..SamplerConfig::default()
+    };
+    RecognitionSweep {
+        name: "letters",
+        description: "Fig. 16a: the 52 raised letters, sampler from above for training and test (PF, MNTI, MN)",
+        title: "Raised letters (sampler from above)",
+        parameter: "",
+        family: Family::Letters,
+        descriptors: TOP_THREE.to_vec(),
+        settings: vec![Setting::single(
+            "6x6",
+            default_sensor(),
+            from_above,
+            TestData::Sampler,
+        )],
+    }
+}
+
+/// Fig. 17: trained on simulated letters with 30% noise ("on the order of 30% of the observed
+/// force range", Sec. V-F), tested on the recorded real frames after the square root and a small
+/// Gaussian blur.
+pub fn sim_to_real() -> RecognitionSweep {
+    let from_above = SamplerConfig {
+        from_above_only: true,
+        ..SamplerConfig::default()
+    };
+    RecognitionSweep {
+        name: "sim-to-real",
+        description: "Fig. 17: trained on simulated letters (30% noise), tested on recorded real frames (trial 0 in recorded order)",
+        title: "Simulation to real sensor",
+        parameter: "",
+        family: Family::RealLabels,
+        descriptors: TOP_THREE.to_vec(),
+        settings: vec![Setting::single(
+            "real",
+            sensor(6, 0.1, 0.3),
+            from_above,
+            TestData::Real,
+        )],
+    }
+}

@@ -1,0 +1,101 @@
+//! The experiments of the paper's Sec. V, each a resumable, shardable run on the experiment
+//! framework writing tidy CSV and a plot like the paper's figure (`taction experiment NAME`), and
+//! all of them in one command (`taction reproduce`).
+//!
+//! | name | figure | varies |
+//! |---|---|---|
+//! | `descriptors` | 7 | the six descriptors |
+//! | `strategy` | 8 | L, the probability of local exploration |
+//! | `validation` | 9 | validation (sampler) vs exploration (planner) test data |
+//! | `perturbation` | 10 | object fixed vs perturbed after every reading |
+//! | `thickness` | 11 | covering thickness |
+//! | `resolution` | 12 | taxels per side |
+//! | `noise` | 13 | additive noise |
+//! | `letters` | 16a | - (52 raised letters, sampler from above) |
+//! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
+//!
+//! Datasets and models are shared between the experiments of a run through `<out>/data` and
+//! `<out>/models` ([`data`]).
+
+pub mod context;
+pub mod data;
+pub mod figures;
+pub mod headline;
+pub mod recognition;
+pub mod scale;
+
+use std::fmt;
+
+pub use context::{PaperContext, RealRecording};
+pub use recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
+pub use scale::{DataCounts, Scale};
+
+use crate::experiment::runner::RunReport;
+use crate::experiment::unit::BoxError;
+
+/// One experiment of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PaperExperiment {
+    Descriptors,
+    Strategy,
+    Validation,
+    Perturbation,
+    Thickness,
+    Resolution,
+    Noise,
+    Letters,
+    SimToReal,
+}
+
+impl PaperExperiment {
+    /// Every experiment, in the order `reproduce` runs them (the paper's figure order).
+    pub const ALL: [PaperExperiment; 9] = [
+        Self::Descriptors,
+        Self::Strategy,
+        Self::Validation,
+        Self::Perturbation,
+        Self::Thickness,
+        Self::Resolution,
+        Self::Noise,
+        Self::Letters,
+        Self::SimToReal,
+    ];
+
+    fn sweep(self) -> RecognitionSweep {
+        match self {
+            Self::Descriptors => figures::descriptors(),
+            Self::Strategy => figures::strategy(),
+            Self::Validation => figures::validation(),
+            Self::Perturbation => figures::perturbation(),
+            Self::Thickness => figures::thickness(),
+            Self::Resolution => figures::resolution(),
+            Self::Noise => figures::noise(),
+            Self::Letters => figures::letters(),
+            Self::SimToReal => figures::sim_to_real(),
+        }
+    }
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        self.sweep().name
+    }
+
+    pub fn description(self) -> &'static str {
+        self.sweep().description
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|e| e.name() == name)
+    }
+
+    /// Runs the experiment in `context`.
+    pub fn run(self, context: &PaperContext) -> Result<RunReport, BoxError> {
+        self.sweep().run(context)
+    }
+}
+
+impl fmt::Display for PaperExperiment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,472 @@
+//! The shape every recognition figure of Sec. V shares (Figs. 7-13, 16a, 17): train a
+//! bag-of-features model per (setting, descriptor) on sampler readings, then recognise test
+//! readings touch by touch and record accuracy and reliability against the number of readings.
+//!
+//! A [`RecognitionSweep`] lists the settings a figure varies (sensor, training sampler) and, for
+//! each, the curves it draws (which test data: validation readings, fresh sampler readings, the
+//! planner's exploration, recorded real frames). One unit per (setting, descriptor): it trains or
+//! loads the model and evaluates every curve of the setting over all trials, so units never share
+//! a model within one experiment.
+
+use std::sync::Arc;
+
+use rand::seq::SliceRandom;
+use serde::Serialize;
+
+use super::context::PaperContext;
+use super::data::{DataRequest, Objects};
+use super::scale::DataCounts;
+use crate::control::ControlConfig;
+use crate::describe::{Descriptor, DescriptorKind};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
+use crate::experiment::layout::ExperimentDir;
+use crate::experiment::name::SafeName;
+use crate::experiment::plot::PlotSpec;
+use crate::experiment::real_data::RealData;
+use crate::experiment::runner::{Experiment, RunReport, run};
+use crate::experiment::sim_to_real::SimToRealPreprocess;
+use crate::experiment::spec::ExperimentSpec;
+use crate::experiment::unit::{BoxError, Unit};
+use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::explore::{PlannerConfig, SamplerConfig};
+use crate::recognize::{
+    LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
+};
+use crate::rng;
+use crate::sim::PerturbationBounds;
+use crate::tactile::SensorConfig;
+
+/// Streams of the experiment seed (see [`crate::rng::substream`]); the same for every setting, so
+/// settings are compared on the same random draws where they can be (common random numbers).
+const TRAINING_STREAM: u64 = 1;
+const VALIDATION_STREAM: u64 = 2;
+const MODEL_STREAM: u64 = 3;
+const NOISE_STREAM: u64 = 4;
+const ORDERING_STREAM: u64 = 5;
+/// Test trial `t` draws from stream `TEST_STREAM + t`.
+const TEST_STREAM: u64 = 100;
+
+/// Which test readings a curve recognises.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum TestData {
+    /// The validation readings the model was chosen on (Fig. 9): one trial.
+    Validation,
+    /// Fresh readings of the training sampler, one dataset per trial (the letters, Sec. V-D).
+    Sampler,
+    /// The planner exploring each object blind with the arm (Sec. III-A), one dataset per trial,
+    /// the object perturbed after every reading within `perturbation` (Sec. V-B4).
+    Planner {
+        local_probability: f64,
+        perturbation: PerturbationBounds,
+    },
+    /// The recorded real frames of the context (Sec. V-F), square-rooted and blurred; trial 0
+    /// presents them in file order (Fig. 17b), the others in seeded random orders (Fig. 17a).
+    Real,
+}
+
+/// One line of a figure: its value of the swept parameter and its test data.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Curve {
+    pub value: String,
+    pub test: TestData,
+}
+
+/// One trained model per descriptor: the sensor and training sampler, and the curves drawn with
+/// that model.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Setting {
+    /// Names the setting in unit keys (`value` of its curve when it has one).
+    pub label: String,
+    pub sensor: SensorConfig,
+    pub sampler: SamplerConfig,
+    pub curves: Vec<Curve>,
+}
+
+impl Setting {
+    /// A setting drawing one curve named like it.
+    pub fn single(
+        value: impl Into<String>,
+        sensor: SensorConfig,
+        sampler: SamplerConfig,
+        test: TestData,
+    ) -> Self {
+        let value = value.into();
+        Self {
+            label: value.clone(),
+            sensor,
+            sampler,
+            curves: vec![Curve { value, test }],
+        }
+    }
+}
+
+/// Which objects a sweep recognises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// The 3D object set (`--objects`, default `shapes`).
+    Shapes,
+    /// The raised letters (`--letters`, default all 52).
+    Letters,
+    /// The letters named by the labels of the real recording (`--real`).
+    RealLabels,
+}
+
+/// A recognition figure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RecognitionSweep {
+    pub name: &'static str,
+    #[serde(skip)]
+    pub description: &'static str,
+    #[serde(skip)]
+    pub title: &'static str,
+    /// The column `parameter` of the rows: what the curves vary.
+    pub parameter: &'static str,
+    pub family: Family,
+    pub descriptors: Vec<DescriptorKind>,
+    pub settings: Vec<Setting>,
+}
+
+/// Everything the rows depend on, written as the run's `config.json`.
+#[derive(Serialize)]
+struct SweepConfig<'a> {
+    sweep: &'a RecognitionSweep,
+    scale: f64,
+    counts: DataCounts,
+    seed: u64,
+    object_set: String,
+    object_set_id: String,
+    objects: Vec<String>,
+    control: ControlConfig,
+    planner: PlannerConfig,
+    training: TrainConfig,
+}
+
+/// One unit's work, before it is wrapped in a closure.
+struct UnitPlan {
+    key: SafeName,
+    setting: usize,
+    descriptor: DescriptorKind,
+}
+
+impl RecognitionSweep {
+    /// Runs the sweep in `context`: prepares the datasets its pending units need, then runs the
+    /// units on the experiment framework (resumable, sharded, parallel).
+    pub fn run(&self, context: &PaperContext) -> Result<RunReport, BoxError> {
+        let objects = context.objects(self.family)?;
+        let counts = context.scale.counts();
+        let training = training_config(context.seed, counts, objects.specs.len());
+        let plans = self.unit_plans()?;
+
+        let name = SafeName::new(self.name)?;
+        let dir = ExperimentDir::new(&context.options.out, &name);
+        let pending: Vec<&UnitPlan> = plans
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| context.options.shard.contains(*i) && !dir.unit_csv(&p.key).exists())
+            .map(|(_, p)| p)
+            .collect();
+        let mut requests = Vec::new();
+        for plan in &pending {
+            requests.extend(self.requests(context, &objects, plan.setting, counts));
+        }
+        context.store.prepare(&requests)?;
+
+        let real = match self.family {
+            Family::RealLabels => Some(context.real_data()?),
+            _ => None,
+        };
+        let units = plans
+            .iter()
+            .map(|plan| {
+                let objects = Arc::clone(&objects);
+                let training = training.clone();
+                let real = real.clone();
+                let setting = plan.setting;
+                let descriptor = plan.descriptor;
+                Unit::new(plan.key.clone(), move || {
+                    self.unit_rows(
+                        context,
+                        &objects,
+                        setting,
+                        descriptor,
+                        counts,
+                        &training,
+                        real.as_deref(),
+                    )
+                })
+            })
+            .collect();
+        let experiment = Experiment {
+            spec: ExperimentSpec {
+                name: name.clone(),
+                description: self.description.to_string(),
+                plots: vec![PlotSpec::accuracy(name, self.title)],
+            },
+            config: SweepConfig {
+                sweep: self,
+                scale: context.scale.fraction(),
+                counts,
+                seed: context.seed,
+                object_set: objects.set.name.clone(),
+                object_set_id: objects.set.id(),
+                objects: objects.names(),
+                control: ControlConfig::default(),
+                planner: PlannerConfig::default(),
+                training,
+            },
+            units,
+        };
+        Ok(run(&experiment, &context.options)?)
+    }
+
+    fn unit_plans(&self) -> Result<Vec<UnitPlan>, BoxError> {
+        let mut plans = Vec::new();
+        for (setting, s) in self.settings.iter().enumerate() {
+            for &descriptor in &self.descriptors {
+                let mut key = SafeName::builder(descriptor.name());
+                if !self.parameter.is_empty() {
+                    key = key.param(self.parameter, &s.label);
+                }
+                let key = key.build()?;
+                plans.push(UnitPlan {
+                    key,
+                    setting,
+                    descriptor,
+                });
+            }
+        }
+        Ok(plans)
+    }
+
+    /// The sensor of a setting with the run's noise stream.
+    fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
+        SensorConfig {
+            noise_seed: rng::substream(context.seed, NOISE_STREAM),
+            ..self.settings[setting].sensor
+        }
+    }
+
+    fn sampler_request(
+        &self,
+        context: &PaperContext,
+        objects: &Arc<Objects>,
+        setting: usize,
+        readings: usize,
+        stream: u64,
+    ) -> DataRequest {
+        DataRequest::new(
+            objects,
+            CollectPlan {
+                mode: CollectMode::Sampler(self.settings[setting].sampler),
+                sensor: self.sensor(context, setting),
+                control: ControlConfig::default(),
+                perturbation: PerturbationBounds::NONE,
+                readings_per_object: readings,
+                seed: rng::substream(context.seed, stream),
+            },
+        )
+    }
+
+    fn training_request(&self, c: &PaperContext, o: &Arc<Objects>, s: usize, n: DataCounts) -> DataRequest {
+        self.sampler_request(c, o, s, n.training_per_object, TRAINING_STREAM)
+    }
+
+    fn validation_request(&self, c: &PaperContext, o: &Arc<Objects>, s: usize, n: DataCounts) -> DataRequest {
+        self.sampler_request(c, o, s, n.validation_per_object, VALIDATION_STREAM)
+    }
+
+    /// The datasets of curve `test` of `setting`, one per trial (none for real frames).
+    fn test_requests(
+        &self,
+        context: &PaperContext,
+        objects: &Arc<Objects>,
+        setting: usize,
+        test: TestData,
+        counts: DataCounts,
+    ) -> Vec<DataRequest> {
+        let trial_stream = |t: usize| TEST_STREAM + t as u64;
+        match test {
+            TestData::Validation => vec![self.validation_request(context, objects, setting, counts)],
+            TestData::Sampler => (0..counts.trials)
+                .map(|t| {
+                    self.sampler_request(context, objects, setting, counts.test_per_object, trial_stream(t))
+                })
+                .collect(),
+            TestData::Planner {
+                local_probability,
+                perturbation,
+            } => (0..counts.trials)
+                .map(|t| {
+                    DataRequest::new(
+                        objects,
+                        CollectPlan {
+                            mode: CollectMode::Planner(PlannerConfig {
+                                local_probability,
+                                ..PlannerConfig::default()
+                            }),
+                            sensor: self.sensor(context, setting),
+                            control: ControlConfig::default(),
+                            perturbation,
+                            readings_per_object: counts.test_per_object,
+                            seed: rng::substream(context.seed, trial_stream(t)),
+                        },
+                    )
+                })
+                .collect(),
+            TestData::Real => Vec::new(),
+        }
+    }
+
+    /// Every dataset a unit of `setting` reads.
+    fn requests(
+        &self,
+        context: &PaperContext,
+        objects: &Arc<Objects>,
+        setting: usize,
+        counts: DataCounts,
+    ) -> Vec<DataRequest> {
+        let mut requests = vec![
+            self.training_request(context, objects, setting, counts),
+            self.validation_request(context, objects, setting, counts),
+        ];
+        for curve in &self.settings[setting].curves {
+            requests.extend(self.test_requests(context, objects, setting, curve.test, counts));
+        }
+        requests
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn unit_rows(
+        &self,
+        context: &PaperContext,
+        objects: &Arc<Objects>,
+        setting: usize,
+        kind: DescriptorKind,
+        counts: DataCounts,
+        training: &TrainConfig,
+        real: Option<&RealData>,
+    ) -> Result<Vec<AccuracyRow>, BoxError> {
+        let descriptor = kind.build();
+        let model = context.store.model(
+            &self.training_request(context, objects, setting, counts),
+            &self.validation_request(context, objects, setting, counts),
+            descriptor.as_ref(),
+            training,
+        )?;
+        let mut rows = Vec::new();
+        for curve in &self.settings[setting].curves {
+            let trials = match curve.test {
+                TestData::Real => {
+                    let real = real.ok_or("internal: the real recording was not loaded")?;
+                    real_trials(real, descriptor.as_ref(), &model, context.seed, counts.trials)?
+                }
+                test => self
+                    .test_requests(context, objects, setting, test, counts)
+                    .iter()
+                    .map(|request| {
+                        let data = context.store.dataset(request)?;
+                        model
+                            .check_sensor(&data.header().sensor)
+                            .map_err(|e| format!("test data of '{}': {e}", curve.value))?;
+                        let features = LabelledFeatures::from_dataset(&data, descriptor.as_ref());
+                        let readings = counts.test_per_object.max(counts.validation_per_object);
+                        Ok((
+                            request.plan.seed,
+                            make_trials(&features, model.bag.objects(), readings)?,
+                        ))
+                    })
+                    .collect::<Result<Vec<_>, BoxError>>()?,
+            };
+            for (trial, (seed, object_trials)) in trials.iter().enumerate() {
+                let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
+                if longest == 0 {
+                    return Err(format!(
+                        "curve '{}', trial {trial}: no converged test reading of any object",
+                        curve.value
+                    )
+                    .into());
+                }
+                let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
+                let meta = AccuracyCurve {
+                    experiment: self.name.to_string(),
+                    descriptor: kind.name().to_string(),
+                    parameter: self.parameter.to_string(),
+                    value: curve.value.clone(),
+                    trial: trial as u32,
+                    seed: *seed,
+                };
+                rows.extend(meta.rows(evaluation.accuracy.iter().map(|a| (a.accuracy(), a.mean_p_true))));
+            }
+        }
+        Ok(rows)
+    }
+}
+
+/// The model-selection grid of Sec. V-B1 (k in {10, 20, 50}, 3 seeded restarts), without the
+/// cluster counts the training data cannot support at small scales (fewer than 4 training
+/// readings per cluster); at least one count remains.
+fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
+    let readings = counts.training_per_object * objects;
+    let mut ks: Vec<usize> = [10, 20, 50].into_iter().filter(|k| k * 4 <= readings).collect();
+    if ks.is_empty() {
+        ks.push((readings / 4).max(2));
+    }
+    TrainConfig {
+        ks,
+        restarts: 3,
+        seed: rng::substream(seed, MODEL_STREAM),
+        trial_readings: counts.validation_per_object.min(10),
+        ..TrainConfig::default()
+    }
+}
+
+/// The recorded frames as trials of the model's objects: each label's frames, preprocessed as in
+/// Sec. V-F; trial 0 in file order, trial `t > 0` in the order of a seeded shuffle.
+fn real_trials(
+    real: &RealData,
+    descriptor: &dyn Descriptor,
+    model: &TrainedModel,
+    seed: u64,
+    trials: usize,
+) -> Result<Vec<(u64, Vec<Trial>)>, BoxError> {
+    if (real.rows, real.cols) != (model.sensor.rows, model.sensor.cols) {
+        return Err(format!(
+            "the real frames are {}x{} taxels but the simulated sensor is {}x{}",
+            real.rows, real.cols, model.sensor.rows, model.sensor.cols
+        )
+        .into());
+    }
+    let preprocess = SimToRealPreprocess::default();
+    let objects = model.bag.objects();
+    let mut per_object: Vec<Vec<Vec<Vec<f64>>>> = vec![Vec::new(); objects.len()];
+    for reading in &real.readings {
+        let j = objects.iter().position(|o| *o == reading.label).ok_or_else(|| {
+            format!(
+                "line {}: label '{}' is not a trained object",
+                reading.line, reading.label
+            )
+        })?;
+        per_object[j].push(descriptor.describe(&preprocess.apply(&reading.image)));
+    }
+    Ok((0..trials)
+        .map(|t| {
+            let trial_seed = rng::substream(rng::substream(seed, ORDERING_STREAM), t as u64);
+            let mut order = rng::rng(trial_seed);
+            let object_trials = per_object
+                .iter()
+                .enumerate()
+                .filter(|(_, frames)| !frames.is_empty())
+                .map(|(object, frames)| {
+                    let mut readings = frames.clone();
+                    if t > 0 {
+                        readings.shuffle(&mut order);
+                    }
+                    Trial { object, readings }
+                })
+                .collect();
+            (trial_seed, object_trials)
+        })
+        .collect())
+}

@@ -1,0 +1,221 @@
+//! The paper's experiments from the command line (issue: every figure as a run): `reproduce` end to
+//! end at a tiny scale on two objects, kill-and-resume, and shards merged against one run. Real
+//! MuJoCo, real sensor, real meshes (the two generated chess pieces and two raised letters).
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use taction::experiment::AccuracyRow;
+use taction::experiment::paper::PaperExperiment;
+use taction::mesh::glyph::Font;
+use taction::mesh::letters::LetterStyle;
+use taction::mesh::ObjectSet;
+
+const ACCURACY_HEADER: &str = "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
+
+fn taction(args: &[&str]) -> Output {
+    let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .output()
+        .expect("the taction binary runs");
+    assert!(
+        output.status.success(),
+        "taction {}: {}\n{}",
+        args.join(" "),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+/// A manifest of two raised letters (upper A, lower b), as `--letters` takes it.
+fn two_letters(dir: &Path) -> PathBuf {
+    let font = Font::load_default().expect("DejaVu Sans (fonts-dejavu-core) is installed");
+    let mut set = ObjectSet::letters(&font, LetterStyle::default());
+    set.objects.retain(|o| o.name == "upper_A" || o.name == "lower_b");
+    set.name = "two-letters".into();
+    assert_eq!(set.objects.len(), 2);
+    let path = dir.join("two-letters.json");
+    set.save_manifest(&path).expect("manifest written");
+    path
+}
+
+fn rows(csv: &Path) -> Vec<AccuracyRow> {
+    let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    assert_eq!(text.lines().next(), Some(ACCURACY_HEADER), "{}", csv.display());
+    csv::Reader::from_reader(text.as_bytes())
+        .deserialize()
+        .collect::<Result<Vec<AccuracyRow>, _>>()
+        .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
+}
+
+fn assert_svg_and_png(stem: &Path) {
+    let svg = std::fs::read_to_string(stem.with_extension("svg")).expect("SVG written");
+    let tree = resvg::usvg::Tree::from_str(&svg, &resvg::usvg::Options::default());
+    assert!(tree.is_ok(), "{}: not a valid SVG", stem.display());
+    assert!(svg.contains("number of readings") && svg.contains("accuracy (%)"));
+    let png = std::fs::read(stem.with_extension("png")).expect("PNG written");
+    let decoded = png::Decoder::new(std::io::Cursor::new(png)).read_info();
+    assert!(decoded.is_ok(), "{}: not a valid PNG", stem.display());
+}
+
+#[test]
+fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("results");
+    let letters = two_letters(dir.path());
+    let output = taction(&[
+        "reproduce",
+        "--scale",
+        "0.001",
+        "--objects",
+        "chess",
+        "--letters",
+        letters.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+
+    for experiment in PaperExperiment::ALL {
+        let name = experiment.name();
+        let root = out.join(name);
+        let rows = rows(&root.join(format!("{name}.csv")));
+        assert!(!rows.is_empty(), "{name}: no rows");
+        let mut curves = BTreeSet::new();
+        for r in &rows {
+            assert_eq!(r.experiment, name);
+            assert!((0.0..=1.0).contains(&r.accuracy), "{name}: accuracy {}", r.accuracy);
+            assert!((0.0..=1.0).contains(&r.reliability), "{name}: reliability {}", r.reliability);
+            assert!(r.n_readings >= 1);
+            curves.insert((r.descriptor.clone(), r.value.clone(), r.trial));
+        }
+        // Every curve starts at one reading and counts up without gaps.
+        for (descriptor, value, trial) in &curves {
+            let ns: Vec<u32> = rows
+                .iter()
+                .filter(|r| (&r.descriptor, &r.value, &r.trial) == (descriptor, value, trial))
+                .map(|r| r.n_readings)
+                .collect();
+            assert_eq!(ns, (1..=ns.len() as u32).collect::<Vec<_>>(), "{name} {descriptor} {value}");
+        }
+        assert_svg_and_png(&root.join(name));
+        let config = std::fs::read_to_string(root.join("config.json")).expect("config.json written");
+        assert!(config.contains("\"seed\": 1"), "{name}: the config records the seed");
+    }
+    // Curves the figures need: six descriptors in Fig. 7, three values of L in Fig. 8, fixed and
+    // perturbed in Fig. 10, three resolutions in Fig. 12, two letters recognised in Fig. 16a.
+    let values = |name: &str| -> BTreeSet<String> {
+        rows(&out.join(name).join(format!("{name}.csv"))).into_iter().map(|r| r.value).collect()
+    };
+    let descriptors: BTreeSet<String> = rows(&out.join("descriptors/descriptors.csv"))
+        .into_iter()
+        .map(|r| r.descriptor)
+        .collect();
+    assert_eq!(descriptors.len(), 6);
+    assert_eq!(values("strategy"), BTreeSet::from(["0".into(), "0.5".into(), "1".into()]));
+    assert_eq!(values("perturbation"), BTreeSet::from(["fixed".into(), "perturbed".into()]));
+    assert_eq!(values("resolution").len(), 3);
+    assert_eq!(values("noise").len(), 4);
+    let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
+    for experiment in PaperExperiment::ALL {
+        assert!(index.contains(experiment.name()), "index lists {experiment}");
+    }
+    assert!(stdout.contains("| descriptors | polar-fourier |"), "headline table printed:\n{stdout}");
+}
+
+/// Runs `experiment` into `out` and returns the assembled CSV's bytes.
+fn run_experiment(name: &str, out: &Path, extra: &[&str]) -> Vec<u8> {
+    let mut args = vec!["experiment", name, "--scale", "0.001", "--objects", "chess", "--out"];
+    args.push(out.to_str().unwrap());
+    args.extend_from_slice(extra);
+    taction(&args);
+    std::fs::read(out.join(name).join(format!("{name}.csv"))).expect("assembled CSV")
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole");
+    let reference = run_experiment("descriptors", &whole, &["--threads", "2"]);
+
+    // Kill a run as soon as its first unit is on disk, then run it again.
+    let killed = dir.path().join("killed");
+    let units = killed.join("descriptors").join("units");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["experiment", "descriptors", "--scale", "0.001", "--objects", "chess", "--threads", "1"])
+        .arg("--out")
+        .arg(&killed)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("taction starts");
+    let started = Instant::now();
+    let mut finished_before_kill = 0;
+    while started.elapsed() < Duration::from_secs(600) {
+        finished_before_kill = std::fs::read_dir(&units).map_or(0, |d| {
+            d.filter_map(Result::ok)
+                .filter(|e| e.path().extension().is_some_and(|x| x == "csv"))
+                .count()
+        });
+        if finished_before_kill > 0 || child.try_wait().ok().flatten().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().ok();
+    child.wait().ok();
+    assert!(finished_before_kill >= 1, "the run saved a unit before it was killed");
+    let killed_dir = killed.join("descriptors");
+    if !killed_dir.join("descriptors.csv").exists() {
+        let resumed = run_experiment("descriptors", &killed, &["--threads", "2"]);
+        assert_eq!(resumed, reference, "the resumed run has the rows of the uninterrupted one");
+    }
+    let lines: Vec<&[u8]> = reference.split(|&b| b == b'\n').filter(|l| !l.is_empty()).collect();
+    let distinct: BTreeSet<&[u8]> = lines.iter().copied().collect();
+    assert_eq!(lines.len(), distinct.len(), "no row twice");
+
+    // Shards 1/3..3/3 in separate roots, merged, give the unsharded files byte for byte.
+    let mut shard_dirs = Vec::new();
+    for k in 1..=3 {
+        let shard_dir = dir.path().join(format!("shard{k}"));
+        let shard = format!("{k}/3");
+        let mut args = vec!["experiment", "descriptors", "--scale", "0.001", "--objects", "chess"];
+        args.extend(["--shard", &shard, "--out", shard_dir.to_str().unwrap()]);
+        taction(&args);
+        assert!(
+            !shard_dir.join("descriptors/descriptors.csv").exists(),
+            "a shard alone does not finish the experiment"
+        );
+        shard_dirs.push(shard_dir);
+    }
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge".to_string()];
+    args.extend(shard_dirs.iter().map(|d| d.display().to_string()));
+    args.extend(["--out".to_string(), merged.display().to_string()]);
+    taction(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let merged_csv = std::fs::read(merged.join("descriptors/descriptors.csv")).expect("merged CSV");
+    assert_eq!(merged_csv, reference, "merged shards == one run, byte for byte");
+}
+
+#[test]
+fn bad_flags_and_unknown_experiments_are_clear_errors() {
+    for (args, needle) in [
+        (vec!["experiment", "figure-99"], "no experiment 'figure-99'"),
+        (vec!["experiment", "descriptors", "--scale", "0"], "--scale"),
+        (vec!["experiment", "descriptors", "--shard", "4/3"], "shard"),
+        (vec!["reproduce", "--only", "noise,nope"], "no experiment 'nope'"),
+        (vec!["experiment", "sim-to-real", "--real", "/nonexistent.csv"], "--real"),
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(&args)
+            .output()
+            .expect("taction runs");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
