@@ -2,24 +2,29 @@
 //! 1000 readings of ~20-dimensional PCA'd features, Sec. V-B) and the per-touch cost of the online
 //! posterior.
 //!
-//! The GMM data are also written to `target/bench-data/gmm_features.csv`, so scikit-learn can be
-//! timed on exactly the same features with the same k and iteration count:
+//! Two GMM groups: `gmm_fit_10x1000x20` runs exactly 100 EM iterations (tolerance 0, the same work
+//! for every implementation) and `gmm_fit_10x1000x20_tol1e-3` runs with the default settings (stop
+//! when the mean log-likelihood changes by < 1e-3, at most 100 iterations), each for k = 10, 20, 50.
+//! The features are written to `target/bench-data/gmm_features.csv` and each fit's iterations and
+//! final mean log-likelihood to `target/bench-data/gmm_taction.json`, so that
+//! `benches/gmm_sklearn.py` times scikit-learn's `GaussianMixture` on exactly the same data with the
+//! same settings and prints the side-by-side table with the ratios (see README, "Benchmarks"):
 //!
 //! ```text
-//! cargo bench --bench recognize -- gmm_fit
-//! target/parity-venv/bin/python tests/parity/bench_sklearn_gmm.py target/bench-data/gmm_features.csv
+//! cargo bench --bench recognize
+//! target/parity-venv/bin/python benches/gmm_sklearn.py
 //! ```
 
 use std::hint::black_box;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use taction::dataset::format_f64;
 use taction::describe::Feature;
 use taction::recognize::{
-    CodebookConfig, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, LabelledFeatures, TrainConfig,
-    train,
+    CodebookConfig, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LabelledFeatures,
+    TrainConfig, train,
 };
 use taction::rng::{Rng, stream};
 
@@ -64,6 +69,10 @@ fn object_features(seed: u64) -> Vec<Vec<Feature>> {
         .collect()
 }
 
+fn bench_data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench-data")
+}
+
 fn export(path: &Path, data: &FeatureMatrix) {
     let mut text = String::new();
     for row in data.iter_rows() {
@@ -77,26 +86,69 @@ fn export(path: &Path, data: &FeatureMatrix) {
     std::fs::write(path, text).expect("write the benchmark features");
 }
 
+/// Adds `entries` (under the group, keyed by k) to the JSON summary of our fits that
+/// `benches/gmm_sklearn.py` reads, keeping the entries of groups and k not run this time.
+fn record_fits(group: &str, entries: &[(usize, GmmFit)]) {
+    let path = bench_data_dir().join("gmm_taction.json");
+    let mut summary: serde_json::Map<String, serde_json::Value> = std::fs::read(&path)
+        .ok()
+        .and_then(|bytes| serde_json::from_slice(&bytes).ok())
+        .unwrap_or_default();
+    summary.insert("threads".into(), rayon::current_num_threads().into());
+    let mut fits = match summary.remove(group) {
+        Some(serde_json::Value::Object(fits)) => fits,
+        _ => serde_json::Map::new(),
+    };
+    for (k, fit) in entries {
+        fits.insert(
+            k.to_string(),
+            serde_json::json!({
+                "iterations": fit.iterations,
+                "converged": fit.converged,
+                "mean_log_likelihood": fit.mean_log_likelihood,
+            }),
+        );
+    }
+    summary.insert(group.into(), fits.into());
+    let text = serde_json::to_string_pretty(&summary).expect("a JSON object");
+    std::fs::write(&path, text).expect("write target/bench-data/gmm_taction.json");
+}
+
 fn gmm_fit(c: &mut Criterion) {
     let features: Vec<Feature> = object_features(2011).into_iter().flatten().collect();
     let data = FeatureMatrix::from_features(&features, "benchmark").expect("finite features");
-    export(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench-data/gmm_features.csv"),
-        &data,
-    );
-    let config = GmmConfig {
+    export(&bench_data_dir().join("gmm_features.csv"), &data);
+    let fixed = GmmConfig {
         max_iterations: ITERATIONS,
         tolerance: 0.0,
         ..GmmConfig::default()
     };
-    let mut group = c.benchmark_group("gmm_fit_10x1000x20");
-    group.sample_size(10);
-    for k in [10, 20, 50] {
-        group.bench_with_input(BenchmarkId::new("k", k), &k, |b, &k| {
-            b.iter(|| black_box(GaussianMixture::fit(&data, k, &config, &mut stream(1, 0)).expect("fit")))
-        });
+    for (name, config) in [
+        ("gmm_fit_10x1000x20", fixed),
+        ("gmm_fit_10x1000x20_tol1e-3", GmmConfig::default()),
+    ] {
+        let mut group = c.benchmark_group(name);
+        group.sample_size(10);
+        let mut fits = Vec::new();
+        for k in [10, 20, 50] {
+            let mut last = None;
+            group.bench_with_input(BenchmarkId::new("k", k), &k, |b, &k| {
+                b.iter(|| {
+                    // The same seeded fit every time: deterministic, so any run's summary will do.
+                    let (model, fit) =
+                        GaussianMixture::fit(&data, k, &config, &mut stream(1, 0)).expect("fit");
+                    last = Some(fit);
+                    black_box(model)
+                })
+            });
+            // `last` is None when a filter skipped this k.
+            fits.extend(last.map(|fit| (k, fit)));
+        }
+        group.finish();
+        if !fits.is_empty() {
+            record_fits(name, &fits);
+        }
     }
-    group.finish();
 }
 
 fn per_touch(c: &mut Criterion) {

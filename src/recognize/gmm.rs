@@ -124,7 +124,7 @@ impl GaussianMixture {
                 .collect()
         };
         let x = data.to_dmatrix();
-        let mut model = m_step(&x, &responsibilities, config.reg_covar)?;
+        let mut model = m_step(&x, data.as_slice(), &responsibilities, config.reg_covar)?;
         let mut lower_bound = f64::NEG_INFINITY;
         let mut converged = false;
         let mut iterations = 0;
@@ -132,7 +132,7 @@ impl GaussianMixture {
             iterations = iteration;
             let previous = lower_bound;
             let (mean_ll, responsibilities) = model.e_step(&x);
-            model = m_step(&x, &responsibilities, config.reg_covar)?;
+            model = m_step(&x, data.as_slice(), &responsibilities, config.reg_covar)?;
             lower_bound = mean_ll;
             if (lower_bound - previous).abs() < config.tolerance {
                 converged = true;
@@ -263,10 +263,7 @@ impl GaussianMixture {
     /// `ln P(x | G)` of every feature.
     pub fn score_samples(&self, data: &FeatureMatrix) -> Vec<f64> {
         let x = data.to_dmatrix();
-        let log_probs = self.weighted_log_prob_columns(&x);
-        (0..data.rows())
-            .map(|r| log_sum_exp_column(&log_probs, r))
-            .collect()
+        log_sum_exp_rows(&self.weighted_log_prob_columns(&x))
     }
 
     /// Mean of `ln P(x | G)` over `data` (scikit-learn's `score`).
@@ -287,9 +284,9 @@ impl GaussianMixture {
                 let y = x * p;
                 let mu_p = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
                 let mut q = vec![0.0; n];
-                for j in 0..d {
-                    let shift = mu_p[j];
-                    for (q, v) in q.iter_mut().zip(y.column(j).iter()) {
+                // Column j of the column-major `y` is one contiguous run of `n` values.
+                for (column, &shift) in y.as_slice().chunks_exact(n).zip(mu_p.iter()) {
+                    for (q, v) in q.iter_mut().zip(column) {
                         let t = v - shift;
                         *q += t * t;
                     }
@@ -304,7 +301,7 @@ impl GaussianMixture {
     fn e_step(&self, x: &DMatrix<f64>) -> (f64, Vec<Vec<f64>>) {
         let n = x.nrows();
         let mut columns = self.weighted_log_prob_columns(x);
-        let norms: Vec<f64> = (0..n).map(|r| log_sum_exp_column(&columns, r)).collect();
+        let norms = log_sum_exp_rows(&columns);
         columns.par_iter_mut().for_each(|c| {
             c.iter_mut()
                 .zip(&norms)
@@ -321,8 +318,11 @@ impl GaussianMixture {
 /// n_i = sum_r p_ri + 10 eps,   mu_i = (sum_r p_ri x_r) / n_i,
 /// Sigma_i = (sum_r p_ri (x_r - mu_i)(x_r - mu_i)^T) / n_i + reg I,   pi_i = n_i / sum_m n_m
 /// ```
+///
+/// `x` is the data column-major (nalgebra) and `x_rows` the same values row-major.
 fn m_step(
     x: &DMatrix<f64>,
+    x_rows: &[f64],
     responsibilities: &[Vec<f64>],
     reg_covar: f64,
 ) -> Result<GaussianMixture, RecognizeError> {
@@ -330,7 +330,8 @@ fn m_step(
         .par_iter()
         .enumerate()
         .map(|(i, resp)| {
-            Component::estimate(x, resp, reg_covar).ok_or(RecognizeError::SingularCovariance { component: i })
+            Component::estimate(x, x_rows, resp, reg_covar)
+                .ok_or(RecognizeError::SingularCovariance { component: i })
         })
         .collect();
     let k = responsibilities.len();
@@ -374,19 +375,27 @@ struct Component {
 }
 
 impl Component {
-    /// The M-step for the component with responsibilities `resp`; `None` when its covariance is not
-    /// positive definite.
-    fn estimate(x: &DMatrix<f64>, resp: &[f64], reg_covar: f64) -> Option<Self> {
+    /// The M-step for the component with responsibilities `resp` (`x` column-major, `x_rows` the
+    /// same data row-major); `None` when its covariance is not positive definite.
+    fn estimate(x: &DMatrix<f64>, x_rows: &[f64], resp: &[f64], reg_covar: f64) -> Option<Self> {
         let (n_rows, d) = x.shape();
         let r = DVector::from_column_slice(resp);
         let n = r.sum() + 10.0 * f64::EPSILON;
         let mean = x.tr_mul(&r) / n;
-        let mut diff = x.clone();
-        for (j, mut column) in diff.column_iter_mut().enumerate() {
-            column.add_scalar_mut(-mean[j]);
+        // D = X - 1 mu^T, column-major, one contiguous column at a time.
+        let mut diff = Vec::with_capacity(n_rows * d);
+        for (column, &m) in x.as_slice().chunks_exact(n_rows).zip(mean.iter()) {
+            diff.extend(column.iter().map(|v| v - m));
         }
-        // (D^T diag(r)) D as one blocked matrix product; D^T diag(r) is built transposed directly.
-        let weighted_t = DMatrix::from_fn(d, n_rows, |j, row| diff[(row, j)] * resp[row]);
+        let diff = DMatrix::from_vec(n_rows, d, diff);
+        // D^T diag(r), a column-major d x n matrix: its column `row` is (x_row - mu) r_row, read
+        // contiguously from the row-major copy of the data.
+        let mut weighted_t = Vec::with_capacity(n_rows * d);
+        for (row, &p) in x_rows.chunks_exact(d).zip(resp) {
+            weighted_t.extend(row.iter().zip(mean.iter()).map(|(v, m)| (v - m) * p));
+        }
+        let weighted_t = DMatrix::from_vec(d, n_rows, weighted_t);
+        // (D^T diag(r)) D as one blocked matrix product.
         let mut sigma = &weighted_t * &diff / n;
         for a in 0..d {
             sigma[(a, a)] += reg_covar;
@@ -425,12 +434,27 @@ pub fn log_sum_exp(v: &[f64]) -> f64 {
     max + v.iter().map(|x| (x - max).exp()).sum::<f64>().ln()
 }
 
-fn log_sum_exp_column(columns: &[Vec<f64>], r: usize) -> f64 {
-    let max = columns.iter().map(|c| c[r]).fold(f64::NEG_INFINITY, f64::max);
-    if !max.is_finite() {
-        return max;
+/// `ln sum_i exp(columns[i][r])` for every row `r`: the same arithmetic as [`log_sum_exp`] on each
+/// row (the exponentials summed in component order), computed a column at a time so every pass
+/// reads contiguous memory.
+fn log_sum_exp_rows(columns: &[Vec<f64>]) -> Vec<f64> {
+    let n = columns.first().map_or(0, Vec::len);
+    let mut max = vec![f64::NEG_INFINITY; n];
+    for column in columns {
+        for (m, &v) in max.iter_mut().zip(column) {
+            *m = m.max(v);
+        }
     }
-    max + columns.iter().map(|c| (c[r] - max).exp()).sum::<f64>().ln()
+    let mut sum = vec![0.0; n];
+    for column in columns {
+        for ((s, &v), &m) in sum.iter_mut().zip(column).zip(&max) {
+            *s += (v - m).exp();
+        }
+    }
+    max.iter()
+        .zip(&sum)
+        .map(|(&m, &s)| if m.is_finite() { m + s.ln() } else { m })
+        .collect()
 }
 
 #[cfg(test)]
