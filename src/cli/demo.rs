@@ -47,6 +47,27 @@ pub struct DemoArgs {
     pub out: PathBuf,
 }
 
+/// The codebook sizes the demo tries when it has the data for them.
+const CODEBOOK_SIZES: [usize; 2] = [10, 20];
+
+/// Training features a codebook needs per cluster: fewer leaves Gaussian components fitted to one
+/// or two features each (kept positive definite only by `reg_covar`) and histograms that are
+/// mostly pseudo-counts.
+const FEATURES_PER_CLUSTER: usize = 5;
+
+/// The sizes of `grid` that `training_features` features support (at least
+/// [`FEATURES_PER_CLUSTER`] per cluster); when none does, the largest size that is supported
+/// (at least 1).
+fn codebook_sizes(grid: &[usize], training_features: usize) -> Vec<usize> {
+    let most = (training_features / FEATURES_PER_CLUSTER).max(1);
+    let supported: Vec<usize> = grid.iter().copied().filter(|&k| k <= most).collect();
+    if supported.is_empty() {
+        vec![most]
+    } else {
+        supported
+    }
+}
+
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.touches == 0 || args.training_readings < 11 {
         return Err("--touches must be 1 or more and --training-readings 11 or more".into());
@@ -107,12 +128,21 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 readings,
             )?;
             let features = LabelledFeatures::from_dataset(&dataset.converged_only(), descriptor.as_ref());
-            let config = TrainConfig {
-                ks: vec![10, 20],
+            let mut config = TrainConfig {
                 restarts: 1,
                 seed: args.seed,
                 ..TrainConfig::default()
             };
+            // The hold-out keeps about `holdout` of each object's readings for validation.
+            let training_features =
+                (features.features().count() as f64 * (1.0 - config.holdout)).floor() as usize;
+            config.ks = codebook_sizes(&CODEBOOK_SIZES, training_features);
+            if config.ks != CODEBOOK_SIZES {
+                println!(
+                    "training: {training_features} training features are too few for k = {CODEBOOK_SIZES:?}; trying k = {:?}",
+                    config.ks
+                );
+            }
             let trained = train(&features, None, &config, &mut |_| {})?;
             let provenance = TrainingProvenance {
                 object_set: set.id(),
@@ -253,4 +283,19 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         args.out.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codebook_sizes_shrink_to_what_the_features_support() {
+        assert_eq!(codebook_sizes(&[10, 20], 1800), vec![10, 20]);
+        assert_eq!(codebook_sizes(&[10, 20], 100), vec![10, 20]);
+        assert_eq!(codebook_sizes(&[10, 20], 99), vec![10]);
+        assert_eq!(codebook_sizes(&[10, 20], 22), vec![4]);
+        assert_eq!(codebook_sizes(&[10, 20], 3), vec![1]);
+        assert_eq!(codebook_sizes(&[10, 20], 0), vec![1]);
+    }
 }

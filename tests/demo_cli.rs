@@ -1,0 +1,105 @@
+//! The README's run command (`cargo xtask demo` runs `taction demo`) end to end on a tiny object set:
+//! the two generated chess pieces (no download), few training readings, two touches. Checks the
+//! exit status, every output file, the model cache on a second run, and that the second run writes
+//! the same per-touch CSV.
+
+use std::path::Path;
+use std::process::Command;
+
+const TOUCHES: usize = 2;
+const HEADER: &str = "touch,object_true,object_guess,p_guess,p_true,entropy_nats";
+
+fn demo(out: &Path) -> (bool, String, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["demo", "--objects", "chess", "--training-readings", "12"])
+        .args(["--touches", &TOUCHES.to_string(), "--seed", "3", "--out"])
+        .arg(out)
+        .output()
+        .expect("the taction binary runs");
+    (
+        output.status.success(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+/// Checks `touches.csv` row by row; returns its text.
+fn check_touches(out: &Path) -> String {
+    let text = std::fs::read_to_string(out.join("touches.csv")).expect("touches.csv is written");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(HEADER), "{text}");
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), TOUCHES, "one row per touch:\n{text}");
+    let pieces = ["pawn", "rook"];
+    let mut truth = None;
+    for (i, row) in rows.iter().enumerate() {
+        let fields: Vec<&str> = row.split(',').collect();
+        assert_eq!(fields.len(), 6, "{row}");
+        assert_eq!(fields[0].parse::<usize>().ok(), Some(i + 1), "{row}");
+        // The same unknown object throughout, one of the set, and a guess among the set.
+        assert!(pieces.contains(&fields[1]), "{row}");
+        assert_eq!(*truth.get_or_insert(fields[1]), fields[1], "{row}");
+        assert!(pieces.contains(&fields[2]), "{row}");
+        let number = |s: &str| s.parse::<f64>().unwrap_or_else(|_| panic!("not a number: {row}"));
+        let (p_guess, p_true, entropy) = (number(fields[3]), number(fields[4]), number(fields[5]));
+        for p in [p_guess, p_true] {
+            assert!((0.0..=1.0).contains(&p), "{row}");
+        }
+        // The guess is the most probable object: nothing, the true object included, beats it;
+        // when the guess is the true object the two probabilities are the same number.
+        assert!(p_guess >= p_true, "{row}");
+        if fields[1] == fields[2] {
+            assert_eq!(p_guess, p_true, "{row}");
+        } else {
+            // Two objects: the guess and the truth share the whole probability.
+            assert!((p_guess + p_true - 1.0).abs() < 1e-9, "{row}");
+        }
+        // Two objects: the entropy of (p, 1 - p) in nats, at most ln 2.
+        let h = |p: f64| if p > 0.0 { -p * p.ln() } else { 0.0 };
+        assert!((entropy - (h(p_guess) + h(1.0 - p_guess))).abs() < 1e-9, "{row}");
+        assert!(entropy <= 2f64.ln() + 1e-12, "{row}");
+    }
+    text
+}
+
+fn check_images(out: &Path) {
+    let svg = std::fs::read_to_string(out.join("posterior.svg")).expect("posterior.svg is written");
+    let doc = roxmltree::Document::parse(&svg).expect("posterior.svg is well-formed XML");
+    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    assert!(
+        doc.descendants().count() > 20,
+        "posterior.svg has almost nothing in it:\n{svg}"
+    );
+    const PNG: &[u8] = b"\x89PNG\r\n\x1a\n";
+    for name in ["posterior.png", "contact_sheet.png"] {
+        let bytes = std::fs::read(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(bytes.starts_with(PNG) && bytes.len() > 100, "{name} is not a PNG");
+    }
+}
+
+#[test]
+fn demo_on_the_chess_pieces_writes_its_outputs_and_reuses_its_model() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let out = dir.path().join("demo");
+
+    let (ok, stdout, stderr) = demo(&out);
+    assert!(ok, "demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
+    assert!(stdout.contains("training:"), "{stdout}");
+    assert!(!stdout.contains("using the model trained before"), "{stdout}");
+    let first = check_touches(&out);
+    check_images(&out);
+    let models: Vec<_> = std::fs::read_dir(&out)
+        .expect("the output folder")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with("model-"))
+        .collect();
+    assert_eq!(models.len(), 1, "one cached model");
+
+    let (ok, stdout, stderr) = demo(&out);
+    assert!(ok, "second demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
+    assert!(
+        stdout.contains("using the model trained before") && !stdout.contains("training:"),
+        "the second run should reuse the cached model:\n{stdout}"
+    );
+    assert_eq!(check_touches(&out), first, "same arguments, same touches");
+}
