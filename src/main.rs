@@ -35,6 +35,8 @@ enum Command {
     Dataset(cli::dataset::DatasetArgs),
     /// Recognise a test dataset touch by touch with a saved model; write posterior, accuracy, confusion CSVs.
     Recognize(cli::recognize::RecognizeArgs),
+    /// Run the surface contact controllers once from a pad pose on a mesh; print the outcome as JSON.
+    Touch(cli::touch::TouchArgs),
     /// Train a bag-of-features model (PCA, k-means or GMM codebook, object histograms) on a dataset.
     Train(cli::train::TrainArgs),
 }
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
         Command::Sense(args) => cli::sense::run(args),
         Command::Dataset(args) => cli::dataset::run(args),
         Command::Recognize(args) => cli::recognize::run(args),
+        Command::Touch(args) => cli::touch::run(args),
         Command::Train(args) => cli::train::run(args),
     };
     match result {

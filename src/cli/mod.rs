@@ -9,4 +9,5 @@ pub mod objects;
 pub mod recognize;
 pub mod sense;
 pub mod sensor_args;
+pub mod touch;
 pub mod train;

@@ -1,7 +1,12 @@
-//! The sensor flags shared by every command that simulates the covering sensor.
+//! The flags shared by every command that simulates the covering sensor: the sensor itself
+//! ([`SensorArgs`]) and the mesh with the pad's pose near it ([`PadArgs`], `sense` and `touch`).
+
+use std::path::PathBuf;
 
 use clap::Args;
-use taction::tactile::{ConfigKey, SensorConfig, psf_sigma_for_thickness};
+use glam::DVec3;
+use taction::sim::ObjectSpec;
+use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
 
 #[derive(Debug, Clone, Args)]
 pub struct SensorArgs {
@@ -74,5 +79,86 @@ impl SensorArgs {
             allowed: e.key.allowed(),
         })?;
         Ok(config)
+    }
+}
+
+/// The object and the pad pose: the mesh is placed as given (its coordinates are metres in the world
+/// frame); the pad's centre is the back of the covering and `--pad-normal` points from the pad into
+/// the covering, toward the object.
+#[derive(Debug, Clone, Args)]
+pub struct PadArgs {
+    /// The object: an OBJ, OFF or STL mesh, coordinates in metres, placed as given.
+    #[arg(long, value_name = "FILE")]
+    pub mesh: PathBuf,
+    /// Centre of the pad (the back of the covering), world metres.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub pad_center: DVec3,
+    /// Pad normal: from the pad into the covering, toward the object (any length).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub pad_normal: DVec3,
+    /// Direction of image row 0 (made perpendicular to the normal) [default: world +z, or +y when
+    /// the normal is vertical].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub pad_up: Option<DVec3>,
+}
+
+/// The pad flags describe no frame.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("--pad-normal / --pad-up: the normal must be non-zero and --pad-up not parallel to it")]
+pub struct PadFrameError;
+
+/// A vector flag: three comma-separated finite numbers.
+pub fn parse_vec3(text: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let bad = || format!("expected three comma-separated finite numbers like 0,0,0.1, got '{text}'");
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let mut v = [0.0; 3];
+    for (slot, part) in v.iter_mut().zip(&parts) {
+        *slot = part
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(bad)?;
+    }
+    Ok(DVec3::from_array(v))
+}
+
+impl PadArgs {
+    /// The pad pose the flags describe.
+    pub fn pad_pose(&self) -> Result<PadPose, PadFrameError> {
+        let up = self.pad_up.unwrap_or_else(|| {
+            let n = self.pad_normal.normalize_or_zero();
+            if n.z.abs() > 0.999 { DVec3::Y } else { DVec3::Z }
+        });
+        PadPose::new(self.pad_center, self.pad_normal, up).ok_or(PadFrameError)
+    }
+
+    /// Loads `--mesh` as the object (named after the file), warning on stderr (prefixed with
+    /// `command`) about validation problems, and reversing inward-wound faces: the sensor tells
+    /// inside from outside by the winding.
+    pub fn load_object(&self, command: &str) -> Result<ObjectSpec, taction::mesh::MeshError> {
+        let loaded = taction::mesh::load(&self.mesh)?;
+        if !loaded.warnings.is_clean() {
+            eprintln!(
+                "taction {command}: warning: {}: {}",
+                self.mesh.display(),
+                loaded.warnings
+            );
+        }
+        let name = self
+            .mesh
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "object".into());
+        let (mesh, flipped) = taction::mesh::orient_outward(loaded.mesh);
+        if flipped {
+            eprintln!(
+                "taction {command}: note: {}: faces wound inward; reversed",
+                self.mesh.display()
+            );
+        }
+        Ok(ObjectSpec::new(name, mesh))
     }
 }

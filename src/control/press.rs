@@ -14,6 +14,46 @@ use crate::tactile::TactileImage;
 /// A taxel at this value is clipped: the object has reached the pad's rigid back.
 pub const CLIPPED: f64 = 0.999;
 
+/// How hard the most pressed part of the pad is pressed, as a noise-free taxel value in [0, 1]: the
+/// image's maximum without noise. With expected noise a single taxel says little (at 75% noise a
+/// taxel at 0.7 reads 1.0 one time in ten, so on a curved patch pressed to a mean of 0.3 some taxel
+/// reads "clipped" in most readings, and Press backed off until the iteration budget ran out;
+/// Sec. V-C), so the peak is taken over the 3x3 neighbourhood
+/// means (the point-spread makes the true image smooth on that scale, while the noise is independent
+/// per taxel), and the clamp's bias is undone ([`ControlConfig::signal_of_reading`]).
+pub fn pressed_peak(image: &TactileImage, config: &ControlConfig) -> f64 {
+    if config.expected_noise_fraction <= 0.0 {
+        return image.max();
+    }
+    let (rows, cols) = (image.rows(), image.cols());
+    let mut peak = 0.0_f64;
+    for r in 0..rows {
+        for c in 0..cols {
+            let (mut sum, mut n) = (0.0, 0.0);
+            for rr in r.saturating_sub(1)..(r + 2).min(rows) {
+                for cc in c.saturating_sub(1)..(c + 2).min(cols) {
+                    sum += image.get(rr, cc);
+                    n += 1.0;
+                }
+            }
+            peak = peak.max(sum / n);
+        }
+    }
+    config.signal_of_reading(peak)
+}
+
+/// Whether the covering is pushed through somewhere (the object at the pad's rigid back). With noise
+/// the estimated peak is itself uncertain, so "clipped" is halfway between the saturation threshold
+/// and full range rather than the full range exactly.
+pub fn is_clipped(image: &TactileImage, config: &ControlConfig) -> bool {
+    let level = if config.expected_noise_fraction > 0.0 {
+        0.5 * (config.saturation_threshold + 1.0)
+    } else {
+        CLIPPED
+    };
+    pressed_peak(image, config) >= level
+}
+
 /// How a Press phase ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PressOutcome {
@@ -37,8 +77,8 @@ pub fn press<C: PadCarrier + ?Sized>(
     let mut commanded = false;
     for _ in 0..config.press_max_steps {
         let error = config.target_mean_pressure - image.mean();
-        let near_saturation = image.max() >= config.saturation_threshold;
-        let step_m = if image.max() >= CLIPPED {
+        let near_saturation = pressed_peak(&image, config) >= config.saturation_threshold;
+        let step_m = if is_clipped(&image, config) {
             // Pushed through the covering: back off whatever the mean says.
             -config.press_max_step_thickness * t * 0.5
         } else if error.abs() <= tolerance || (near_saturation && error > 0.0) {
@@ -66,4 +106,36 @@ pub fn press<C: PadCarrier + ?Sized>(
         image = carrier.read()?;
     }
     Ok(PressOutcome::Done { image, commanded })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(values: impl Fn(usize, usize) -> f64) -> TactileImage {
+        let v = (0..36).map(|i| values(i / 6, i % 6)).collect();
+        TactileImage::new(6, 6, v).unwrap()
+    }
+
+    #[test]
+    fn noise_aware_clipping_needs_a_clipped_neighbourhood() {
+        let noisy = ControlConfig {
+            expected_noise_fraction: 0.75,
+            ..ControlConfig::default()
+        };
+        // One taxel at full range among taxels at 0.7: noise, not a pushed-through covering.
+        let one = image(|r, c| if (r, c) == (2, 3) { 1.0 } else { 0.7 });
+        assert!(is_clipped(&one, &ControlConfig::default()));
+        assert!(!is_clipped(&one, &noisy));
+        // A saturated corner read through noise (1 + u clamped: 1 or a bit less).
+        let corner = image(|r, c| {
+            if r < 3 && c < 3 {
+                if (r + c) % 2 == 0 { 1.0 } else { 0.8 }
+            } else {
+                0.2
+            }
+        });
+        assert!(is_clipped(&corner, &noisy));
+        assert!(pressed_peak(&corner, &noisy) <= 1.0);
+    }
 }

@@ -15,6 +15,7 @@
 pub mod accuracy;
 pub mod assemble;
 pub mod atomic;
+pub mod convergence;
 pub mod error;
 pub mod figure;
 pub mod font;

@@ -1,0 +1,191 @@
+//! `taction touch`: one run of the surface contact controllers (Sec. III-B, Fig. 3a: Approach ->
+//! Press <-> Orient) from a given pad pose, printed as one JSON object.
+//!
+//! The mesh and pad flags are those of `taction sense`: the pad starts at `--pad-center`, looking
+//! along `--pad-normal`, and approaches along that normal. By default the pad is the free-floating
+//! one of the training sampler (Sec. V-A3), teleported by pose commands. With `--arm` the same
+//! controllers drive the arm of Sec. V-A1: the mesh is placed in the MuJoCo world with its origin at
+//! the world origin, on the table top (z = 0), the arm is put at an inverse-kinematics solution for
+//! the start pose, and every command goes through the IK and is executed by MuJoCo stepping.
+//!
+//! The output's `pad_center` is metres in the world, `pad_normal` a unit vector, `mean_pressure` and
+//! the `image` values fractions of the sensing range (row 0 the pad's up edge, as in `sense`).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use taction::control::arm_pad::ArmPad;
+use taction::control::free_pad::FreePad;
+use taction::control::{ContactOutcome, ContactReport, ControlConfig, settle};
+use taction::explore::collect::sensor_reader;
+use taction::explore::planner::precise_motion;
+use taction::sim::arm::PAD_SITE;
+use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
+use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
+
+use crate::cli::sensor_args::{PadArgs, PadFrameError, SensorArgs, SensorFlagError};
+
+#[derive(Debug, Args)]
+pub struct TouchArgs {
+    #[command(flatten)]
+    pub pad: PadArgs,
+    #[command(flatten)]
+    pub sensor: SensorArgs,
+    /// Noise seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Drive the arm in the MuJoCo world (object on the table at its origin) instead of the
+    /// free-floating pad. The arm's IK leaves the pad's rotation about its normal free, so
+    /// `--pad-up` has no effect.
+    #[arg(long)]
+    pub arm: bool,
+    /// Press target: the mean taxel value, a fraction of the sensing range in (0, 1)
+    /// [default: the controller config's, 0.3].
+    #[arg(long, allow_hyphen_values = true)]
+    pub target_pressure: Option<f64>,
+    /// Controller configuration as JSON (the fields of `ControlConfig`, any subset; units in their
+    /// names). `expected_noise_fraction` is always taken from `--noise`.
+    #[arg(long, value_name = "FILE.json")]
+    pub control: Option<PathBuf>,
+}
+
+/// What can go wrong; each names the flag or file at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum TouchError {
+    #[error(transparent)]
+    Flag(#[from] SensorFlagError),
+    #[error(transparent)]
+    PadFrame(#[from] PadFrameError),
+    #[error("--target-pressure: {0} is out of range: want a fraction of the range in (0, 1)")]
+    TargetPressure(f64),
+    #[error("--control: {path}: {what}")]
+    ControlFile { path: String, what: String },
+    #[error(
+        "--pad-center / --pad-normal: the arm cannot reach the start pose ({0}); with --arm the object stands on the table at the world origin, the arm's base at x = -0.35 m"
+    )]
+    Unreachable(IkError),
+    #[error(
+        "--pad-center / --pad-normal: at the start pose the arm touches something ({a} with {b}); start further from the object"
+    )]
+    StartsInCollision { a: String, b: String },
+    #[error(transparent)]
+    Mesh(#[from] taction::mesh::MeshError),
+    #[error(transparent)]
+    Tactile(#[from] taction::tactile::TactileError),
+    #[error(transparent)]
+    Config(#[from] taction::tactile::ConfigError),
+    #[error(transparent)]
+    Sim(#[from] taction::sim::SimError),
+    #[error(transparent)]
+    Control(#[from] taction::control::ControlError),
+    #[error("cannot write the JSON: {0}")]
+    Json(#[from] serde_json::Error),
+}
+
+impl TouchArgs {
+    /// The controller configuration the flags describe, validated. The controllers expect the
+    /// sensor's own noise: their contact threshold and tolerances widen with it.
+    pub fn control_config(&self, sensor: &SensorConfig) -> Result<ControlConfig, TouchError> {
+        let mut config = match &self.control {
+            None => ControlConfig::default(),
+            Some(path) => {
+                let file_error = |what: String| TouchError::ControlFile {
+                    path: path.display().to_string(),
+                    what,
+                };
+                let text = std::fs::read_to_string(path).map_err(|e| file_error(e.to_string()))?;
+                serde_json::from_str(&text).map_err(|e| file_error(e.to_string()))?
+            }
+        };
+        if let Some(target) = self.target_pressure {
+            if !(target > 0.0 && target < 1.0) {
+                return Err(TouchError::TargetPressure(target));
+            }
+            config.target_mean_pressure = target;
+        }
+        config.expected_noise_fraction = sensor.noise_fraction;
+        config
+            .validate()
+            .map_err(|e| match (e.field, self.target_pressure) {
+                ("target_mean_pressure", Some(t)) => TouchError::TargetPressure(t),
+                _ => TouchError::ControlFile {
+                    path: self
+                        .control
+                        .as_ref()
+                        .map_or_else(|| "(defaults)".into(), |p| p.display().to_string()),
+                    what: e.to_string(),
+                },
+            })?;
+        Ok(config)
+    }
+}
+
+/// The controllers on the free-floating pad, from `start`.
+fn touch_free(
+    object: ObjectSpec,
+    sensor: SensorConfig,
+    control: &ControlConfig,
+    start: &PadPose,
+) -> Result<ContactOutcome, TouchError> {
+    let mut free = FreeFloatingSensor::new(object, &sensor)?;
+    let reader = sensor_reader(free.sensor().clone());
+    let mut pad = FreePad::new(free.scene_mut(), sensor, reader)?;
+    pad.place(start);
+    Ok(settle(&mut pad, control)?)
+}
+
+/// The controllers on the arm, the object on the table at the world origin, from the arm
+/// configuration that puts the pad at `start`.
+fn touch_arm(
+    object: ObjectSpec,
+    sensor: SensorConfig,
+    control: &ControlConfig,
+    start: &PadPose,
+) -> Result<ContactOutcome, TouchError> {
+    let builder = SceneBuilder::with_arm_and_table().object(object);
+    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)?.build()?;
+    let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
+    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+    let (ik_options, motion) = precise_motion();
+    let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
+    let home = arm.q(scene.data());
+    let q = ik
+        .solve(
+            &PadTarget {
+                center_m: start.center_m,
+                normal: start.normal,
+            },
+            &home,
+        )
+        .map_err(TouchError::Unreachable)?;
+    arm.teleport(&mut scene, &q);
+    if let Some(c) = arm.collision(&scene) {
+        return Err(TouchError::StartsInCollision {
+            a: c.body_a,
+            b: c.body_b,
+        });
+    }
+    let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?;
+    Ok(settle(&mut pad, control)?)
+}
+
+/// Runs the controllers once and prints the outcome as one JSON object.
+pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let sensor = args.sensor.config(args.seed).map_err(TouchError::from)?;
+    let start = args.pad.pad_pose().map_err(TouchError::from)?;
+    let control = args.control_config(&sensor)?;
+    if args.arm && args.pad.pad_up.is_some() {
+        eprintln!(
+            "taction touch: note: --pad-up has no effect with --arm (the IK leaves the pad's roll free)"
+        );
+    }
+    let object = args.pad.load_object("touch").map_err(TouchError::from)?;
+    let outcome = if args.arm {
+        touch_arm(object, sensor, &control, &start)?
+    } else {
+        touch_free(object, sensor, &control, &start)?
+    };
+    let json = serde_json::to_string(&ContactReport::from(&outcome)).map_err(TouchError::from)?;
+    println!("{json}");
+    Ok(())
+}
