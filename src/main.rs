@@ -25,6 +25,10 @@ enum Command {
     Demo(cli::demo::DemoArgs),
     /// Print the feature vectors of one tactile image (Sec. IV-B), one per line, comma-separated.
     Describe(cli::describe::DescribeArgs),
+    /// Run one experiment of the paper (Sec. V) as a resumable, shardable job; `experiment list` lists them.
+    Experiment(cli::experiment::ExperimentArgs),
+    /// Run every experiment of the paper, then print the headline accuracy table.
+    Reproduce(cli::experiment::ReproduceArgs),
     /// Combine the output directories of sharded experiment runs (`--shard k/n`) into one.
     Merge(cli::merge::MergeArgs),
     /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
@@ -47,6 +51,8 @@ fn main() -> ExitCode {
         Command::Collect(args) => cli::collect::run(args),
         Command::Demo(args) => cli::demo::run(args),
         Command::Describe(args) => cli::describe::run(args),
+        Command::Experiment(args) => cli::experiment::run_experiment(args),
+        Command::Reproduce(args) => cli::experiment::run_reproduce(args),
         Command::Merge(args) => cli::merge::run(args),
         Command::Objects(args) => cli::objects::run(args),
         Command::Sense(args) => cli::sense::run(args),

@@ -9,11 +9,12 @@ use std::time::{Duration, Instant};
 
 use taction::experiment::AccuracyRow;
 use taction::experiment::paper::PaperExperiment;
+use taction::mesh::ObjectSet;
 use taction::mesh::glyph::Font;
 use taction::mesh::letters::LetterStyle;
-use taction::mesh::ObjectSet;
 
-const ACCURACY_HEADER: &str = "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
+const ACCURACY_HEADER: &str =
+    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
 
 fn taction(args: &[&str]) -> Output {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
@@ -87,8 +88,16 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
         let mut curves = BTreeSet::new();
         for r in &rows {
             assert_eq!(r.experiment, name);
-            assert!((0.0..=1.0).contains(&r.accuracy), "{name}: accuracy {}", r.accuracy);
-            assert!((0.0..=1.0).contains(&r.reliability), "{name}: reliability {}", r.reliability);
+            assert!(
+                (0.0..=1.0).contains(&r.accuracy),
+                "{name}: accuracy {}",
+                r.accuracy
+            );
+            assert!(
+                (0.0..=1.0).contains(&r.reliability),
+                "{name}: reliability {}",
+                r.reliability
+            );
             assert!(r.n_readings >= 1);
             curves.insert((r.descriptor.clone(), r.value.clone(), r.trial));
         }
@@ -99,36 +108,63 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
                 .filter(|r| (&r.descriptor, &r.value, &r.trial) == (descriptor, value, trial))
                 .map(|r| r.n_readings)
                 .collect();
-            assert_eq!(ns, (1..=ns.len() as u32).collect::<Vec<_>>(), "{name} {descriptor} {value}");
+            assert_eq!(
+                ns,
+                (1..=ns.len() as u32).collect::<Vec<_>>(),
+                "{name} {descriptor} {value}"
+            );
         }
         assert_svg_and_png(&root.join(name));
         let config = std::fs::read_to_string(root.join("config.json")).expect("config.json written");
-        assert!(config.contains("\"seed\": 1"), "{name}: the config records the seed");
+        assert!(
+            config.contains("\"seed\": 1"),
+            "{name}: the config records the seed"
+        );
     }
     // Curves the figures need: six descriptors in Fig. 7, three values of L in Fig. 8, fixed and
     // perturbed in Fig. 10, three resolutions in Fig. 12, two letters recognised in Fig. 16a.
     let values = |name: &str| -> BTreeSet<String> {
-        rows(&out.join(name).join(format!("{name}.csv"))).into_iter().map(|r| r.value).collect()
+        rows(&out.join(name).join(format!("{name}.csv")))
+            .into_iter()
+            .map(|r| r.value)
+            .collect()
     };
     let descriptors: BTreeSet<String> = rows(&out.join("descriptors/descriptors.csv"))
         .into_iter()
         .map(|r| r.descriptor)
         .collect();
     assert_eq!(descriptors.len(), 6);
-    assert_eq!(values("strategy"), BTreeSet::from(["0".into(), "0.5".into(), "1".into()]));
-    assert_eq!(values("perturbation"), BTreeSet::from(["fixed".into(), "perturbed".into()]));
+    assert_eq!(
+        values("strategy"),
+        BTreeSet::from(["0".into(), "0.5".into(), "1".into()])
+    );
+    assert_eq!(
+        values("perturbation"),
+        BTreeSet::from(["fixed".into(), "perturbed".into()])
+    );
     assert_eq!(values("resolution").len(), 3);
     assert_eq!(values("noise").len(), 4);
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");
     }
-    assert!(stdout.contains("| descriptors | polar-fourier |"), "headline table printed:\n{stdout}");
+    assert!(
+        stdout.contains("| descriptors | polar-fourier |"),
+        "headline table printed:\n{stdout}"
+    );
 }
 
 /// Runs `experiment` into `out` and returns the assembled CSV's bytes.
 fn run_experiment(name: &str, out: &Path, extra: &[&str]) -> Vec<u8> {
-    let mut args = vec!["experiment", name, "--scale", "0.001", "--objects", "chess", "--out"];
+    let mut args = vec![
+        "experiment",
+        name,
+        "--scale",
+        "0.001",
+        "--objects",
+        "chess",
+        "--out",
+    ];
     args.push(out.to_str().unwrap());
     args.extend_from_slice(extra);
     taction(&args);
@@ -145,7 +181,16 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
     let killed = dir.path().join("killed");
     let units = killed.join("descriptors").join("units");
     let mut child = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(["experiment", "descriptors", "--scale", "0.001", "--objects", "chess", "--threads", "1"])
+        .args([
+            "experiment",
+            "descriptors",
+            "--scale",
+            "0.001",
+            "--objects",
+            "chess",
+            "--threads",
+            "1",
+        ])
         .arg("--out")
         .arg(&killed)
         .stdout(Stdio::null())
@@ -167,13 +212,22 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
     }
     child.kill().ok();
     child.wait().ok();
-    assert!(finished_before_kill >= 1, "the run saved a unit before it was killed");
+    assert!(
+        finished_before_kill >= 1,
+        "the run saved a unit before it was killed"
+    );
     let killed_dir = killed.join("descriptors");
     if !killed_dir.join("descriptors.csv").exists() {
         let resumed = run_experiment("descriptors", &killed, &["--threads", "2"]);
-        assert_eq!(resumed, reference, "the resumed run has the rows of the uninterrupted one");
+        assert_eq!(
+            resumed, reference,
+            "the resumed run has the rows of the uninterrupted one"
+        );
     }
-    let lines: Vec<&[u8]> = reference.split(|&b| b == b'\n').filter(|l| !l.is_empty()).collect();
+    let lines: Vec<&[u8]> = reference
+        .split(|&b| b == b'\n')
+        .filter(|l| !l.is_empty())
+        .collect();
     let distinct: BTreeSet<&[u8]> = lines.iter().copied().collect();
     assert_eq!(lines.len(), distinct.len(), "no row twice");
 
@@ -182,7 +236,14 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
     for k in 1..=3 {
         let shard_dir = dir.path().join(format!("shard{k}"));
         let shard = format!("{k}/3");
-        let mut args = vec!["experiment", "descriptors", "--scale", "0.001", "--objects", "chess"];
+        let mut args = vec![
+            "experiment",
+            "descriptors",
+            "--scale",
+            "0.001",
+            "--objects",
+            "chess",
+        ];
         args.extend(["--shard", &shard, "--out", shard_dir.to_str().unwrap()]);
         taction(&args);
         assert!(
@@ -207,7 +268,10 @@ fn bad_flags_and_unknown_experiments_are_clear_errors() {
         (vec!["experiment", "descriptors", "--scale", "0"], "--scale"),
         (vec!["experiment", "descriptors", "--shard", "4/3"], "shard"),
         (vec!["reproduce", "--only", "noise,nope"], "no experiment 'nope'"),
-        (vec!["experiment", "sim-to-real", "--real", "/nonexistent.csv"], "--real"),
+        (
+            vec!["experiment", "sim-to-real", "--real", "/nonexistent.csv"],
+            "--real",
+        ),
     ] {
         let output = Command::new(env!("CARGO_BIN_EXE_taction"))
             .args(&args)

@@ -4,6 +4,7 @@ pub mod collect;
 pub mod dataset;
 pub mod demo;
 pub mod describe;
+pub mod experiment;
 pub mod merge;
 pub mod objects;
 pub mod recognize;

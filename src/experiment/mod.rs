@@ -23,6 +23,7 @@ pub mod index;
 pub mod layout;
 pub mod merge;
 pub mod name;
+pub mod paper;
 pub mod plot;
 pub mod real_data;
 pub mod runner;

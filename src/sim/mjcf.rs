@@ -11,6 +11,8 @@ use crate::sim::SimError;
 pub const ARM_XML: &str = include_str!("../../mjcf/arm.xml");
 /// `mjcf/table.xml`: the table, its top at z = 0.
 pub const TABLE_XML: &str = include_str!("../../mjcf/table.xml");
+/// Height of the table top in `mjcf/table.xml` (the object rests on it), metres.
+pub const TABLE_TOP_Z_M: f64 = 0.0;
 
 /// The children of the root `<mujoco>` element of `xml` (what `<include>` would insert).
 pub fn inner(xml: &str, origin: &str) -> Result<String, SimError> {

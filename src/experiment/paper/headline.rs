@@ -11,7 +11,7 @@ use crate::experiment::name::SafeName;
 use crate::experiment::unit::read_rows;
 
 /// The reading counts of the headline table.
-pub const HEADLINE_READINGS: [u32; 5] = [1, 10, 30, 60, 100];
+pub const HEADLINE_READINGS: [u32; 6] = [1, 10, 20, 30, 60, 100];
 
 /// A Markdown table with one line per (experiment, descriptor, value) of the experiments in `names`
 /// that are complete under `out`, and the mean accuracy over trials (in %) after each of

@@ -11,6 +11,7 @@
 //! | `thickness` | 11 | covering thickness |
 //! | `resolution` | 12 | taxels per side |
 //! | `noise` | 13 | additive noise |
+//! | `convergence` | 14 | controller convergence against noise ([`crate::experiment::convergence`]) |
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //!
@@ -30,7 +31,8 @@ pub use context::{PaperContext, RealRecording};
 pub use recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
 pub use scale::{DataCounts, Scale};
 
-use crate::experiment::runner::RunReport;
+use crate::experiment::convergence;
+use crate::experiment::runner::{RunReport, run};
 use crate::experiment::unit::BoxError;
 
 /// One experiment of the paper.
@@ -43,13 +45,14 @@ pub enum PaperExperiment {
     Thickness,
     Resolution,
     Noise,
+    Convergence,
     Letters,
     SimToReal,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order).
-    pub const ALL: [PaperExperiment; 9] = [
+    pub const ALL: [PaperExperiment; 10] = [
         Self::Descriptors,
         Self::Strategy,
         Self::Validation,
@@ -57,12 +60,14 @@ impl PaperExperiment {
         Self::Thickness,
         Self::Resolution,
         Self::Noise,
+        Self::Convergence,
         Self::Letters,
         Self::SimToReal,
     ];
 
-    fn sweep(self) -> RecognitionSweep {
-        match self {
+    /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve.
+    fn sweep(self) -> Option<RecognitionSweep> {
+        Some(match self {
             Self::Descriptors => figures::descriptors(),
             Self::Strategy => figures::strategy(),
             Self::Validation => figures::validation(),
@@ -70,18 +75,22 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
+            Self::Convergence => return None,
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
-        }
+        })
     }
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        self.sweep().name
+        self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name)
     }
 
     pub fn description(self) -> &'static str {
-        self.sweep().description
+        self.sweep().map_or(
+            "Fig. 14: controller convergence and iterations against noise 0-150% (the dragon, or every 3D object without one)",
+            |s| s.description,
+        )
     }
 
     pub fn from_name(name: &str) -> Option<Self> {
@@ -90,8 +99,30 @@ impl PaperExperiment {
 
     /// Runs the experiment in `context`.
     pub fn run(self, context: &PaperContext) -> Result<RunReport, BoxError> {
-        self.sweep().run(context)
+        match self.sweep() {
+            Some(sweep) => sweep.run(context),
+            None => run_convergence(context),
+        }
     }
+}
+
+/// Fig. 14 on the paper's object, the dragon, when the 3D set has one; otherwise on every object of
+/// the set.
+fn run_convergence(context: &PaperContext) -> Result<RunReport, BoxError> {
+    let objects = context.objects(Family::Shapes)?;
+    let dragon: Vec<_> = objects
+        .specs
+        .iter()
+        .filter(|o| o.name == convergence::PAPER_OBJECT)
+        .cloned()
+        .collect();
+    let chosen = if dragon.is_empty() {
+        objects.specs.clone()
+    } else {
+        dragon
+    };
+    let experiment = convergence::convergence_experiment(chosen, context.scale.fraction(), context.seed)?;
+    Ok(run(&experiment, &context.options)?)
 }
 
 impl fmt::Display for PaperExperiment {

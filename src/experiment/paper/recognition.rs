@@ -248,6 +248,15 @@ impl RecognitionSweep {
         }
     }
 
+    /// The controllers, told the sensor's noise width as a real controller knows its sensor's
+    /// noise floor (see [`ControlConfig::expected_noise_fraction`]).
+    fn control(&self, setting: usize) -> ControlConfig {
+        ControlConfig {
+            expected_noise_fraction: self.settings[setting].sensor.noise_fraction,
+            ..ControlConfig::default()
+        }
+    }
+
     fn sampler_request(
         &self,
         context: &PaperContext,
@@ -261,7 +270,7 @@ impl RecognitionSweep {
             CollectPlan {
                 mode: CollectMode::Sampler(self.settings[setting].sampler),
                 sensor: self.sensor(context, setting),
-                control: ControlConfig::default(),
+                control: self.control(setting),
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: readings,
                 seed: rng::substream(context.seed, stream),
@@ -307,7 +316,7 @@ impl RecognitionSweep {
                                 ..PlannerConfig::default()
                             }),
                             sensor: self.sensor(context, setting),
-                            control: ControlConfig::default(),
+                            control: self.control(setting),
                             perturbation,
                             readings_per_object: counts.test_per_object,
                             seed: rng::substream(context.seed, trial_stream(t)),
