@@ -1,10 +1,26 @@
-//! The pad on the arm as a [`PadCarrier`]: pose commands go through inverse kinematics and are
-//! executed by the position servos while MuJoCo steps (Sec. III-B on the arm of Sec. V-A1).
+//! The pad on the arm as a [`PadCarrier`]: pose commands go through inverse kinematics (warm-started
+//! at the current configuration) and are executed by [`Arm::move_to`] with the carrier's
+//! [`MoveOptions`]: position servos while MuJoCo steps, or MuJoCo-checked kinematic motion (see
+//! `sim::arm`), Sec. III-B on the arm of Sec. V-A1. The sensor is read only when a command is done.
+//!
+//! The pad's rigid back is as wide as the covering, so it reaches the surface exactly when a taxel
+//! would read full compression. A Press command that would press it onto the surface is refused
+//! (the carrier stays at its previous pose and reports [`PadMotion::RigidContact`], Press's
+//! saturation termination). An Orient command that would do so, because tilting the pad about the
+//! contact centroid lowers its far edge, is executed backed off along the new pad normal by the
+//! least of t/4, t/2 or t that keeps the back clear, as a compliant wrist would; Press then closes the
+//! gap. Refusing the rotation instead (the carrier returning to its previous pose) left Orient
+//! repeating the same refused command until the iteration budget ran out, the arm's most common
+//! failure (`MaxIterations`) while the free-floating pad, whose back passes through the surface,
+//! converged at the same place.
 
 use glam::DVec3;
 
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
-use crate::sim::{Arm, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene};
+use crate::sim::arm::Execution;
+use crate::sim::{
+    Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene,
+};
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
 
 /// The pad frame of a pad site pose: centre at the site, normal its +z, up its +y.
@@ -24,6 +40,8 @@ pub struct ArmPad<'s, R> {
     sensor: SensorConfig,
     reader: R,
     motion: MoveOptions,
+    /// The configuration at which a Press command was last refused outright by a rigid contact.
+    refused_at: Option<Vec<f64>>,
 }
 
 impl<'s, R> ArmPad<'s, R>
@@ -46,6 +64,7 @@ where
             sensor,
             reader,
             motion,
+            refused_at: None,
         })
     }
 
@@ -96,25 +115,79 @@ where
 
     fn move_pad(&mut self, target: &PadPose) -> Result<PadMotion, ControlError> {
         let start = self.arm.q(self.scene.data());
+        let current = self.pad_pose();
+        let (motion, contact) = self.try_move(target, &start)?;
+        let Some(contact) = contact else {
+            return Ok(motion);
+        };
+        // An Orient command (the normal turns): back off along the new normal until the back is clear.
+        if current.normal.angle_between(target.normal) > 1e-6 {
+            let t = self.sensor.thickness_m;
+            for back_off_m in [0.25 * t, 0.5 * t, t] {
+                self.arm.place(self.scene, &start);
+                let retreated = PadPose {
+                    center_m: target.center_m - target.normal * back_off_m,
+                    ..*target
+                };
+                match self.try_move(&retreated, &start)? {
+                    (_, Some(_)) => {}
+                    (other, None) => return Ok(other),
+                }
+            }
+            self.arm.place(self.scene, &start);
+            return Ok(PadMotion::RigidContact);
+        }
+        // A Press command refused at once, twice from the same configuration (nothing moved the pad
+        // in between): the back rests on the surface while the covering is not saturated under the
+        // pad (a sliver of the pad over an edge, say) and Orient has nothing to turn. Pressing cannot
+        // proceed; the rigid contact is reported as the collision it is rather than refused again
+        // until the iteration budget runs out.
+        if self.motion.execution == Execution::Kinematic && self.arm.q(self.scene.data()) == start {
+            if self.refused_at.as_deref() == Some(start.as_slice()) {
+                return Ok(PadMotion::Collided(contact));
+            }
+            self.refused_at = Some(start);
+        }
+        Ok(motion)
+    }
+}
+
+impl<R> ArmPad<'_, R>
+where
+    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+{
+    /// One command from configuration `start` (where the arm is): IK, then the guarded motion; with
+    /// [`PadMotion::RigidContact`] the contact. At a rigid contact of the pad the kinematic execution
+    /// stays at the last contact-free sample of the motion (the back within `max_pad_step_m` of the
+    /// surface: Press has pushed as far as the back allows); the servo execution, which stops in
+    /// contact, goes back to `start`, which was free of contact (the servo's retreat, not simulated
+    /// step by step).
+    fn try_move(
+        &mut self,
+        target: &PadPose,
+        start: &[f64],
+    ) -> Result<(PadMotion, Option<Collision>), ControlError> {
         let q = match self.ik.solve(
             &PadTarget {
                 center_m: target.center_m,
                 normal: target.normal,
             },
-            &start,
+            start,
         ) {
             Ok(q) => q,
-            Err(IkError::Unreachable { .. } | IkError::BadTarget) => return Ok(PadMotion::Unreachable),
-        };
-        match self.arm.move_to(self.scene, &q, &self.motion, |_| false)? {
-            MoveOutcome::Reached | MoveOutcome::Stopped => Ok(PadMotion::Moved),
-            MoveOutcome::Collided(c) if self.is_pad_contact(&c) => {
-                // A controller command pressed the pad's rigid back onto the surface: back off to the
-                // last pose, which was free of contact (the servo's retreat, not simulated step by step).
-                self.arm.teleport(self.scene, &start);
-                Ok(PadMotion::RigidContact)
+            Err(IkError::Unreachable { .. } | IkError::BadTarget) => {
+                return Ok((PadMotion::Unreachable, None));
             }
-            MoveOutcome::Collided(c) => Ok(PadMotion::Collided(c)),
-        }
+        };
+        Ok(match self.arm.move_to(self.scene, &q, &self.motion, |_| false)? {
+            MoveOutcome::Reached | MoveOutcome::Stopped => (PadMotion::Moved, None),
+            MoveOutcome::Collided(c) if self.is_pad_contact(&c) => {
+                if self.motion.execution == Execution::Servo {
+                    self.arm.place(self.scene, start);
+                }
+                (PadMotion::RigidContact, Some(c))
+            }
+            MoveOutcome::Collided(c) => (PadMotion::Collided(c), None),
+        })
     }
 }

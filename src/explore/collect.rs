@@ -41,11 +41,12 @@ pub struct CollectPlan {
     pub seed: u64,
 }
 
-/// A reading function for a scene's covering sensor: runs `mj_forward` (the plugin computes at the
-/// sensor stage) and returns the image.
+/// A reading function for a scene's covering sensor: computes kinematics and the position-stage
+/// sensors ([`Scene::compute_sensors`]; the plugin computes there, from the site and geom frames) and
+/// returns the image. The dynamics stages of a full `mj_forward` would change nothing the plugin reads.
 pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> {
     move |scene: &mut Scene| {
-        scene.forward();
+        scene.compute_sensors();
         Ok(sensor.read(scene.data())?)
     }
 }

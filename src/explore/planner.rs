@@ -16,6 +16,24 @@
 //! Returning to a vertex: the arm's state is reset to the vertex configuration. A real arm would retrace
 //! the tree's collision-free edges back to it; simulating that retrace would cost time and change no
 //! reading, so it is skipped.
+//!
+//! Motions ([`PlannerConfig::execution`], see `sim::arm`): by default edges are checked the way
+//! sampling-based planners check them, MuJoCo's kinematics and collision detection at samples of the
+//! joint-space segment, and the arm is placed at rest at the end; [`Execution::Servo`] steps the
+//! position servos through MuJoCo's dynamics instead (the behaviour before, kept for comparison). On a
+//! kinematic edge the sensor is watched where it can feel something: while MuJoCo's distance between
+//! the pad's rigid back and every geom outside the arm exceeds the covering's reach beyond the back,
+//! no ray of the covering can meet a solid, so the plugin would read zero (and noise below the
+//! contact threshold); samples there are spaced by that clearance (conservative advancement) and the
+//! plugin is not evaluated. Closer, the plugin is read at every sample, the pad advancing at most one
+//! Approach step (`approach_step_thickness * t`) between readings, so the first contact is felt
+//! within a fraction of the covering rather than after the rigid back has met the surface (which a
+//! control interval of the servo execution could overshoot). Every reading still comes from the
+//! sensor plugin in the MuJoCo scene.
+//!
+//! The vertex added after a converged reading is the configuration the arm actually reached lifting
+//! the pad off the surface along its normal (a checked motion), so the tree holds only collision-free
+//! configurations.
 
 use glam::DVec3;
 use rand::RngExt;
@@ -28,8 +46,10 @@ use crate::explore::reading::{ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::tree::ExplorationTree;
 use crate::rng::Rng;
+use crate::sim::arm::{Execution, Watch};
+use crate::sim::mjcf::TABLE_TOP_Z_M;
 use crate::sim::{
-    IkOptions, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, PerturbationBounds, Scene,
+    Arm, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, PerturbationBounds, Scene,
 };
 use crate::tactile::{SensorConfig, TactileImage};
 
@@ -37,7 +57,8 @@ use crate::tactile::{SensorConfig, TactileImage};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlannerConfig {
-    /// Lower corner of the workspace box, metres (the only thing the planner knows of the object).
+    /// Lower corner of the workspace box, metres (the only thing the planner knows of the object). Its
+    /// floor is 2 cm above the table: targets lower than that send the pad onto the table.
     pub workspace_min_m: DVec3,
     /// Upper corner of the workspace box, metres.
     pub workspace_max_m: DVec3,
@@ -59,12 +80,15 @@ pub struct PlannerConfig {
     pub max_turn_per_step_rad: f64,
     /// Iterations allowed before giving up on reaching the requested number of readings.
     pub max_iterations: usize,
+    /// How the arm's motions are executed: MuJoCo-checked kinematic edges (default) or servo
+    /// dynamics (the earlier behaviour; see the module documentation).
+    pub execution: Execution,
 }
 
 impl Default for PlannerConfig {
     fn default() -> Self {
         Self {
-            workspace_min_m: DVec3::new(-0.15, -0.15, 0.005),
+            workspace_min_m: DVec3::new(-0.15, -0.15, 0.02),
             workspace_max_m: DVec3::new(0.15, 0.15, 0.22),
             local_probability: 0.5,
             step_m: 0.02,
@@ -74,6 +98,7 @@ impl Default for PlannerConfig {
             lift_off_m: 0.01,
             max_turn_per_step_rad: 30f64.to_radians(),
             max_iterations: 20_000,
+            execution: Execution::Kinematic,
         }
     }
 }
@@ -116,6 +141,9 @@ pub struct Planner<R> {
     expansion_ik: InverseKinematics,
     motion: MoveOptions,
     expansion_motion: MoveOptions,
+    /// How far the covering reaches beyond the pad's rigid back, metres: a clearance of the back above
+    /// this means the sensor cannot feel anything.
+    covering_reach_m: f64,
     tree: ExplorationTree,
     grid: ReadingGrid,
     rng: Rng,
@@ -123,12 +151,15 @@ pub struct Planner<R> {
 }
 
 /// Tight solver and servo settings for controller commands: sub-millimetre Press steps must be executed
-/// to a few hundredths of a millimetre.
+/// to a few hundredths of a millimetre. Near convergence Press commands steps of `t k_p e`, e.g.
+/// 1.2 mm x 0.8 x 0.015 = 15 um, so the solver must be far tighter than that: with a 20 um tolerance
+/// the warm-started solver returned the current configuration unchanged and Press repeated the same
+/// command until its budget ran out.
 pub fn precise_motion() -> (IkOptions, MoveOptions) {
     (
         IkOptions {
-            position_tolerance_m: 2e-5,
-            angle_tolerance_rad: 0.02_f64.to_radians(),
+            position_tolerance_m: 1e-6,
+            angle_tolerance_rad: 0.002_f64.to_radians(),
             ..IkOptions::default()
         },
         MoveOptions {
@@ -137,6 +168,29 @@ pub fn precise_motion() -> (IkOptions, MoveOptions) {
             ..MoveOptions::default()
         },
     )
+}
+
+/// The controller-command settings of [`precise_motion`] with kinematic execution, checked every
+/// `max_pad_step_m` of pad travel (controller commands are sub-millimetre, so usually one sample).
+pub fn precise_kinematic_motion(max_pad_step_m: f64) -> (IkOptions, MoveOptions) {
+    let (ik, motion) = precise_motion();
+    (
+        ik,
+        MoveOptions {
+            max_pad_step_m,
+            ..motion.kinematic()
+        },
+    )
+}
+
+/// How far the covering of `sensor` reaches beyond the rigid back `back_half_size_m` (the MuJoCo box
+/// half-sizes: depth along the normal, then the two in-plane half-widths) of the arm: the largest
+/// distance from a covering point to the back.
+pub fn covering_reach_m(sensor: &SensorConfig, back_half_size_m: [f64; 3]) -> f64 {
+    let half_face = back_half_size_m[1].min(back_half_size_m[2]);
+    let over_w = (0.5 * sensor.pad_width_m - half_face).max(0.0);
+    let over_h = (0.5 * sensor.pad_height_m - half_face).max(0.0);
+    (over_w * over_w + over_h * over_h + sensor.thickness_m * sensor.thickness_m).sqrt()
 }
 
 impl<R> Planner<R>
@@ -158,9 +212,23 @@ where
             .map_err(|message| crate::sim::SimError::BadConfiguration { message })?;
         control.validate()?;
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
-        let (ik_options, motion) = precise_motion();
+        let t = sensor.thickness_m;
+        let (ik_options, motion, expansion_motion) = match config.execution {
+            Execution::Servo => {
+                let (ik, motion) = precise_motion();
+                (ik, motion, MoveOptions::default())
+            }
+            Execution::Kinematic => {
+                let (ik, motion) = precise_kinematic_motion(0.125 * t);
+                (ik, motion, MoveOptions::default().kinematic())
+            }
+        };
         let ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
         let expansion_ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
+        let covering_reach_m = match arm.back_geom() {
+            Some(g) => covering_reach_m(&sensor, scene.model().geom_size()[g]),
+            None => f64::INFINITY,
+        };
         let q = arm.q(scene.data());
         let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
         Ok(Self {
@@ -171,7 +239,8 @@ where
             ik,
             expansion_ik,
             motion,
-            expansion_motion: MoveOptions::default(),
+            expansion_motion,
+            covering_reach_m,
             tree: ExplorationTree::new(q, pad.center_m, pad.normal),
             grid: ReadingGrid::new(config.workspace_min_m, config.grid_cell_m),
             rng,
@@ -208,7 +277,8 @@ where
                 };
             let target = match strategy {
                 Strategy::Local => match self.grid.local_target(self.config.local_radius_m, &mut self.rng) {
-                    Some(p) => p,
+                    // Targets stay in the workspace, above the table.
+                    Some(p) => p.clamp(self.config.workspace_min_m, self.config.workspace_max_m),
                     None => continue,
                 },
                 _ => {
@@ -221,7 +291,7 @@ where
                 }
             };
             let mut vertex = self.tree.nearest(target);
-            arm.teleport(scene, &self.tree.vertices()[vertex].q.clone());
+            arm.place(scene, &self.tree.vertices()[vertex].q.clone());
             let facing = self.tree.vertices()[vertex].pad_normal;
 
             for _ in 0..self.config.max_steps_per_iteration {
@@ -261,22 +331,7 @@ where
                     report.unreachable_steps += 1;
                     break;
                 };
-                let reader = &mut self.reader;
-                let mut sensed = false;
-                let mut read_error = None;
-                let outcome = arm.move_to(scene, &q, &self.expansion_motion, |s| match reader(s) {
-                    Ok(image) => {
-                        sensed = image.max() > threshold;
-                        sensed
-                    }
-                    Err(e) => {
-                        read_error = Some(e);
-                        true
-                    }
-                })?;
-                if let Some(e) = read_error {
-                    return Err(e);
-                }
+                let (outcome, sensed) = self.expand_to(scene, &arm, &q, threshold)?;
                 if let MoveOutcome::Collided(_) = outcome {
                     report.collisions += 1;
                     break;
@@ -288,7 +343,12 @@ where
                         .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
                     continue;
                 }
-                let reading = self.settle_here(scene, object, strategy)?;
+                let mut reading = self.settle_here(scene, object, strategy)?;
+                if reading.status == ContactStatus::Converged
+                    && covering_meets_table(&reading.image, &self.sensor)
+                {
+                    reading.status = ContactStatus::Collision;
+                }
                 let converged = reading.status == ContactStatus::Converged;
                 if converged {
                     let pose = reading.image.pose().copied().unwrap_or(pad);
@@ -298,8 +358,13 @@ where
                         normal: pose.normal,
                     };
                     let start = arm.q(scene.data());
-                    if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start) {
-                        self.tree.add(vertex, q_lift, lifted.center_m, lifted.normal);
+                    if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start)
+                        && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)?
+                            == MoveOutcome::Reached
+                    {
+                        let q = arm.q(scene.data());
+                        let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+                        self.tree.add(vertex, q, pad.center_m, pad.normal);
                     }
                 }
                 report.readings.push(reading);
@@ -312,6 +377,59 @@ where
             }
         }
         Ok(report)
+    }
+
+    /// One guarded expansion motion to `q`, watching the sensor: the motion's outcome and whether the
+    /// sensor felt the object (a taxel above `threshold`), which stopped it.
+    fn expand_to(
+        &mut self,
+        scene: &mut Scene,
+        arm: &Arm,
+        q: &[f64],
+        threshold: f64,
+    ) -> Result<(MoveOutcome, bool), ControlError> {
+        let reader = &mut self.reader;
+        let mut sensed = false;
+        let mut read_error = None;
+        let mut read = |s: &mut Scene| match reader(s) {
+            Ok(image) => {
+                sensed = image.max() > threshold;
+                sensed
+            }
+            Err(e) => {
+                read_error = Some(e);
+                true
+            }
+        };
+        let outcome = match self.expansion_motion.execution {
+            Execution::Servo => arm.move_to(scene, q, &self.expansion_motion, read)?,
+            Execution::Kinematic => {
+                let reach_m = self.covering_reach_m;
+                let fine_m = self.control.approach_step_thickness * self.sensor.thickness_m;
+                let horizon_m = reach_m + self.expansion_motion.max_pad_step_m;
+                arm.move_kinematic(scene, q, &self.expansion_motion, |s| {
+                    if reach_m.is_finite()
+                        && let Some(clearance_m) = arm.pad_clearance_m(s, horizon_m)?
+                        && clearance_m > reach_m + fine_m
+                    {
+                        return Ok(Watch::Continue {
+                            max_pad_step_m: clearance_m - reach_m,
+                        });
+                    }
+                    Ok(if read(s) {
+                        Watch::Stop
+                    } else {
+                        Watch::Continue {
+                            max_pad_step_m: fine_m,
+                        }
+                    })
+                })?
+            }
+        };
+        if let Some(e) = read_error {
+            return Err(e);
+        }
+        Ok((outcome, sensed))
     }
 
     /// Hands over to surface contact control at the current pose and packages the outcome.
@@ -341,6 +459,26 @@ where
             strategy,
         })
     }
+}
+
+/// Whether the covering's volume (the pad rectangle swept `t` along the normal) reaches the table
+/// top. The robot knows its table, as it knows the workspace box: a reading pressed on the table is
+/// a reading of the environment, not of the unknown object, so the planner reports it as a
+/// `Collision` (with the environment), keeps it out of the grid and out of recognition.
+pub fn covering_meets_table(image: &TactileImage, sensor: &SensorConfig) -> bool {
+    let Some(pose) = image.pose() else {
+        return false;
+    };
+    let (half_w, half_h) = (0.5 * sensor.pad_width_m, 0.5 * sensor.pad_height_m);
+    let lowest_z = [-1.0, 1.0]
+        .into_iter()
+        .flat_map(|a| {
+            [-1.0, 1.0].map(|b| pose.center_m + pose.right() * (a * half_w) + pose.up * (b * half_h))
+        })
+        .flat_map(|corner| [corner, corner + pose.normal * sensor.thickness_m])
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
+    lowest_z <= TABLE_TOP_Z_M + 1e-4
 }
 
 /// `from` turned toward `to` (both unit) by at most `max_rad`.

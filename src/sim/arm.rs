@@ -2,10 +2,28 @@
 //!
 //! Joint order is the chain order of `mjcf/arm.xml`: shoulder (z, y), elbow (z, y), forearm (z, y),
 //! wrist (y, z). Configurations `q` are radians in that order.
+//!
+//! Motions are guarded: they stop at the first MuJoCo contact of an arm body (or of the pad's rigid
+//! back) with anything, so the planner's tree keeps "collision-free configurations" joined by
+//! "collision-free motions" (Sec. III-A). Two executions of the same straight joint-space motion:
+//!
+//! - [`Execution::Servo`]: the position servos track an interpolated command while MuJoCo steps the
+//!   dynamics, the observer running once per control interval. The tactile plugin is not evaluated on
+//!   the steps in between ([`Scene::step_without_sensors`]): nothing reads it there.
+//! - [`Execution::Kinematic`]: the segment is sampled (at most `max_step_rad` per joint and
+//!   `max_pad_step_m` of pad travel between samples, the observer may ask for finer samples near a
+//!   surface) and each sample is checked with MuJoCo's own kinematics and collision detection, as
+//!   sampling-based motion planners check edges; the arm is then placed at rest at the end. This is
+//!   what the servo execution converges to: the arm is gravity-compensated, position-controlled and
+//!   the soft covering exerts no force in MuJoCo (the sensor plugin measures it), so at rest the
+//!   servos hold exactly the commanded configuration and, short of a rigid contact, which stops both
+//!   executions, the transient between two commands changes no reading. It costs a few kinematics and
+//!   collision evaluations per motion instead of hundreds of physics steps.
 
 use glam::{DMat3, DQuat, DVec3};
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
+use serde::{Deserialize, Serialize};
 
 use crate::sim::scene::Scene;
 use crate::sim::{Pose, SimError};
@@ -25,6 +43,8 @@ pub const ARM_JOINTS: [&str; 8] = [
 pub const PAD_SITE: &str = "pad";
 /// The arm's root body.
 pub const ARM_BASE: &str = "base";
+/// The pad's rigid back: a box whose front face is the pad plane (the covering lies in front of it).
+pub const PAD_BACK_GEOM: &str = "sensor_back";
 
 /// One joint of the arm.
 #[derive(Debug, Clone)]
@@ -43,6 +63,10 @@ pub struct Arm {
     joints: Vec<ArmJoint>,
     site: usize,
     root_body: usize,
+    /// The pad's rigid back geom, when the model has one.
+    back_geom: Option<usize>,
+    /// Geoms outside the arm's kinematic tree (what the pad can touch: table, object).
+    outside_geoms: Vec<usize>,
 }
 
 /// A collision that stopped a motion: the two bodies MuJoCo found in contact.
@@ -69,17 +93,34 @@ pub enum MoveOutcome {
     Stopped,
 }
 
+/// How [`Arm::move_to`] executes a motion (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Execution {
+    /// Position servos and MuJoCo's dynamics, stepped until the arm settles.
+    #[default]
+    Servo,
+    /// Kinematic checks of the segment at a resolution, then the arm placed at rest at the end.
+    Kinematic,
+}
+
 /// Speed and accuracy of [`Arm::move_to`].
 #[derive(Debug, Clone, Copy)]
 pub struct MoveOptions {
-    /// Largest change of any joint's command per control interval, radians.
+    /// Largest change of any joint's command per control interval (servo) or between two checked
+    /// samples (kinematic), radians.
     pub max_step_rad: f64,
     /// Physics steps per control interval (the observer runs once per interval).
     pub steps_per_interval: usize,
-    /// Joint error at which the motion counts as reached, radians.
+    /// Joint error at which the motion counts as reached, radians (servo).
     pub tolerance_rad: f64,
     /// Control intervals allowed after the last command for the servos to settle.
     pub settle_intervals: usize,
+    /// Servo dynamics or kinematic checks.
+    pub execution: Execution,
+    /// Kinematic: largest travel of the pad between two checked samples, metres (centre travel plus
+    /// the rotation times the rigid back's bounding radius).
+    pub max_pad_step_m: f64,
 }
 
 impl Default for MoveOptions {
@@ -90,8 +131,30 @@ impl Default for MoveOptions {
             steps_per_interval: 5,
             tolerance_rad: 2e-3,
             settle_intervals: 60,
+            execution: Execution::Servo,
+            max_pad_step_m: 0.005,
         }
     }
+}
+
+impl MoveOptions {
+    /// The same options with kinematic execution.
+    pub fn kinematic(self) -> Self {
+        Self {
+            execution: Execution::Kinematic,
+            ..self
+        }
+    }
+}
+
+/// What an observer of a kinematic motion asks for after a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Watch {
+    /// Stop here.
+    Stop,
+    /// Go on, with the pad travelling at most this far (metres) before the next sample (the motion's
+    /// own `max_pad_step_m` still applies).
+    Continue { max_pad_step_m: f64 },
 }
 
 impl Arm {
@@ -123,10 +186,22 @@ impl Arm {
                 range_rad: model.jnt_range()[j],
             });
         }
+        let root_body = model.body_rootid()[base] as usize;
+        let back_geom = model
+            .name_to_id(MjtObjBase::mjOBJ_GEOM, PAD_BACK_GEOM)
+            .filter(|&g| model.body_rootid()[model.geom_bodyid()[g] as usize] as usize == root_body);
+        let outside_geoms = (0..model.ffi().ngeom as usize)
+            .filter(|&g| {
+                let b = model.geom_bodyid()[g] as usize;
+                !(b != 0 && model.body_rootid()[b] as usize == root_body)
+            })
+            .collect();
         Ok(Some(Arm {
             joints,
             site,
-            root_body: model.body_rootid()[base] as usize,
+            root_body,
+            back_geom,
+            outside_geoms,
         }))
     }
 
@@ -191,6 +266,43 @@ impl Arm {
         scene.forward();
     }
 
+    /// Like [`teleport`](Self::teleport), computing only kinematics and contacts (what motions and
+    /// [`collision`](Self::collision) need): `sensordata` and the velocity and acceleration stages are
+    /// stale until the next `mj_forward` or `mj_step` (sensor readers compute what they read).
+    pub fn place(&self, scene: &mut Scene, q: &[f64]) {
+        self.rest_at(scene, q);
+        scene.kinematics_and_collision();
+    }
+
+    /// Zero velocity and servo commands equal to `q`, which must be the configuration in `qpos`.
+    fn rest_at(&self, scene: &mut Scene, q: &[f64]) {
+        let data = scene.data_mut();
+        self.set_q(data, q);
+        for j in &self.joints {
+            data.qvel_mut()[j.dof_adr] = 0.0;
+        }
+        self.command(data, q);
+    }
+
+    /// The pad's rigid back geom, if the model has one named [`PAD_BACK_GEOM`] on the arm.
+    pub fn back_geom(&self) -> Option<usize> {
+        self.back_geom
+    }
+
+    /// Smallest distance (MuJoCo's `mj_geomDistance`; convex hulls for meshes, so never more than the
+    /// true distance) between the pad's rigid back and any geom outside the arm, capped at
+    /// `dist_max_m`; `None` when the model has no rigid back. Needs current kinematics.
+    pub fn pad_clearance_m(&self, scene: &mut Scene, dist_max_m: f64) -> Result<Option<f64>, SimError> {
+        let Some(back) = self.back_geom else {
+            return Ok(None);
+        };
+        let mut clearance = dist_max_m;
+        for &g in &self.outside_geoms {
+            clearance = clearance.min(scene.geom_distance_m(back, g, clearance)?);
+        }
+        Ok(Some(clearance))
+    }
+
     fn command<M: ModelType>(&self, data: &mut MjData<M>, q: &[f64]) {
         for (j, &v) in self.joints.iter().zip(q) {
             data.ctrl_mut()[j.actuator] = v;
@@ -211,10 +323,13 @@ impl Arm {
         })
     }
 
-    /// Drives the position servos toward `target` in small interpolated steps while MuJoCo steps,
-    /// stopping at the first contact of the arm (or the pad's rigid back) with anything, or when
-    /// `observer` returns `true` (it runs after every control interval with the scene, e.g. to read
-    /// the sensor).
+    /// Moves the arm to `target`, stopping at the first contact of the arm (or the pad's rigid back)
+    /// with anything, or when `observer` returns `true`. Servo execution drives the position servos
+    /// in small interpolated steps while MuJoCo steps, the observer running after every control
+    /// interval; kinematic execution runs it after every checked sample (see
+    /// [`move_kinematic`](Self::move_kinematic)). Either way the observer sees current kinematics and
+    /// contacts but stale `sensordata`: to read a sensor it runs `mj_forward` (or
+    /// [`Scene::compute_sensors`]) first.
     pub fn move_to<F>(
         &self,
         scene: &mut Scene,
@@ -225,13 +340,18 @@ impl Arm {
     where
         F: FnMut(&mut Scene) -> bool,
     {
-        if target.len() != self.dof() || target.iter().any(|v| !v.is_finite()) {
-            return Err(SimError::BadConfiguration {
-                message: format!("{target:?} is not an arm configuration"),
+        if options.execution == Execution::Kinematic {
+            return self.move_kinematic(scene, target, options, |s| {
+                if observer(s) {
+                    Ok(Watch::Stop)
+                } else {
+                    Ok(Watch::Continue {
+                        max_pad_step_m: f64::INFINITY,
+                    })
+                }
             });
         }
-        let mut target = target.to_vec();
-        self.clamp(&mut target);
+        let target = self.checked_target(target)?;
         let start: Vec<f64> = self
             .joints
             .iter()
@@ -253,7 +373,7 @@ impl Arm {
                 self.command(scene.data_mut(), &command);
             }
             for _ in 0..options.steps_per_interval {
-                scene.step()?;
+                scene.step_without_sensors()?;
                 if let Some(c) = self.collision(scene) {
                     return Ok(MoveOutcome::Collided(c));
                 }
@@ -279,6 +399,95 @@ impl Arm {
                 options.settle_intervals
             ),
         })
+    }
+
+    /// `target` validated and clamped into the joint limits.
+    fn checked_target(&self, target: &[f64]) -> Result<Vec<f64>, SimError> {
+        if target.len() != self.dof() || target.iter().any(|v| !v.is_finite()) {
+            return Err(SimError::BadConfiguration {
+                message: format!("{target:?} is not an arm configuration"),
+            });
+        }
+        let mut target = target.to_vec();
+        self.clamp(&mut target);
+        Ok(target)
+    }
+
+    /// The kinematic execution of a straight joint-space motion from the current configuration to
+    /// `target`: samples no farther apart than `max_step_rad` on any joint and `max_pad_step_m` (or
+    /// the observer's last, smaller request) of pad travel, each checked by MuJoCo's kinematics and
+    /// collision detection. At a collision the arm is placed at rest at the last collision-free
+    /// sample and the collision returned; when the observer says [`Watch::Stop`] (it sees the sample's
+    /// kinematics and contacts) the arm is placed at rest at that sample; otherwise at `target`.
+    pub fn move_kinematic<F>(
+        &self,
+        scene: &mut Scene,
+        target: &[f64],
+        options: &MoveOptions,
+        mut observer: F,
+    ) -> Result<MoveOutcome, SimError>
+    where
+        F: FnMut(&mut Scene) -> Result<Watch, SimError>,
+    {
+        let target = self.checked_target(target)?;
+        let start = self.q(scene.data());
+        let span = start
+            .iter()
+            .zip(&target)
+            .map(|(a, b)| (b - a).abs())
+            .fold(0.0, f64::max);
+        let reach_m = self.back_geom.map_or(0.0, |g| scene.model().geom_rbound()[g]);
+        let max_step_rad = options.max_step_rad.max(1e-6);
+        let mut limit_m = options.max_pad_step_m;
+        let mut q = start.clone();
+        let mut last_free = start.clone();
+        scene.data_mut().kinematics();
+        let mut previous = self.pad_pose(scene.data());
+        let mut s = 0.0_f64;
+        while s < 1.0 {
+            let mut ds = (1.0 - s).min(max_step_rad / span.max(1e-12));
+            // Shrink the increment until the pad travels at most `limit_m` (kinematics are cheap).
+            loop {
+                let next = (s + ds).min(1.0);
+                if next >= 1.0 {
+                    q.copy_from_slice(&target);
+                } else {
+                    for (v, (a, b)) in q.iter_mut().zip(start.iter().zip(&target)) {
+                        *v = a + (b - a) * next;
+                    }
+                }
+                self.set_q(scene.data_mut(), &q);
+                scene.data_mut().kinematics();
+                let pose = self.pad_pose(scene.data());
+                let travel = (pose.position_m - previous.position_m).length()
+                    + pose.rotation.angle_between(previous.rotation) * reach_m;
+                if travel <= limit_m || ds * span <= 1e-7 {
+                    previous = pose;
+                    s = next;
+                    break;
+                }
+                ds *= (0.9 * limit_m / travel).clamp(0.1, 0.5);
+            }
+            scene.data_mut().collision();
+            if let Some(c) = self.collision(scene) {
+                self.place(scene, &last_free);
+                return Ok(MoveOutcome::Collided(c));
+            }
+            last_free.copy_from_slice(&q);
+            // The observer may have computed sensors; kinematics and contacts stay those of `q`.
+            match observer(scene)? {
+                Watch::Stop => {
+                    self.rest_at(scene, &q);
+                    return Ok(MoveOutcome::Stopped);
+                }
+                Watch::Continue { max_pad_step_m } => {
+                    limit_m = max_pad_step_m.min(options.max_pad_step_m).max(1e-6);
+                }
+            }
+        }
+        // The last sample was `target` itself: its kinematics and contacts are current.
+        self.rest_at(scene, &target);
+        Ok(MoveOutcome::Reached)
     }
 }
 

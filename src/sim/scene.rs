@@ -192,6 +192,36 @@ impl Scene {
     /// One physics step; an unstable state (non-finite positions or velocities) is an error naming the time.
     pub fn step(&mut self) -> Result<(), SimError> {
         self.data.step();
+        self.check_finite()
+    }
+
+    /// One physics step like [`step`](Self::step), but without the sensor stages: `mj_step` with
+    /// `mj_forwardSkip(.., skipsensor = 1)` in place of `mj_forward`, then the model's integrator.
+    ///
+    /// The tactile plugin computes at the sensor stage, so a plain `mj_step` raycasts the covering on
+    /// every physics step although a motion reads it once per control interval at most; this step
+    /// leaves `sensordata` stale, and whoever reads a sensor runs `mj_forward` (or
+    /// [`compute_sensors`](Self::compute_sensors)) first. Positions, velocities and contacts evolve
+    /// exactly as with `mj_step`.
+    pub fn step_without_sensors(&mut self) -> Result<(), SimError> {
+        let integrator = self.model.opt().integrator;
+        if integrator == MjtIntegrator::mjINT_RK4 as i32 {
+            // RK4 re-evaluates the dynamics itself; keep MuJoCo's own step.
+            return self.step();
+        }
+        self.data.check_pos();
+        self.data.check_vel();
+        self.data.forward_skip(MjtStage::mjSTAGE_NONE, true);
+        self.data.check_acc();
+        if integrator == MjtIntegrator::mjINT_EULER as i32 {
+            self.data.euler();
+        } else {
+            self.data.implicit();
+        }
+        self.check_finite()
+    }
+
+    fn check_finite(&self) -> Result<(), SimError> {
         let finite = self
             .data
             .qpos()
@@ -205,6 +235,33 @@ impl Scene {
                 message: format!("non-finite state at t = {} s", self.data.time()),
             })
         }
+    }
+
+    /// Kinematics and MuJoCo's collision detection for the current `qpos` (no dynamics, no sensors):
+    /// what a sampling-based motion planner evaluates at each configuration of an edge. Contacts are
+    /// then in [`contact_bodies`](Self::contact_bodies).
+    pub fn kinematics_and_collision(&mut self) {
+        self.data.kinematics();
+        self.data.collision();
+    }
+
+    /// Kinematics and the position-stage sensors for the current `qpos` (and mocap poses): all that
+    /// a sensor depending only on poses needs, such as the tactile plugin, which reads site and geom
+    /// frames. Contacts and the velocity and acceleration stages are left as they were (the next
+    /// `mj_step`/`mj_forward` recomputes them), so a sensor that needs those needs `forward`.
+    pub fn compute_sensors(&mut self) {
+        self.data.kinematics();
+        self.data.sensor_pos();
+    }
+
+    /// Signed distance between geoms `a` and `b` (MuJoCo's `mj_geomDistance`, convex hulls for
+    /// meshes), or `dist_max_m` when they are farther apart than that. Needs current kinematics.
+    pub fn geom_distance_m(&mut self, a: usize, b: usize, dist_max_m: f64) -> Result<f64, SimError> {
+        self.data
+            .try_geom_distance(a, b, dist_max_m, None)
+            .map_err(|e| SimError::Physics {
+                message: format!("distance between geoms {a} and {b}: {e:?}"),
+            })
     }
 
     /// Name of body `id` (or `body <id>` when unnamed).
