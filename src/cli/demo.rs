@@ -10,16 +10,15 @@ use std::path::PathBuf;
 use clap::Args;
 use rand::RngExt;
 use taction::control::{ContactStatus, ControlConfig};
-use taction::dataset::{Dataset, DatasetHeader};
+use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, Series};
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::recognize::OnlinePosterior;
-use taction::recognize::labelled::LabelledFeatures;
-use taction::recognize::model::{TrainedModel, TrainingProvenance};
-use taction::recognize::selection::{TrainConfig, train};
+use taction::recognize::model::TrainedModel;
+use taction::recognize::selection::{TrainConfig, supported_codebook_sizes};
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{ObjectSpec, PerturbationBounds, SceneBuilder};
@@ -49,24 +48,6 @@ pub struct DemoArgs {
 
 /// The codebook sizes the demo tries when it has the data for them.
 const CODEBOOK_SIZES: [usize; 2] = [10, 20];
-
-/// Training features a codebook needs per cluster: fewer leaves Gaussian components fitted to one
-/// or two features each (kept positive definite only by `reg_covar`) and histograms that are
-/// mostly pseudo-counts.
-const FEATURES_PER_CLUSTER: usize = 5;
-
-/// The sizes of `grid` that `training_features` features support (at least
-/// [`FEATURES_PER_CLUSTER`] per cluster); when none does, the largest size that is supported
-/// (at least 1).
-fn codebook_sizes(grid: &[usize], training_features: usize) -> Vec<usize> {
-    let most = (training_features / FEATURES_PER_CLUSTER).max(1);
-    let supported: Vec<usize> = grid.iter().copied().filter(|&k| k <= most).collect();
-    if supported.is_empty() {
-        vec![most]
-    } else {
-        supported
-    }
-}
 
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.touches == 0 || args.training_readings < 11 {
@@ -117,46 +98,24 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 readings_per_object: args.training_readings,
                 seed: args.seed,
             };
-            let readings = plan
-                .collect(&objects, 0)?
-                .into_iter()
-                .flat_map(|r| r.readings)
-                .collect();
-            let names = objects.iter().map(|o| o.name.clone()).collect();
-            let dataset = Dataset::new(
-                DatasetHeader::new(sensor, set.id(), names, "sampler", args.seed),
-                readings,
-            )?;
-            let features = LabelledFeatures::from_dataset(&dataset.converged_only(), descriptor.as_ref());
+            let dataset = Dataset::collect(&plan, &set.id(), &objects, 0)?;
             let mut config = TrainConfig {
                 restarts: 1,
                 seed: args.seed,
                 ..TrainConfig::default()
             };
-            // The hold-out keeps about `holdout` of each object's readings for validation.
+            // The hold-out keeps about `holdout` of each object's readings for validation; one
+            // Polar-Fourier feature per converged reading.
             let training_features =
-                (features.features().count() as f64 * (1.0 - config.holdout)).floor() as usize;
-            config.ks = codebook_sizes(&CODEBOOK_SIZES, training_features);
+                (dataset.converged_only().len() as f64 * (1.0 - config.holdout)).floor() as usize;
+            config.ks = supported_codebook_sizes(&CODEBOOK_SIZES, training_features);
             if config.ks != CODEBOOK_SIZES {
                 println!(
                     "training: {training_features} training features are too few for k = {CODEBOOK_SIZES:?}; trying k = {:?}",
                     config.ks
                 );
             }
-            let trained = train(&features, None, &config, &mut |_| {})?;
-            let provenance = TrainingProvenance {
-                object_set: set.id(),
-                generator: "sampler".into(),
-                dataset_seed: args.seed,
-                config,
-            };
-            let model = TrainedModel::new(
-                descriptor.params(),
-                sensor,
-                trained.bag,
-                trained.selection,
-                provenance,
-            );
+            let model = TrainedModel::fit(&dataset, None, descriptor.as_ref(), config, &mut |_| {})?;
             model.save(&model_path)?;
             model
         }
@@ -283,19 +242,4 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         args.out.display()
     );
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn codebook_sizes_shrink_to_what_the_features_support() {
-        assert_eq!(codebook_sizes(&[10, 20], 1800), vec![10, 20]);
-        assert_eq!(codebook_sizes(&[10, 20], 100), vec![10, 20]);
-        assert_eq!(codebook_sizes(&[10, 20], 99), vec![10]);
-        assert_eq!(codebook_sizes(&[10, 20], 22), vec![4]);
-        assert_eq!(codebook_sizes(&[10, 20], 3), vec![1]);
-        assert_eq!(codebook_sizes(&[10, 20], 0), vec![1]);
-    }
 }

@@ -44,4 +44,6 @@ pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_sa
 pub use object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 pub use pca::{Pca, VarianceFraction};
 pub use posterior::{Belief, OnlinePosterior};
-pub use selection::{CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, train};
+pub use selection::{
+    CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, supported_codebook_sizes, train,
+};

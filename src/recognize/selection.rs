@@ -75,6 +75,24 @@ impl TrainConfig {
     }
 }
 
+/// Training features a codebook needs per cluster: fewer leaves Gaussian components fitted to one
+/// or two features each (kept positive definite only by `reg_covar`) and histograms that are
+/// mostly pseudo-counts.
+pub const MIN_FEATURES_PER_CLUSTER: usize = 5;
+
+/// The cluster counts of `grid` that `training_features` features support (at least
+/// [`MIN_FEATURES_PER_CLUSTER`] per cluster); when none does, the largest count that is supported
+/// (at least 1). Small runs (the demo, experiments at small `--scale`) train on what they have.
+pub fn supported_codebook_sizes(grid: &[usize], training_features: usize) -> Vec<usize> {
+    let most = (training_features / MIN_FEATURES_PER_CLUSTER).max(1);
+    let supported: Vec<usize> = grid.iter().copied().filter(|&k| k <= most).collect();
+    if supported.is_empty() {
+        vec![most]
+    } else {
+        supported
+    }
+}
+
 /// One candidate's validation result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CandidateScore {
@@ -381,5 +399,20 @@ mod tests {
         assert!(!score(8, 0.5, false).is_better_than(&score(8, 0.5, false)));
         assert!(score(0, 0.0, false).is_better_than(&score(9, 0.9, true)));
         assert!(!score(9, 0.9, true).is_better_than(&score(0, 0.0, false)));
+    }
+}
+
+#[cfg(test)]
+mod codebook_size_tests {
+    use super::supported_codebook_sizes;
+
+    #[test]
+    fn codebook_sizes_shrink_to_what_the_features_support() {
+        assert_eq!(supported_codebook_sizes(&[10, 20], 1800), vec![10, 20]);
+        assert_eq!(supported_codebook_sizes(&[10, 20], 100), vec![10, 20]);
+        assert_eq!(supported_codebook_sizes(&[10, 20], 99), vec![10]);
+        assert_eq!(supported_codebook_sizes(&[10, 20], 22), vec![4]);
+        assert_eq!(supported_codebook_sizes(&[10, 20], 3), vec![1]);
+        assert_eq!(supported_codebook_sizes(&[10, 20], 0), vec![1]);
     }
 }

@@ -10,8 +10,10 @@ use super::scale::Scale;
 use crate::experiment::real_data::{RealData, RealImport, parse_real_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
+use crate::mesh::glyph::Font;
+use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
-use crate::mesh::{ObjectSet, ObjectSource};
+use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
 
 /// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):
 /// the sim-to-real experiment's default input, so that its whole path runs without a recording.
@@ -108,35 +110,50 @@ impl PaperContext {
     }
 
     /// The letters the recording's labels name, each named by its label: a label is a single
-    /// character (`A`) or a letter's object name (`upper_A`).
+    /// character (`A`) or a letter's object name (`upper_A`). They are made in the font and style
+    /// of the letters set (DejaVu Sans when that set holds no generated letters).
     fn real_letters(&self) -> Result<ObjectSet, BoxError> {
         let real = self.real_data()?;
+        let template = match self.letters.objects.iter().find_map(|o| match &o.source {
+            ObjectSource::Letter { font, style, .. } => Some((font.clone(), *style)),
+            _ => None,
+        }) {
+            Some(found) => found,
+            None => {
+                let default = ObjectSet::letters(&Font::load_default()?, LetterStyle::default());
+                match default.objects.first().map(|o| &o.source) {
+                    Some(ObjectSource::Letter { font, style, .. }) => (font.clone(), *style),
+                    _ => return Err("the default letters set holds no letters".into()),
+                }
+            }
+        };
         let mut objects = Vec::new();
         for label in real.labels() {
             let mut chars = label.chars();
             let glyph = match (chars.next(), chars.next()) {
-                (Some(c), None) => Some(c),
+                (Some(c), None) if c.is_ascii_alphabetic() => Some(c),
                 _ => letter_from_name(label),
-            };
-            let object = self
-                .letters
-                .objects
-                .iter()
-                .find(|o| matches!(o.source, ObjectSource::Letter { glyph: g, .. } if Some(g) == glyph))
-                .ok_or_else(|| {
-                    format!(
-                        "{}: label '{label}' names none of the letters (labels are single letters such as 'A' or names such as 'upper_A')",
-                        self.real.origin
-                    )
-                })?;
-            let mut object = object.clone();
-            object.name = label.to_string();
-            objects.push(object);
+            }
+            .ok_or_else(|| {
+                format!(
+                    "{}: label '{label}' names no letter (labels are single letters such as 'A' or names such as 'upper_A')",
+                    self.real.origin
+                )
+            })?;
+            objects.push(NamedObject {
+                name: label.to_string(),
+                source: ObjectSource::Letter {
+                    glyph,
+                    font: template.0.clone(),
+                    style: template.1,
+                },
+            });
         }
         Ok(ObjectSet {
             name: "real-letters".into(),
+            version: 1,
+            diagonal_m: None,
             objects,
-            ..self.letters.clone()
         })
     }
 }

@@ -31,6 +31,7 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
     LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
+    supported_codebook_sizes,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -414,14 +415,10 @@ impl RecognitionSweep {
 }
 
 /// The model-selection grid of Sec. V-B1 (k in {10, 20, 50}, 3 seeded restarts), without the
-/// cluster counts the training data cannot support at small scales (fewer than 4 training
-/// readings per cluster); at least one count remains.
+/// cluster counts the training data cannot support at small scales
+/// ([`supported_codebook_sizes`], counting one feature per training reading).
 fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
-    let readings = counts.training_per_object * objects;
-    let mut ks: Vec<usize> = [10, 20, 50].into_iter().filter(|k| k * 4 <= readings).collect();
-    if ks.is_empty() {
-        ks.push((readings / 4).max(2));
-    }
+    let ks = supported_codebook_sizes(&[10, 20, 50], counts.training_per_object * objects);
     TrainConfig {
         ks,
         restarts: 3,
