@@ -80,7 +80,26 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     ]);
     let stdout = String::from_utf8_lossy(&output.stdout);
 
-    for experiment in PaperExperiment::ALL {
+    let convergence = std::fs::read_to_string(out.join("convergence/convergence.csv")).expect("Fig. 14 CSV");
+    let header = convergence.lines().next().unwrap_or_default();
+    for column in [
+        "noise_fraction",
+        "attempts",
+        "converged",
+        "convergence_rate",
+        "mean_iterations",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == column),
+            "convergence.csv lacks {column}: {header}"
+        );
+    }
+    assert_eq!(
+        convergence.lines().count(),
+        1 + 2 * 7,
+        "both chess pieces at the seven noise levels"
+    );
+    for experiment in PaperExperiment::ALL.into_iter().filter(|e| e.is_recognition()) {
         let name = experiment.name();
         let root = out.join(name);
         let rows = rows(&root.join(format!("{name}.csv")));

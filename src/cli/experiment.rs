@@ -110,7 +110,11 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
         println!("{report}");
         eprintln!("== {experiment} done in {:.1} s", begun.elapsed().as_secs_f64());
     }
-    let names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
+    let names: Vec<&str> = experiments
+        .iter()
+        .filter(|e| e.is_recognition())
+        .map(|e| e.name())
+        .collect();
     let table = headline_table(&context.options.out, &names)?;
     println!(
         "\naccuracy (%) after n readings, mean over trials, scale {}:\n{table}\nreproduce took {:.1} s",

@@ -81,6 +81,12 @@ impl PaperExperiment {
         })
     }
 
+    /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]);
+    /// Fig. 14's are convergence statistics.
+    pub fn is_recognition(self) -> bool {
+        self.sweep().is_some()
+    }
+
     /// The command-line name.
     pub fn name(self) -> &'static str {
         self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name)
