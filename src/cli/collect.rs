@@ -1,7 +1,8 @@
 //! `taction collect`: readings of a set of objects by the training sampler or the planner, written as
-//! a dataset (format: `taction::dataset`).
+//! a dataset (format: `taction::dataset`), with a PNG contact sheet per object of its first converged
+//! readings beside it (`<out stem>.<object>.png`, like the strips of the paper's Fig. 1 and Fig. 5).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use taction::control::ControlConfig;
@@ -10,6 +11,7 @@ use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::explore::{PlannerConfig, SamplerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::tactile::image::write_contact_sheet;
 
 use crate::cli::sensor_args::SensorArgs;
 
@@ -56,6 +58,10 @@ pub struct CollectArgs {
     /// Dataset file to write.
     #[arg(long)]
     pub out: PathBuf,
+    /// Converged readings per object drawn on its contact sheet, `<out stem>.<object>.png` beside the
+    /// dataset (0: no contact sheets).
+    #[arg(long, default_value_t = 24, value_name = "N")]
+    pub contact_sheet: usize,
 }
 
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -115,5 +121,55 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let dataset = Dataset::new(header, readings)?;
     dataset.write(&args.out)?;
     println!("{}: {}", args.out.display(), dataset.summary());
+    for path in write_contact_sheets(&dataset, &args.out, args.contact_sheet)? {
+        println!("{}", path.display());
+    }
     Ok(())
+}
+
+/// Writes one contact sheet per object with its first `per_object` converged readings (12 a row,
+/// about 48 pixels an image) beside `out`; objects without converged readings get none. Returns the
+/// files written.
+pub fn write_contact_sheets(
+    dataset: &Dataset,
+    out: &Path,
+    per_object: usize,
+) -> Result<Vec<PathBuf>, Box<dyn std::error::Error>> {
+    let mut written = Vec::new();
+    if per_object == 0 {
+        return Ok(written);
+    }
+    let stem = out
+        .file_stem()
+        .ok_or_else(|| format!("--out {}: has no file name", out.display()))?
+        .to_string_lossy()
+        .into_owned();
+    let dir = out.parent().unwrap_or_else(|| Path::new(""));
+    for (object, readings) in dataset.header().objects.iter().zip(dataset.by_object()) {
+        let images: Vec<_> = readings
+            .iter()
+            .filter(|r| r.status == taction::control::ContactStatus::Converged)
+            .take(per_object)
+            .map(|r| r.image.clone())
+            .collect();
+        let Some(first) = images.first() else {
+            continue;
+        };
+        let scale = (48 / first.cols().max(first.rows()).max(1)).max(1);
+        let safe: String = object
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let path = dir.join(format!("{stem}.{safe}.png"));
+        write_contact_sheet(&images, images.len().min(12), scale, &path)
+            .map_err(|e| format!("contact sheet {}: {e}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
 }

@@ -1,0 +1,193 @@
+//! Readings per second of the two ways of collecting readings (Sec. III-A and V-A3), each against a
+//! baseline measured in the same run, on the chess pawn (12 cm diagonal) with the 6x6 sensor:
+//!
+//! - `sensor/bare_reading`: one free-floating reading (place the pad, `mj_forward`, copy out of
+//!   `sensordata`), the cost floor of any reading;
+//! - `sampler/6x6`: converged readings of the training sampler (free-floating pad, Approach, Press,
+//!   Orient), reported per reading and as a ratio to the bare reading rate;
+//! - `planner/kinematic`: converged readings of the planner with the arm, MuJoCo-checked kinematic
+//!   edges (the default); the summary also times the same planner stepping the position servos
+//!   through MuJoCo's dynamics (`Execution::Servo`, the previous behaviour, too slow for criterion's
+//!   ten samples) and reports the ratio kinematic / servo, the speed-up.
+//!
+//! Scenes are compiled once per configuration, outside the timed loops (a collection run compiles one
+//! per object). After criterion's own report a summary prints readings/s and the ratios, measured
+//! with plain timers on the same routines. Quick: well under two minutes in release.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, Throughput, criterion_group};
+use glam::DVec3;
+use taction::control::ControlConfig;
+use taction::explore::collect::sensor_reader;
+use taction::explore::{ExplorationReport, Planner, PlannerConfig, SamplerConfig, sample_readings};
+use taction::mesh::{BuildOptions, ObjectSet};
+use taction::sim::arm::{Execution, PAD_SITE};
+use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
+use taction::tactile::sensor::{CoveringSensor, add_sensor};
+use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+
+/// Converged readings per timed run.
+const SAMPLER_READINGS: usize = 20;
+const PLANNER_READINGS: usize = 10;
+const SERVO_READINGS: usize = 2;
+
+fn sensor() -> SensorConfig {
+    SensorConfig::square(6, 6, 0.012, 0.0012)
+}
+
+fn pawn() -> ObjectSpec {
+    let built = ObjectSet::chess()
+        .build_object("pawn", &BuildOptions::default())
+        .expect("the chess pawn is generated, no download");
+    ObjectSpec::new("pawn", built.mesh)
+}
+
+fn arm_scene(object: &ObjectSpec) -> Scene {
+    let builder = SceneBuilder::with_arm_and_table().object(object.clone());
+    add_sensor(builder, &sensor(), "covering", PAD_SITE)
+        .expect("sensor xml")
+        .build()
+        .expect("arm scene compiles")
+}
+
+/// A pad 0.3 t into the side of the pawn's base, level: a reading with contact.
+fn touching_pose() -> PadPose {
+    let pawn = pawn();
+    let (lo, hi) = pawn.mesh.bounds().expect("pawn has vertices");
+    let z = lo.z + 0.1 * (hi.z - lo.z);
+    PadPose::new(DVec3::new(lo.x + 0.3 * 0.0012, 0.0, z), DVec3::X, DVec3::Z).expect("unit frame")
+}
+
+fn bare_reading(free: &mut FreeFloatingSensor, pose: &PadPose) -> f64 {
+    free.read_at(pose).expect("reading").mean()
+}
+
+fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
+    let reader = sensor_reader(free.sensor().clone());
+    let mut rng = taction::rng::rng(seed);
+    sample_readings(
+        free.scene_mut(),
+        "pawn",
+        sensor(),
+        &ControlConfig::default(),
+        &SamplerConfig::default(),
+        PerturbationBounds::NONE,
+        SAMPLER_READINGS,
+        &mut rng,
+        reader,
+    )
+    .expect("sampler run")
+}
+
+fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u64) -> ExplorationReport {
+    let home = scene.arm().expect("arm").q(scene.data());
+    let arm = scene.arm().expect("arm").clone();
+    arm.teleport(scene, &home);
+    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).expect("sensor"));
+    let config = PlannerConfig {
+        execution,
+        ..PlannerConfig::default()
+    };
+    let mut planner = Planner::new(
+        scene,
+        config,
+        ControlConfig::default(),
+        sensor(),
+        PerturbationBounds::NONE,
+        taction::rng::rng(seed),
+        reader,
+    )
+    .expect("planner");
+    let report = planner.explore(scene, "pawn", readings).expect("planner run");
+    arm.teleport(scene, &home);
+    report
+}
+
+fn benches(c: &mut Criterion) {
+    let object = pawn();
+    let pose = touching_pose();
+    let mut free = FreeFloatingSensor::new(object.clone(), &sensor()).expect("free-floating scene");
+    let mut group = c.benchmark_group("explore");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("sensor/bare_reading", |b| {
+        b.iter(|| bare_reading(&mut free, black_box(&pose)))
+    });
+    group.throughput(Throughput::Elements(SAMPLER_READINGS as u64));
+    let mut seed = 0;
+    group.bench_function("sampler/6x6", |b| {
+        b.iter(|| {
+            seed += 1;
+            sampler_run(&mut free, seed)
+        })
+    });
+    let mut scene = arm_scene(&object);
+    group.throughput(Throughput::Elements(PLANNER_READINGS as u64));
+    group.bench_function("planner/kinematic", |b| {
+        b.iter(|| {
+            seed += 1;
+            planner_run(&mut scene, Execution::Kinematic, PLANNER_READINGS, seed)
+        })
+    });
+    group.finish();
+}
+
+/// Converged readings and attempts per second over `runs` timed runs.
+fn rate(runs: u64, mut run: impl FnMut(u64) -> ExplorationReport) -> (f64, f64, usize, usize) {
+    let (mut converged, mut attempts) = (0, 0);
+    let start = Instant::now();
+    for seed in 0..runs {
+        let report = run(1000 + seed);
+        converged += report.converged();
+        attempts += report.readings.len();
+    }
+    let s = start.elapsed().as_secs_f64();
+    (converged as f64 / s, attempts as f64 / s, converged, attempts)
+}
+
+fn summary() {
+    let object = pawn();
+    let pose = touching_pose();
+    let mut free = FreeFloatingSensor::new(object.clone(), &sensor()).expect("free-floating scene");
+    let n = 2000;
+    let start = Instant::now();
+    for _ in 0..n {
+        black_box(bare_reading(&mut free, &pose));
+    }
+    let bare = n as f64 / start.elapsed().as_secs_f64();
+    let (sampler, sampler_attempts, sc, sa) = rate(10, |seed| sampler_run(&mut free, seed));
+    let mut scene = arm_scene(&object);
+    let (kinematic, kinematic_attempts, kc, ka) = rate(5, |seed| {
+        planner_run(&mut scene, Execution::Kinematic, PLANNER_READINGS, seed)
+    });
+    let (servo, servo_attempts, vc, va) = rate(2, |seed| {
+        planner_run(&mut scene, Execution::Servo, SERVO_READINGS, seed)
+    });
+    println!("\nexplore summary (pawn, 6x6, one core; converged readings per second):");
+    println!("  bare sensor reading       {bare:9.0} /s  (baseline of the sampler)");
+    println!(
+        "  sampler 6x6               {sampler:9.1} /s  = {:.4} x bare reading; {sampler_attempts:.1} attempts/s, {sc}/{sa} converged",
+        sampler / bare
+    );
+    println!(
+        "  planner, servo (previous) {servo:9.2} /s  (baseline of the planner); {servo_attempts:.2} attempts/s, {vc}/{va} converged"
+    );
+    println!(
+        "  planner, kinematic        {kinematic:9.1} /s  = {:.1} x servo, {:.4} x bare reading; {kinematic_attempts:.1} attempts/s, {kc}/{ka} converged",
+        kinematic / servo,
+        kinematic / bare
+    );
+}
+
+criterion_group!(explore, benches);
+
+fn main() {
+    explore();
+    Criterion::default().configure_from_args().final_summary();
+    summary();
+}
