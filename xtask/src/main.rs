@@ -25,7 +25,7 @@ const USAGE: &str = "\
 usage: cargo xtask <task> [args...]
 
 tasks:
-  setup          fetch and check the MuJoCo runtime (and the object meshes) if missing
+  setup          fetch and check the MuJoCo runtime if missing (object meshes are fetched on first use)
   demo [args]    setup, then `cargo run --release -- demo [args]`
   test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`)
   bench [args]   setup, then `cargo bench [args]`
