@@ -9,7 +9,7 @@ use taction::control::ControlConfig;
 use taction::dataset::{Dataset, DatasetHeader};
 use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::explore::{PlannerConfig, SamplerConfig};
-use taction::mesh::{BuildOptions, ObjectSet};
+use taction::mesh::ObjectSet;
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::image::write_contact_sheet;
 
@@ -74,14 +74,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed)?;
     let set = ObjectSet::resolve(&args.objects, None, args.object_size_m)?;
-    let built = set.build(&BuildOptions {
-        fetch: true,
-        ..BuildOptions::default()
-    })?;
-    let objects: Vec<ObjectSpec> = built
-        .into_iter()
-        .map(|b| ObjectSpec::new(b.name, b.mesh))
-        .collect();
+    let objects = ObjectSpec::all_of(&set)?;
     let (mode, generator) = match args.mode {
         Mode::Sampler => {
             let config = SamplerConfig {

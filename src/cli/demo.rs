@@ -15,7 +15,7 @@ use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, Series};
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
-use taction::mesh::{BuildOptions, ObjectSet};
+use taction::mesh::ObjectSet;
 use taction::recognize::OnlinePosterior;
 use taction::recognize::model::TrainedModel;
 use taction::recognize::selection::{TrainConfig, supported_codebook_sizes};
@@ -56,14 +56,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, None)?;
-    let built = set.build(&BuildOptions {
-        fetch: true,
-        ..BuildOptions::default()
-    })?;
-    let objects: Vec<ObjectSpec> = built
-        .into_iter()
-        .map(|b| ObjectSpec::new(b.name, b.mesh))
-        .collect();
+    let objects = ObjectSpec::all_of(&set)?;
     let descriptor_kind = DescriptorKind::PolarFourier;
     let descriptor = descriptor_kind.build();
 
@@ -106,8 +99,12 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             };
             // The hold-out keeps about `holdout` of each object's readings for validation; one
             // Polar-Fourier feature per converged reading.
-            let training_features =
-                (dataset.converged_only().len() as f64 * (1.0 - config.holdout)).floor() as usize;
+            let converged = dataset
+                .readings()
+                .iter()
+                .filter(|r| r.status == ContactStatus::Converged)
+                .count();
+            let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
             config.ks = supported_codebook_sizes(&CODEBOOK_SIZES, training_features);
             if config.ks != CODEBOOK_SIZES {
                 println!(

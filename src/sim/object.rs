@@ -4,7 +4,7 @@
 //! the mesh's own frame (vertices are written as given, metres), so the object's pose in MuJoCo is
 //! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
 
-use crate::mesh::TriMesh;
+use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
 use crate::sim::mjcf::{Document, Section, escape_attr, numbers};
 use crate::sim::{Pose, SimError};
 
@@ -49,6 +49,16 @@ impl ObjectSpec {
             mount: ObjectMount::Mocap,
             mass_kg: 0.2,
         }
+    }
+
+    /// Every object of `set`, built (missing CGAL meshes fetched) and resting at the origin as the
+    /// set places it, in set order: the objects a collection run puts in its scenes.
+    pub fn all_of(set: &ObjectSet) -> Result<Vec<Self>, MeshError> {
+        let built = set.build(&BuildOptions {
+            fetch: true,
+            ..BuildOptions::default()
+        })?;
+        Ok(built.into_iter().map(|b| Self::new(b.name, b.mesh)).collect())
     }
 
     /// Adds the mesh asset and the object body to `doc`.

@@ -28,8 +28,8 @@ use crate::dataset::{Dataset, generator_name};
 use crate::describe::Descriptor;
 use crate::experiment::unit::BoxError;
 use crate::explore::collect::CollectPlan;
+use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
-use crate::mesh::{BuildOptions, ObjectSet};
 use crate::recognize::{TrainConfig, TrainedModel};
 use crate::sim::ObjectSpec;
 
@@ -42,14 +42,7 @@ pub struct Objects {
 impl Objects {
     /// Builds every object of `set` (fetching the CGAL meshes when missing).
     pub fn build(set: ObjectSet) -> Result<Self, BoxError> {
-        let built = set.build(&BuildOptions {
-            fetch: true,
-            ..BuildOptions::default()
-        })?;
-        let specs = built
-            .into_iter()
-            .map(|b| ObjectSpec::new(b.name, b.mesh))
-            .collect();
+        let specs = ObjectSpec::all_of(&set)?;
         Ok(Self { set, specs })
     }
 
