@@ -184,8 +184,9 @@ impl DataStore {
 
     /// The model trained with `descriptor` and `config` on `training`, chosen on `validation`:
     /// read from `<out>/models/` when an earlier run trained it, otherwise trained and saved.
-    /// Two units needing the same model at once both train it (identically); nothing shares a
-    /// lock inside the thread pool.
+    /// No two units of one experiment need the same model (one unit per setting and descriptor)
+    /// and experiments run one after another, so no two threads save the same model file; nothing
+    /// shares a lock inside the thread pool.
     pub fn model(
         &self,
         training: &DataRequest,
