@@ -4,7 +4,7 @@
 //! objects) and the [`Reading`]s themselves, each a tactile image with the pad pose it was taken at,
 //! the object's pose, and how the contact controllers ended.
 //!
-//! # File format (version 1)
+//! # File format (version 2)
 //!
 //! One UTF-8 text file, so a dataset is a single atomic unit (written to a temporary file in the
 //! same folder, then renamed over the target) and any CSV reader can open it after skipping the
@@ -12,10 +12,10 @@
 //!
 //! ```text
 //! # taction dataset
-//! # {"format_version":1,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
+//! # {"format_version":2,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
 //! #   "generator":"sampler","seed":7,"readings":11000}          <- one line of JSON
-//! object,status,strategy,iterations,object_x_m,...,t_0_0,t_0_1,...,t_{rows-1}_{cols-1}
-//! bunny,converged,sampler,4,0.1,...,0,0.25,...
+//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,t_0_0,t_0_1,...,t_{rows-1}_{cols-1}
+//! bunny,converged,sampler,4,0.1,...,,0,0.25,...
 //! ...
 //! # end 11000
 //! ```
@@ -25,8 +25,10 @@
 //!   `status` ([`ContactStatus::name`]), `strategy` ([`Strategy::name`]), `iterations`,
 //!   the object pose `object_x_m, object_y_m, object_z_m, object_qw, object_qx, object_qy,
 //!   object_qz`, the pad pose `pad_x_m, pad_y_m, pad_z_m, pad_normal_x, pad_normal_y, pad_normal_z,
-//!   pad_up_x, pad_up_y, pad_up_z` (all nine empty when the image carries no pose), then the
-//!   `rows x cols` taxels row-major as `t_{row}_{col}`, row 0 being the pad's `+up` edge.
+//!   pad_up_x, pad_up_y, pad_up_z` (all nine empty when the image carries no pose), `cause`
+//!   ([`AttemptCause::name`]: the two bodies that touched as `arm_body/other_body`, or
+//!   `covering_meets_table`; empty when the status says it all), then the `rows x cols` taxels
+//!   row-major as `t_{row}_{col}`, row 0 being the pad's `+up` edge. Version 1 had no `cause`.
 //! - The last line, `# end N`, repeats the row count, so a file cut anywhere (even inside the
 //!   last number) is reported as truncated rather than read short.
 //! - Numbers are written in shortest round-trip form, so reading back is bit-exact.
@@ -44,8 +46,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::ContactStatus;
 pub use crate::explore::Reading;
-use crate::explore::Strategy;
 use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::explore::{AttemptCause, CauseKind, Strategy};
 use crate::sim::ObjectSpec;
 use crate::sim::Pose;
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
@@ -60,12 +62,12 @@ pub fn generator_name(mode: &CollectMode) -> String {
 }
 
 /// The file format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &str = "# taction dataset";
 const END_PREFIX: &str = "# end ";
 /// Columns before the taxels.
-const META_COLUMNS: [&str; 20] = [
+const META_COLUMNS: [&str; 21] = [
     "object",
     "status",
     "strategy",
@@ -86,7 +88,9 @@ const META_COLUMNS: [&str; 20] = [
     "pad_up_x",
     "pad_up_y",
     "pad_up_z",
+    "cause",
 ];
+const CAUSE_COLUMN: usize = 20;
 const PAD_COLUMNS: std::ops::Range<usize> = 11..20;
 
 /// Errors from building, reading or writing a dataset; each names the file, line and field.
@@ -102,7 +106,7 @@ pub enum DatasetError {
     Header { path: String, line: usize, what: String },
     #[error("{path}: truncated: {what}")]
     Truncated { path: String, what: String },
-    #[error("{path}: line {line}: {fields} columns, expected {expected} (20 + {rows}x{cols} taxels)")]
+    #[error("{path}: line {line}: {fields} columns, expected {expected} ({meta} + {rows}x{cols} taxels)", meta = META_COLUMNS.len())]
     ColumnCount {
         path: String,
         line: u64,
@@ -287,6 +291,24 @@ impl Dataset {
         }
     }
 
+    /// The objects that got fewer than `wanted` converged readings, in header order: what a run
+    /// that produced less than asked must report.
+    pub fn shortfalls(&self, wanted: usize) -> Vec<Shortfall> {
+        self.by_object()
+            .iter()
+            .zip(&self.header.objects)
+            .map(|(readings, object)| Shortfall {
+                object: object.clone(),
+                converged: readings
+                    .iter()
+                    .filter(|r| r.status == ContactStatus::Converged)
+                    .count(),
+                wanted,
+            })
+            .filter(|s| s.converged < wanted)
+            .collect()
+    }
+
     /// Readings grouped by object, in header order, each group in dataset order.
     pub fn by_object(&self) -> Vec<Vec<&Reading>> {
         let mut groups = vec![Vec::new(); self.header.objects.len()];
@@ -311,9 +333,21 @@ impl Dataset {
         for r in &self.readings {
             *by_strategy.entry(r.strategy.name()).or_insert(0) += 1;
         }
+        let mut causes = vec![BTreeMap::new(); self.header.objects.len()];
+        for r in &self.readings {
+            if let Some(i) = self.header.object_index(&r.object) {
+                let kind = match (&r.cause, r.status) {
+                    (Some(cause), _) => FailureCause::Cause(cause.kind()),
+                    (None, ContactStatus::NoContact) if r.iterations > 0 => FailureCause::LostContact,
+                    _ => continue,
+                };
+                *causes[i].entry(kind).or_insert(0) += 1;
+            }
+        }
         DatasetSummary {
             header: self.header.clone(),
             per_object,
+            causes,
             by_strategy,
         }
     }
@@ -439,9 +473,10 @@ impl Dataset {
                         expected_columns[i]
                     ),
                     None => format!(
-                        "{} column names, expected {} (20 + {rows}x{cols} taxels)",
+                        "{} column names, expected {} ({} + {rows}x{cols} taxels)",
                         columns.len(),
-                        expected_columns.len()
+                        expected_columns.len(),
+                        META_COLUMNS.len()
                     ),
                 },
             });
@@ -574,6 +609,7 @@ fn reading_row(r: &Reading, row: &mut Vec<String>) {
         }
         None => row.extend(std::iter::repeat_n(String::new(), PAD_COLUMNS.len())),
     }
+    row.push(r.cause.as_ref().map(AttemptCause::name).unwrap_or_default());
     row.extend(r.image.values().iter().map(|&v| format_f64(v)));
 }
 
@@ -652,6 +688,17 @@ fn parse_reading(
             up: v(17)?,
         })
     };
+    let cause_text = record[CAUSE_COLUMN].trim();
+    let cause = if cause_text.is_empty() {
+        None
+    } else {
+        Some(AttemptCause::from_name(cause_text).ok_or_else(|| {
+            (
+                columns[CAUSE_COLUMN].clone(),
+                format!("'{cause_text}' is neither 'covering_meets_table' nor two bodies 'a/b'"),
+            )
+        })?)
+    };
     let first_taxel = META_COLUMNS.len();
     let mut values = Vec::with_capacity(record.len() - first_taxel);
     for (i, column) in columns.iter().enumerate().take(record.len()).skip(first_taxel) {
@@ -674,6 +721,7 @@ fn parse_reading(
         status,
         iterations,
         strategy,
+        cause,
     })
 }
 
@@ -711,14 +759,70 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
     result.map_err(io)
 }
 
+/// An object that got fewer converged readings than asked.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Shortfall {
+    pub object: String,
+    pub converged: usize,
+    pub wanted: usize,
+}
+
+impl fmt::Display for Shortfall {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {} of {}", self.object, self.converged, self.wanted)
+    }
+}
+
+/// One line naming every short object, e.g. `2 objects got fewer converged readings than asked:
+/// camel 3 of 10, homer 0 of 10`.
+pub fn describe_shortfalls(shortfalls: &[Shortfall]) -> String {
+    let list: Vec<String> = shortfalls.iter().map(Shortfall::to_string).collect();
+    format!(
+        "{} object{} got fewer converged readings than asked: {}",
+        shortfalls.len(),
+        if shortfalls.len() == 1 { "" } else { "s" },
+        list.join(", ")
+    )
+}
+
 /// Counts for `taction dataset show`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DatasetSummary {
     pub header: DatasetHeader,
     /// Per object (header order): readings by status.
     pub per_object: Vec<BTreeMap<ContactStatus, usize>>,
+    /// Per object (header order): failed attempts by what ended them.
+    pub causes: Vec<BTreeMap<FailureCause, usize>>,
     /// Readings by strategy name.
     pub by_strategy: BTreeMap<&'static str, usize>,
+}
+
+/// What ended a failed attempt, as `collect` and `dataset show` count them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FailureCause {
+    /// A recorded [`AttemptCause`], by kind.
+    Cause(CauseKind),
+    /// `no_contact` after the controllers had pressed (Orient or Press lifted the pad off a narrow
+    /// feature), as opposed to an Approach that met nothing.
+    LostContact,
+}
+
+impl FailureCause {
+    pub const ALL: [FailureCause; 6] = [
+        Self::Cause(CauseKind::PadOnObject),
+        Self::Cause(CauseKind::ArmOnObject),
+        Self::Cause(CauseKind::ArmOnTable),
+        Self::Cause(CauseKind::ArmOnArm),
+        Self::Cause(CauseKind::CoveringOnTable),
+        Self::LostContact,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Cause(kind) => kind.name(),
+            Self::LostContact => "lost_contact",
+        }
+    }
 }
 
 impl DatasetSummary {
@@ -780,6 +884,20 @@ impl fmt::Display for DatasetSummary {
             write!(f, " {n:>14}")?;
         }
         writeln!(f)?;
+        if self.causes.iter().any(|c| !c.is_empty()) {
+            write!(f, "{:<width$} {:>8}", "causes", "")?;
+            for cause in FailureCause::ALL {
+                write!(f, " {:>17}", cause.name())?;
+            }
+            writeln!(f)?;
+            for (name, counts) in h.objects.iter().zip(&self.causes) {
+                write!(f, "{name:<width$} {:>8}", "")?;
+                for cause in FailureCause::ALL {
+                    write!(f, " {:>17}", counts.get(&cause).copied().unwrap_or(0))?;
+                }
+                writeln!(f)?;
+            }
+        }
         let strategies: Vec<String> = self.by_strategy.iter().map(|(k, v)| format!("{k} {v}")).collect();
         write!(
             f,
@@ -835,6 +953,10 @@ mod tests {
             } else {
                 Strategy::Recorded
             },
+            cause: (status == ContactStatus::Collision).then(|| AttemptCause::Touched {
+                body_a: "link4".into(),
+                body_b: "world".into(),
+            }),
         }
     }
 
@@ -906,6 +1028,19 @@ mod tests {
     }
 
     #[test]
+    fn shortfalls_name_each_object_below_the_count() {
+        let d = dataset();
+        // "a,\"b\"" has one converged reading, "c" one of two.
+        assert!(d.shortfalls(1).is_empty());
+        let short = d.shortfalls(2);
+        assert_eq!(short.len(), 2);
+        assert_eq!(
+            describe_shortfalls(&short),
+            "2 objects got fewer converged readings than asked: a,\"b\" 1 of 2, c 1 of 2"
+        );
+    }
+
+    #[test]
     fn converged_only_summary_and_grouping() {
         let d = dataset();
         assert_eq!(d.converged_only().len(), 2);
@@ -942,6 +1077,28 @@ mod tests {
     }
 
     #[test]
+    fn causes_round_trip_are_counted_and_a_bad_cause_is_named() {
+        let mut d = dataset();
+        d.push(reading("c", ContactStatus::Collision, 4.0, true)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.csv");
+        d.write(&path).unwrap();
+        assert_eq!(Dataset::read(&path).unwrap(), d);
+        let s = d.summary();
+        // "c": the no_contact reading after 2 iterations lost contact; the collision is link4/world.
+        assert_eq!(s.causes[1][&FailureCause::LostContact], 1);
+        assert_eq!(s.causes[1][&FailureCause::Cause(CauseKind::ArmOnTable)], 1);
+        assert!(s.causes[0].is_empty());
+        assert!(s.to_string().contains("arm_on_table"), "{s}");
+        let t = std::fs::read_to_string(&path).unwrap();
+        let e = parse_err(&t.replace(",link4/world,", ",link4,"));
+        assert!(
+            e.contains("line 7") && e.contains("'cause'") && e.contains("'link4'"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn wrong_column_count_names_the_line() {
         let t = text();
         let lines: Vec<&str> = t.lines().collect();
@@ -949,7 +1106,7 @@ mod tests {
         let broken = t.replace(lines[4], short);
         let e = parse_err(&broken);
         assert!(
-            e.contains("d.csv: line 5") && e.contains("25 columns, expected 26"),
+            e.contains("d.csv: line 5") && e.contains("26 columns, expected 27 (21 + 2x3 taxels)"),
             "{e}"
         );
     }
@@ -1009,7 +1166,7 @@ mod tests {
     fn wrong_version_and_wrong_magic_are_named() {
         let t = text();
         let e = Dataset::parse(
-            &t.replace("\"format_version\":1", "\"format_version\":7"),
+            &t.replace("\"format_version\":2", "\"format_version\":7"),
             "d.csv",
         )
         .unwrap_err();
@@ -1018,7 +1175,7 @@ mod tests {
                 e,
                 DatasetError::Version {
                     found: 7,
-                    expected: 1,
+                    expected: 2,
                     ..
                 }
             ),

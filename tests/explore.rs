@@ -42,7 +42,7 @@ fn planner_collects_converged_readings_on_a_box() {
             report.converged(),
             report.readings.len(),
             report.iterations,
-            report.collisions,
+            report.collisions(),
             report.unreachable_steps,
             report.by_status(),
             t0.elapsed()
@@ -65,27 +65,53 @@ fn planner_collects_converged_readings_on_a_box() {
             if r.status != ContactStatus::Converged {
                 continue;
             }
-            // A converged reading is a real contact with the box: pressed to the target mean, pad
-            // on (within the covering of) one of the box's faces and aligned with its normal.
+            // A converged reading is a real contact with the box: pressed to the target mean, the
+            // covering (the pad rectangle swept t along the normal) reaching the box, and the pad
+            // facing the box's normal cone at its nearest point: a face's normal, or on an edge
+            // any direction between its two faces' normals (within 10 degrees).
             let mean = r.image.mean();
             assert!(
                 (mean - plan.control.target_mean_pressure).abs() <= 0.05,
                 "mean pressure {mean}"
             );
             assert!(r.image.max() < 1.0, "saturated image reported converged");
-            let p = r.object_pose.inverse().transform_point(pose.center_m);
-            let outside = (box_min - p).max(p - box_max).max_element();
+            // The most compressed taxel's centre on the pad plane, in the box frame.
+            let (row, col) = (0..r.image.rows())
+                .flat_map(|row| (0..r.image.cols()).map(move |col| (row, col)))
+                .max_by(|&a, &b| r.image.get(a.0, a.1).total_cmp(&r.image.get(b.0, b.1)))
+                .expect("a non-empty image");
+            let x = ((col as f64 + 0.5) / r.image.cols() as f64 - 0.5) * plan.sensor.pad_width_m;
+            let y = (0.5 - (row as f64 + 0.5) / r.image.rows() as f64) * plan.sensor.pad_height_m;
+            let p = r
+                .object_pose
+                .inverse()
+                .transform_point(pose.center_m + pose.right() * x + pose.up * y);
+            let q = p.clamp(box_min, box_max);
             assert!(
-                outside > 0.0 && outside < t + 1e-4,
-                "pad centre {p:?} is {outside} m outside the box; normal {:?}, image {:?}",
+                p != q && p.distance(q) < t,
+                "the most pressed taxel is {} m from the box (t = {t}); normal {:?}, image {:?}",
+                p.distance(q),
                 pose.normal,
                 r.image.values()
             );
-            let n = r.object_pose.rotation.inverse() * pose.normal;
-            assert!(
-                n.abs().max_element() > 10f64.to_radians().cos(),
-                "pad normal {n:?} not aligned with a face normal"
-            );
+            let outward = -(r.object_pose.rotation.inverse() * pose.normal);
+            let slack = 10f64.to_radians().sin();
+            for axis in 0..3 {
+                let (n, on_min, on_max) = (
+                    outward[axis],
+                    q[axis] <= box_min[axis] + 1e-9,
+                    q[axis] >= box_max[axis] - 1e-9,
+                );
+                let in_cone = match (on_min, on_max) {
+                    (true, _) => n <= slack,
+                    (_, true) => n >= -slack,
+                    _ => n.abs() <= slack,
+                };
+                assert!(
+                    in_cone,
+                    "pad normal {outward:?} outside the normal cone of the box at {q:?}"
+                );
+            }
         }
         let moved = report
             .readings
@@ -307,7 +333,7 @@ fn planner_rates() {
             report.readings.len(),
             100.0 * report.converged() as f64 / report.readings.len() as f64,
             report.iterations,
-            report.collisions,
+            report.collisions(),
             report.by_status(),
             s,
             report.converged() as f64 / s

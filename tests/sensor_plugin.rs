@@ -83,6 +83,7 @@ fn bad_config_fails_compilation_naming_the_key_and_range() {
 }
 
 use glam::DQuat;
+use taction::sim::mjcf::COLLISION_GROUP;
 use taction::sim::{ObjectMount, ObjectSpec, Pose};
 use taction::tactile::{FreeFloatingSensor, PadPose, TactileImage};
 
@@ -330,10 +331,13 @@ fn mesh_depths_agree_with_mj_ray() {
             }
             let (x, y) = taxel_centre(&config, i, j);
             let p = pose.center_m + pose.right() * x + pose.up * y;
+            // Every geom group but the collision shell's, which the covering does not sense.
+            let mut groups = [1u8; 6];
+            groups[COLLISION_GROUP as usize] = 0;
             let (geom, d) = sensor.scene_mut().data_mut().ray(
                 &p.to_array(),
                 &pose.normal.to_array(),
-                None,
+                Some(&groups),
                 true,
                 Some(pad_body),
                 None,

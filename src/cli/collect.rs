@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use taction::control::ControlConfig;
-use taction::dataset::{Dataset, DatasetHeader};
+use taction::dataset::{Dataset, DatasetHeader, describe_shortfalls};
 use taction::explore::collect::{CollectMode, CollectPlan};
-use taction::explore::{PlannerConfig, SamplerConfig};
+use taction::explore::{ExplorationReport, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::image::write_contact_sheet;
@@ -39,6 +39,9 @@ pub struct CollectArgs {
     /// Planner: probability L of the local strategy.
     #[arg(long, default_value_t = 0.5)]
     pub local_prob: f64,
+    /// Planner: iterations allowed per object before it gives up short of `--readings`.
+    #[arg(long, default_value_t = PlannerConfig::default().max_iterations)]
+    pub max_iterations: usize,
     /// Sampler: approach only from above (raised letters, Sec. V-D).
     #[arg(long)]
     pub from_above: bool,
@@ -58,6 +61,10 @@ pub struct CollectArgs {
     /// Dataset file to write.
     #[arg(long)]
     pub out: PathBuf,
+    /// Exit 0 even when some object got fewer converged readings than `--readings` (the shortfall
+    /// is still reported on stderr). Without it such a run writes its dataset and exits 1.
+    #[arg(long)]
+    pub allow_short: bool,
     /// Converged readings per object drawn on its contact sheet, `<out stem>.<object>.png` beside the
     /// dataset (0: no contact sheets).
     #[arg(long, default_value_t = 24, value_name = "N")]
@@ -67,6 +74,9 @@ pub struct CollectArgs {
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.readings == 0 {
         return Err("--readings: want 1 or more".into());
+    }
+    if args.max_iterations == 0 {
+        return Err("--max-iterations: want 1 or more".into());
     }
     if !(0.0..=1.0).contains(&args.local_prob) {
         return Err(format!("--local-prob: {} is outside [0, 1]", args.local_prob).into());
@@ -86,8 +96,10 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         Mode::Planner => {
             let config = PlannerConfig {
                 local_probability: args.local_prob,
+                max_iterations: args.max_iterations,
                 ..PlannerConfig::default()
-            };
+            }
+            .fitted_to(&objects);
             (
                 CollectMode::Planner(config),
                 format!("planner L={}", args.local_prob),
@@ -110,14 +122,39 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         generator,
         args.seed,
     );
+    let planner_lines: Vec<String> = match args.mode {
+        Mode::Planner => objects
+            .iter()
+            .zip(&reports)
+            .map(|(object, report)| planner_line(&object.name, report))
+            .collect(),
+        Mode::Sampler => Vec::new(),
+    };
     let readings = reports.into_iter().flat_map(|r| r.readings).collect();
     let dataset = Dataset::new(header, readings)?;
     dataset.write(&args.out)?;
     println!("{}: {}", args.out.display(), dataset.summary());
+    for line in planner_lines {
+        println!("{line}");
+    }
     for path in write_contact_sheets(&dataset, &args.out, args.contact_sheet)? {
         println!("{}", path.display());
     }
-    Ok(())
+    let short = dataset.shortfalls(args.readings);
+    if short.is_empty() {
+        return Ok(());
+    }
+    let message = format!(
+        "{} ({} written; the causes per object are in the table above)",
+        describe_shortfalls(&short),
+        args.out.display()
+    );
+    if args.allow_short {
+        eprintln!("warning: {message}");
+        Ok(())
+    } else {
+        Err(format!("{message}; pass --allow-short to accept a short dataset").into())
+    }
 }
 
 /// Writes one contact sheet per object with its first `per_object` converged readings (12 a row,
@@ -165,4 +202,25 @@ pub fn write_contact_sheets(
         written.push(path);
     }
     Ok(written)
+}
+
+/// What the planner did on the way to `object`'s readings, beyond them: iterations, expansion steps
+/// stopped by a collision (by who touched whom) or without an inverse-kinematics solution.
+fn planner_line(object: &str, report: &ExplorationReport) -> String {
+    let collisions: Vec<String> = report
+        .expansion_collisions
+        .iter()
+        .map(|(kind, n)| format!("{} {n}", kind.name()))
+        .collect();
+    format!(
+        "planner {object}: {} iterations, {} expansion steps stopped by collisions ({}), {} unreachable steps",
+        report.iterations,
+        report.collisions(),
+        if collisions.is_empty() {
+            "none".to_string()
+        } else {
+            collisions.join(", ")
+        },
+        report.unreachable_steps
+    )
 }

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use clap::Args;
 use rand::RngExt;
 use taction::control::{ContactStatus, ControlConfig};
-use taction::dataset::Dataset;
+use taction::dataset::{Dataset, describe_shortfalls};
 use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, Series};
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
@@ -92,6 +92,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 seed: args.seed,
             };
             let dataset = Dataset::collect(&plan, &set.id(), &objects, 0)?;
+            let short = dataset.shortfalls(args.training_readings);
+            if !short.is_empty() {
+                eprintln!("warning: training: {}", describe_shortfalls(&short));
+            }
             let mut config = TrainConfig {
                 restarts: 1,
                 seed: args.seed,
@@ -150,7 +154,8 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         PlannerConfig {
             local_probability: 0.8,
             ..PlannerConfig::default()
-        },
+        }
+        .fitted_to(&objects),
         ControlConfig::default(),
         sensor,
         PerturbationBounds::NONE,
@@ -171,8 +176,14 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         attempts += report.readings.len();
         if report.converged() == 0 {
             return Err(format!(
-                "the planner found no converged reading after {attempts} attempts ({} iterations, {} collisions, {} unreachable steps)",
-                report.iterations, report.collisions, report.unreachable_steps
+                "the planner found no converged reading of '{}' after {attempts} attempts ({} iterations, \
+                 {} collisions, {} unreachable steps); `taction collect --objects {} --mode planner` \
+                 prints why its attempts fail, per object; try another --seed or --object",
+                unknown.name,
+                report.iterations,
+                report.collisions(),
+                report.unreachable_steps,
+                args.objects.display()
             )
             .into());
         }

@@ -4,7 +4,10 @@
 //! `sim::arm`), Sec. III-B on the arm of Sec. V-A1. The sensor is read only when a command is done.
 //!
 //! The pad's rigid back is as wide as the covering, so it reaches the surface exactly when a taxel
-//! would read full compression. A Press command that would press it onto the surface is refused
+//! would read full compression: MuJoCo's contacts see it reach the table, the covering sensor (an
+//! optional check, [`ArmPad::with_back_check`]) sees it reach the object's exact surface, which the
+//! object's convex collision pieces only approximate. A Press command that would press it onto the
+//! surface is refused
 //! (the carrier stays at its previous pose and reports [`PadMotion::RigidContact`], Press's
 //! saturation termination). An Orient command that would do so, because tilting the pad about the
 //! contact centroid lowers its far edge, is executed backed off along the new pad normal by the
@@ -17,11 +20,12 @@
 use glam::DVec3;
 
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
-use crate::sim::arm::Execution;
+use crate::sim::arm::{Execution, PAD_BODY};
+use crate::sim::object::OBJECT_BODY;
 use crate::sim::{
     Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene,
 };
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
 
 /// The pad frame of a pad site pose: centre at the site, normal its +z, up its +y.
 pub fn pad_pose_of_site(site: &Pose) -> PadPose {
@@ -30,6 +34,18 @@ pub fn pad_pose_of_site(site: &Pose) -> PadPose {
         normal: site.transform_vector(DVec3::Z).normalize(),
         up: site.transform_vector(DVec3::Y).normalize(),
     }
+}
+
+/// Whether the object reaches the pad's rigid back in the scene's current configuration.
+pub type BackCheck<'s> = Box<dyn FnMut(&mut Scene) -> Result<bool, ControlError> + 's>;
+
+/// The back check of the covering sensor `covering` on the pad: computes the scene's sensors at
+/// the current configuration and asks it whether the object reached the rigid back.
+pub fn covering_back_check<'s>(covering: CoveringSensor) -> BackCheck<'s> {
+    Box::new(move |scene: &mut Scene| {
+        scene.compute_sensors();
+        Ok(covering.back_reached(scene.model(), scene.data()))
+    })
 }
 
 /// The arm-mounted pad: a scene with an arm, an IK solver, and a way to read the sensor.
@@ -42,6 +58,9 @@ pub struct ArmPad<'s, R> {
     motion: MoveOptions,
     /// The configuration at which a Press command was last refused outright by a rigid contact.
     refused_at: Option<Vec<f64>>,
+    /// The back's contact with the object, when MuJoCo's contacts do not see it (see
+    /// [`with_back_check`](Self::with_back_check)).
+    back_check: Option<BackCheck<'s>>,
 }
 
 impl<'s, R> ArmPad<'s, R>
@@ -65,7 +84,18 @@ where
             reader,
             motion,
             refused_at: None,
+            back_check: None,
         })
+    }
+
+    /// Treats the object reaching the pad's rigid back, as `check` tells after every command, as the
+    /// rigid contact MuJoCo would report: the object's collision shell does not collide with the
+    /// back (`mjcf/arm.xml`), so that the back can come as close to the exact surface as the
+    /// covering allows, and the covering sensor, which sees the exact triangles, says when it
+    /// arrives (`CoveringSensor::back_reached`).
+    pub fn with_back_check(mut self, check: BackCheck<'s>) -> Self {
+        self.back_check = Some(check);
+        self
     }
 
     pub fn scene(&mut self) -> &mut Scene {
@@ -180,7 +210,24 @@ where
             }
         };
         Ok(match self.arm.move_to(self.scene, &q, &self.motion, |_| false)? {
-            MoveOutcome::Reached | MoveOutcome::Stopped => (PadMotion::Moved, None),
+            MoveOutcome::Reached | MoveOutcome::Stopped => {
+                let back_reached = match &mut self.back_check {
+                    Some(check) => check(self.scene)?,
+                    None => false,
+                };
+                if back_reached {
+                    // The exact check sees only where the motion ended: back to where it began,
+                    // which was clear (the servo's retreat).
+                    self.arm.place(self.scene, start);
+                    let contact = Collision {
+                        body_a: PAD_BODY.to_string(),
+                        body_b: OBJECT_BODY.to_string(),
+                    };
+                    (PadMotion::RigidContact, Some(contact))
+                } else {
+                    (PadMotion::Moved, None)
+                }
+            }
             MoveOutcome::Collided(c) if self.is_pad_contact(&c) => {
                 if self.motion.execution == Execution::Servo {
                     self.arm.place(self.scene, start);

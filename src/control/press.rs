@@ -57,7 +57,8 @@ pub fn is_clipped(image: &TactileImage, config: &ControlConfig) -> bool {
 /// How a Press phase ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PressOutcome {
-    /// Press terminated; `commanded` tells whether it moved the pad at all in this phase.
+    /// Press terminated; `commanded` tells whether it moved the pad at all in this phase (a command
+    /// the carrier refused moved nothing).
     Done { image: TactileImage, commanded: bool },
     /// The carrier could not move.
     Blocked(PadMotion),
@@ -74,7 +75,7 @@ pub fn press<C: PadCarrier + ?Sized>(
     let mut image = carrier.read()?;
     let tolerance = config.effective_pressure_tolerance(image.values().len());
     let mut previous_error = None;
-    let mut commanded = false;
+    let mut moved = false;
     for _ in 0..config.press_max_steps {
         let error = config.target_mean_pressure - image.mean();
         let near_saturation = pressed_peak(&image, config) >= config.saturation_threshold;
@@ -92,20 +93,29 @@ pub fn press<C: PadCarrier + ?Sized>(
         let mut pose = carrier.pad_pose();
         pose.center_m += pose.normal * step_m;
         trace.push(Command::Press, pose);
-        commanded = true;
         match carrier.move_pad(&pose)? {
-            PadMotion::Moved => {}
+            PadMotion::Moved => moved = true,
             PadMotion::RigidContact => {
                 // The covering is fully compressed under part of the pad: the strongest form of the
-                // "close to fully saturated" termination.
+                // "close to fully saturated" termination. When the image shows it (a taxel near
+                // saturation), the refused command moved nothing and the controllers may converge
+                // where they are. When it does not (the object's tip or blade bottomed out between
+                // taxels, blurred away), the refusal counts as a command, so that a second one from
+                // the same place ends the attempt as the rigid contact it is.
                 image = carrier.read()?;
+                if pressed_peak(&image, config) < config.saturation_threshold {
+                    moved = true;
+                }
                 break;
             }
             blocked => return Ok(PressOutcome::Blocked(blocked)),
         }
         image = carrier.read()?;
     }
-    Ok(PressOutcome::Done { image, commanded })
+    Ok(PressOutcome::Done {
+        image,
+        commanded: moved,
+    })
 }
 
 #[cfg(test)]

@@ -10,6 +10,6 @@ pub mod surface_sampling;
 pub mod tree;
 
 pub use planner::{Planner, PlannerConfig};
-pub use reading::{ExplorationReport, Reading};
+pub use reading::{AttemptCause, CauseKind, ExplorationReport, Reading};
 pub use sampler::{SamplerConfig, sample_readings};
 pub use strategy::Strategy;

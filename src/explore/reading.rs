@@ -6,7 +6,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::ContactStatus;
 use crate::explore::strategy::Strategy;
-use crate::sim::Pose;
+use crate::sim::arm::{ARM_BODIES, PAD_BODY};
+use crate::sim::object::OBJECT_BODY;
+use crate::sim::{Collision, Pose};
 use crate::tactile::TactileImage;
 
 /// One reading: the tactile image (tagged with the pad pose it was taken at) and how it was obtained.
@@ -22,6 +24,113 @@ pub struct Reading {
     /// Press/Orient alternations the controllers ran.
     pub iterations: u32,
     pub strategy: Strategy,
+    /// Why the attempt ended, where its status alone does not say: the bodies that touched (a
+    /// `Collision` reading), or the covering on the table.
+    pub cause: Option<AttemptCause>,
+}
+
+/// What ended a reading attempt short of convergence, beyond its [`ContactStatus`].
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AttemptCause {
+    /// Two rigid bodies touched: an arm link or the pad's rigid back, and the object, the table
+    /// (`world`) or another arm link. Collision-free motions are the planner's premise (Sec. III-A).
+    Touched { body_a: String, body_b: String },
+    /// The controllers converged, but the covering's volume reaches the table top: a reading of the
+    /// environment, not of the object (see `covering_meets_table`).
+    CoveringMeetsTable,
+}
+
+/// The kinds of [`AttemptCause`] a user tells apart: who touched whom.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CauseKind {
+    /// The pad's rigid back on the object: the covering fully compressed somewhere while the
+    /// controllers were still pressing or turning.
+    PadOnObject,
+    /// An arm link (not the pad) on the object.
+    ArmOnObject,
+    /// Any arm body, the pad included, on the table.
+    ArmOnTable,
+    /// Two arm links on each other.
+    ArmOnArm,
+    /// The covering-meets-table rule.
+    CoveringOnTable,
+}
+
+impl CauseKind {
+    pub const ALL: [CauseKind; 5] = [
+        Self::PadOnObject,
+        Self::ArmOnObject,
+        Self::ArmOnTable,
+        Self::ArmOnArm,
+        Self::CoveringOnTable,
+    ];
+
+    /// The snake_case name used in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::PadOnObject => "pad_on_object",
+            Self::ArmOnObject => "arm_on_object",
+            Self::ArmOnTable => "arm_on_table",
+            Self::ArmOnArm => "arm_on_arm",
+            Self::CoveringOnTable => "covering_on_table",
+        }
+    }
+}
+
+impl AttemptCause {
+    /// The collision that stopped a motion, the arm's body first.
+    pub fn touched(collision: &Collision) -> Self {
+        let (a, b) = (&collision.body_a, &collision.body_b);
+        let (body_a, body_b) = if ARM_BODIES.contains(&b.as_str()) && !ARM_BODIES.contains(&a.as_str()) {
+            (b.clone(), a.clone())
+        } else {
+            (a.clone(), b.clone())
+        };
+        Self::Touched { body_a, body_b }
+    }
+
+    /// The text of the dataset's `cause` column: `covering_meets_table`, or the two bodies as
+    /// `arm_body/other_body` (e.g. `sensor/object`, `link4/world`).
+    pub fn name(&self) -> String {
+        match self {
+            Self::Touched { body_a, body_b } => format!("{body_a}/{body_b}"),
+            Self::CoveringMeetsTable => "covering_meets_table".into(),
+        }
+    }
+
+    /// Parses [`name`](Self::name).
+    pub fn from_name(text: &str) -> Option<Self> {
+        if text == "covering_meets_table" {
+            return Some(Self::CoveringMeetsTable);
+        }
+        let (a, b) = text.split_once('/')?;
+        (!a.is_empty() && !b.is_empty()).then(|| Self::Touched {
+            body_a: a.to_string(),
+            body_b: b.to_string(),
+        })
+    }
+
+    /// Who touched whom. The pad's body is the arm's last (`sensor`); the table is the world body.
+    pub fn kind(&self) -> CauseKind {
+        match self {
+            Self::CoveringMeetsTable => CauseKind::CoveringOnTable,
+            Self::Touched { body_a, body_b } => {
+                let other = body_b.as_str();
+                if ARM_BODIES.contains(&other) {
+                    CauseKind::ArmOnArm
+                } else if other == OBJECT_BODY {
+                    if body_a == PAD_BODY {
+                        CauseKind::PadOnObject
+                    } else {
+                        CauseKind::ArmOnObject
+                    }
+                } else {
+                    CauseKind::ArmOnTable
+                }
+            }
+        }
+    }
 }
 
 /// The readings of one exploration or sampling run, and what happened on the way.
@@ -31,8 +140,8 @@ pub struct ExplorationReport {
     pub readings: Vec<Reading>,
     /// Planner iterations (or sampler draws) used.
     pub iterations: usize,
-    /// Expansion steps stopped by a collision of the arm.
-    pub collisions: usize,
+    /// Expansion steps stopped by a collision of the arm, by who touched whom.
+    pub expansion_collisions: BTreeMap<CauseKind, usize>,
     /// Expansion steps with no inverse-kinematics solution.
     pub unreachable_steps: usize,
 }
@@ -46,6 +155,11 @@ impl ExplorationReport {
             .count()
     }
 
+    /// Expansion steps stopped by a collision of the arm.
+    pub fn collisions(&self) -> usize {
+        self.expansion_collisions.values().sum()
+    }
+
     /// Reading attempts by status.
     pub fn by_status(&self) -> BTreeMap<ContactStatus, usize> {
         let mut counts = BTreeMap::new();
@@ -53,5 +167,31 @@ impl ExplorationReport {
             *counts.entry(r.status).or_insert(0) += 1;
         }
         counts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn causes_put_the_arm_first_round_trip_and_classify() {
+        let touched = |a: &str, b: &str| {
+            AttemptCause::touched(&Collision {
+                body_a: a.into(),
+                body_b: b.into(),
+            })
+        };
+        let pad = touched("object", "sensor");
+        assert_eq!(pad.name(), "sensor/object");
+        assert_eq!(pad.kind(), CauseKind::PadOnObject);
+        assert_eq!(touched("link3", "object").kind(), CauseKind::ArmOnObject);
+        assert_eq!(touched("world", "link4").kind(), CauseKind::ArmOnTable);
+        assert_eq!(touched("base", "link3").kind(), CauseKind::ArmOnArm);
+        for cause in [pad, touched("world", "link4"), AttemptCause::CoveringMeetsTable] {
+            assert_eq!(AttemptCause::from_name(&cause.name()), Some(cause));
+        }
+        assert_eq!(AttemptCause::from_name("sensor"), None);
+        assert_eq!(AttemptCause::from_name("/object"), None);
     }
 }

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::free_pad::FreePad;
 use crate::control::{ControlConfig, ControlError, settle};
-use crate::explore::reading::{ExplorationReport, Reading};
+use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
@@ -117,6 +117,7 @@ where
             status: outcome.status,
             iterations: outcome.iterations,
             strategy: Strategy::Sampler,
+            cause: outcome.collision.as_ref().map(AttemptCause::touched),
         });
         if !perturbation.is_none() {
             let scene = pad.scene();

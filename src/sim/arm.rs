@@ -25,6 +25,7 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use serde::{Deserialize, Serialize};
 
+use crate::sim::mjcf::COLLISION_GROUP;
 use crate::sim::scene::Scene;
 use crate::sim::{Pose, SimError};
 
@@ -39,6 +40,10 @@ pub const ARM_JOINTS: [&str; 8] = [
     "wrist_y",
     "wrist_z",
 ];
+/// The arm's bodies in `mjcf/arm.xml`, base to pad: what a collision's body names are checked against.
+pub const ARM_BODIES: [&str; 5] = [ARM_BASE, "link2", "link3", "link4", PAD_BODY];
+/// The body carrying the pad (its rigid back and holder).
+pub const PAD_BODY: &str = "sensor";
 /// The site whose frame is the pad frame (+z the pad normal, +y image up).
 pub const PAD_SITE: &str = "pad";
 /// The arm's root body.
@@ -190,11 +195,22 @@ impl Arm {
         let back_geom = model
             .name_to_id(MjtObjBase::mjOBJ_GEOM, PAD_BACK_GEOM)
             .filter(|&g| model.body_rootid()[model.geom_bodyid()[g] as usize] as usize == root_body);
+        let outside = |g: usize| {
+            let b = model.geom_bodyid()[g] as usize;
+            !(b != 0 && model.body_rootid()[b] as usize == root_body)
+        };
+        // A contact-free geom whose body carries a collision shell is represented by the shell's
+        // pieces: they enclose its surface, so their distance is a lower bound of its own, and a far
+        // tighter one than that of its convex hull, which is what MuJoCo would measure.
+        let shelled = |g: usize| {
+            let b = model.geom_bodyid()[g];
+            model.geom_contype()[g] == 0
+                && model.geom_conaffinity()[g] == 0
+                && (0..model.ffi().ngeom as usize)
+                    .any(|h| model.geom_bodyid()[h] == b && model.geom_group()[h] == COLLISION_GROUP)
+        };
         let outside_geoms = (0..model.ffi().ngeom as usize)
-            .filter(|&g| {
-                let b = model.geom_bodyid()[g] as usize;
-                !(b != 0 && model.body_rootid()[b] as usize == root_body)
-            })
+            .filter(|&g| outside(g) && !shelled(g))
             .collect();
         Ok(Some(Arm {
             joints,
@@ -290,14 +306,25 @@ impl Arm {
     }
 
     /// Smallest distance (MuJoCo's `mj_geomDistance`; convex hulls for meshes, so never more than the
-    /// true distance) between the pad's rigid back and any geom outside the arm, capped at
+    /// true distance) between the pad's rigid back and any geom outside the arm (an object's collision
+    /// shell standing in for its exact mesh), capped at
     /// `dist_max_m`; `None` when the model has no rigid back. Needs current kinematics.
     pub fn pad_clearance_m(&self, scene: &mut Scene, dist_max_m: f64) -> Result<Option<f64>, SimError> {
         let Some(back) = self.back_geom else {
             return Ok(None);
         };
         let mut clearance = dist_max_m;
+        let back_center = DVec3::from_array(scene.data().geom_xpos()[back]);
+        let back_radius_m = scene.model().geom_rbound()[back];
         for &g in &self.outside_geoms {
+            // Bounding spheres farther apart than the clearance found so far cannot lower it; the
+            // exact (GJK) distance is asked only of the geoms near the back. A zero radius is a
+            // plane, which has no bounding sphere.
+            let radius_m = scene.model().geom_rbound()[g];
+            let center = DVec3::from_array(scene.data().geom_xpos()[g]);
+            if radius_m > 0.0 && (center - back_center).length() - radius_m - back_radius_m >= clearance {
+                continue;
+            }
             clearance = clearance.min(scene.geom_distance_m(back, g, clearance)?);
         }
         Ok(Some(clearance))

@@ -13,6 +13,9 @@ pub const ARM_XML: &str = include_str!("../../mjcf/arm.xml");
 pub const TABLE_XML: &str = include_str!("../../mjcf/table.xml");
 /// Height of the table top in `mjcf/table.xml` (the object rests on it), metres.
 pub const TABLE_TOP_Z_M: f64 = 0.0;
+/// The geom group of collision-only geoms (MuJoCo's usual convention, hidden in its viewer by
+/// default): they take part in contacts, and the tactile sensor does not see them.
+pub const COLLISION_GROUP: i32 = 3;
 
 /// The children of the root `<mujoco>` element of `xml` (what `<include>` would insert).
 pub fn inner(xml: &str, origin: &str) -> Result<String, SimError> {

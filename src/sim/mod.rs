@@ -2,6 +2,7 @@
 //! the object under exploration, free to be perturbed between readings (Sec. V-B4).
 
 pub mod arm;
+pub mod collision_shell;
 pub mod ik;
 pub mod mjcf;
 pub mod object;

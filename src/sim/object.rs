@@ -5,7 +5,8 @@
 //! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
 
 use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
-use crate::sim::mjcf::{Document, Section, escape_attr, numbers};
+use crate::sim::collision_shell::{ShellOptions, collision_shell};
+use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, escape_attr, numbers};
 use crate::sim::{Pose, SimError};
 
 /// Body, geom and joint names of the object slot.
@@ -92,6 +93,23 @@ impl ObjectSpec {
             format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"),
         );
 
+        // Contacts go through the shell (see `collision_shell`), the sensor reads the exact mesh.
+        let mut shell = String::new();
+        for (i, piece) in collision_shell(&self.mesh, &ShellOptions::default())
+            .iter()
+            .enumerate()
+        {
+            let vertex = numbers(piece.iter().flat_map(|v| v.to_array()));
+            doc.add(
+                Section::Asset,
+                format!("<mesh name=\"{OBJECT_GEOM}_shell_{i}\" inertia=\"shell\" vertex=\"{vertex}\"/>"),
+            );
+            shell.push_str(&format!(
+                "<geom name=\"{OBJECT_GEOM}_shell_{i}\" type=\"mesh\" mesh=\"{OBJECT_GEOM}_shell_{i}\" \
+                 group=\"{COLLISION_GROUP}\" contype=\"2\" conaffinity=\"2\" rgba=\"0.8 0.5 0.3 0.3\" friction=\"0.6\"/>\n"
+            ));
+        }
+
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
         let inertia = 0.4 * self.mass_kg * radius * radius;
@@ -107,8 +125,8 @@ impl ObjectSpec {
                 "<body name=\"{OBJECT_BODY}\" pos=\"{pos}\" quat=\"{quat}\"{mount_attr}>\n\
                  <!-- {} -->\n{joint}\n\
                  <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>\n\
-                 <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"object\" rgba=\"0.8 0.5 0.3 1\" friction=\"0.6\"/>\n\
-                 </body>",
+                 <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"object\" rgba=\"0.8 0.5 0.3 1\" contype=\"0\" conaffinity=\"0\"/>\n\
+                 {shell}</body>",
                 escape_attr(&self.name).replace("--", "- -"),
                 numbers(center.to_array()),
                 self.mass_kg

@@ -21,6 +21,7 @@
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
 
+use crate::sim::mjcf::COLLISION_GROUP;
 use crate::tactile::SensorConfig;
 use crate::tactile::config::ConfigError;
 use crate::tactile::formation::ImageFormation;
@@ -87,6 +88,10 @@ pub struct CoveringStats {
     pub readings: u64,
     /// Mesh faces rasterised in the last reading (the BVH's candidates near the pad).
     pub last_faces: usize,
+    /// Samples of the last reading at full penetration: there the object reached the pad's rigid
+    /// back (the covering is fully compressed), which the image, blurred by the point-spread and
+    /// averaged over taxels, may show well below 1 (a sliver of an edge, a thin blade).
+    pub last_full_samples: usize,
 }
 
 /// A plugin instance's state (stored behind MuJoCo's `plugin_data`).
@@ -154,7 +159,9 @@ impl Covering {
                 } else {
                     model.body_rootid[geom_body] as usize == root
                 };
-                if own {
+                // Collision-only geoms (an object's collision shell) are not the surface the
+                // covering presses on.
+                if own || model.geom_group[geom] == COLLISION_GROUP {
                     continue;
                 }
                 let size = &model.geom_size[3 * geom..3 * geom + 3];
@@ -269,8 +276,11 @@ impl Covering {
     /// `reading` numbers the reading for the noise streams.
     pub fn compute(&mut self, poses: &PoseView, reading: u64, sensordata: &mut [f64]) {
         self.stats.last_faces = 0;
+        self.stats.last_full_samples = 0;
         for k in 0..self.sensors.len() {
             self.penetration(k, poses);
+            let t = self.config.thickness_m;
+            self.stats.last_full_samples += self.nearest_m.iter().filter(|&&p| p >= t).count();
             let sensor = &self.sensors[k];
             let n = self.config.taxel_count();
             let out = &mut sensordata[sensor.adr..sensor.adr + n];

@@ -23,6 +23,7 @@ unsafe fn slice<'a, T>(ptr: *const T, len: i64) -> &'a [T] {
 pub struct ModelView<'a> {
     pub geom_type: &'a [i32],
     pub geom_bodyid: &'a [i32],
+    pub geom_group: &'a [i32],
     pub geom_dataid: &'a [i32],
     /// 3 per geom.
     pub geom_size: &'a [f64],
@@ -59,6 +60,7 @@ impl<'a> ModelView<'a> {
             Self {
                 geom_type: slice(m.geom_type, m.ngeom),
                 geom_bodyid: slice(m.geom_bodyid, m.ngeom),
+                geom_group: slice(m.geom_group, m.ngeom),
                 geom_dataid: slice(m.geom_dataid, m.ngeom),
                 geom_size: slice(m.geom_size, 3 * m.ngeom),
                 geom_rbound: slice(m.geom_rbound, m.ngeom),

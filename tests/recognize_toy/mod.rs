@@ -72,6 +72,7 @@ pub fn dataset(per_object: usize, seed: u64) -> Dataset {
                 status: ContactStatus::Converged,
                 iterations: 3,
                 strategy: Strategy::Sampler,
+                cause: None,
             });
         }
     }

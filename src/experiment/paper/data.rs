@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::dataset::{Dataset, generator_name};
+use crate::dataset::{Dataset, describe_shortfalls, generator_name};
 use crate::describe::Descriptor;
 use crate::experiment::unit::BoxError;
 use crate::explore::collect::CollectPlan;
@@ -153,6 +153,7 @@ impl DataStore {
                 )?;
                 crate::experiment::atomic::create_dir_all(&self.root.join("data"))?;
                 dataset.write(&path)?;
+
                 eprintln!(
                     "  {} readings ({} converged) in {:.1} s -> {}",
                     dataset.len(),
@@ -162,6 +163,12 @@ impl DataStore {
                 );
                 dataset
             };
+            let short = dataset.shortfalls(request.plan.readings_per_object);
+            if !short.is_empty() {
+                // Accuracy counts an object read fewer times as `experiment::accuracy` defines it;
+                // the user must still know it happened.
+                eprintln!("  warning: {} ({})", describe_shortfalls(&short), path.display());
+            }
             self.lock().insert(key, Arc::new(dataset));
         }
         Ok(())

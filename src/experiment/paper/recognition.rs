@@ -312,10 +312,13 @@ impl RecognitionSweep {
                     DataRequest::new(
                         objects,
                         CollectPlan {
-                            mode: CollectMode::Planner(PlannerConfig {
-                                local_probability,
-                                ..PlannerConfig::default()
-                            }),
+                            mode: CollectMode::Planner(
+                                PlannerConfig {
+                                    local_probability,
+                                    ..PlannerConfig::default()
+                                }
+                                .fitted_to(&objects.specs),
+                            ),
                             sensor: self.sensor(context, setting),
                             control: self.control(setting),
                             perturbation,

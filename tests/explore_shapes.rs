@@ -1,0 +1,261 @@
+//! Blind exploration on every object of the `shapes` set (the ten CGAL meshes and the two chess
+//! pieces): the planner reaches the asked number of converged readings on each object with the
+//! global strategy alone, the mixed one and the local one alone (L = 0, 0.5, 1; Sec. V-B3), also
+//! with the object perturbed after every reading (Sec. V-B4), and every converged reading is a real
+//! touch of the object: the covering meets the exact mesh under the pad, and the pad faces the local
+//! surface. A run that cannot reach its count says so and exits non-zero.
+
+mod common;
+
+use std::process::Command;
+
+use glam::DVec3;
+use taction::control::{ContactStatus, ControlConfig};
+use taction::dataset::Dataset;
+use taction::explore::collect::{CollectMode, CollectPlan};
+use taction::explore::{PlannerConfig, Reading};
+use taction::mesh::{ObjectSet, TriMesh, write_obj};
+use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::tactile::SensorConfig;
+
+const READINGS: usize = 10;
+
+/// The planner's readings of every shape, `READINGS` converged ones asked of each.
+fn explore(local_probability: f64, perturbation: PerturbationBounds) -> (Vec<ObjectSpec>, Dataset) {
+    let set = ObjectSet::shapes();
+    let objects = ObjectSpec::all_of(&set).expect("the shapes (fetched by `cargo xtask setup`)");
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(
+            PlannerConfig {
+                local_probability,
+                ..PlannerConfig::default()
+            }
+            .fitted_to(&objects),
+        ),
+        sensor: SensorConfig::square(6, 6, 0.012, 0.0012),
+        control: ControlConfig::default(),
+        perturbation,
+        readings_per_object: READINGS,
+        seed: 11,
+    };
+    let dataset = Dataset::collect(&plan, &set.id(), &objects, 0).expect("exploration runs");
+    (objects, dataset)
+}
+
+/// Where the ray `origin + s * direction` (s >= 0) first meets one of `triangles`, metres
+/// (Moller-Trumbore).
+fn first_hit(triangles: &[[DVec3; 3]], origin: DVec3, direction: DVec3) -> Option<(f64, bool)> {
+    let mut best: Option<(f64, bool)> = None;
+    for &[a, b, c] in triangles {
+        let (e1, e2) = (b - a, c - a);
+        let p = direction.cross(e2);
+        let det = e1.dot(p);
+        if det.abs() < 1e-18 {
+            continue;
+        }
+        let s = origin - a;
+        let u = s.dot(p) / det;
+        let q = s.cross(e1);
+        let v = direction.dot(q) / det;
+        if u < 0.0 || v < 0.0 || u + v > 1.0 {
+            continue;
+        }
+        let distance = e2.dot(q) / det;
+        if distance >= 0.0 && best.is_none_or(|(d, _)| distance < d) {
+            best = Some((distance, e1.cross(e2).dot(direction) < 0.0));
+        }
+    }
+    best
+}
+
+/// Rays per pad side for [`touch_of`]: finer than the 6x6 taxels, so that a contact between taxel
+/// centres is found.
+const RAYS_PER_SIDE: usize = 24;
+
+/// How a converged reading touches `mesh`, looking along the pad normal from a grid of points on
+/// the pad plane: the nearest surface point's depth (metres); how deep the pad plane, the front of
+/// the rigid back, lies inside the object at worst (metres; 0 when it is outside everywhere); and
+/// the tilt (degrees) between the pad plane and the plane fitted (least squares) to the depths met
+/// within 2t, the surface under the pad, which Orient levels the pad with (Sec. III-B).
+fn touch_of(reading: &Reading, mesh: &TriMesh, sensor: &SensorConfig) -> (f64, f64, f64) {
+    let pose = reading
+        .image
+        .pose()
+        .expect("a planner reading carries its pad pose");
+    let to_mesh = reading.object_pose.inverse();
+    let center = to_mesh.transform_point(pose.center_m);
+    let normal = (reading.object_pose.rotation.inverse() * pose.normal).normalize();
+    let up = (reading.object_pose.rotation.inverse() * pose.up).normalize();
+    let right = (reading.object_pose.rotation.inverse() * pose.right()).normalize();
+    let t = sensor.thickness_m;
+    // Only triangles near the covering can be met within 2t.
+    let reach = 0.5 * sensor.pad_width_m.hypot(sensor.pad_height_m) + 2.0 * t;
+    let near: Vec<[DVec3; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| mesh.vertices[i as usize]))
+        .filter(|[a, b, c]| {
+            let centroid = (*a + *b + *c) / 3.0;
+            let radius = [a, b, c].iter().map(|p| p.distance(centroid)).fold(0.0, f64::max);
+            centroid.distance(center) <= reach + radius
+        })
+        .collect();
+    let mut nearest = f64::INFINITY;
+    let mut inside = 0.0f64;
+    // Normal equations of depth = a + b x + c y over the rays that meet the surface within 2t.
+    let mut ata = glam::DMat3::ZERO;
+    let mut atb = DVec3::ZERO;
+    for i in 0..RAYS_PER_SIDE {
+        for j in 0..RAYS_PER_SIDE {
+            let x = ((j as f64 + 0.5) / RAYS_PER_SIDE as f64 - 0.5) * sensor.pad_width_m;
+            let y = ((i as f64 + 0.5) / RAYS_PER_SIDE as f64 - 0.5) * sensor.pad_height_m;
+            let origin = center + right * x + up * y;
+            if let Some((d, entering)) = first_hit(&near, origin, normal) {
+                if !entering {
+                    // The first surface ahead is left, not entered: the point is inside.
+                    let behind = first_hit(&near, origin, -normal).map_or(0.0, |(b, _)| b);
+                    inside = inside.max(behind);
+                }
+                nearest = nearest.min(d);
+                if d <= 2.0 * t {
+                    let v = DVec3::new(1.0, x, y);
+                    ata += glam::DMat3::from_cols(v * v.x, v * v.y, v * v.z);
+                    atb += v * d;
+                }
+            }
+        }
+    }
+    if ata.determinant().abs() < 1e-24 {
+        return (nearest, inside, 0.0);
+    }
+    let [_, b, c] = (ata.inverse() * atb).to_array();
+    (nearest, inside, b.hypot(c).atan().to_degrees())
+}
+
+/// Every object got its readings, and every converged one touches its object: the covering meets
+/// the surface (within t) and the rigid back stays out of it (within the covering's sampling);
+/// and the pad lies level with the
+/// surface under it (within 10 degrees) on most readings of every object (its median) and on 85% of
+/// the set's. The others rest on a ridge, an edge or a tip (a horn, a finger), whose normal cone is
+/// wide: the plane fitted to the surface within 2t there is a side of the feature, not the surface
+/// the pad presses.
+fn check(objects: &[ObjectSpec], dataset: &Dataset, what: &str) {
+    let summary = dataset.summary();
+    assert!(
+        dataset.shortfalls(READINGS).is_empty(),
+        "{what}: {:?}\n{summary}",
+        dataset.shortfalls(READINGS)
+    );
+    let t = dataset.header().sensor.thickness_m;
+    let (mut level_total, mut total) = (0, 0);
+    for (object, readings) in objects.iter().zip(dataset.by_object()) {
+        let mut tilts = Vec::new();
+        for r in readings.iter().filter(|r| r.status == ContactStatus::Converged) {
+            let (depth, inside, tilt) = touch_of(r, &object.mesh, &dataset.header().sensor);
+            assert!(
+                depth <= t,
+                "{what} {}: the covering does not reach the surface (nearest {depth} m, t = {t} m), pad {:?}",
+                object.name,
+                r.image.pose()
+            );
+            // The back check sees the covering's samples (2x2 per taxel, 1 mm apart), these rays
+            // are twice as fine: a ridge or tip narrower than the samples' spacing may poke
+            // behind the pad plane between them, by up to 0.66 mm (elephant) in these runs.
+            assert!(
+                inside <= t,
+                "{what} {}: the rigid back is {inside} m inside the object, pad {:?}",
+                object.name,
+                r.image.pose()
+            );
+            tilts.push(tilt);
+        }
+        tilts.sort_by(f64::total_cmp);
+        let level = tilts.iter().filter(|&&a| a <= 10.0).count();
+        eprintln!(
+            "{what} {}: {} attempts, {level} of {} converged within 10 deg, tilts {:?}",
+            object.name,
+            readings.len(),
+            tilts.len(),
+            tilts.iter().map(|a| a.round()).collect::<Vec<_>>()
+        );
+        assert!(
+            tilts[tilts.len() / 2] <= 10.0,
+            "{what} {}: tilts {tilts:?}",
+            object.name
+        );
+        level_total += level;
+        total += tilts.len();
+    }
+    assert!(
+        100 * level_total >= 85 * total,
+        "{what}: {level_total} of {total} converged readings level within 10 deg"
+    );
+}
+
+#[test]
+fn every_shape_is_read_with_the_global_mixed_and_local_strategies() {
+    for l in [0.0, 0.5, 1.0] {
+        let (objects, dataset) = explore(l, PerturbationBounds::NONE);
+        check(&objects, &dataset, &format!("L = {l}"));
+    }
+}
+
+#[test]
+fn every_shape_is_read_when_perturbed_after_every_reading() {
+    let (objects, dataset) = explore(0.5, PerturbationBounds::new(10.0, 0.1).expect("valid bounds"));
+    check(&objects, &dataset, "perturbed");
+    for readings in dataset.by_object() {
+        assert!(
+            readings.windows(2).any(|w| w[0].object_pose != w[1].object_pose),
+            "the object never moved"
+        );
+    }
+}
+
+#[test]
+fn a_run_short_of_its_count_exits_non_zero_naming_the_object() {
+    // A 6 cm cube standing 1.5 m from the arm, far outside its workspace.
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let mesh = dir.path().join("faraway.obj");
+    let mut cube = common::box_mesh(DVec3::splat(0.06));
+    for v in &mut cube.vertices {
+        v.x += 1.5;
+    }
+    write_obj(&cube, &mesh, "a cube out of reach").expect("write the mesh");
+    let out = dir.path().join("faraway.tsv");
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args([
+                "collect",
+                "--mode",
+                "planner",
+                "--readings",
+                "3",
+                "--max-iterations",
+                "200",
+            ])
+            .arg("--objects")
+            .arg(&mesh)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .expect("the taction binary runs")
+    };
+    let output = run(&[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "a short run exited 0: {stderr}");
+    assert!(
+        stderr.contains("faraway 0 of 3") && stderr.contains("--allow-short"),
+        "{stderr}"
+    );
+    // The readings it did collect are kept.
+    assert!(Dataset::read(&out).is_ok());
+    let output = run(&["--allow-short"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning") && stderr.contains("faraway 0 of 3"),
+        "{stderr}"
+    );
+}
