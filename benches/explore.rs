@@ -77,6 +77,7 @@ fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
         SAMPLER_READINGS,
         &mut rng,
         reader,
+        &mut || {},
     )
     .expect("sampler run")
 }

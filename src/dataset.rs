@@ -250,7 +250,18 @@ impl Dataset {
         objects: &[ObjectSpec],
         threads: usize,
     ) -> Result<Dataset, DatasetError> {
-        let reports = plan.collect(objects, threads)?;
+        Self::collect_reporting(plan, object_set, objects, threads, &|| {})
+    }
+
+    /// [`collect`](Self::collect), running `on_converged` after each converged reading.
+    pub fn collect_reporting(
+        plan: &CollectPlan,
+        object_set: &str,
+        objects: &[ObjectSpec],
+        threads: usize,
+        on_converged: &(dyn Fn() + Sync),
+    ) -> Result<Dataset, DatasetError> {
+        let reports = plan.collect_reporting(objects, threads, on_converged)?;
         let header = DatasetHeader::new(
             plan.sensor,
             object_set,

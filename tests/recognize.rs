@@ -321,6 +321,57 @@ fn toy_objects_are_recognised_at_100_percent_with_10_readings() {
 }
 
 #[test]
+fn accuracy_counts_every_object_an_unread_one_as_a_miss() {
+    let trained = train(
+        &toy_features(60, 1),
+        None,
+        &toy_config(CodebookKind::Gmm),
+        &mut |_| {},
+    )
+    .unwrap();
+    let test = toy_features(30, 3);
+    // Object 0 read 10 times, object 1 twice, object 2 never (the exploration failed on it).
+    let readings = vec![
+        test.readings(0)[..10].to_vec(),
+        test.readings(1)[..2].to_vec(),
+        Vec::new(),
+    ];
+    let partial = LabelledFeatures::new(test.objects().to_vec(), readings).unwrap();
+    let trials = make_trials(&partial, trained.bag.objects(), 10).unwrap();
+    assert_eq!(trials.len(), 3, "the unread object is a trial with no readings");
+    assert!(trials[2].readings.is_empty());
+    let evaluation = evaluate(&trained.bag, &trials, ReadingRange::new(1, 10).unwrap()).unwrap();
+    let full = evaluate(
+        &trained.bag,
+        &make_trials(&test, trained.bag.objects(), 10).unwrap(),
+        ReadingRange::new(1, 10).unwrap(),
+    )
+    .unwrap();
+    // The toy objects are told apart after two readings: objects 0 and 1 are right from then on
+    // (object 1 keeping its belief after its last reading), object 2 never is.
+    for n in 2..=10 {
+        let row = &evaluation.accuracy[n - 1];
+        assert_eq!((row.n_readings, row.trials, row.correct), (n, 3, 2), "{row:?}");
+        assert_eq!(full.accuracy_at(n), Some(1.0), "{:?}", full.accuracy);
+    }
+    // The unread object's p(true) is the uniform prior 1/3; the others' the belief they reached.
+    let p_true = |t: usize, n: usize| {
+        evaluation
+            .touches
+            .iter()
+            .find(|r| r.trial == t && r.n_readings == n)
+            .map(|r| r.p_true)
+            .unwrap()
+    };
+    let expected = (p_true(0, 10) + p_true(1, 2) + 1.0 / 3.0) / 3.0;
+    assert!((evaluation.accuracy[9].mean_p_true - expected).abs() < 1e-12);
+    // No row beyond the longest trial; the unread object has no touches and no confusion entry.
+    assert_eq!(evaluation.accuracy.len(), 10);
+    assert!(evaluation.touches.iter().all(|r| r.trial != 2));
+    assert_eq!(evaluation.confusion.total(), 2);
+}
+
+#[test]
 fn training_is_seeded_and_deterministic() {
     let training = toy_features(30, 4);
     let a = train(&training, None, &toy_config(CodebookKind::Gmm), &mut |_| {}).unwrap();

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, ValueEnum};
 use taction::control::ControlConfig;
 use taction::dataset::{Dataset, DatasetHeader, describe_shortfalls};
+use taction::experiment::progress::CollectionProgress;
 use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
@@ -114,7 +115,9 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         readings_per_object: args.readings,
         seed: args.seed,
     };
-    let reports = plan.collect(&objects, args.threads)?;
+    let progress = CollectionProgress::new(&format!("collect {}", set.name), objects.len(), args.readings);
+    let reports = plan.collect_reporting(&objects, args.threads, &|| progress.converged())?;
+    progress.finish(reports.iter().map(ExplorationReport::converged).sum());
     let header = DatasetHeader::new(
         sensor,
         set.id(),

@@ -13,6 +13,7 @@ use taction::control::{ContactStatus, ControlConfig};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, Series};
+use taction::experiment::progress::CollectionProgress;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
@@ -91,7 +92,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 readings_per_object: args.training_readings,
                 seed: args.seed,
             };
-            let dataset = Dataset::collect(&plan, &set.id(), &objects, 0)?;
+            let progress = CollectionProgress::new("training data", objects.len(), args.training_readings);
+            let dataset =
+                Dataset::collect_reporting(&plan, &set.id(), &objects, 0, &|| progress.converged())?;
+            progress.finish(dataset.converged_only().len());
             let short = dataset.shortfalls(args.training_readings);
             if !short.is_empty() {
                 eprintln!("warning: training: {}", describe_shortfalls(&short));

@@ -96,16 +96,13 @@ pub fn press<C: PadCarrier + ?Sized>(
         match carrier.move_pad(&pose)? {
             PadMotion::Moved => moved = true,
             PadMotion::RigidContact => {
-                // The covering is fully compressed under part of the pad: the strongest form of the
-                // "close to fully saturated" termination. When the image shows it (a taxel near
-                // saturation), the refused command moved nothing and the controllers may converge
-                // where they are. When it does not (the object's tip or blade bottomed out between
-                // taxels, blurred away), the refusal counts as a command, so that a second one from
-                // the same place ends the attempt as the rigid contact it is.
+                // The covering is fully compressed under part of the pad: the paper's "any single
+                // sensor element close to fully saturated" termination, in its strongest form, seen
+                // on the covering's samples before the point-spread blurs them (a tip or a ridge
+                // narrower than a taxel bottoms out while its blurred taxel reads well below 1).
+                // The refused command moved nothing, so the controllers may converge where they
+                // are, the rigid back resting on the object.
                 image = carrier.read()?;
-                if pressed_peak(&image, config) < config.saturation_threshold {
-                    moved = true;
-                }
                 break;
             }
             blocked => return Ok(PressOutcome::Blocked(blocked)),

@@ -335,6 +335,7 @@ pub fn run_level(
         config.convergences,
         &mut placement,
         reader,
+        &mut || {},
     )?;
     let attempts = report.readings.len();
     let count = |s: ContactStatus| report.readings.iter().filter(|r| r.status == s).count();

@@ -25,6 +25,7 @@ pub mod merge;
 pub mod name;
 pub mod paper;
 pub mod plot;
+pub mod progress;
 pub mod real_data;
 pub mod runner;
 pub mod shard;

@@ -6,7 +6,6 @@ use std::num::NonZeroUsize;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -16,6 +15,7 @@ use super::atomic::{create_dir_all, remove_stale_temporaries, write_atomic};
 use super::error::{ExperimentError, UnitFailure};
 use super::index::write_index;
 use super::layout::ExperimentDir;
+use super::progress::progress_bar;
 use super::shard::Shard;
 use super::spec::{ExperimentSpec, Manifest, to_json, write_manifest, write_or_check};
 use super::unit::{Unit, parse_rows, read_rows, rows_to_csv};
@@ -190,7 +190,7 @@ where
             threads,
             what: e.to_string(),
         })?;
-    let progress = progress_bar(pending.len(), &spec.name.to_string());
+    let progress = progress_bar(pending.len(), &spec.name.to_string(), "units");
     let stop = AtomicBool::new(false);
     let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
         pending
@@ -257,16 +257,4 @@ fn run_unit<R: Serialize + DeserializeOwned>(
         }
     }
     write_atomic(&path, &bytes).map_err(|e| fail(e.to_string()))
-}
-
-/// A progress bar with ETA on stderr; indicatif hides it when stderr is not a terminal.
-fn progress_bar(len: usize, name: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{prefix} [{bar:30}] {pos}/{len} units, {elapsed_precise} elapsed, ETA {eta}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_prefix(name.to_string());
-    bar
 }

@@ -66,6 +66,17 @@ impl CollectPlan {
         object: &ObjectSpec,
         index: usize,
     ) -> Result<ExplorationReport, ControlError> {
+        self.collect_object_reporting(object, index, &mut || {})
+    }
+
+    /// [`collect_object`](Self::collect_object), running `on_converged` after each converged
+    /// reading.
+    pub fn collect_object_reporting(
+        &self,
+        object: &ObjectSpec,
+        index: usize,
+        on_converged: &mut dyn FnMut(),
+    ) -> Result<ExplorationReport, ControlError> {
         let sensor = self.sensor_for(index);
         let mut rng = rng::stream(self.seed, index as u64);
         match self.mode {
@@ -82,6 +93,7 @@ impl CollectPlan {
                     self.readings_per_object,
                     &mut rng,
                     reader,
+                    on_converged,
                 )
             }
             CollectMode::Planner(config) => {
@@ -99,7 +111,7 @@ impl CollectPlan {
                     rng,
                     reader,
                 )?;
-                planner.explore(&mut scene, &object.name, self.readings_per_object)
+                planner.explore_reporting(&mut scene, &object.name, self.readings_per_object, on_converged)
             }
         }
     }
@@ -110,6 +122,17 @@ impl CollectPlan {
         objects: &[ObjectSpec],
         threads: usize,
     ) -> Result<Vec<ExplorationReport>, ControlError> {
+        self.collect_reporting(objects, threads, &|| {})
+    }
+
+    /// [`collect`](Self::collect), running `on_converged` (from any worker thread) after each
+    /// converged reading of any object: what progress bars count.
+    pub fn collect_reporting(
+        &self,
+        objects: &[ObjectSpec],
+        threads: usize,
+        on_converged: &(dyn Fn() + Sync),
+    ) -> Result<Vec<ExplorationReport>, ControlError> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -118,7 +141,7 @@ impl CollectPlan {
             objects
                 .par_iter()
                 .enumerate()
-                .map(|(i, object)| self.collect_object(object, i))
+                .map(|(i, object)| self.collect_object_reporting(object, i, &mut || on_converged()))
                 .collect()
         })
     }

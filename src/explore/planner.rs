@@ -46,12 +46,13 @@ use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::tree::ExplorationTree;
 use crate::rng::Rng;
-use crate::sim::arm::PAD_SITE;
 use crate::sim::arm::{Execution, Watch};
+use crate::sim::arm::{PAD_BODY, PAD_SITE};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
+use crate::sim::object::OBJECT_BODY;
 use crate::sim::{
-    Arm, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget, PerturbationBounds,
-    Scene,
+    Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget,
+    PerturbationBounds, Scene,
 };
 use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 
@@ -306,6 +307,18 @@ where
         object: &str,
         converged_target: usize,
     ) -> Result<ExplorationReport, ControlError> {
+        self.explore_reporting(scene, object, converged_target, &mut || {})
+    }
+
+    /// [`explore`](Self::explore), running `on_converged` after each converged reading (progress
+    /// reports).
+    pub fn explore_reporting(
+        &mut self,
+        scene: &mut Scene,
+        object: &str,
+        converged_target: usize,
+        on_converged: &mut dyn FnMut(),
+    ) -> Result<ExplorationReport, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let mut report = ExplorationReport::default();
         let threshold = self.control.effective_contact_threshold();
@@ -397,6 +410,7 @@ where
                 }
                 let converged = reading.status == ContactStatus::Converged;
                 if converged {
+                    on_converged();
                     let pose = reading.image.pose().copied().unwrap_or(pad);
                     self.grid.add(pose.center_m);
                     let lifted = PadTarget {
@@ -435,6 +449,7 @@ where
         threshold: f64,
     ) -> Result<(MoveOutcome, bool), ControlError> {
         let reader = &mut self.reader;
+        let covering = self.covering.as_ref();
         let mut sensed = false;
         let mut read_error = None;
         let mut read = |s: &mut Scene| match reader(s) {
@@ -446,6 +461,16 @@ where
                 read_error = Some(e);
                 true
             }
+        };
+        // The object at the pad's rigid back as the sensor last saw it (a wall met side-on, a
+        // blade between two samples): a collision of the motion, like MuJoCo's.
+        let back_reached = |s: &Scene| {
+            covering
+                .is_some_and(|c| c.back_reached(s.model(), s.data()))
+                .then(|| Collision {
+                    body_a: PAD_BODY.to_string(),
+                    body_b: OBJECT_BODY.to_string(),
+                })
         };
         let outcome = match self.expansion_motion.execution {
             Execution::Servo => arm.move_to(scene, q, &self.expansion_motion, read)?,
@@ -462,7 +487,11 @@ where
                             max_pad_step_m: clearance_m - reach_m,
                         });
                     }
-                    Ok(if read(s) {
+                    let felt = read(s);
+                    if let Some(contact) = back_reached(s) {
+                        return Ok(Watch::Blocked(contact));
+                    }
+                    Ok(if felt {
                         Watch::Stop
                     } else {
                         Watch::Continue {

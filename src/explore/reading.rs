@@ -44,8 +44,8 @@ pub enum AttemptCause {
 /// The kinds of [`AttemptCause`] a user tells apart: who touched whom.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum CauseKind {
-    /// The pad's rigid back on the object: the covering fully compressed somewhere while the
-    /// controllers were still pressing or turning.
+    /// The pad's body on the object: its rigid back (the covering fully compressed somewhere while
+    /// the controllers were still pressing or turning) or, during a motion, its holder.
     PadOnObject,
     /// An arm link (not the pad) on the object.
     ArmOnObject,

@@ -15,7 +15,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use crate::control::free_pad::FreePad;
-use crate::control::{ControlConfig, ControlError, settle};
+use crate::control::{ContactStatus, ControlConfig, ControlError, settle};
 use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::surface_sampling::SurfaceSampler;
@@ -58,7 +58,8 @@ fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
 }
 
 /// Collects `converged_target` converged readings of the object in `scene` (which holds the object and
-/// a free-floating pad), perturbing the object after each reading if `perturbation` allows.
+/// a free-floating pad), perturbing the object after each reading if `perturbation` allows;
+/// `on_converged` runs after each converged reading (progress reports).
 #[allow(clippy::too_many_arguments)]
 pub fn sample_readings<R>(
     scene: &mut Scene,
@@ -70,6 +71,7 @@ pub fn sample_readings<R>(
     converged_target: usize,
     rng: &mut Rng,
     reader: R,
+    on_converged: &mut dyn FnMut(),
 ) -> Result<ExplorationReport, ControlError>
 where
     R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
@@ -119,6 +121,9 @@ where
             strategy: Strategy::Sampler,
             cause: outcome.collision.as_ref().map(AttemptCause::touched),
         });
+        if outcome.status == ContactStatus::Converged {
+            on_converged();
+        }
         if !perturbation.is_none() {
             let scene = pad.scene();
             let width = scene.object_width_m().ok_or(SimError::NoObject)?;

@@ -24,8 +24,10 @@ pub struct Trial {
 }
 
 /// Splits each object's readings, in order, into trials of `readings_per_trial` consecutive
-/// readings (the last trial of an object may be shorter). Objects are matched to `model_objects`
-/// by name; one the model does not know is an error.
+/// readings (the last trial of an object may be shorter); an object of the data with no reading at
+/// all (the exploration never read it) is one trial with no readings, which [`evaluate`] counts as
+/// a miss. Objects are matched to `model_objects` by name; one the model does not know is an
+/// error.
 pub fn make_trials(
     data: &LabelledFeatures,
     model_objects: &[String],
@@ -47,6 +49,12 @@ pub fn make_trials(
                     object: name.clone(),
                     known: model_objects.to_vec(),
                 })?;
+        if data.readings(j).is_empty() {
+            trials.push(Trial {
+                object,
+                readings: Vec::new(),
+            });
+        }
         for chunk in data.readings(j).chunks(readings_per_trial) {
             trials.push(Trial {
                 object,
@@ -124,11 +132,18 @@ pub struct TouchRow {
     pub entropy_nats: f64,
 }
 
-/// Accuracy over the trials that have at least `n_readings` readings.
+/// Accuracy after `n_readings` readings over every trial: the one definition `taction recognize`
+/// and the paper's experiments report (Sec. V-B2, "correctly identifying any unknown object"). A
+/// trial shorter than `n_readings` keeps its belief after its last reading; a trial with no reading
+/// (an object the exploration never read) keeps the uniform prior: not identified, p(true) = 1/J.
+/// Averaging only over the trials that reached n readings would flatter an exploration that
+/// fails on the hard objects.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccuracyRow {
     pub n_readings: usize,
+    /// Every trial.
     pub trials: usize,
+    /// Trials whose most probable object after `n_readings` readings (or their last) is the true one.
     pub correct: usize,
     /// Mean probability on the true object (the paper's "reliability").
     pub mean_p_true: f64,
@@ -150,7 +165,7 @@ pub struct Evaluation {
     pub objects: Vec<String>,
     /// One row per trial and reading count in the range.
     pub touches: Vec<TouchRow>,
-    /// One row per reading count in the range that at least one trial reaches.
+    /// One row per reading count in the range up to the longest trial ([`AccuracyRow`]).
     pub accuracy: Vec<AccuracyRow>,
     /// Each trial's final guess (after `min(last, trial length)` readings) against the truth.
     pub confusion: ConfusionMatrix,
@@ -164,52 +179,61 @@ pub fn evaluate(
     trials: &[Trial],
     range: ReadingRange,
 ) -> Result<Evaluation, RecognizeError> {
-    #[allow(clippy::type_complexity)]
-    let per_trial: Vec<Result<(Vec<TouchRow>, Option<usize>), RecognizeError>> = trials
+    // Every trial's belief after 1, 2, ... readings (up to the range's end).
+    let per_trial: Vec<Result<Vec<TouchRow>, RecognizeError>> = trials
         .par_iter()
         .enumerate()
         .map(|(t, trial)| {
             let mut posterior = bag.posterior();
-            let mut rows = Vec::new();
-            let mut last_guess = None;
+            let mut beliefs = Vec::new();
             for reading in trial.readings.iter().take(range.last) {
                 let belief = posterior.observe(reading)?;
-                if range.contains(belief.readings) {
-                    rows.push(TouchRow {
-                        trial: t,
-                        object_true: trial.object,
-                        n_readings: belief.readings,
-                        object_guess: belief.guess(),
-                        p_true: belief.probabilities()[trial.object],
-                        entropy_nats: belief.entropy_nats(),
-                    });
-                    last_guess = Some(belief.guess());
-                }
+                beliefs.push(TouchRow {
+                    trial: t,
+                    object_true: trial.object,
+                    n_readings: belief.readings,
+                    object_guess: belief.guess(),
+                    p_true: belief.probabilities()[trial.object],
+                    entropy_nats: belief.entropy_nats(),
+                });
             }
-            Ok((rows, last_guess))
+            Ok(beliefs)
         })
         .collect();
-    let mut touches = Vec::new();
-    let mut confusion = ConfusionMatrix::new(bag.objects().to_vec());
-    for (trial, result) in trials.iter().zip(per_trial) {
-        let (rows, last_guess) = result?;
-        touches.extend(rows);
-        if let Some(guess) = last_guess {
-            confusion.add(trial.object, guess);
-        }
-    }
+    let per_trial: Vec<Vec<TouchRow>> = per_trial.into_iter().collect::<Result<_, _>>()?;
+    let longest = per_trial.iter().map(Vec::len).max().unwrap_or(0);
+    let prior = 1.0 / bag.objects().len().max(1) as f64;
     let mut accuracy: Vec<AccuracyRow> = Vec::new();
-    for n in range.first..=range.last {
-        let at_n: Vec<&TouchRow> = touches.iter().filter(|r| r.n_readings == n).collect();
-        if at_n.is_empty() {
-            continue;
+    for n in range.first..=range.last.min(longest) {
+        let (mut correct, mut p_true) = (0, 0.0);
+        for beliefs in &per_trial {
+            // The belief after n readings, or after the trial's last; none before any reading.
+            match n.min(beliefs.len()).checked_sub(1).map(|i| &beliefs[i]) {
+                Some(b) => {
+                    correct += usize::from(b.object_guess == b.object_true);
+                    p_true += b.p_true;
+                }
+                None => p_true += prior,
+            }
         }
         accuracy.push(AccuracyRow {
             n_readings: n,
-            trials: at_n.len(),
-            correct: at_n.iter().filter(|r| r.object_guess == r.object_true).count(),
-            mean_p_true: at_n.iter().map(|r| r.p_true).sum::<f64>() / at_n.len() as f64,
+            trials: per_trial.len(),
+            correct,
+            mean_p_true: p_true / per_trial.len() as f64,
         });
+    }
+    let mut touches = Vec::new();
+    let mut confusion = ConfusionMatrix::new(bag.objects().to_vec());
+    for (trial, beliefs) in trials.iter().zip(per_trial) {
+        let in_range: Vec<TouchRow> = beliefs
+            .into_iter()
+            .filter(|b| range.contains(b.n_readings))
+            .collect();
+        if let Some(last) = in_range.last() {
+            confusion.add(trial.object, last.object_guess);
+        }
+        touches.extend(in_range);
     }
     Ok(Evaluation {
         objects: bag.objects().to_vec(),

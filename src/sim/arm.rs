@@ -153,13 +153,16 @@ impl MoveOptions {
 }
 
 /// What an observer of a kinematic motion asks for after a sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Watch {
     /// Stop here.
     Stop,
     /// Go on, with the pad travelling at most this far (metres) before the next sample (the motion's
     /// own `max_pad_step_m` still applies).
     Continue { max_pad_step_m: f64 },
+    /// The sample is in contact where MuJoCo's contacts do not see it (the covering sensor's exact
+    /// check of the pad's rigid back): the motion ends as at a MuJoCo collision.
+    Blocked(Collision),
 }
 
 impl Arm {
@@ -444,8 +447,9 @@ impl Arm {
     /// `target`: samples no farther apart than `max_step_rad` on any joint and `max_pad_step_m` (or
     /// the observer's last, smaller request) of pad travel, each checked by MuJoCo's kinematics and
     /// collision detection. At a collision the arm is placed at rest at the last collision-free
-    /// sample and the collision returned; when the observer says [`Watch::Stop`] (it sees the sample's
-    /// kinematics and contacts) the arm is placed at rest at that sample; otherwise at `target`.
+    /// sample and the collision returned, as when the observer says [`Watch::Blocked`]; when it says
+    /// [`Watch::Stop`] (it sees the sample's kinematics and contacts) the arm is placed at rest at
+    /// that sample; otherwise at `target`.
     pub fn move_kinematic<F>(
         &self,
         scene: &mut Scene,
@@ -500,17 +504,21 @@ impl Arm {
                 self.place(scene, &last_free);
                 return Ok(MoveOutcome::Collided(c));
             }
-            last_free.copy_from_slice(&q);
             // The observer may have computed sensors; kinematics and contacts stay those of `q`.
             match observer(scene)? {
                 Watch::Stop => {
                     self.rest_at(scene, &q);
                     return Ok(MoveOutcome::Stopped);
                 }
+                Watch::Blocked(c) => {
+                    self.place(scene, &last_free);
+                    return Ok(MoveOutcome::Collided(c));
+                }
                 Watch::Continue { max_pad_step_m } => {
                     limit_m = max_pad_step_m.min(options.max_pad_step_m).max(1e-6);
                 }
             }
+            last_free.copy_from_slice(&q);
         }
         // The last sample was `target` itself: its kinematics and contacts are current.
         self.rest_at(scene, &target);

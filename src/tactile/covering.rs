@@ -23,6 +23,7 @@ use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
 
 use crate::sim::mjcf::COLLISION_GROUP;
 use crate::tactile::SensorConfig;
+use crate::tactile::back_contact::triangle_overlaps_box;
 use crate::tactile::config::ConfigError;
 use crate::tactile::formation::ImageFormation;
 use crate::tactile::grid::SampleGrid;
@@ -92,7 +93,16 @@ pub struct CoveringStats {
     /// back (the covering is fully compressed), which the image, blurred by the point-spread and
     /// averaged over taxels, may show well below 1 (a sliver of an edge, a thin blade).
     pub last_full_samples: usize,
+    /// Whether, in the last reading, a mesh triangle lay in the pad's rigid back (the pad's
+    /// rectangle swept [`RIGID_BACK_DEPTH_M`] behind the pad plane): the object at the back even
+    /// between the samples, or a blade that one turn of the pad swept past the covering
+    /// ([`triangle_overlaps_box`]).
+    pub last_back_touched: bool,
 }
+
+/// Depth of the pad's rigid back behind the pad plane, metres: the `sensor_back` box of
+/// `mjcf/arm.xml` (8 mm).
+pub const RIGID_BACK_DEPTH_M: f64 = 0.008;
 
 /// A plugin instance's state (stored behind MuJoCo's `plugin_data`).
 #[derive(Debug)]
@@ -277,6 +287,7 @@ impl Covering {
     pub fn compute(&mut self, poses: &PoseView, reading: u64, sensordata: &mut [f64]) {
         self.stats.last_faces = 0;
         self.stats.last_full_samples = 0;
+        self.stats.last_back_touched = false;
         for k in 0..self.sensors.len() {
             self.penetration(k, poses);
             let t = self.config.thickness_m;
@@ -324,9 +335,16 @@ impl Covering {
                     self.candidates.clear();
                     mesh.faces_near(&region, &mut self.stack, &mut self.candidates);
                     self.stats.last_faces += self.candidates.len();
+                    let back_center = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
+                    let back_half = DVec3::new(hw, hh, 0.5 * RIGID_BACK_DEPTH_M);
                     for &face in &self.candidates {
                         let corners = mesh.corners(face, &m, o);
                         rasterise_triangle(&self.grid, corners, t, &mut self.nearest_m, &mut self.behind);
+                        if !self.stats.last_back_touched
+                            && triangle_overlaps_box(corners, back_center, back_half)
+                        {
+                            self.stats.last_back_touched = true;
+                        }
                     }
                     self.behind.resolve_into(&self.grid, &mut self.nearest_m);
                 }

@@ -16,6 +16,7 @@
 //! image       TactileImage and PadPose
 //! ```
 
+pub mod back_contact;
 pub mod config;
 pub mod covering;
 pub mod formation;

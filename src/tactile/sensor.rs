@@ -131,12 +131,14 @@ impl CoveringSensor {
         Ok(image.with_pose(self.pad_pose(data)?))
     }
 
-    /// Whether the object reached the pad's rigid back at the last computed reading (some sample
-    /// of the covering fully compressed, [`CoveringStats::last_full_samples`]). The arm's guard
+    /// Whether the object reached the pad's rigid back at the last computed reading: some sample
+    /// of the covering fully compressed ([`CoveringStats::last_full_samples`]), or a mesh triangle
+    /// at the back between the samples ([`CoveringStats::last_back_touched`]). The arm's guard
     /// against pressing its rigid back into the object: exact on the object's triangles, where
     /// MuJoCo's contacts would see its convex pieces.
     pub fn back_reached<M: ModelType>(&self, model: &MjModel, data: &MjData<M>) -> bool {
-        self.stats(model, data).is_some_and(|s| s.last_full_samples > 0)
+        self.stats(model, data)
+            .is_some_and(|s| s.last_full_samples > 0 || s.last_back_touched)
     }
 
     /// The instance's counters (BVHs built, readings computed) in `data`.

@@ -26,6 +26,7 @@ use serde::Serialize;
 
 use crate::dataset::{Dataset, describe_shortfalls, generator_name};
 use crate::describe::Descriptor;
+use crate::experiment::progress::CollectionProgress;
 use crate::experiment::unit::BoxError;
 use crate::explore::collect::CollectPlan;
 use crate::mesh::ObjectSet;
@@ -145,12 +146,19 @@ impl DataStore {
                     request.plan.sensor.rows,
                     request.plan.sensor.cols,
                 );
-                let dataset = Dataset::collect(
+                let progress = CollectionProgress::new(
+                    &format!("  dataset {}/{total}", i + 1),
+                    request.objects.specs.len(),
+                    request.plan.readings_per_object,
+                );
+                let dataset = Dataset::collect_reporting(
                     &request.plan,
                     &request.object_set,
                     &request.objects.specs,
                     self.threads,
+                    &|| progress.converged(),
                 )?;
+                progress.finish(dataset.converged_only().len());
                 crate::experiment::atomic::create_dir_all(&self.root.join("data"))?;
                 dataset.write(&path)?;
 

@@ -30,8 +30,8 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
-    Evaluation, LabelledFeatures, ReadingRange, TouchRow, TrainConfig, TrainedModel, Trial, evaluate,
-    make_trials, supported_codebook_sizes,
+    LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
+    supported_codebook_sizes,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -410,48 +410,13 @@ impl RecognitionSweep {
                     trial: trial as u32,
                     seed: *seed,
                 };
-                let objects = model.bag.objects().len();
-                rows.extend(meta.rows(curve_points(&evaluation, object_trials.len(), objects, longest)));
+                // One definition of accuracy (`AccuracyRow`): every object counts, an unread one as
+                // a miss.
+                rows.extend(meta.rows(evaluation.accuracy.iter().map(|r| (r.accuracy(), r.mean_p_true))));
             }
         }
         Ok(rows)
     }
-}
-
-/// Accuracy and reliability after 1..=`longest` readings over every object of the model (Sec.
-/// V-B2, "correctly identifying any unknown object"): an object whose test run gathered fewer than
-/// n readings keeps its belief after its last reading, and one the exploration never read keeps
-/// the uniform prior, counted as not identified with p(true) = 1/J. Averaging only over the objects
-/// that happened to be read would flatter an exploration that fails on the hard ones.
-fn curve_points(evaluation: &Evaluation, trials: usize, objects: usize, longest: usize) -> Vec<(f64, f64)> {
-    let denominator = objects.max(trials).max(1) as f64;
-    let unread = objects.saturating_sub(trials) as f64;
-    let mut by_n: Vec<Vec<&TouchRow>> = vec![Vec::new(); longest + 1];
-    for row in &evaluation.touches {
-        if row.n_readings <= longest {
-            by_n[row.n_readings].push(row);
-        }
-    }
-    let mut last: Vec<Option<(bool, f64)>> = vec![None; trials];
-    let prior = 1.0 / objects.max(1) as f64;
-    (1..=longest)
-        .map(|n| {
-            for row in &by_n[n] {
-                last[row.trial] = Some((row.object_guess == row.object_true, row.p_true));
-            }
-            let (mut correct, mut p_true) = (0.0, unread * prior);
-            for belief in &last {
-                match belief {
-                    Some((right, p)) => {
-                        correct += f64::from(u8::from(*right));
-                        p_true += p;
-                    }
-                    None => p_true += prior,
-                }
-            }
-            (correct / denominator, p_true / denominator)
-        })
-        .collect()
 }
 
 /// The model-selection grid of Sec. V-B1 (k in {10, 20, 50}, 3 seeded restarts), without the
@@ -515,46 +480,4 @@ fn real_trials(
             (trial_seed, object_trials)
         })
         .collect())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::recognize::ConfusionMatrix;
-
-    fn touch(trial: usize, n: usize, right: bool, p_true: f64) -> TouchRow {
-        TouchRow {
-            trial,
-            object_true: trial,
-            n_readings: n,
-            object_guess: if right { trial } else { trial + 1 },
-            p_true,
-            entropy_nats: 0.0,
-        }
-    }
-
-    #[test]
-    fn unread_and_short_objects_count_against_accuracy() {
-        // Four objects: trial 0 read twice (wrong, then right), trial 1 read once (right), and two
-        // objects never read.
-        let names: Vec<String> = ["a", "b", "c", "d"].map(String::from).to_vec();
-        let evaluation = Evaluation {
-            objects: names.clone(),
-            touches: vec![
-                touch(0, 1, false, 0.2),
-                touch(0, 2, true, 0.6),
-                touch(1, 1, true, 0.9),
-            ],
-            accuracy: Vec::new(),
-            confusion: ConfusionMatrix::new(names),
-        };
-        let points = curve_points(&evaluation, 2, 4, 2);
-        assert_eq!(points.len(), 2);
-        // n = 1: one right of four; p = (0.2 + 0.9 + 0.25 + 0.25) / 4.
-        assert!((points[0].0 - 0.25).abs() < 1e-12);
-        assert!((points[0].1 - 1.6 / 4.0).abs() < 1e-12);
-        // n = 2: trial 1 keeps its belief after one reading: two right of four.
-        assert!((points[1].0 - 0.5).abs() < 1e-12);
-        assert!((points[1].1 - 2.0 / 4.0).abs() < 1e-12);
-    }
 }

@@ -1,0 +1,59 @@
+//! Progress of long runs on stderr: a bar with an ETA while stderr is a terminal (indicatif hides
+//! it otherwise), and one summary line when it is not, so that a log still says what was done.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// A bar over `len` items named `unit` (e.g. "units", "converged readings"), prefixed `name`.
+pub fn progress_bar(len: usize, name: &str, unit: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len as u64);
+    if let Ok(style) = ProgressStyle::with_template(&format!(
+        "{{prefix}} [{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed_precise}} elapsed, ETA {{eta}}"
+    )) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_prefix(name.to_string());
+    bar
+}
+
+/// Converged readings collected against those asked, over an object set (`collect`, and the data
+/// collection of `demo` and the experiments).
+pub struct CollectionProgress {
+    bar: ProgressBar,
+    name: String,
+    asked: usize,
+    started: Instant,
+}
+
+impl CollectionProgress {
+    /// `readings_per_object` converged readings asked of each of `objects` objects.
+    pub fn new(name: &str, objects: usize, readings_per_object: usize) -> Self {
+        let asked = objects.saturating_mul(readings_per_object);
+        Self {
+            bar: progress_bar(asked, name, "converged readings"),
+            name: name.to_string(),
+            asked,
+            started: Instant::now(),
+        }
+    }
+
+    /// One more converged reading (any thread).
+    pub fn converged(&self) {
+        self.bar.inc(1);
+    }
+
+    /// Clears the bar; without a terminal, prints the summary line instead.
+    pub fn finish(&self, converged: usize) {
+        self.bar.finish_and_clear();
+        if !std::io::stderr().is_terminal() {
+            eprintln!(
+                "{}: {converged} of {} converged readings in {:.1} s",
+                self.name,
+                self.asked,
+                self.started.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
