@@ -8,7 +8,12 @@
 //! - `planner/kinematic`: converged readings of the planner with the arm, MuJoCo-checked kinematic
 //!   edges (the default); the summary also times the same planner stepping the position servos
 //!   through MuJoCo's dynamics (`Execution::Servo`, the previous behaviour, too slow for criterion's
-//!   ten samples) and reports the ratio kinematic / servo, the speed-up.
+//!   ten samples) and reports the ratio kinematic / servo, the speed-up;
+//! - `planner/shapes`: the planner over every object of the `shapes` set (the ten CGAL meshes, which
+//!   `cargo xtask setup` fetches, and the two chess pieces), `SHAPES_READINGS` converged readings of
+//!   each, one thread, the workspace fitted to the set as `taction collect` does; the summary
+//!   reports converged readings per second per core and the fraction of attempts that converge,
+//!   per object and over the set.
 //!
 //! Scenes are compiled once per configuration, outside the timed loops (a collection run compiles one
 //! per object). After criterion's own report a summary prints readings/s and the ratios, measured
@@ -20,7 +25,7 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, Throughput, criterion_group};
 use glam::DVec3;
 use taction::control::ControlConfig;
-use taction::explore::collect::sensor_reader;
+use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig, SamplerConfig, sample_readings};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::arm::{Execution, PAD_SITE};
@@ -32,6 +37,7 @@ use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
 const SAMPLER_READINGS: usize = 20;
 const PLANNER_READINGS: usize = 10;
 const SERVO_READINGS: usize = 2;
+const SHAPES_READINGS: usize = 5;
 
 fn sensor() -> SensorConfig {
     SensorConfig::square(6, 6, 0.012, 0.0012)
@@ -106,6 +112,23 @@ fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u
     report
 }
 
+fn shapes() -> Vec<ObjectSpec> {
+    ObjectSpec::all_of(&ObjectSet::shapes()).expect("the shapes (fetched by `cargo xtask setup`)")
+}
+
+/// `SHAPES_READINGS` converged planner readings of every object of `objects`, on one thread.
+fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(PlannerConfig::default().fitted_to(objects)),
+        sensor: sensor(),
+        control: ControlConfig::default(),
+        perturbation: PerturbationBounds::NONE,
+        readings_per_object: SHAPES_READINGS,
+        seed,
+    };
+    plan.collect(objects, 1).expect("planner runs")
+}
+
 fn benches(c: &mut Criterion) {
     let object = pawn();
     let pose = touching_pose();
@@ -133,6 +156,14 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             seed += 1;
             planner_run(&mut scene, Execution::Kinematic, PLANNER_READINGS, seed)
+        })
+    });
+    let objects = shapes();
+    group.throughput(Throughput::Elements((SHAPES_READINGS * objects.len()) as u64));
+    group.bench_function("planner/shapes", |b| {
+        b.iter(|| {
+            seed += 1;
+            shapes_run(&objects, seed)
         })
     });
     group.finish();
@@ -183,6 +214,29 @@ fn summary() {
         kinematic / servo,
         kinematic / bare
     );
+    // The whole `shapes` set: per object and over the set, three seeds.
+    let objects = shapes();
+    let mut per_object = vec![(0, 0); objects.len()];
+    let start = Instant::now();
+    for seed in 0..3 {
+        for (counts, report) in per_object.iter_mut().zip(shapes_run(&objects, 2000 + seed)) {
+            counts.0 += report.converged();
+            counts.1 += report.readings.len();
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let (converged, attempts) = per_object
+        .iter()
+        .fold((0, 0), |(c, a), (oc, oa)| (c + oc, a + oa));
+    println!(
+        "  planner, shapes set       {:9.1} /s  = {:.4} x bare reading; {converged}/{attempts} attempts converged ({:.0}%), 3 x {SHAPES_READINGS} asked of each object:",
+        converged as f64 / seconds,
+        converged as f64 / seconds / bare,
+        100.0 * converged as f64 / attempts.max(1) as f64
+    );
+    for (object, (c, a)) in objects.iter().zip(&per_object) {
+        println!("    {:12} {c:3}/{a:3} converged", object.name);
+    }
 }
 
 criterion_group!(explore, benches);

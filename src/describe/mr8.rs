@@ -1,5 +1,5 @@
 //! MR-8 (Sec. IV-B3): the Varma-Zisserman maximal-response filter bank [48], built as the Oxford VGG
-//! RFS bank [49] (DESIGN.md §6), scaled down to tactile images.
+//! RFS bank [49], scaled down to tactile images.
 //!
 //! The bank, on a square support of half-width `h` (centred coordinates, y up), with the 1-D
 //! Gaussian `g_s(t) = exp(-t^2 / 2 s^2) / sqrt(2 pi s^2)` and its derivatives

@@ -9,8 +9,8 @@
 //!    theta_j = 2 pi j / D
 //!    I_P(i, j) = I(x0 + r_i cos theta_j, y0 + r_i sin theta_j)        (bilinear, zero outside)
 //!    ```
-//! 3. Between adjacent rings insert their mean and half-difference (Eq. 6-8 with the erratum of
-//!    DESIGN.md §5: the printed equations combine a row with itself), giving `3D - 2` rows:
+//! 3. Between adjacent rings insert their mean and half-difference (Eq. 6-8, corrected: as
+//!    printed they combine a row with itself), giving `3D - 2` rows:
 //!    ```text
 //!    I_Q(3i) = I_P(i),  I_Q(3i+1) = (I_P(i) + I_P(i+1)) / 2,  I_Q(3i+2) = (I_P(i) - I_P(i+1)) / 2
 //!    ```

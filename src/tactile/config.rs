@@ -1,4 +1,4 @@
-//! The covering sensor's configuration (Sec. V-A2, DESIGN.md §4): what the `<config>` keys of a
+//! The covering sensor's configuration (Sec. V-A2): what the `<config>` keys of a
 //! `taction.covering` plugin instance mean, their defaults, their allowed ranges, and the
 //! point-spread law.
 

@@ -1,5 +1,5 @@
 //! The covering sensor's computation for one plugin instance: what it senses, the BVHs it built at
-//! init, and the per-reading pass from geom poses to the taxel image (Sec. V-A2, DESIGN.md §4).
+//! init, and the per-reading pass from geom poses to the taxel image (Sec. V-A2).
 //!
 //! The computation runs in the pad site's frame (x, y, z) = (site x, up, normal), right-handed.
 //! The image's columns run the other way, along `PadPose::right() = normal x up = -site x` (column

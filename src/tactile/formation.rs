@@ -1,4 +1,4 @@
-//! Image formation (DESIGN.md §4, Sec. V-A2): supersampled penetration -> Gaussian point-spread ->
+//! Image formation (Sec. V-A2): supersampled penetration -> Gaussian point-spread ->
 //! area average to taxels -> fraction of the sensing range -> saturation -> additive noise.
 //!
 //! With `p(x, y)` the penetration (metres, in `[0, t]`) at the samples `S` of the grid:

@@ -1,4 +1,4 @@
-//! The supersampling grid: where the pad's parallel rays pierce the pad plane (DESIGN.md §4).
+//! The supersampling grid: where the pad's parallel rays pierce the pad plane.
 //!
 //! Pad frame: x = right, y = up, z = the pad normal (into the covering). A `rows x cols` taxel
 //! image supersampled `k x k` has `(rows k) x (cols k)` samples; sample (i, j) sits at the centre
