@@ -19,7 +19,7 @@ use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
 use taction::recognize::OnlinePosterior;
 use taction::recognize::model::TrainedModel;
-use taction::recognize::selection::{TrainConfig, supported_codebook_sizes};
+use taction::recognize::selection::{TrainConfig, codebook_sizes};
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{ObjectSpec, PerturbationBounds, SceneBuilder};
@@ -46,9 +46,6 @@ pub struct DemoArgs {
     #[arg(long, default_value = "results/demo")]
     pub out: PathBuf,
 }
-
-/// The codebook sizes the demo tries when it has the data for them.
-const CODEBOOK_SIZES: [usize; 2] = [10, 20];
 
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.touches == 0 || args.training_readings < 11 {
@@ -113,13 +110,13 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 .filter(|r| r.status == ContactStatus::Converged)
                 .count();
             let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
-            config.ks = supported_codebook_sizes(&CODEBOOK_SIZES, training_features);
-            if config.ks != CODEBOOK_SIZES {
-                println!(
-                    "training: {training_features} training features are too few for k = {CODEBOOK_SIZES:?}; trying k = {:?}",
-                    config.ks
-                );
-            }
+            let objects: std::collections::BTreeSet<&str> =
+                dataset.readings().iter().map(|r| r.object.as_str()).collect();
+            config.ks = codebook_sizes(objects.len(), training_features);
+            println!(
+                "training: {training_features} training features; trying k = {:?}",
+                config.ks
+            );
             let model = TrainedModel::fit(&dataset, None, descriptor.as_ref(), config, &mut |_| {})?;
             model.save(&model_path)?;
             model

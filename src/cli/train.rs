@@ -1,14 +1,17 @@
 //! `taction train`: fit a bag-of-features model (Sec. IV-A) on a dataset, choosing the number of
 //! clusters on validation data (Sec. V-B1), and save it.
 
+use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use taction::control::ContactStatus;
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
     CodebookKind, PseudoCount, RecognizeError, TrainConfig, TrainProgress, TrainedModel, VarianceFraction,
+    codebook_sizes,
 };
 
 #[derive(Debug, Args)]
@@ -26,9 +29,11 @@ pub struct TrainArgs {
     /// gmm (soft membership) | kmeans (hard membership)
     #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
     pub codebook: CodebookKind,
-    /// Cluster counts to try, comma-separated.
-    #[arg(long = "k", value_name = "K,...", value_delimiter = ',', default_values_t = [10, 20, 50])]
-    pub ks: Vec<usize>,
+    /// Cluster counts to try, comma-separated. Default: four steps of 10, 20, 50, 100, 200, 400, ...
+    /// starting near one cluster per object ({50, 100, 200, 400} for 52 objects), without counts
+    /// that leave fewer than 5 training readings per cluster.
+    #[arg(long = "k", value_name = "K,...", value_delimiter = ',')]
+    pub ks: Option<Vec<usize>>,
     /// Seeded restarts per cluster count.
     #[arg(long, default_value_t = 3)]
     pub restarts: usize,
@@ -64,9 +69,23 @@ fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
 }
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let training = Dataset::read(&args.dataset)?;
+    let ks = match &args.ks {
+        Some(ks) => ks.clone(),
+        None => {
+            // One feature per converged reading: the fewest any descriptor gives.
+            let converged: Vec<_> = training
+                .readings()
+                .iter()
+                .filter(|r| r.status == ContactStatus::Converged)
+                .collect();
+            let objects: BTreeSet<&str> = converged.iter().map(|r| r.object.as_str()).collect();
+            codebook_sizes(objects.len(), converged.len())
+        }
+    };
     let config = TrainConfig {
         codebook: args.codebook,
-        ks: args.ks.clone(),
+        ks,
         restarts: args.restarts,
         seed: args.seed,
         variance_kept: VarianceFraction::new(args.variance_kept)?,
@@ -74,7 +93,6 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         trial_readings: args.trial_readings,
         ..TrainConfig::default()
     };
-    let training = Dataset::read(&args.dataset)?;
     let validation = args.validation.as_deref().map(Dataset::read).transpose()?;
     let descriptor = args.descriptor.build();
 

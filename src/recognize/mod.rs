@@ -45,5 +45,6 @@ pub use object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 pub use pca::{Pca, VarianceFraction};
 pub use posterior::{Belief, OnlinePosterior};
 pub use selection::{
-    CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, supported_codebook_sizes, train,
+    CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, codebook_sizes,
+    supported_codebook_sizes, train,
 };

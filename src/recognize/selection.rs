@@ -17,7 +17,7 @@ use crate::rng::{stream, substream};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfig {
     pub codebook: CodebookKind,
-    /// The cluster counts to try.
+    /// The cluster counts to try ([`codebook_sizes`] chooses them for a problem).
     pub ks: Vec<usize>,
     /// Seeded restarts per `k`.
     pub restarts: usize,
@@ -91,6 +91,26 @@ pub fn supported_codebook_sizes(grid: &[usize], training_features: usize) -> Vec
     } else {
         supported
     }
+}
+
+/// The ladder the candidate cluster counts come from (roughly doubling).
+const CODEBOOK_LADDER: [usize; 9] = [10, 20, 50, 100, 200, 400, 800, 1600, 3200];
+
+/// Candidate cluster counts per problem: [`CODEBOOK_LADDER`] steps tried.
+const CODEBOOK_STEPS: usize = 4;
+
+/// The cluster counts model selection (Sec. V-B1) tries for `objects` objects and
+/// `training_features` training features; validation accuracy, ties broken by reliability, then
+/// picks one. The paper names no `k`; a fixed small grid starves large problems (on the 52 letters
+/// validation accuracy kept rising from k = 10 to 400), so the grid starts at about one cluster per
+/// object (the ladder value at or below `objects`, at least 10) and climbs [`CODEBOOK_STEPS`]
+/// ladder steps: {10, 20, 50, 100} for 12 objects, {50, 100, 200, 400} for 52. Counts the
+/// features cannot support are dropped ([`supported_codebook_sizes`]). `train`, `demo` and the
+/// experiments all take their grid from here.
+pub fn codebook_sizes(objects: usize, training_features: usize) -> Vec<usize> {
+    let first = CODEBOOK_LADDER.iter().rposition(|&k| k <= objects).unwrap_or(0);
+    let last = (first + CODEBOOK_STEPS).min(CODEBOOK_LADDER.len());
+    supported_codebook_sizes(&CODEBOOK_LADDER[first..last], training_features)
 }
 
 /// One candidate's validation result.
@@ -380,6 +400,20 @@ fn score_candidate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn codebook_sizes_grow_with_the_objects_and_fit_the_features() {
+        // Paper scale: 1000 training readings per object.
+        assert_eq!(codebook_sizes(52, 52_000), vec![50, 100, 200, 400]);
+        assert_eq!(codebook_sizes(12, 12_000), vec![10, 20, 50, 100]);
+        assert_eq!(codebook_sizes(2, 2_000), vec![10, 20, 50, 100]);
+        assert_eq!(codebook_sizes(5000, 10_000_000), vec![3200]);
+        // 52 letters at a small scale: 30 readings each support k <= 312.
+        assert_eq!(codebook_sizes(52, 52 * 30), vec![50, 100, 200]);
+        // Too few features for any: the largest count they support.
+        assert_eq!(codebook_sizes(52, 100), vec![20]);
+        assert_eq!(codebook_sizes(3, 0), vec![1]);
+    }
 
     fn score(correct: usize, reliability: f64, failure: bool) -> CandidateScore {
         CandidateScore {

@@ -30,8 +30,7 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
-    LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
-    supported_codebook_sizes,
+    LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate, make_trials,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -419,11 +418,10 @@ impl RecognitionSweep {
     }
 }
 
-/// The model-selection grid of Sec. V-B1 (k in {10, 20, 50}, 3 seeded restarts), without the
-/// cluster counts the training data cannot support at small scales
-/// ([`supported_codebook_sizes`], counting one feature per training reading).
+/// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
+/// problem ([`codebook_sizes`], counting one feature per training reading).
 fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
-    let ks = supported_codebook_sizes(&[10, 20, 50], counts.training_per_object * objects);
+    let ks = codebook_sizes(objects, counts.training_per_object * objects);
     TrainConfig {
         ks,
         restarts: 3,
