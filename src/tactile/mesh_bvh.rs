@@ -130,6 +130,21 @@ impl MeshBvh {
         self.faces.len()
     }
 
+    /// Bytes this mesh and its BVH hold on the heap (what a large scan costs in memory on top of
+    /// MuJoCo's own copy of the mesh).
+    pub fn heap_bytes(&self) -> usize {
+        fn bytes<T>(v: &[T]) -> usize {
+            std::mem::size_of_val(v)
+        }
+        bytes(&self.vertices)
+            + bytes(&self.faces)
+            + bytes(&self.bvh.nodes)
+            + bytes(&self.bvh.primitive_indices)
+            + bytes(&self.bvh.primitive_indices_freelist)
+            + bytes(&self.bvh.primitives_to_nodes)
+            + bytes(&self.bvh.parents)
+    }
+
     /// The corners of face `f` mapped by `x -> rotation x + offset`.
     #[inline]
     pub fn corners(&self, f: u32, rotation: &DMat3, offset: DVec3) -> [DVec3; 3] {
@@ -228,6 +243,24 @@ mod tests {
             }
         }
         assert!(near.len() < 400, "{} candidates", near.len());
+    }
+
+    #[test]
+    fn heap_bytes_count_the_mesh_and_grow_linearly_with_it() {
+        let size = |n: usize| {
+            let (v, f) = square_grid(n);
+            let mesh = MeshBvh::new(&v, &f).unwrap();
+            // At least the f64 vertices, the faces and one BVH node per leaf.
+            let floor = (n + 1) * (n + 1) * 24 + 2 * n * n * 12;
+            assert!(mesh.heap_bytes() > floor, "{} <= {floor}", mesh.heap_bytes());
+            mesh.heap_bytes() as f64 / (2 * n * n) as f64
+        };
+        let (small, large) = (size(20), size(80));
+        // Bytes per triangle stay about constant (a BVH is linear in the primitives).
+        assert!(
+            (large / small - 1.0).abs() < 0.25,
+            "{small} vs {large} bytes per triangle"
+        );
     }
 
     #[test]

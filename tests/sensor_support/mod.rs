@@ -10,11 +10,10 @@ use taction::sim::mjcf::Section;
 use taction::tactile::free_floating::free_pad_body_xml;
 use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
 
-/// An icosphere of radius `radius_m` about `center_m`: the icosahedron with every face split into
-/// four `subdivisions` times, vertices pushed onto the sphere; 20 * 4^subdivisions outward faces.
-pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
+/// The unit icosahedron: 12 vertices, 20 outward faces.
+fn icosahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let p = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut vertices: Vec<DVec3> = [
+    let vertices: Vec<DVec3> = [
         (-1.0, p, 0.0),
         (1.0, p, 0.0),
         (-1.0, -p, 0.0),
@@ -31,7 +30,7 @@ pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
     .iter()
     .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
     .collect();
-    let mut faces: Vec<[u32; 3]> = vec![
+    let faces: Vec<[u32; 3]> = vec![
         [0, 11, 5],
         [0, 5, 1],
         [0, 1, 7],
@@ -53,6 +52,13 @@ pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
         [8, 6, 7],
         [9, 8, 1],
     ];
+    (vertices, faces)
+}
+
+/// An icosphere of radius `radius_m` about `center_m`: the icosahedron with every face split into
+/// four `subdivisions` times, vertices pushed onto the sphere; 20 * 4^subdivisions outward faces.
+pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
+    let (mut vertices, mut faces) = icosahedron();
     for _ in 0..subdivisions {
         let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
         let mut midpoint = |a: u32, b: u32, vertices: &mut Vec<DVec3>| {
@@ -74,6 +80,57 @@ pub fn icosphere(center_m: DVec3, radius_m: f64, subdivisions: u32) -> TriMesh {
         vertices: vertices.into_iter().map(|v| center_m + v * radius_m).collect(),
         triangles: faces,
     }
+}
+
+/// A geodesic sphere of radius `radius_m` about `center_m`: every icosahedron face cut into a
+/// triangular lattice of `frequency^2` triangles, vertices pushed onto the sphere; exactly
+/// `20 * frequency^2` outward faces (so any size near a target, unlike the 4x steps of
+/// [`icosphere`]), closed: lattice points shared by two faces are one vertex.
+pub fn geodesic_sphere(center_m: DVec3, radius_m: f64, frequency: u32) -> TriMesh {
+    let (corners, base_faces) = icosahedron();
+    let m = frequency.max(1);
+    let mut vertices = Vec::new();
+    let mut index: HashMap<[(u32, u32); 3], u32> = HashMap::new();
+    // A lattice point is named by its (corner, weight) pairs in corner order, so the faces that
+    // share it compute it identically and find the same vertex.
+    let mut vertex = |weights: [(u32, u32); 3], vertices: &mut Vec<DVec3>| -> u32 {
+        let mut key = weights.map(|(c, w)| if w == 0 { (u32::MAX, 0) } else { (c, w) });
+        key.sort_unstable();
+        *index.entry(key).or_insert_with(|| {
+            let p: DVec3 = key
+                .iter()
+                .filter(|(c, _)| *c != u32::MAX)
+                .map(|&(c, w)| corners[c as usize] * w as f64)
+                .sum();
+            vertices.push(center_m + p.normalize() * radius_m);
+            (vertices.len() - 1) as u32
+        })
+    };
+    let mut triangles = Vec::with_capacity(20 * (m * m) as usize);
+    for [a, b, c] in base_faces {
+        // Lattice point (i, j) = ((m - i - j) a + i b + j c) / m.
+        let mut p =
+            |i: u32, j: u32, vertices: &mut Vec<DVec3>| vertex([(a, m - i - j), (b, i), (c, j)], vertices);
+        for i in 0..m {
+            for j in 0..m - i {
+                let t = [
+                    p(i, j, &mut vertices),
+                    p(i + 1, j, &mut vertices),
+                    p(i, j + 1, &mut vertices),
+                ];
+                triangles.push(t);
+                if i + j + 1 < m {
+                    let t = [
+                        p(i + 1, j, &mut vertices),
+                        p(i + 1, j + 1, &mut vertices),
+                        p(i, j + 1, &mut vertices),
+                    ];
+                    triangles.push(t);
+                }
+            }
+        }
+    }
+    TriMesh { vertices, triangles }
 }
 
 /// A closed axis-aligned box mesh between `lo` and `hi`, outward faces.
