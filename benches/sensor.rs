@@ -37,6 +37,7 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use sensor_support::{geodesic_sphere, icosphere, taxel_centre};
 use taction::mesh::TriMesh;
+use taction::sim::mjcf::COLLISION_GROUP;
 use taction::sim::mjcf::numbers;
 use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml, pad_rotation};
@@ -98,6 +99,14 @@ impl RawScene {
     }
 }
 
+/// MuJoCo's rays see the geom groups the covering senses: every group but the objects' collision
+/// shells (`taction::sim::mjcf::COLLISION_GROUP`), which would only add geoms for MuJoCo to test.
+const SENSED_GROUPS: [u8; 6] = {
+    let mut groups = [1; 6];
+    groups[COLLISION_GROUP as usize] = 0;
+    groups
+};
+
 /// `mj_multiRay` from 1 m behind the pad through each sample point, excluding the pad's body.
 struct MultiRay {
     eye: [f64; 3],
@@ -117,7 +126,15 @@ impl MultiRay {
 
     fn cast(&self, free: &mut FreeFloatingSensor) -> f64 {
         let data = free.scene_mut().data_mut();
-        let (_, dist) = data.multi_ray(&self.eye, &self.dirs, None, true, Some(self.pad_body), 2.0, None);
+        let (_, dist) = data.multi_ray(
+            &self.eye,
+            &self.dirs,
+            Some(&SENSED_GROUPS),
+            true,
+            Some(self.pad_body),
+            2.0,
+            None,
+        );
         dist.iter().sum()
     }
 }
@@ -287,7 +304,14 @@ fn sensor(c: &mut Criterion) {
                         let data = free.scene_mut().data_mut();
                         let mut sum = 0.0;
                         for p in &points {
-                            let (_, d) = data.ray(&p.to_array(), &dir, None, true, Some(pad_body), None);
+                            let (_, d) = data.ray(
+                                &p.to_array(),
+                                &dir,
+                                Some(&SENSED_GROUPS),
+                                true,
+                                Some(pad_body),
+                                None,
+                            );
                             sum += d.min(t);
                         }
                         black_box(sum)
