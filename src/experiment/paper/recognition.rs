@@ -420,7 +420,12 @@ impl RecognitionSweep {
 /// n readings keeps its belief after its last reading, and one the exploration never read keeps
 /// the uniform prior, counted as not identified with p(true) = 1/J. Averaging only over the objects
 /// that happened to be read would flatter an exploration that fails on the hard ones.
-fn curve_points(evaluation: &Evaluation, trials: usize, objects: usize, longest: usize) -> Vec<(f64, f64)> {
+pub(super) fn curve_points(
+    evaluation: &Evaluation,
+    trials: usize,
+    objects: usize,
+    longest: usize,
+) -> Vec<(f64, f64)> {
     let denominator = objects.max(trials).max(1) as f64;
     let unread = objects.saturating_sub(trials) as f64;
     let mut by_n: Vec<Vec<&TouchRow>> = vec![Vec::new(); longest + 1];
@@ -455,12 +460,27 @@ fn curve_points(evaluation: &Evaluation, trials: usize, objects: usize, longest:
 /// cluster counts the training data cannot support at small scales
 /// ([`supported_codebook_sizes`], counting one feature per training reading).
 fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
-    let ks = supported_codebook_sizes(&[10, 20, 50], counts.training_per_object * objects);
+    selection_config(
+        rng::substream(seed, MODEL_STREAM),
+        counts.training_per_object,
+        counts.validation_per_object,
+        objects,
+    )
+}
+
+/// The model-selection grid for `training_per_object` training and `validation_per_object`
+/// validation readings of each of `objects` objects, seeded with `model_seed`.
+pub(super) fn selection_config(
+    model_seed: u64,
+    training_per_object: usize,
+    validation_per_object: usize,
+    objects: usize,
+) -> TrainConfig {
     TrainConfig {
-        ks,
+        ks: supported_codebook_sizes(&[10, 20, 50], training_per_object * objects),
         restarts: 3,
-        seed: rng::substream(seed, MODEL_STREAM),
-        trial_readings: counts.validation_per_object.min(10),
+        seed: model_seed,
+        trial_readings: validation_per_object.min(10),
         ..TrainConfig::default()
     }
 }
