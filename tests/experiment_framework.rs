@@ -855,6 +855,7 @@ fn the_example_file_imports_and_splits() {
         &RealImport {
             normalisation: Normalisation::FileMax,
             allowed_labels: Some(allowed),
+            calibration: None,
         },
     )
     .unwrap();
@@ -900,6 +901,7 @@ fn malformed_real_csvs_name_the_line() {
     let opts = RealImport {
         normalisation: Normalisation::FileMax,
         allowed_labels: Some(["A", "E"].iter().map(|s| s.to_string()).collect()),
+        calibration: None,
     };
     let cases = [
         ("A,1,2,3\n", "line 3: 4 columns, expected 5"),
@@ -929,6 +931,7 @@ fn malformed_real_csvs_name_the_line() {
             e.contains("line 2: bad header") && e.contains(needle),
             "{bad:?}: {e}"
         );
+        calibration: None,
     }
     let range = RealImport {
         normalisation: Normalisation::Range(3.0),
@@ -961,6 +964,7 @@ fn import_normalises_by_the_file_maximum_or_the_range() {
     let ranged = RealImport {
         normalisation: "400".parse().unwrap(),
         allowed_labels: None,
+        calibration: None,
     };
     assert_eq!(
         parse_real_csv(text, "t", &ranged).unwrap().readings[1]
