@@ -855,6 +855,7 @@ fn the_example_file_imports_and_splits() {
         &RealImport {
             normalisation: Normalisation::FileMax,
             allowed_labels: Some(allowed),
+            calibration: None,
         },
     )
     .unwrap();
@@ -894,24 +895,56 @@ fn the_example_file_imports_and_splits() {
     );
 }
 
+/// The header of a 4x4 recording, `label,r0c0,...,r3c3`.
+fn header_4x4() -> String {
+    let cells: Vec<String> = (0..16).map(|k| format!("r{}c{}", k / 4, k % 4)).collect();
+    format!("label,{}\n", cells.join(","))
+}
+
+/// A 4x4 frame of `label`: taxel k reads `k + 1`, except the `(k, text)` replacements.
+fn frame_4x4(label: &str, replace: &[(usize, &str)]) -> String {
+    let values: Vec<String> = (0..16)
+        .map(|k| {
+            replace
+                .iter()
+                .find(|(at, _)| *at == k)
+                .map_or_else(|| (k + 1).to_string(), |(_, text)| text.to_string())
+        })
+        .collect();
+    format!("{label},{}\n", values.join(","))
+}
+
 #[test]
 fn malformed_real_csvs_name_the_line() {
-    let header = "label,r0c0,r0c1,r1c0,r1c1\n";
+    let header = header_4x4();
     let opts = RealImport {
         normalisation: Normalisation::FileMax,
         allowed_labels: Some(["A", "E"].iter().map(|s| s.to_string()).collect()),
+        calibration: None,
     };
     let cases = [
-        ("A,1,2,3\n", "line 3: 4 columns, expected 5"),
-        ("A,1,2,x,4\n", "line 3: column r1c0: 'x' is not a number"),
-        ("A,1,NaN,3,4\n", "line 3: column r0c1: NaN is not finite"),
-        ("A,1,inf,3,4\n", "line 3: column r0c1: inf is not finite"),
-        ("A,1,2,-3,4\n", "line 3: column r1c0: -3 is negative"),
-        ("Q,1,2,3,4\n", "line 3: unknown label 'Q' (allowed: A, E)"),
-        (",1,2,3,4\n", "line 3: empty label"),
+        ("A,1,2,3\n".to_string(), "line 3: 4 columns, expected 17"),
+        (
+            frame_4x4("A", &[(4, "x")]),
+            "line 3: column r1c0: 'x' is not a number",
+        ),
+        (
+            frame_4x4("A", &[(1, "NaN")]),
+            "line 3: column r0c1: NaN is not finite",
+        ),
+        (
+            frame_4x4("A", &[(1, "inf")]),
+            "line 3: column r0c1: inf is not finite",
+        ),
+        (
+            frame_4x4("A", &[(4, "-3")]),
+            "line 3: column r1c0: -3 is negative",
+        ),
+        (frame_4x4("Q", &[]), "line 3: unknown label 'Q' (allowed: A, E)"),
+        (frame_4x4("", &[]), "line 3: empty label"),
     ];
     for (bad, needle) in cases {
-        let text = format!("{header}E,0,1,2,3\n{bad}");
+        let text = format!("{header}{}{bad}", frame_4x4("E", &[]));
         let e = parse_real_csv(&text, "f.csv", &opts).unwrap_err().to_string();
         assert!(e.starts_with("f.csv: ") && e.contains(needle), "{bad:?}: {e}");
     }
@@ -920,6 +953,10 @@ fn malformed_real_csvs_name_the_line() {
         ("label,r0c0,r1c1\n", "expected r0c1"),
         ("label,r0c0,x\n", "'x' is not r<row>c<col>"),
         ("label,r0c0,r0c1,r1c0\n", "do not fill a 2x2 grid"),
+        (
+            "label,r0c0,r0c1,r1c0,r1c1\n",
+            "a 2x2 sensor; accepted are 4 to 32",
+        ),
     ];
     for (bad, needle) in header_cases {
         let e = parse_real_csv(&format!("# c\n{bad}A,1,2,3\n"), "f.csv", &opts)
@@ -933,16 +970,22 @@ fn malformed_real_csvs_name_the_line() {
     let range = RealImport {
         normalisation: Normalisation::Range(3.0),
         allowed_labels: None,
+        calibration: None,
     };
-    let e = parse_real_csv(&format!("{header}A,1,2,3,4\n"), "f.csv", &range)
+    let e = parse_real_csv(&format!("{header}{}", frame_4x4("A", &[])), "f.csv", &range)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("line 2: column r1c1: 4 exceeds the range 3"), "{e}");
-    let e = parse_real_csv(&format!("{header}A,0,0,0,0\n"), "f.csv", &RealImport::default())
-        .unwrap_err()
-        .to_string();
+    assert!(e.contains("line 2: column r0c3: 4 exceeds the range 3"), "{e}");
+    let zeros: Vec<(usize, &str)> = (0..16).map(|k| (k, "0")).collect();
+    let e = parse_real_csv(
+        &format!("{header}{}", frame_4x4("A", &zeros)),
+        "f.csv",
+        &RealImport::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("every value is zero"), "{e}");
-    let e = parse_real_csv(header, "f.csv", &RealImport::default())
+    let e = parse_real_csv(&header, "f.csv", &RealImport::default())
         .unwrap_err()
         .to_string();
     assert!(e.contains("no frames"), "{e}");
@@ -950,10 +993,16 @@ fn malformed_real_csvs_name_the_line() {
 
 #[test]
 fn import_normalises_by_the_file_maximum_or_the_range() {
-    let text = "label,r0c0,r0c1\nA,0,50\nB,200,100\n";
-    let data = parse_real_csv(text, "t", &RealImport::default()).unwrap();
-    assert_eq!(data.readings[0].image.values(), &[0.0, 0.25]);
-    assert_eq!(data.readings[1].image.values(), &[1.0, 0.5]);
+    // Taxel k of A reads k + 1 but r0c0 (0) and r0c1 (50); B reads 200 at r0c0, 100 at r0c1.
+    let text = format!(
+        "{}{}{}",
+        header_4x4(),
+        frame_4x4("A", &[(0, "0"), (1, "50")]),
+        frame_4x4("B", &[(0, "200"), (1, "100")])
+    );
+    let data = parse_real_csv(&text, "t", &RealImport::default()).unwrap();
+    assert_eq!(&data.readings[0].image.values()[..2], &[0.0, 0.25]);
+    assert_eq!(&data.readings[1].image.values()[..2], &[1.0, 0.5]);
     assert_eq!((data.readings[1].label.as_str(), data.readings[1].line), ("B", 3));
     assert_eq!("max".parse::<Normalisation>(), Ok(Normalisation::FileMax));
     assert_eq!("400".parse::<Normalisation>(), Ok(Normalisation::Range(400.0)));
@@ -961,11 +1010,12 @@ fn import_normalises_by_the_file_maximum_or_the_range() {
     let ranged = RealImport {
         normalisation: "400".parse().unwrap(),
         allowed_labels: None,
+        calibration: None,
     };
     assert_eq!(
-        parse_real_csv(text, "t", &ranged).unwrap().readings[1]
+        &parse_real_csv(&text, "t", &ranged).unwrap().readings[1]
             .image
-            .values(),
+            .values()[..2],
         &[0.5, 0.25]
     );
 }

@@ -6,7 +6,9 @@ use std::time::Instant;
 use clap::Args;
 use taction::experiment::RunOptions;
 use taction::experiment::paper::headline::headline_table;
+use taction::experiment::paper::real_frames::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
 use taction::experiment::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
+use taction::experiment::real_data::Calibration;
 use taction::mesh::ObjectSet;
 
 /// What every paper experiment takes.
@@ -26,28 +28,56 @@ pub struct PaperArgs {
     /// The raised letters (Fig. 16a): the built-in `letters` or another set.
     #[arg(long, num_args = 1.., default_value = "letters", value_name = "SET")]
     pub letters: Vec<PathBuf>,
-    /// Recorded real frames for the sim-to-real experiment (format: `taction::experiment::real_data`)
-    /// [default: the shipped synthetic example].
+    /// Recorded real frames for the sim-to-real and real-frames experiments [default: the shipped
+    /// synthetic example]. CSV: a header `label,r0c0,r0c1,...` naming every taxel of a rows x cols
+    /// grid (4x4 to 32x32), then one frame per line: its label, then one non-negative raw value
+    /// per taxel; `#` lines are comments. Frames of the wrong size or with non-finite values are
+    /// rejected with their line number. Values are divided by the file's largest value.
     #[arg(long, value_name = "CSV")]
     pub real: Option<PathBuf>,
+    /// Per-taxel calibration of `--real`, applied on import as gain * (raw - offset), clamped at 0.
+    /// CSV: a header `taxel,gain,offset`, then one line per taxel (`r0c0,1.02,13`), every taxel of
+    /// the grid exactly once.
+    #[arg(long, value_name = "CSV", requires = "real")]
+    pub calibration: Option<PathBuf>,
+    /// real-frames (Fig. 16b): frames whose largest taxel is below this fraction of the sensing
+    /// range are dropped as non-contacts before the split; the counts per label go to config.json.
+    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION")]
+    pub contact_threshold: f64,
+    /// real-frames (Fig. 16b): trials of the whole split-train-test process.
+    #[arg(long, default_value_t = PAPER_TRIALS, value_name = "N")]
+    pub trials: usize,
+    /// real-frames (Fig. 16b): square root of every taxel before describing (Sec. V-F; off because
+    /// training and test frames come from the same sensor).
+    #[arg(long)]
+    pub square_root: bool,
+    /// real-frames (Fig. 16b): Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
+    #[arg(long, default_value_t = 0.0, value_name = "TAXELS")]
+    pub blur_sigma: f64,
 }
 
 impl PaperArgs {
     fn context(&self) -> Result<PaperContext, Box<dyn std::error::Error>> {
         let shapes = ObjectSet::resolve(&self.objects, None, None).map_err(|e| format!("--objects: {e}"))?;
         let letters = ObjectSet::resolve(&self.letters, None, None).map_err(|e| format!("--letters: {e}"))?;
-        let real = match &self.real {
+        let mut real = match &self.real {
             Some(path) => RealRecording::read(path).map_err(|e| format!("--real: {e}"))?,
             None => RealRecording::example(),
         };
-        Ok(PaperContext::new(
-            self.scale,
-            self.seed,
-            self.run.clone(),
-            shapes,
-            letters,
-            real,
-        ))
+        if let Some(path) = &self.calibration {
+            real.calibration = Some(Calibration::read(path).map_err(|e| format!("--calibration: {e}"))?);
+        }
+        let real_frames = RealFramesOptions {
+            contact_threshold: self.contact_threshold,
+            square_root: self.square_root,
+            blur_sigma_taxels: self.blur_sigma,
+            trials: self.trials,
+        };
+        real_frames.validate()?;
+        Ok(
+            PaperContext::new(self.scale, self.seed, self.run.clone(), shapes, letters, real)
+                .with_real_frames(real_frames),
+        )
     }
 }
 

@@ -18,11 +18,33 @@
 //! - lines are frames in collection order (Fig. 17b uses that order); fields are separated by commas
 //!   and trimmed, without quoting; blank lines and lines starting with `#` are skipped.
 //!
-//! Import divides every value by one number so that frames land in [0, 1] of the sensing range
-//! ([`Normalisation`]): the largest value in the file, or a given range (`--range`), above which a
-//! value is an error. Errors name the file, the line and the column.
+//! Sensors of [`MIN_TAXELS_PER_SIDE`] to [`MAX_TAXELS_PER_SIDE`] taxels per side are accepted (the
+//! paper's PPS sensor is 6x6; Sec. V-C compares 6x6 to 26x26).
+//!
+//! When a per-taxel [`Calibration`] is given, every raw value `v` of taxel `(i, j)` first becomes
+//! `gain(i, j) * (v - offset(i, j))`, clamped at 0 (a taxel reading below its no-load offset
+//! carries no pressure), so that elements of different sensitivity read alike (Sec. V-F: the
+//! real elements differ from each other). Without one, raw values must be non-negative.
+//!
+//! Import then divides every value by one number so that frames land in [0, 1] of the sensing
+//! range ([`Normalisation`]): the largest value in the file, or a given range (`--range`), above
+//! which a value is an error. Errors name the file, the line and the column.
+//!
+//! # Calibration format
+//!
+//! ```text
+//! # comment lines start with '#'
+//! taxel,gain,offset
+//! r0c0,1.02,13
+//! r0c1,0.97,9
+//! ...
+//! ```
+//!
+//! One line per taxel of the recording's grid, each taxel exactly once (any order); `gain` finite
+//! and non-negative, `offset` finite, both in raw units of the recording.
 
 use std::collections::BTreeSet;
+use std::ops::RangeInclusive;
 use std::path::Path;
 
 use crate::tactile::TactileImage;
@@ -54,12 +76,21 @@ impl std::str::FromStr for Normalisation {
     }
 }
 
+/// The smallest sensor side accepted, in taxels.
+pub const MIN_TAXELS_PER_SIDE: usize = 4;
+/// The largest sensor side accepted, in taxels.
+pub const MAX_TAXELS_PER_SIDE: usize = 32;
+/// The accepted sensor sides, in taxels.
+pub const TAXELS_PER_SIDE: RangeInclusive<usize> = MIN_TAXELS_PER_SIDE..=MAX_TAXELS_PER_SIDE;
+
 /// Import settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RealImport {
     pub normalisation: Normalisation,
     /// When set, the only labels accepted.
     pub allowed_labels: Option<BTreeSet<String>>,
+    /// Per-taxel gain and offset applied to raw values before normalisation.
+    pub calibration: Option<Calibration>,
 }
 
 impl Default for RealImport {
@@ -67,8 +98,134 @@ impl Default for RealImport {
         Self {
             normalisation: Normalisation::FileMax,
             allowed_labels: None,
+            calibration: None,
         }
     }
+}
+
+/// Per-taxel gain and offset of a recording (format in the module docs), row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibration {
+    /// Where it came from, for errors.
+    pub origin: String,
+    pub rows: usize,
+    pub cols: usize,
+    pub gain: Vec<f64>,
+    pub offset: Vec<f64>,
+}
+
+impl Calibration {
+    /// Reads a calibration file.
+    pub fn read(path: &Path) -> Result<Self, RealDataError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| RealDataError::Io {
+            origin: origin.clone(),
+            source,
+        })?;
+        Self::parse(&text, &origin)
+    }
+
+    /// Parses calibration text; `origin` names the source in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Self, RealDataError> {
+        let invalid = |line: u64, what: String| RealDataError::Invalid {
+            origin: origin.to_string(),
+            line,
+            what,
+        };
+        let mut header_seen = false;
+        let mut entries: Vec<(u64, usize, usize, f64, f64)> = Vec::new();
+        for (i, text_line) in text.lines().enumerate() {
+            let line = i as u64 + 1;
+            let trimmed = text_line.trim();
+            if trimmed.is_empty() || trimmed.starts_with('#') {
+                continue;
+            }
+            let record: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+            if !header_seen {
+                if record != ["taxel", "gain", "offset"] {
+                    return Err(RealDataError::Header {
+                        origin: origin.to_string(),
+                        line,
+                        what: format!("expected 'taxel,gain,offset', got '{trimmed}'"),
+                    });
+                }
+                header_seen = true;
+                continue;
+            }
+            if record.len() != 3 {
+                return Err(invalid(
+                    line,
+                    format!("{} columns, expected 3 (taxel,gain,offset)", record.len()),
+                ));
+            }
+            let (row, col) = parse_taxel_name(record[0])
+                .ok_or_else(|| invalid(line, format!("taxel '{}' is not r<row>c<col>", record[0])))?;
+            let number = |column: &str, text: &str| -> Result<f64, RealDataError> {
+                match text.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    _ => Err(invalid(line, format!("{column} '{text}' is not a finite number"))),
+                }
+            };
+            let gain = number("gain", record[1])?;
+            if gain < 0.0 {
+                return Err(invalid(line, format!("gain {gain} is negative")));
+            }
+            let offset = number("offset", record[2])?;
+            entries.push((line, row, col, gain, offset));
+        }
+        if !header_seen {
+            return Err(RealDataError::NoHeader {
+                origin: origin.to_string(),
+            });
+        }
+        if entries.is_empty() {
+            return Err(invalid(
+                text.lines().count() as u64,
+                "no taxel lines after the header".to_string(),
+            ));
+        }
+        let rows = entries.iter().map(|e| e.1).max().unwrap_or(0) + 1;
+        let cols = entries.iter().map(|e| e.2).max().unwrap_or(0) + 1;
+        let mut gain = vec![f64::NAN; rows * cols];
+        let mut offset = vec![f64::NAN; rows * cols];
+        for &(line, row, col, g, o) in &entries {
+            let k = row * cols + col;
+            if !gain[k].is_nan() {
+                return Err(invalid(line, format!("taxel r{row}c{col} is listed twice")));
+            }
+            gain[k] = g;
+            offset[k] = o;
+        }
+        if let Some(k) = gain.iter().position(|g| g.is_nan()) {
+            return Err(RealDataError::Invalid {
+                origin: origin.to_string(),
+                line: entries.last().map_or(0, |e| e.0),
+                what: format!(
+                    "taxel r{}c{} is missing ({rows}x{cols} grid, every taxel needs a line)",
+                    k / cols,
+                    k % cols
+                ),
+            });
+        }
+        Ok(Self {
+            origin: origin.to_string(),
+            rows,
+            cols,
+            gain,
+            offset,
+        })
+    }
+
+    /// `gain * (raw - offset)` of taxel `k` (row-major), clamped at 0.
+    fn apply(&self, k: usize, raw: f64) -> f64 {
+        (self.gain[k] * (raw - self.offset[k])).max(0.0)
+    }
+}
+
+/// `r<row>c<col>` as (row, col).
+fn parse_taxel_name(name: &str) -> Option<(usize, usize)> {
+    let (r, c) = name.strip_prefix('r')?.split_once('c')?;
+    Some((r.parse().ok()?, c.parse().ok()?))
 }
 
 /// One imported frame.
@@ -193,7 +350,20 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
         }
         let record: Vec<&str> = trimmed.split(',').map(str::trim).collect();
         let Some((rows, cols, names)) = &header else {
-            header = Some(parse_header(&record, line, origin)?);
+            let parsed = parse_header(&record, line, origin)?;
+            if let Some(calibration) = &options.calibration
+                && (calibration.rows, calibration.cols) != (parsed.0, parsed.1)
+            {
+                return Err(RealDataError::Header {
+                    origin: origin_s(),
+                    line,
+                    what: format!(
+                        "the frames are {}x{} taxels but the calibration {} is {}x{}",
+                        parsed.0, parsed.1, calibration.origin, calibration.rows, calibration.cols
+                    ),
+                });
+            }
+            header = Some(parsed);
             continue;
         };
         let expected = 1 + rows * cols;
@@ -226,22 +396,26 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
             });
         }
         let mut values = Vec::with_capacity(rows * cols);
-        for (text, column) in record[1..].iter().zip(names) {
+        for (k, (text, column)) in record[1..].iter().zip(names).enumerate() {
             let column = column.clone();
-            let value: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
+            let raw: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
                 origin: origin_s(),
                 line,
                 column: column.clone(),
                 text: text.to_string(),
             })?;
-            if !value.is_finite() {
+            if !raw.is_finite() {
                 return Err(RealDataError::NotFinite {
                     origin: origin_s(),
                     line,
                     column,
-                    value,
+                    value: raw,
                 });
             }
+            let value = match &options.calibration {
+                Some(calibration) => calibration.apply(k, raw),
+                None => raw,
+            };
             if value < 0.0 {
                 return Err(RealDataError::Negative {
                     origin: origin_s(),
@@ -321,10 +495,7 @@ fn parse_header(
     let cells = names
         .iter()
         .map(|name| {
-            name.strip_prefix('r')
-                .and_then(|rest| rest.split_once('c'))
-                .and_then(|(r, c)| Some((r.parse::<usize>().ok()?, c.parse::<usize>().ok()?)))
-                .ok_or_else(|| bad(format!("taxel column '{name}' is not r<row>c<col>")))
+            parse_taxel_name(name).ok_or_else(|| bad(format!("taxel column '{name}' is not r<row>c<col>")))
         })
         .collect::<Result<Vec<_>, _>>()?;
     let rows = cells.iter().map(|c| c.0).max().unwrap_or(0) + 1;
@@ -343,6 +514,11 @@ fn parse_header(
         return Err(bad(format!(
             "{} taxel columns do not fill a {rows}x{cols} grid",
             cells.len()
+        )));
+    }
+    if !(TAXELS_PER_SIDE.contains(&rows) && TAXELS_PER_SIDE.contains(&cols)) {
+        return Err(bad(format!(
+            "a {rows}x{cols} sensor; accepted are {MIN_TAXELS_PER_SIDE} to {MAX_TAXELS_PER_SIDE} taxels per side"
         )));
     }
     Ok((rows, cols, names))

@@ -5,9 +5,10 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use super::data::{DataStore, Objects};
+use super::real_frames::RealFramesOptions;
 use super::recognition::Family;
 use super::scale::Scale;
-use crate::experiment::real_data::{RealData, RealImport, parse_real_csv};
+use crate::experiment::real_data::{Calibration, RealData, RealImport, parse_real_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
 use crate::mesh::glyph::Font;
@@ -24,6 +25,8 @@ pub const EXAMPLE_REAL_CSV: &str = include_str!("../../../data/real_letters_exam
 pub struct RealRecording {
     pub origin: String,
     pub text: String,
+    /// Per-taxel gain and offset applied on import.
+    pub calibration: Option<Calibration>,
 }
 
 impl RealRecording {
@@ -32,6 +35,7 @@ impl RealRecording {
         Self {
             origin: "data/real_letters_example.csv (built in)".into(),
             text: EXAMPLE_REAL_CSV.into(),
+            calibration: None,
         }
     }
 
@@ -40,6 +44,7 @@ impl RealRecording {
         Ok(Self {
             origin: path.display().to_string(),
             text,
+            calibration: None,
         })
     }
 }
@@ -54,6 +59,8 @@ pub struct PaperContext {
     /// The raised letters (Fig. 16a) and the source of the sim-to-real letters.
     pub letters: ObjectSet,
     pub real: RealRecording,
+    /// Fig. 16b's settings ([`super::real_frames`]).
+    pub real_frames: RealFramesOptions,
     pub(crate) store: DataStore,
     built: Mutex<HashMap<String, Arc<Objects>>>,
 }
@@ -76,6 +83,7 @@ impl PaperContext {
             shapes,
             letters,
             real,
+            real_frames: RealFramesOptions::default(),
             built: Mutex::new(HashMap::new()),
         }
     }
@@ -100,12 +108,22 @@ impl PaperContext {
         self.built.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// The real recording, normalised to the sensing range by its largest value.
+    /// The context with Fig. 16b's settings.
+    pub fn with_real_frames(mut self, options: RealFramesOptions) -> Self {
+        self.real_frames = options;
+        self
+    }
+
+    /// The real recording, calibrated when it has a calibration, normalised to the sensing range by
+    /// its largest value.
     pub fn real_data(&self) -> Result<Arc<RealData>, BoxError> {
         Ok(Arc::new(parse_real_csv(
             &self.real.text,
             &self.real.origin,
-            &RealImport::default(),
+            &RealImport {
+                calibration: self.real.calibration.clone(),
+                ..RealImport::default()
+            },
         )?))
     }
 

@@ -13,6 +13,7 @@
 //! | `noise` | 13 | additive noise |
 //! | `convergence` | 14 | controller convergence against noise ([`crate::experiment::convergence`]) |
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
+//! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
@@ -22,6 +23,7 @@ pub mod context;
 pub mod data;
 pub mod figures;
 pub mod headline;
+pub mod real_frames;
 pub mod recognition;
 pub mod scale;
 
@@ -47,12 +49,13 @@ pub enum PaperExperiment {
     Noise,
     Convergence,
     Letters,
+    RealFrames,
     SimToReal,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order).
-    pub const ALL: [PaperExperiment; 10] = [
+    pub const ALL: [PaperExperiment; 11] = [
         Self::Descriptors,
         Self::Strategy,
         Self::Validation,
@@ -62,10 +65,12 @@ impl PaperExperiment {
         Self::Noise,
         Self::Convergence,
         Self::Letters,
+        Self::RealFrames,
         Self::SimToReal,
     ];
 
-    /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve.
+    /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve, and
+    /// Fig. 16b, which trains on recorded frames rather than on simulated readings.
     fn sweep(self) -> Option<RecognitionSweep> {
         Some(match self {
             Self::Descriptors => figures::descriptors(),
@@ -75,7 +80,7 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
-            Self::Convergence => return None,
+            Self::Convergence | Self::RealFrames => return None,
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
         })
@@ -84,15 +89,21 @@ impl PaperExperiment {
     /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]);
     /// Fig. 14's are convergence statistics.
     pub fn is_recognition(self) -> bool {
-        self.sweep().is_some()
+        self != Self::Convergence
     }
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name)
+        match self {
+            Self::RealFrames => real_frames::EXPERIMENT_NAME,
+            _ => self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name),
+        }
     }
 
     pub fn description(self) -> &'static str {
+        if self == Self::RealFrames {
+            return real_frames::DESCRIPTION;
+        }
         self.sweep().map_or(
             "Fig. 14: controller convergence and iterations against noise 0-150% (the dragon, or every 3D object without one)",
             |s| s.description,
@@ -107,6 +118,7 @@ impl PaperExperiment {
     pub fn run(self, context: &PaperContext) -> Result<RunReport, BoxError> {
         match self.sweep() {
             Some(sweep) => sweep.run(context),
+            None if self == Self::RealFrames => real_frames::run_real_frames(context),
             None => run_convergence(context),
         }
     }

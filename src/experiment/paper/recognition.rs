@@ -421,12 +421,27 @@ impl RecognitionSweep {
 /// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
 /// problem ([`codebook_sizes`], counting one feature per training reading).
 fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
-    let ks = codebook_sizes(objects, counts.training_per_object * objects);
+    selection_config(
+        rng::substream(seed, MODEL_STREAM),
+        counts.training_per_object,
+        counts.validation_per_object,
+        objects,
+    )
+}
+
+/// The model-selection settings for `training_per_object` training and `validation_per_object`
+/// validation readings of each of `objects` objects, seeded with `model_seed`.
+pub(super) fn selection_config(
+    model_seed: u64,
+    training_per_object: usize,
+    validation_per_object: usize,
+    objects: usize,
+) -> TrainConfig {
     TrainConfig {
-        ks,
+        ks: codebook_sizes(objects, training_per_object * objects),
         restarts: 3,
-        seed: rng::substream(seed, MODEL_STREAM),
-        trial_readings: counts.validation_per_object.min(10),
+        seed: model_seed,
+        trial_readings: validation_per_object.min(10),
         ..TrainConfig::default()
     }
 }

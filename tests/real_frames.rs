@@ -1,0 +1,299 @@
+//! Fig. 16b, trained and tested on recorded frames (`taction experiment real-frames`): the shipped
+//! example end to end, known answers on constructed recordings, the per-trial splits, and the
+//! import of user recordings (sizes, bad values, calibration). Real descriptors, real training.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use taction::experiment::AccuracyRow;
+use taction::experiment::paper::context::EXAMPLE_REAL_CSV;
+use taction::experiment::paper::real_frames::{prune, scaled_split_sizes, trial_split};
+use taction::experiment::real_data::{Calibration, RealImport, parse_real_csv};
+
+const ACCURACY_HEADER: &str =
+    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
+
+fn taction(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .output()
+        .expect("the taction binary runs")
+}
+
+fn run_ok(args: &[&str]) {
+    let output = taction(args);
+    assert!(
+        output.status.success(),
+        "taction {}: {}\n{}",
+        args.join(" "),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+fn rows(out: &Path) -> Vec<AccuracyRow> {
+    let csv = out.join("real-frames/real-frames.csv");
+    let text = std::fs::read_to_string(&csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    assert_eq!(text.lines().next(), Some(ACCURACY_HEADER));
+    csv::Reader::from_reader(text.as_bytes())
+        .deserialize()
+        .collect::<Result<Vec<AccuracyRow>, _>>()
+        .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
+}
+
+/// A 6x6 recording: `frames[label]` lists each frame's 36 raw values.
+fn recording(frames: &[(&str, Vec<Vec<f64>>)]) -> String {
+    let mut text = String::from("label");
+    for r in 0..6 {
+        for c in 0..6 {
+            text.push_str(&format!(",r{r}c{c}"));
+        }
+    }
+    text.push('\n');
+    for (label, list) in frames {
+        for frame in list {
+            let values: Vec<String> = frame.iter().map(|v| v.to_string()).collect();
+            text.push_str(&format!("{label},{}\n", values.join(",")));
+        }
+    }
+    text
+}
+
+/// Mean accuracy and reliability over every row with `n_readings == n`.
+fn mean_at(rows: &[AccuracyRow], n: u32) -> (f64, f64) {
+    let at: Vec<&AccuracyRow> = rows.iter().filter(|r| r.n_readings == n).collect();
+    assert!(!at.is_empty(), "no rows at {n} readings");
+    let k = at.len() as f64;
+    (
+        at.iter().map(|r| r.accuracy).sum::<f64>() / k,
+        at.iter().map(|r| r.reliability).sum::<f64>() / k,
+    )
+}
+
+#[test]
+fn the_shipped_example_runs_end_to_end_with_every_descriptor_and_trial() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    run_ok(&[
+        "experiment",
+        "real-frames",
+        "--scale",
+        "0.02",
+        "--trials",
+        "3",
+        "--out",
+        out,
+    ]);
+    let rows = rows(dir.path());
+    let descriptors: BTreeSet<&str> = rows.iter().map(|r| r.descriptor.as_str()).collect();
+    assert_eq!(descriptors.len(), 6, "{descriptors:?}");
+    let trials: BTreeSet<u32> = rows.iter().map(|r| r.trial).collect();
+    assert_eq!(trials, BTreeSet::from([0, 1, 2]));
+    // 8 frames per vowel, scale 0.02 -> 7 used: 4 training, 1 validation, 2 test.
+    assert!(
+        rows.iter()
+            .all(|r| r.experiment == "real-frames" && r.value == "real")
+    );
+    assert!(rows.iter().all(|r| (1..=2).contains(&r.n_readings)));
+    assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r.accuracy)));
+    let config = std::fs::read_to_string(dir.path().join("real-frames/config.json")).unwrap();
+    for needle in [
+        "\"train\": 4",
+        "\"validation\": 1",
+        "\"test\": 2",
+        "\"dropped\": 0",
+        "\"kept\": 8",
+        "\"seed\": 1",
+    ] {
+        assert!(config.contains(needle), "config.json lacks {needle}:\n{config}");
+    }
+    assert!(dir.path().join("real-frames/real-frames.png").exists());
+}
+
+#[test]
+fn two_labels_with_disjoint_constant_frames_are_told_apart_after_one_reading() {
+    let bar = |rows: std::ops::Range<usize>| -> Vec<f64> {
+        (0..36)
+            .map(|k| if rows.contains(&(k / 6)) { 900.0 } else { 0.0 })
+            .collect()
+    };
+    let cross: Vec<f64> = (0..36)
+        .map(|k| if k / 6 == 2 || k % 6 == 2 { 500.0 } else { 0.0 })
+        .collect();
+    let text = recording(&[("A", vec![bar(0..3); 14]), ("B", vec![cross; 14])]);
+    let dir = tempfile::tempdir().unwrap();
+    let real = dir.path().join("two.csv");
+    std::fs::write(&real, text).unwrap();
+    let out = dir.path().join("out");
+    run_ok(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        real.to_str().unwrap(),
+        "--trials",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let rows = rows(&out);
+    for r in rows.iter().filter(|r| r.n_readings == 1) {
+        assert_eq!(r.accuracy, 1.0, "{} trial {}", r.descriptor, r.trial);
+    }
+}
+
+#[test]
+fn labels_sharing_the_same_frames_stay_at_chance() {
+    let frame: Vec<f64> = (0..36).map(|k| (k % 7) as f64 * 100.0).collect();
+    let labels = ["A", "E", "I", "O"];
+    let frames: Vec<(&str, Vec<Vec<f64>>)> = labels.iter().map(|l| (*l, vec![frame.clone(); 14])).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let real = dir.path().join("same.csv");
+    std::fs::write(&real, recording(&frames)).unwrap();
+    let out = dir.path().join("out");
+    run_ok(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        real.to_str().unwrap(),
+        "--trials",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let rows = rows(&out);
+    // Identical evidence for every label: the belief stays at the uniform prior.
+    for n in 1..=4 {
+        let (_, reliability) = mean_at(&rows, n);
+        assert!(
+            (reliability - 0.25).abs() < 1e-9,
+            "p(true) {reliability} after {n}"
+        );
+    }
+    let (accuracy, _) = mean_at(&rows, 1);
+    assert!(accuracy <= 0.25 + 1e-9, "accuracy {accuracy} above chance");
+}
+
+#[test]
+fn splits_are_disjoint_seeded_and_differ_across_trials() {
+    let real = parse_real_csv(EXAMPLE_REAL_CSV, "example", &RealImport::default()).unwrap();
+    let (kept, counts) = prune(&real, 0.1);
+    assert_eq!(kept.len(), 40);
+    assert!(counts.values().all(|c| (c.kept, c.dropped) == (8, 0)));
+    let kept: Vec<_> = kept.into_iter().cloned().collect();
+    let sizes = scaled_split_sizes(8, 1.0).unwrap();
+    let lines = |part: &[&taction::experiment::real_data::RealReading]| -> Vec<u64> {
+        part.iter().map(|r| r.line).collect()
+    };
+    let mut trials = Vec::new();
+    for trial in 0..7 {
+        let split = trial_split(&kept, sizes, 1, trial).unwrap();
+        let (train, validation, test) = (lines(&split.train), lines(&split.validation), lines(&split.test));
+        assert_eq!((train.len(), validation.len(), test.len()), (25, 5, 10));
+        let all: BTreeSet<u64> = train.iter().chain(&validation).chain(&test).copied().collect();
+        assert_eq!(all.len(), 40, "trial {trial}: a frame is in two sets");
+        let again = trial_split(&kept, sizes, 1, trial).unwrap();
+        assert_eq!(lines(&again.test), test, "trial {trial} is not deterministic");
+        trials.push(test);
+    }
+    let distinct: BTreeSet<&Vec<u64>> = trials.iter().collect();
+    assert_eq!(distinct.len(), 7, "every trial has its own split");
+}
+
+#[test]
+fn frames_below_the_contact_threshold_are_pruned_and_counted() {
+    let contact: Vec<f64> = (0..36).map(|k| if k % 5 == 0 { 800.0 } else { 10.0 }).collect();
+    let touchless = vec![30.0; 36];
+    let text = recording(&[
+        ("A", vec![contact.clone(), touchless.clone(), contact.clone()]),
+        ("B", vec![touchless.clone(), touchless]),
+    ]);
+    let real = parse_real_csv(&text, "t.csv", &RealImport::default()).unwrap();
+    let (kept, counts) = prune(&real, 0.1);
+    assert_eq!(kept.len(), 2);
+    assert_eq!((counts["A"].kept, counts["A"].dropped), (2, 1));
+    assert_eq!((counts["B"].kept, counts["B"].dropped), (0, 2));
+}
+
+#[test]
+fn too_few_frames_after_pruning_is_an_error_naming_the_label() {
+    let contact: Vec<f64> = (0..36).map(|k| if k % 4 == 0 { 800.0 } else { 0.0 }).collect();
+    let text = recording(&[("A", vec![contact.clone(); 10]), ("B", vec![contact; 2])]);
+    let dir = tempfile::tempdir().unwrap();
+    let real = dir.path().join("short.csv");
+    std::fs::write(&real, text).unwrap();
+    let output = taction(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        real.to_str().unwrap(),
+        "--out",
+        dir.path().join("out").to_str().unwrap(),
+    ]);
+    assert!(!output.status.success());
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(err.contains("short.csv") && err.contains("'B'"), "{err}");
+}
+
+#[test]
+fn imports_reject_bad_frames_with_their_line_and_accept_4_to_32_taxels() {
+    let frame = vec!["1"; 36].join(",");
+    let header = recording(&[]);
+    let short = format!("{header}A,{frame}\nA,1,2,3\n");
+    let err = parse_real_csv(&short, "f.csv", &RealImport::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("f.csv") && err.contains("line 3"), "{err}");
+    let nan = format!("{header}A,{frame}\n\nA,{}\n", ["nan"; 36].join(","));
+    let err = parse_real_csv(&nan, "f.csv", &RealImport::default())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("line 4") && err.contains("not finite"), "{err}");
+
+    let grid = |side: usize| -> String {
+        let names: Vec<String> = (0..side * side)
+            .map(|k| format!("r{}c{}", k / side, k % side))
+            .collect();
+        let values = vec!["5"; side * side].join(",");
+        format!("label,{}\nA,{values}\n", names.join(","))
+    };
+    for side in [4, 32] {
+        let data = parse_real_csv(&grid(side), "g.csv", &RealImport::default()).unwrap();
+        assert_eq!((data.rows, data.cols), (side, side));
+    }
+    for side in [3, 33] {
+        let err = parse_real_csv(&grid(side), "g.csv", &RealImport::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("4 to 32"), "{side}: {err}");
+    }
+}
+
+#[test]
+fn a_calibration_applies_gain_and_offset_per_taxel() {
+    let mut calibration = String::from("# gains and offsets\ntaxel,gain,offset\n");
+    for k in 0..36 {
+        let (gain, offset) = if k == 0 { (2.0, 10.0) } else { (1.0, 0.0) };
+        calibration.push_str(&format!("r{}c{},{gain},{offset}\n", k / 6, k % 6));
+    }
+    let calibration = Calibration::parse(&calibration, "cal.csv").unwrap();
+    let mut frame = vec![50.0; 36];
+    frame[0] = 60.0;
+    frame[1] = 100.0;
+    let text = recording(&[("A", vec![frame])]);
+    let options = RealImport {
+        calibration: Some(calibration),
+        ..RealImport::default()
+    };
+    let data = parse_real_csv(&text, "f.csv", &options).unwrap();
+    let values = data.readings[0].image.values();
+    // Taxel 0: 2 * (60 - 10) = 100, the file's largest value with taxel 1.
+    assert_eq!((values[0], values[1], values[2]), (1.0, 1.0, 0.5));
+
+    let missing = "taxel,gain,offset\nr0c0,1,0\nr1c1,1,0\n";
+    let err = Calibration::parse(missing, "cal.csv").unwrap_err().to_string();
+    assert!(err.contains("cal.csv") && err.contains("missing"), "{err}");
+    let bad = "taxel,gain,offset\nr0c0,inf,0\n";
+    let err = Calibration::parse(bad, "cal.csv").unwrap_err().to_string();
+    assert!(err.contains("line 2") && err.contains("gain"), "{err}");
+}
