@@ -347,6 +347,12 @@ where
             };
             let mut vertex = self.tree.nearest(target);
             arm.place(scene, &self.tree.vertices()[vertex].q.clone());
+            if vertex != 0 && arm.collision(scene).is_some() {
+                // A perturbation moved the object into the arm at this vertex: expanding from it
+                // would only collide again.
+                self.tree.block(vertex);
+                continue;
+            }
             let facing = self.tree.vertices()[vertex].pad_normal;
 
             for _ in 0..self.config.max_steps_per_iteration {

@@ -14,6 +14,9 @@ pub struct Vertex {
     pub pad_normal: DVec3,
     /// The vertex this one was reached from (`None` for the root).
     pub parent: Option<usize>,
+    /// The configuration is known to be in collision now (a perturbation moved the object into
+    /// the arm there): nearest-vertex queries pass it over.
+    pub blocked: bool,
 }
 
 /// Configurations connected by collision-free motions.
@@ -30,6 +33,7 @@ impl ExplorationTree {
                 pad_m,
                 pad_normal,
                 parent: None,
+                blocked: false,
             }],
         }
     }
@@ -53,14 +57,21 @@ impl ExplorationTree {
             pad_m,
             pad_normal,
             parent: Some(parent),
+            blocked: false,
         });
         self.vertices.len() - 1
     }
 
-    /// The vertex whose pad position is nearest to `p` (the first of equals, so ties are deterministic).
+    /// Marks vertex `i` as in collision (see [`Vertex::blocked`]).
+    pub fn block(&mut self, i: usize) {
+        self.vertices[i].blocked = true;
+    }
+
+    /// The vertex whose pad position is nearest to `p` (the first of equals, so ties are
+    /// deterministic), among those not blocked; the root when every other one is.
     pub fn nearest(&self, p: DVec3) -> usize {
         let mut best = (0, f64::INFINITY);
-        for (i, v) in self.vertices.iter().enumerate() {
+        for (i, v) in self.vertices.iter().enumerate().filter(|(_, v)| !v.blocked) {
             let d = v.pad_m.distance_squared(p);
             if d < best.1 {
                 best = (i, d);
