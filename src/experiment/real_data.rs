@@ -134,19 +134,13 @@ impl Calibration {
         };
         let mut header_seen = false;
         let mut entries: Vec<(u64, usize, usize, f64, f64)> = Vec::new();
-        for (i, text_line) in text.lines().enumerate() {
-            let line = i as u64 + 1;
-            let trimmed = text_line.trim();
-            if trimmed.is_empty() || trimmed.starts_with('#') {
-                continue;
-            }
-            let record: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+        for (line, record) in records(text) {
             if !header_seen {
                 if record != ["taxel", "gain", "offset"] {
                     return Err(RealDataError::Header {
                         origin: origin.to_string(),
                         line,
-                        what: format!("expected 'taxel,gain,offset', got '{trimmed}'"),
+                        what: format!("expected 'taxel,gain,offset', got '{}'", record.join(",")),
                     });
                 }
                 header_seen = true;
@@ -342,13 +336,7 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
     }
     let mut header: Option<(usize, usize, Vec<String>)> = None;
     let mut raw: Vec<(String, u64, Vec<f64>)> = Vec::new();
-    for (i, text_line) in text.lines().enumerate() {
-        let line = i as u64 + 1;
-        let trimmed = text_line.trim();
-        if trimmed.is_empty() || trimmed.starts_with('#') {
-            continue;
-        }
-        let record: Vec<&str> = trimmed.split(',').map(str::trim).collect();
+    for (line, record) in records(text) {
         let Some((rows, cols, names)) = &header else {
             let parsed = parse_header(&record, line, origin)?;
             if let Some(calibration) = &options.calibration
@@ -522,4 +510,14 @@ fn parse_header(
         )));
     }
     Ok((rows, cols, names))
+}
+
+/// The lines of a CSV text that carry data, as (1-based line number, trimmed comma-separated
+/// fields): blank lines and `#` comments are skipped.
+fn records(text: &str) -> impl Iterator<Item = (u64, Vec<&str>)> {
+    text.lines().enumerate().filter_map(|(i, text_line)| {
+        let trimmed = text_line.trim();
+        (!trimmed.is_empty() && !trimmed.starts_with('#'))
+            .then(|| (i as u64 + 1, trimmed.split(',').map(str::trim).collect()))
+    })
 }
