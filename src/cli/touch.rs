@@ -14,7 +14,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use taction::control::arm_pad::{ArmPad, covering_back_check};
+use taction::control::arm_pad::ArmPad;
+use taction::control::carrier::covering_back_check;
 use taction::control::free_pad::FreePad;
 use taction::control::{ContactOutcome, ContactReport, ControlConfig, settle};
 use taction::explore::collect::sensor_reader;

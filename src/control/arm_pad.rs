@@ -19,13 +19,13 @@
 
 use glam::DVec3;
 
-use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
+use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off};
 use crate::sim::arm::{Execution, PAD_BODY};
 use crate::sim::object::OBJECT_BODY;
 use crate::sim::{
     Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene,
 };
-use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
+use crate::tactile::{PadPose, SensorConfig, TactileImage};
 
 /// The pad frame of a pad site pose: centre at the site, normal its +z, up its +y.
 pub fn pad_pose_of_site(site: &Pose) -> PadPose {
@@ -34,18 +34,6 @@ pub fn pad_pose_of_site(site: &Pose) -> PadPose {
         normal: site.transform_vector(DVec3::Z).normalize(),
         up: site.transform_vector(DVec3::Y).normalize(),
     }
-}
-
-/// Whether the object reaches the pad's rigid back in the scene's current configuration.
-pub type BackCheck<'s> = Box<dyn FnMut(&mut Scene) -> Result<bool, ControlError> + 's>;
-
-/// The back check of the covering sensor `covering` on the pad: computes the scene's sensors at
-/// the current configuration and asks it whether the object reached the rigid back.
-pub fn covering_back_check<'s>(covering: CoveringSensor) -> BackCheck<'s> {
-    Box::new(move |scene: &mut Scene| {
-        scene.compute_sensors();
-        Ok(covering.back_reached(scene.model(), scene.data()))
-    })
 }
 
 /// The arm-mounted pad: a scene with an arm, an IK solver, and a way to read the sensor.
@@ -152,13 +140,8 @@ where
         };
         // An Orient command (the normal turns): back off along the new normal until the back is clear.
         if current.normal.angle_between(target.normal) > 1e-6 {
-            let t = self.sensor.thickness_m;
-            for back_off_m in [0.25 * t, 0.5 * t, t] {
+            for retreated in backed_off(target, self.sensor.thickness_m) {
                 self.arm.place(self.scene, &start);
-                let retreated = PadPose {
-                    center_m: target.center_m - target.normal * back_off_m,
-                    ..*target
-                };
                 match self.try_move(&retreated, &start)? {
                     (_, Some(_)) => {}
                     (other, None) => return Ok(other),

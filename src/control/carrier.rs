@@ -3,8 +3,8 @@
 //! One controller implementation drives both the free-floating pad (a mocap body, Sec. V-A3) and the
 //! arm-mounted pad (pose commands through inverse kinematics, executed by MuJoCo stepping).
 
-use crate::sim::{Collision, SimError};
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::sim::{Collision, Scene, SimError};
+use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
 
 /// How a pose command went.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,4 +43,26 @@ pub trait PadCarrier {
     fn read(&mut self) -> Result<TactileImage, ControlError>;
     /// Moves the pad to `target`.
     fn move_pad(&mut self, target: &PadPose) -> Result<PadMotion, ControlError>;
+}
+
+/// Whether the object reaches the pad's rigid back in the scene's current configuration.
+pub type BackCheck<'s> = Box<dyn FnMut(&mut Scene) -> Result<bool, ControlError> + 's>;
+
+/// The back check of the covering sensor `covering` on the pad: computes the scene's sensors at
+/// the current configuration and asks it whether the object reached the rigid back.
+pub fn covering_back_check<'s>(covering: CoveringSensor) -> BackCheck<'s> {
+    Box::new(move |scene: &mut Scene| {
+        scene.compute_sensors();
+        Ok(covering.back_reached(scene.model(), scene.data()))
+    })
+}
+
+/// Where a turned pad retries when its rigid back would meet the surface: backed off along the new
+/// normal by t/4, t/2, then t, as a compliant wrist would (Press then closes the gap); the arm's
+/// carrier retries Orient commands so.
+pub fn backed_off(target: &PadPose, thickness_m: f64) -> [PadPose; 3] {
+    [0.25, 0.5, 1.0].map(|k| PadPose {
+        center_m: target.center_m - target.normal * (k * thickness_m),
+        ..*target
+    })
 }

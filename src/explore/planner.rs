@@ -39,7 +39,8 @@ use glam::DVec3;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use crate::control::arm_pad::{ArmPad, covering_back_check, pad_pose_of_site};
+use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
+use crate::control::carrier::covering_back_check;
 use crate::control::{ContactStatus, ControlConfig, ControlError, settle};
 use crate::explore::grid::ReadingGrid;
 use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
