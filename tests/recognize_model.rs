@@ -92,23 +92,23 @@ fn truncated_file() {
 #[test]
 fn file_from_another_version() {
     let (_dir, path, text) = saved();
-    assert!(text.starts_with("{\"format_version\":2,"), "{}", &text[..40]);
+    assert!(text.starts_with("{\"format_version\":1,"), "{}", &text[..40]);
     let e = load_text(
         &path,
-        &text.replacen("\"format_version\":2", "\"format_version\":1", 1),
+        &text.replacen("\"format_version\":1", "\"format_version\":2", 1),
     );
     assert!(
         matches!(
             e,
             RecognizeError::Version {
-                found: 1,
-                expected: 2,
+                found: 2,
+                expected: 1,
                 ..
             }
         ),
         "{e}"
     );
-    let e = load_text(&path, &text.replacen("\"format_version\":2,", "", 1));
+    let e = load_text(&path, &text.replacen("\"format_version\":1,", "", 1));
     assert!(
         matches!(e, RecognizeError::NotAModel { .. }) && e.to_string().contains("format_version"),
         "{e}"

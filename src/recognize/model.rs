@@ -20,10 +20,8 @@ use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::selection::{SelectionReport, TrainConfig, TrainProgress, train};
 use crate::tactile::{SensorConfig, TactileImage};
 
-/// The model file format version this build writes and reads. Version 2: Polar-Fourier samples
-/// 4D angles, so a version-1 model's codebook describes other features and is refused rather than
-/// silently misread.
-pub const MODEL_FORMAT_VERSION: u32 = 2;
+/// The model file format version this build writes and reads.
+pub const MODEL_FORMAT_VERSION: u32 = 1;
 
 /// Where the training data came from (for the record; not used to recognise).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
