@@ -110,9 +110,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 .filter(|r| r.status == ContactStatus::Converged)
                 .count();
             let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
-            let objects: std::collections::BTreeSet<&str> =
-                dataset.readings().iter().map(|r| r.object.as_str()).collect();
-            config.ks = codebook_sizes(objects.len(), training_features);
+            config.ks = codebook_sizes(dataset.header().objects.len(), training_features);
             println!(
                 "training: {training_features} training features; trying k = {:?}",
                 config.ks

@@ -20,8 +20,7 @@
 use glam::DVec3;
 
 use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off};
-use crate::sim::arm::{Execution, PAD_BODY};
-use crate::sim::object::OBJECT_BODY;
+use crate::sim::arm::Execution;
 use crate::sim::{
     Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene,
 };
@@ -202,11 +201,7 @@ where
                     // The exact check sees only where the motion ended: back to where it began,
                     // which was clear (the servo's retreat).
                     self.arm.place(self.scene, start);
-                    let contact = Collision {
-                        body_a: PAD_BODY.to_string(),
-                        body_b: OBJECT_BODY.to_string(),
-                    };
-                    (PadMotion::RigidContact, Some(contact))
+                    (PadMotion::RigidContact, Some(Collision::back_on_object()))
                 } else {
                     (PadMotion::Moved, None)
                 }

@@ -47,10 +47,8 @@ use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
 use crate::explore::tree::ExplorationTree;
 use crate::rng::Rng;
-use crate::sim::arm::{Execution, Watch};
-use crate::sim::arm::{PAD_BODY, PAD_SITE};
+use crate::sim::arm::{Execution, PAD_SITE, Watch};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
-use crate::sim::object::OBJECT_BODY;
 use crate::sim::{
     Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget,
     PerturbationBounds, Scene,
@@ -474,10 +472,7 @@ where
         let back_reached = |s: &Scene| {
             covering
                 .is_some_and(|c| c.back_reached(s.model(), s.data()))
-                .then(|| Collision {
-                    body_a: PAD_BODY.to_string(),
-                    body_b: OBJECT_BODY.to_string(),
-                })
+                .then(Collision::back_on_object)
         };
         let outcome = match self.expansion_motion.execution {
             Execution::Servo => arm.move_to(scene, q, &self.expansion_motion, read)?,

@@ -26,6 +26,7 @@ use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use serde::{Deserialize, Serialize};
 
 use crate::sim::mjcf::COLLISION_GROUP;
+use crate::sim::object::OBJECT_BODY;
 use crate::sim::scene::Scene;
 use crate::sim::{Pose, SimError};
 
@@ -79,6 +80,17 @@ pub struct Arm {
 pub struct Collision {
     pub body_a: String,
     pub body_b: String,
+}
+
+impl Collision {
+    /// The pad's rigid back on the object, as the covering sensor finds it (MuJoCo's contacts do
+    /// not: the object's collision shell does not collide with the back, see `mjcf/arm.xml`).
+    pub fn back_on_object() -> Self {
+        Self {
+            body_a: PAD_BODY.to_string(),
+            body_b: OBJECT_BODY.to_string(),
+        }
+    }
 }
 
 impl std::fmt::Display for Collision {
