@@ -1,13 +1,28 @@
-//! Raised letters from the default font (DejaVu Sans, Debian's fonts-dejavu-core): every letter is a
-//! closed, consistently oriented solid with the glyph's holes, the right heights and volume.
+//! Raised letters of the built-in letters set (OpenDyslexic, capital 'I' of DejaVu Sans Mono): every
+//! letter is a closed, consistently oriented solid with the glyph's holes, the right heights and
+//! volume, and no letter is another one turned round.
 
 use std::collections::BTreeMap;
 
-use taction::mesh::glyph::Font;
-use taction::mesh::letters::{LetterStyle, alphabet, letter_from_name, letter_name, raised_letter};
-use taction::mesh::{EdgeTopology, MeshError, TriMesh, ValidationReport, connected_components};
+use std::path::Path;
 
-/// Counters of DejaVu Sans' letters (its 'g' is single-storey).
+use taction::mesh::glyph::Font;
+use taction::mesh::glyph_overlap::{LetterPair, letter_pairs};
+use taction::mesh::letters::{
+    LetterStyle, alphabet, letter_from_name, letter_name, letter_outline, raised_letter,
+};
+use taction::mesh::{EdgeTopology, MeshError, ObjectSet, TriMesh, ValidationReport, connected_components};
+
+/// The font the built-in set draws `ch` in.
+fn built_in_font(ch: char) -> Font {
+    if ch == 'I' {
+        Font::load_capital_i().unwrap()
+    } else {
+        Font::load_default().unwrap()
+    }
+}
+
+/// Counters of the built-in letters (single-storey 'g').
 fn expected_holes(ch: char) -> usize {
     match ch {
         'B' => 2,
@@ -31,12 +46,11 @@ fn faces_at(mesh: &TriMesh, z: f64) -> TriMesh {
 
 #[test]
 fn all_52_letters_are_closed_oriented_solids_with_their_holes() {
-    let font = Font::load_default().unwrap();
     let style = LetterStyle::default();
     let z_top = style.plate_thickness_m + style.raise_m;
     let mut meshes = BTreeMap::new();
     for ch in alphabet() {
-        let mesh = raised_letter(&font, ch, &style).unwrap_or_else(|e| panic!("{ch}: {e}"));
+        let mesh = raised_letter(&built_in_font(ch), ch, &style).unwrap_or_else(|e| panic!("{ch}: {e}"));
         let report = ValidationReport::of(&mesh);
         assert!(report.is_clean(), "{ch}: {report}");
         let topology = EdgeTopology::new(&mesh);
@@ -157,4 +171,47 @@ fn letter_names_round_trip() {
     assert_eq!(letter_from_name("upper_a"), None);
     assert_eq!(letter_from_name("lower_ab"), None);
     assert_eq!(letter_from_name("pawn"), None);
+}
+
+/// Largest best-rotation IoU allowed between two built-in letters (`meshes/README.md` has the table).
+/// Touch cannot tell which way a letter lies (the descriptors are rotation invariant, Sec. IV), so
+/// two letters this alike or more would be told apart by little more than chance.
+const MOST_ALIKE_IOU: f64 = 0.75;
+
+#[test]
+fn no_built_in_letter_is_another_turned_round_and_dejavu_sans_shows_why_that_matters() {
+    let pairs = letter_pairs(&ObjectSet::default_letters(LetterStyle::default()).unwrap()).unwrap();
+    assert_eq!(pairs.len(), 52 * 51 / 2);
+    let most = &pairs[0];
+    assert!(
+        most.iou < MOST_ALIKE_IOU,
+        "{} and {} overlap {:.3} at their best turn",
+        most.first,
+        most.second,
+        most.iou
+    );
+    // Known answers: in DejaVu Sans 'q' is a 'b' turned half round, 'u' an 'n', and 'I' and 'l' are
+    // both plain bars; the built-in capital 'I' has cross-bars.
+    let dejavu = Font::load(Path::new("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf")).unwrap();
+    let dejavu_pairs = letter_pairs(&ObjectSet::letters(&dejavu, LetterStyle::default())).unwrap();
+    let iou = |pairs: &[LetterPair], a: &str, b: &str| {
+        pairs
+            .iter()
+            .find(|p| (p.first == a && p.second == b) || (p.first == b && p.second == a))
+            .map(|p| p.iou)
+            .unwrap()
+    };
+    for (a, b) in [
+        ("lower_b", "lower_q"),
+        ("lower_d", "lower_p"),
+        ("lower_n", "lower_u"),
+        ("upper_I", "lower_l"),
+    ] {
+        assert!(iou(&dejavu_pairs, a, b) > 0.95, "DejaVu Sans {a}/{b}");
+        assert!(iou(&pairs, a, b) < 0.7, "built-in {a}/{b}");
+    }
+    let capital_i = letter_outline(&Font::load_capital_i().unwrap(), 'I', &LetterStyle::default()).unwrap();
+    let xs = || capital_i.contours.iter().flatten().map(|p| p.x);
+    let width_m = xs().fold(f64::MIN, f64::max) - xs().fold(f64::MAX, f64::min);
+    assert!(width_m > 0.01, "capital I is {width_m} m wide: no cross-bars");
 }

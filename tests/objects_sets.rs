@@ -34,11 +34,12 @@ fn builtin_ids_are_stable_and_change_with_content() {
     assert_ne!(rescaled.id(), ObjectSet::chess().id());
 
     let font = Font::load_default().unwrap();
-    let letters = ObjectSet::letters(&font, LetterStyle::default());
+    let letters = ObjectSet::default_letters(LetterStyle::default()).unwrap();
     assert_eq!(letters.objects.len(), 52);
     assert_eq!(letters.object_names()[..2], ["upper_A", "upper_B"]);
-    let raised_more = ObjectSet::letters(
+    let raised_more = ObjectSet::letters_with(
         &font,
+        &Font::load_capital_i().unwrap(),
         LetterStyle {
             raise_m: 0.004,
             ..LetterStyle::default()

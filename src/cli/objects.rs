@@ -1,10 +1,11 @@
-//! `taction objects list|fetch|letters|export`: the object sets the arm explores.
+//! `taction objects list|fetch|letters|overlap|export`: the object sets the arm explores.
 
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
 use taction::mesh::cgal::{CGAL_MESHES, ObjectCache};
 use taction::mesh::glyph::Font;
+use taction::mesh::glyph_overlap::letter_pairs;
 use taction::mesh::letters::LetterStyle;
 use taction::mesh::object_set::BUILTIN_SETS;
 use taction::mesh::{BuildOptions, MeshError, ObjectSet, ObjectSource, write_obj};
@@ -22,7 +23,7 @@ pub struct ObjectsArgs {
 pub enum ObjectsCommand {
     /// List the built-in sets (name, version, id) and their objects.
     List {
-        /// Font of the letters set [default: DejaVu Sans].
+        /// Font of the letters set [default: OpenDyslexic, capital I of DejaVu Sans Mono, built in].
         #[arg(long, value_name = "FILE.ttf")]
         font: Option<PathBuf>,
     },
@@ -34,11 +35,21 @@ pub enum ObjectsCommand {
     },
     /// Write the 52 raised letters as OBJ (metres): upper_A.obj ... lower_z.obj, plus manifest.json.
     Letters {
-        /// TrueType/OpenType font [default: DejaVu Sans, Debian's fonts-dejavu-core].
+        /// TrueType/OpenType font [default: the built-in letters: OpenDyslexic, capital I of DejaVu Sans Mono].
         #[arg(long, value_name = "FILE.ttf")]
         font: Option<PathBuf>,
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+    },
+    /// How alike the letters are under rotation: every pair's best-rotation IoU, most alike first.
+    /// Touch cannot tell which way a letter lies, so a pair near 1 can never be told apart.
+    Overlap {
+        /// TrueType/OpenType font of every letter [default: the built-in letters].
+        #[arg(long, value_name = "FILE.ttf")]
+        font: Option<PathBuf>,
+        /// How many of the most alike pairs to print.
+        #[arg(long, default_value_t = 10, value_name = "N")]
+        top: usize,
     },
     /// Write every object of a set as OBJ (metres, normalised as the set says), plus manifest.json.
     Export {
@@ -47,7 +58,7 @@ pub enum ObjectsCommand {
         set: Vec<PathBuf>,
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
-        /// Font of the letters set [default: DejaVu Sans].
+        /// Font of the letters set [default: OpenDyslexic, capital I of DejaVu Sans Mono, built in].
         #[arg(long, value_name = "FILE.ttf")]
         font: Option<PathBuf>,
         /// Rescale user meshes to this bounding-box diagonal, metres (centred, resting on z = 0).
@@ -81,12 +92,19 @@ pub fn run(args: &ObjectsArgs) -> Result<(), Box<dyn std::error::Error>> {
             Ok(())
         }
         ObjectsCommand::Letters { font, out } => {
-            let font = match font {
-                Some(path) => Font::load(path)?,
-                None => Font::load_default()?,
+            let set = match font {
+                Some(path) => ObjectSet::letters(&Font::load(path)?, LetterStyle::default()),
+                None => ObjectSet::default_letters(LetterStyle::default())?,
             };
-            let set = ObjectSet::letters(&font, LetterStyle::default());
             export(&set, &BuildOptions { cache, fetch: false }, out)
+        }
+        ObjectsCommand::Overlap { font, top } => {
+            let set = ObjectSet::builtin("letters", font.as_deref())?;
+            println!("first,second,iou");
+            for pair in letter_pairs(&set)?.iter().take(*top) {
+                println!("{},{},{:.3}", pair.first, pair.second, pair.iou);
+            }
+            Ok(())
         }
         ObjectsCommand::Export {
             set,

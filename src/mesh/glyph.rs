@@ -14,11 +14,31 @@ use glam::DVec2;
 use super::checksum::sha256_hex;
 use super::error::MeshError;
 
-/// The default font: DejaVu Sans, a clean sans serif close to the rounded letters of a child's
-/// magnetic alphabet.
-pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-/// The Debian package that installs [`DEFAULT_FONT`].
-pub const DEFAULT_FONT_PACKAGE: &str = "fonts-dejavu-core";
+/// Fonts compiled into the binary, named by a path with this prefix (`taction:OpenDyslexic-Regular.otf`).
+/// The files and their licences are in the repository's `fonts/` folder.
+pub const BUILTIN_FONT_PREFIX: &str = "taction:";
+
+const BUILTIN_FONTS: [(&str, &[u8]); 2] = [
+    (
+        "OpenDyslexic-Regular.otf",
+        include_bytes!("../../fonts/OpenDyslexic-Regular.otf"),
+    ),
+    (
+        "DejaVuSansMono.ttf",
+        include_bytes!("../../fonts/DejaVuSansMono.ttf"),
+    ),
+];
+
+/// The default letter font: OpenDyslexic, a rounded sans serif drawn so that no letter is another
+/// one turned round (its 'b' is not a turned 'q': the bowls are weighted to the bottom). The
+/// descriptors cannot see which way a letter lies (Sec. IV), so in a font where 'q' is a turned 'b'
+/// the two can never be told apart by touch; `meshes/README.md` measures every pair.
+pub const DEFAULT_FONT: &str = "taction:OpenDyslexic-Regular.otf";
+
+/// The font of the default capital 'I': DejaVu Sans Mono, whose 'I' has cross-bars. The paper took
+/// its capital 'I' from a second font for the same reason: the physical letter has cross-bars,
+/// which tell it from 'l' (Sec. V-D, footnote 1).
+pub const CAPITAL_I_FONT: &str = "taction:DejaVuSansMono.ttf";
 
 /// A font file in memory, with its checksum (object-set manifests pin the font by it).
 #[derive(Debug, Clone)]
@@ -35,21 +55,27 @@ pub struct GlyphOutline {
 }
 
 impl Font {
-    /// Reads and checks a font file (it must parse and map characters to glyphs).
+    /// Reads and checks a font file, or a built-in font named with [`BUILTIN_FONT_PREFIX`] (it must
+    /// parse and map characters to glyphs).
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let data = std::fs::read(path).map_err(|e| {
-            let mut what = e.to_string();
-            if path == Path::new(DEFAULT_FONT) {
-                what = format!(
-                    "{what}; the default font comes from the Debian package {DEFAULT_FONT_PACKAGE} \
-                     (apt-get install {DEFAULT_FONT_PACKAGE}), or pass another font with --font FILE.ttf"
-                );
-            }
-            MeshError::Font {
+        let builtin = path.to_str().and_then(|p| p.strip_prefix(BUILTIN_FONT_PREFIX));
+        let data = match builtin {
+            Some(name) => BUILTIN_FONTS
+                .iter()
+                .find(|(file, _)| *file == name)
+                .map(|(_, data)| data.to_vec())
+                .ok_or_else(|| MeshError::Font {
+                    path: path.to_path_buf(),
+                    what: format!(
+                        "no built-in font '{name}' (the built-in fonts are {})",
+                        BUILTIN_FONTS.map(|(file, _)| file).join(", ")
+                    ),
+                })?,
+            None => std::fs::read(path).map_err(|e| MeshError::Font {
                 path: path.to_path_buf(),
-                what,
-            }
-        })?;
+                what: e.to_string(),
+            })?,
+        };
         ttf_parser::Face::parse(&data, 0).map_err(|e| MeshError::Font {
             path: path.to_path_buf(),
             what: format!("not a usable font: {e}"),
@@ -67,6 +93,11 @@ impl Font {
         Self::load(Path::new(DEFAULT_FONT))
     }
 
+    /// Reads [`CAPITAL_I_FONT`].
+    pub fn load_capital_i() -> Result<Self, MeshError> {
+        Self::load(Path::new(CAPITAL_I_FONT))
+    }
+
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -82,20 +113,21 @@ impl Font {
         })
     }
 
-    /// The height of the capital letters in font units: the OS/2 cap height, or the top of 'H'.
+    /// The height of the capital letters in font units: the top of 'H' as drawn, else the OS/2 cap
+    /// height. The drawn height comes first because some fonts' OS/2 value is not their letters'
+    /// (OpenDyslexic's would make its capitals 18 mm tall instead of 25).
     pub fn cap_height_units(&self) -> Result<f64, MeshError> {
         let face = self.face()?;
-        if let Some(h) = face.capital_height().filter(|&h| h > 0) {
-            return Ok(h as f64);
-        }
-        face.glyph_index('H')
+        let drawn = face
+            .glyph_index('H')
             .and_then(|g| face.glyph_bounding_box(g))
             .map(|r| r.y_max as f64)
-            .filter(|&h| h > 0.0)
-            .ok_or_else(|| MeshError::Font {
-                path: self.path.clone(),
-                what: "the font gives no cap height and has no 'H' to measure it".into(),
-            })
+            .filter(|&h| h > 0.0);
+        let declared = face.capital_height().filter(|&h| h > 0).map(f64::from);
+        drawn.or(declared).ok_or_else(|| MeshError::Font {
+            path: self.path.clone(),
+            what: "the font gives no cap height and has no 'H' to measure it".into(),
+        })
     }
 
     /// The outline of `ch` scaled by `metres_per_unit`, curves flattened to within `tolerance_m`.

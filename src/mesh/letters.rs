@@ -196,12 +196,17 @@ impl Builder {
     }
 }
 
+/// The outline of letter `ch` in `font` at `style`'s size (capitals `cap_height_m` tall), metres.
+pub fn letter_outline(font: &Font, ch: char, style: &LetterStyle) -> Result<GlyphOutline, MeshError> {
+    style.check()?;
+    let metres_per_unit = style.cap_height_m / font.cap_height_units()?;
+    font.outline(ch, metres_per_unit, style.flatten_tolerance_m)
+}
+
 /// The raised letter `ch` in `font`: closed, outward-oriented, plate centred on x = y = 0 with its
 /// bottom on z = 0 and the letter on top (+z).
 pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMesh, MeshError> {
-    style.check()?;
-    let metres_per_unit = style.cap_height_m / font.cap_height_units()?;
-    let outline = font.outline(ch, metres_per_unit, style.flatten_tolerance_m)?;
+    let outline = letter_outline(font, ch, style)?;
     let nesting = Nesting::new(&outline);
     let all = || outline.contours.iter().flatten();
     let lo = all().fold(DVec2::splat(f64::INFINITY), |m, &p| m.min(p)) - DVec2::splat(style.margin_m);

@@ -12,6 +12,7 @@ pub mod checksum;
 pub mod chess;
 pub mod error;
 pub mod glyph;
+pub mod glyph_overlap;
 pub mod letters;
 pub mod load;
 pub mod normalise;

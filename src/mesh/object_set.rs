@@ -182,9 +182,10 @@ impl ObjectSet {
     }
 
     /// The 52 raised letters (version 1) of `font` in `style` (Sec. V-D), named `upper_A` ...
-    /// `lower_z`.
-    pub fn letters(font: &Font, style: LetterStyle) -> Self {
-        let font_ref = FontRef {
+    /// `lower_z`, the capital 'I' from `capital_i` (the paper's letters take it from a second font
+    /// for its cross-bars).
+    pub fn letters_with(font: &Font, capital_i: &Font, style: LetterStyle) -> Self {
+        let font_ref = |font: &Font| FontRef {
             path: font.path().to_path_buf(),
             sha256: font.sha256().into(),
         };
@@ -193,7 +194,7 @@ impl ObjectSet {
                 name: letter_name(glyph),
                 source: ObjectSource::Letter {
                     glyph,
-                    font: font_ref.clone(),
+                    font: font_ref(if glyph == 'I' { capital_i } else { font }),
                     style,
                 },
             })
@@ -206,18 +207,31 @@ impl ObjectSet {
         }
     }
 
-    /// A built-in set by name; `font` is used by `letters` (default: DejaVu Sans).
+    /// The 52 raised letters, all of `font`.
+    pub fn letters(font: &Font, style: LetterStyle) -> Self {
+        Self::letters_with(font, font, style)
+    }
+
+    /// The built-in letters: [`DEFAULT_FONT`](super::glyph::DEFAULT_FONT) with the capital 'I' of
+    /// [`CAPITAL_I_FONT`](super::glyph::CAPITAL_I_FONT).
+    pub fn default_letters(style: LetterStyle) -> Result<Self, MeshError> {
+        Ok(Self::letters_with(
+            &Font::load_default()?,
+            &Font::load_capital_i()?,
+            style,
+        ))
+    }
+
+    /// A built-in set by name; `font`, when given, draws every letter of `letters` (default:
+    /// [`ObjectSet::default_letters`]).
     pub fn builtin(name: &str, font: Option<&Path>) -> Result<Self, MeshError> {
         match name {
             "shapes" => Ok(Self::shapes()),
             "chess" => Ok(Self::chess()),
-            "letters" => {
-                let font = match font {
-                    Some(path) => Font::load(path)?,
-                    None => Font::load_default()?,
-                };
-                Ok(Self::letters(&font, LetterStyle::default()))
-            }
+            "letters" => match font {
+                Some(path) => Ok(Self::letters(&Font::load(path)?, LetterStyle::default())),
+                None => Self::default_letters(LetterStyle::default()),
+            },
             other => Err(set_error(format!(
                 "no built-in set '{other}' (the built-in sets are {})",
                 BUILTIN_SETS.join(", ")

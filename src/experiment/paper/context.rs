@@ -1,7 +1,7 @@
 //! What every experiment of a run shares: the scale, the seed, where and how to run, the object
 //! sets, the real recording, and the store of datasets and models.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use super::data::{DataStore, Objects};
@@ -11,7 +11,6 @@ use super::scale::Scale;
 use crate::experiment::real_data::{Calibration, RealData, RealImport, parse_real_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
-use crate::mesh::glyph::Font;
 use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
 use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
@@ -128,23 +127,24 @@ impl PaperContext {
     }
 
     /// The letters the recording's labels name, each named by its label: a label is a single
-    /// character (`A`) or a letter's object name (`upper_A`). They are made in the font and style
-    /// of the letters set (DejaVu Sans when that set holds no generated letters).
+    /// character (`A`) or a letter's object name (`upper_A`). Each is made as the letters set makes
+    /// that letter (font and style); the built-in letters stand in when that set holds no generated
+    /// letters.
     fn real_letters(&self) -> Result<ObjectSet, BoxError> {
         let real = self.real_data()?;
-        let template = match self.letters.objects.iter().find_map(|o| match &o.source {
-            ObjectSource::Letter { font, style, .. } => Some((font.clone(), *style)),
-            _ => None,
-        }) {
-            Some(found) => found,
-            None => {
-                let default = ObjectSet::letters(&Font::load_default()?, LetterStyle::default());
-                match default.objects.first().map(|o| &o.source) {
-                    Some(ObjectSource::Letter { font, style, .. }) => (font.clone(), *style),
-                    _ => return Err("the default letters set holds no letters".into()),
-                }
-            }
+        let generated = |set: &ObjectSet| -> BTreeMap<char, ObjectSource> {
+            set.objects
+                .iter()
+                .filter_map(|o| match &o.source {
+                    ObjectSource::Letter { glyph, .. } => Some((*glyph, o.source.clone())),
+                    _ => None,
+                })
+                .collect()
         };
+        let mut sources = generated(&self.letters);
+        if sources.is_empty() {
+            sources = generated(&ObjectSet::default_letters(LetterStyle::default())?);
+        }
         let mut objects = Vec::new();
         for label in real.labels() {
             let mut chars = label.chars();
@@ -158,13 +158,18 @@ impl PaperContext {
                     self.real.origin
                 )
             })?;
+            // A letter the set lacks is drawn like the set's other letters.
+            let source = match sources.get(&glyph).or_else(|| sources.values().next()) {
+                Some(ObjectSource::Letter { font, style, .. }) => ObjectSource::Letter {
+                    glyph,
+                    font: font.clone(),
+                    style: *style,
+                },
+                _ => return Err("the letters set holds no letters".into()),
+            };
             objects.push(NamedObject {
                 name: label.to_string(),
-                source: ObjectSource::Letter {
-                    glyph,
-                    font: template.0.clone(),
-                    style: template.1,
-                },
+                source,
             });
         }
         Ok(ObjectSet {
