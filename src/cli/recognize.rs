@@ -6,11 +6,11 @@ use std::path::PathBuf;
 use clap::Args;
 use indicatif::ProgressBar;
 use taction::dataset::Dataset;
-use taction::recognize::{LabelledFeatures, ReadingRange, TrainedModel, evaluate, make_trials};
+use taction::recognize::{ReadingRange, Recognizer};
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
-    /// A model written by `taction train`.
+    /// A model written by `taction train` (one descriptor, or several fused).
     #[arg(long, value_name = "FILE")]
     pub model: PathBuf,
     /// Test dataset; each object's converged readings, in order, are split into trials of as many
@@ -26,26 +26,22 @@ pub struct RecognizeArgs {
 }
 
 pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let model = TrainedModel::load(&args.model)?;
+    let model = Recognizer::load(&args.model)?;
     let test = Dataset::read(&args.dataset)?;
-    model
-        .check_sensor(&test.header().sensor)
-        .map_err(|e| format!("{}: {e}", args.dataset.display()))?;
-    let descriptor = model.build_descriptor()?;
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-    let features = LabelledFeatures::from_dataset(&test, descriptor.as_ref());
-    let trials = make_trials(&features, model.bag.objects(), args.readings.last())?;
-    let evaluation = evaluate(&model.bag, &trials, args.readings)?;
+    let (evaluation, trials) = model
+        .evaluate(&test, args.readings)
+        .map_err(|e| format!("{}: {e}", args.dataset.display()))?;
     spinner.finish_and_clear();
     let paths = evaluation.write_csvs(&args.out)?;
+    let ks: Vec<String> = model.chosen_ks().iter().map(usize::to_string).collect();
     println!(
-        "{} trials of up to {} readings over {} objects (model k = {}, {})",
-        trials.len(),
+        "{trials} trials of up to {} readings over {} objects (model k = {}, {})",
         args.readings.last(),
-        features.objects().len(),
-        model.selection.chosen_k,
-        model.descriptor.kind().name()
+        model.objects().len(),
+        ks.join("+"),
+        model.choice().name()
     );
     for n in [1, 10, 30, 100] {
         if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {

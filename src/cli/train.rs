@@ -10,8 +10,8 @@ use taction::control::ContactStatus;
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    CodebookKind, PseudoCount, RecognizeError, TrainConfig, TrainProgress, TrainedModel, VarianceFraction,
-    codebook_sizes,
+    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, TrainConfig, TrainProgress,
+    TrainedModel, VarianceFraction, codebook_sizes,
 };
 
 #[derive(Debug, Args)]
@@ -23,9 +23,11 @@ pub struct TrainArgs {
     /// training readings are held out.
     #[arg(long, value_name = "FILE")]
     pub validation: Option<PathBuf>,
-    /// vectorize | sift | mr8 | moment-normalized | polar-fourier | mnti (default parameters)
-    #[arg(long, value_name = "NAME", value_parser = parse_descriptor)]
-    pub descriptor: DescriptorKind,
+    /// vectorize | sift | mr8 | moment-normalized (mn) | polar-fourier (pf) | mnti (default
+    /// parameters); several joined by '+' (e.g. mnti+mn) train one model per descriptor on the same
+    /// data, written as one fused model whose posterior multiplies their likelihoods.
+    #[arg(long, value_name = "NAME[+NAME]", value_parser = DescriptorChoice::parse)]
+    pub descriptor: DescriptorChoice,
     /// gmm (soft membership) | kmeans (hard membership)
     #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
     pub codebook: CodebookKind,
@@ -52,16 +54,6 @@ pub struct TrainArgs {
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-}
-
-fn parse_descriptor(name: &str) -> Result<DescriptorKind, String> {
-    DescriptorKind::from_name(name).ok_or_else(|| {
-        let known: Vec<&str> = DescriptorKind::ALL.iter().map(|k| k.name()).collect();
-        format!(
-            "unknown descriptor '{name}'; expected one of {}",
-            known.join(", ")
-        )
-    })
 }
 
 fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
@@ -94,14 +86,41 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         ..TrainConfig::default()
     };
     let validation = args.validation.as_deref().map(Dataset::read).transpose()?;
-    let descriptor = args.descriptor.build();
+    let mut models = Vec::new();
+    for &kind in args.descriptor.kinds() {
+        let model = fit_one(args, kind, &training, validation.as_ref(), config.clone())?;
+        print_selection(&model);
+        models.push(model);
+    }
+    if args.descriptor.is_fused() {
+        FusedModel::new(models)?.save(&args.out)?;
+        println!(
+            "fused model ({}) written to {}",
+            args.descriptor.name(),
+            args.out.display()
+        );
+    } else if let Some(model) = models.first() {
+        model.save(&args.out)?;
+        println!("model written to {}", args.out.display());
+    }
+    Ok(())
+}
 
+/// Trains the model of one descriptor, with a progress bar.
+fn fit_one(
+    args: &TrainArgs,
+    kind: DescriptorKind,
+    training: &Dataset,
+    validation: Option<&Dataset>,
+    config: TrainConfig,
+) -> Result<TrainedModel, Box<dyn std::error::Error>> {
+    let descriptor = kind.build();
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} candidates  {msg}  [{elapsed}]")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    bar.set_message(format!("describing readings ({})", args.descriptor.name()));
+    bar.set_message(format!("describing readings ({})", kind.name()));
     let mut on_progress = |event: TrainProgress| match event {
         TrainProgress::PcaFitted { total, .. } => bar.set_length(total as u64),
         TrainProgress::Fitting { k, restart, .. } => {
@@ -110,8 +129,8 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         TrainProgress::Scored(_) => bar.inc(1),
     };
     let model = TrainedModel::fit(
-        &training,
-        validation.as_ref(),
+        training,
+        validation,
         descriptor.as_ref(),
         config,
         &mut on_progress,
@@ -121,11 +140,15 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         _ => e.to_string(),
     })?;
     bar.finish_and_clear();
+    Ok(model)
+}
 
-    model.save(&args.out)?;
+/// What model selection tried and chose.
+fn print_selection(model: &TrainedModel) {
     let s = &model.selection;
     println!(
-        "trained on {} readings ({} features) of {} objects; validation: {}",
+        "{}: trained on {} readings ({} features) of {} objects; validation: {}",
+        model.descriptor.kind().name(),
         s.training_readings,
         s.training_features,
         model.bag.objects().len(),
@@ -158,6 +181,4 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         )
     });
     println!("chosen k = {}, restart {}{chosen}", s.chosen_k, s.chosen_restart);
-    println!("model written to {}", args.out.display());
-    Ok(())
 }

@@ -78,9 +78,9 @@ pub struct ControlConfigError {
 }
 
 impl ControlConfig {
-    /// Checks every field's range.
+    /// Checks every field's range (and that it is finite).
     pub fn validate(&self) -> Result<(), ControlConfigError> {
-        let checks: [(&'static str, f64, bool, &'static str); 14] = [
+        let checks: [(&'static str, f64, bool, &'static str); 15] = [
             (
                 "contact_threshold",
                 self.contact_threshold,
@@ -158,6 +158,14 @@ impl ControlConfig {
                 self.orient_tolerance_rad,
                 self.orient_tolerance_rad > 0.0,
                 "(0, inf)",
+            ),
+            (
+                // A negative step would turn the pad away from the surface; beyond a half turn the
+                // rotation is no longer the short way round.
+                "orient_max_step_rad",
+                self.orient_max_step_rad,
+                self.orient_max_step_rad > 0.0 && self.orient_max_step_rad <= std::f64::consts::PI,
+                "(0, pi]",
             ),
             (
                 "max_iterations",
@@ -256,6 +264,31 @@ mod tests {
             ..ControlConfig::default()
         };
         assert_eq!(bad.validate().unwrap_err().field, "saturation_threshold");
+    }
+
+    #[test]
+    fn every_field_is_checked() {
+        // Each field in turn set out of range (negative, or zero for the counts) must be the one named.
+        let defaults = serde_json::to_value(ControlConfig::default()).unwrap();
+        let fields = defaults.as_object().unwrap();
+        assert_eq!(fields.len(), 15);
+        for (name, value) in fields {
+            let mut bad = fields.clone();
+            let out_of_range = if value.is_u64() {
+                serde_json::json!(0)
+            } else {
+                serde_json::json!(-1.0)
+            };
+            bad.insert(name.clone(), out_of_range);
+            let config: ControlConfig = serde_json::from_value(serde_json::Value::Object(bad)).unwrap();
+            let error = config.validate().expect_err(name);
+            assert_eq!(error.field, name.as_str());
+        }
+        let nan = ControlConfig {
+            orient_max_step_rad: f64::NAN,
+            ..ControlConfig::default()
+        };
+        assert_eq!(nan.validate().unwrap_err().field, "orient_max_step_rad");
     }
 
     #[test]

@@ -92,9 +92,21 @@ impl DescriptorKind {
         }
     }
 
-    /// Parses [`name`](Self::name).
+    /// The short name: `mn` and `pf` for the two long names (as the paper abbreviates them), the
+    /// name otherwise.
+    pub fn short_name(self) -> &'static str {
+        match self {
+            Self::MomentNormalized => "mn",
+            Self::PolarFourier => "pf",
+            other => other.name(),
+        }
+    }
+
+    /// Parses [`name`](Self::name) or [`short_name`](Self::short_name).
     pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name)
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name || k.short_name() == name)
     }
 
     /// Its documented default parameters.

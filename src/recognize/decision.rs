@@ -44,9 +44,13 @@ impl ObjectModels {
     /// (Eq. 15-16), so the guess and the distribution come from the same numbers:
     /// `p(O_j | U) = exp(ln p(U | O_j) - ln sum_m p(U | O_m))`.
     pub fn decide(&self, u: &ClusterHistogram) -> Decision {
+        Decision::from_log_likelihoods(self.log_likelihoods(u), u.features())
+    }
+
+    /// `ln p(U | O_j) = sum_i s_i ln p(c_i | O_j)` for every object `j` (Eq. 15-16).
+    pub fn log_likelihoods(&self, u: &ClusterHistogram) -> Vec<f64> {
         debug_assert_eq!(u.clusters(), self.clusters());
-        let n_objects = self.objects().len();
-        let log_likelihood: Vec<f64> = (0..n_objects)
+        (0..self.objects().len())
             .map(|j| {
                 u.sums()
                     .iter()
@@ -54,13 +58,19 @@ impl ObjectModels {
                     .map(|(s, l)| s * l)
                     .sum()
             })
-            .collect();
-        let n = u.features();
+            .collect()
+    }
+}
+
+impl Decision {
+    /// The decision given `ln p(U | O_j)` for every object and the number of features `n_U` behind
+    /// them: the most likely object and the softmax of the log-likelihoods (Eq. 16).
+    pub fn from_log_likelihoods(log_likelihood: Vec<f64>, n: usize) -> Decision {
         let cross_entropy: Vec<f64> = log_likelihood
             .iter()
             .map(|l| if n == 0 { 0.0 } else { -l / n as f64 })
             .collect();
-        let guess = (0..n_objects).fold(0, |best, j| {
+        let guess = (0..log_likelihood.len()).fold(0, |best, j| {
             if log_likelihood[j] > log_likelihood[best] {
                 j
             } else {

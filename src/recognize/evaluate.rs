@@ -13,14 +13,16 @@ use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::confusion::{ConfusionMatrix, csv_row};
 use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::posterior::Belief;
 
-/// Consecutive readings of one object, given to the recogniser one at a time.
+/// Consecutive readings of one object, given to the recogniser one at a time. A reading is its
+/// features (`R = Vec<Feature>`), or for a fused recogniser one feature list per descriptor.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Trial {
+pub struct Trial<R = Vec<Feature>> {
     /// The true object, as an index of the model's objects.
     pub object: usize,
     /// Each reading's features.
-    pub readings: Vec<Vec<Feature>>,
+    pub readings: Vec<R>,
 }
 
 /// Splits each object's readings, in order, into trials of `readings_per_trial` consecutive
@@ -179,15 +181,33 @@ pub fn evaluate(
     trials: &[Trial],
     range: ReadingRange,
 ) -> Result<Evaluation, RecognizeError> {
+    evaluate_with(bag.objects(), trials, range, || {
+        let mut posterior = bag.posterior();
+        move |reading: &Vec<Feature>| posterior.observe(reading)
+    })
+}
+
+/// [`evaluate`] for any recogniser over `objects`: `start` gives, per trial, a fresh posterior that
+/// takes one reading and returns the belief after it.
+pub fn evaluate_with<R, P>(
+    objects: &[String],
+    trials: &[Trial<R>],
+    range: ReadingRange,
+    start: impl Fn() -> P + Sync,
+) -> Result<Evaluation, RecognizeError>
+where
+    R: Sync,
+    P: FnMut(&R) -> Result<Belief, RecognizeError>,
+{
     // Every trial's belief after 1, 2, ... readings (up to the range's end).
     let per_trial: Vec<Result<Vec<TouchRow>, RecognizeError>> = trials
         .par_iter()
         .enumerate()
         .map(|(t, trial)| {
-            let mut posterior = bag.posterior();
+            let mut observe = start();
             let mut beliefs = Vec::new();
             for reading in trial.readings.iter().take(range.last) {
-                let belief = posterior.observe(reading)?;
+                let belief = observe(reading)?;
                 beliefs.push(TouchRow {
                     trial: t,
                     object_true: trial.object,
@@ -202,7 +222,7 @@ pub fn evaluate(
         .collect();
     let per_trial: Vec<Vec<TouchRow>> = per_trial.into_iter().collect::<Result<_, _>>()?;
     let longest = per_trial.iter().map(Vec::len).max().unwrap_or(0);
-    let prior = 1.0 / bag.objects().len().max(1) as f64;
+    let prior = 1.0 / objects.len().max(1) as f64;
     let mut accuracy: Vec<AccuracyRow> = Vec::new();
     for n in range.first..=range.last.min(longest) {
         let (mut correct, mut p_true) = (0, 0.0);
@@ -224,7 +244,7 @@ pub fn evaluate(
         });
     }
     let mut touches = Vec::new();
-    let mut confusion = ConfusionMatrix::new(bag.objects().to_vec());
+    let mut confusion = ConfusionMatrix::new(objects.to_vec());
     for (trial, beliefs) in trials.iter().zip(per_trial) {
         let in_range: Vec<TouchRow> = beliefs
             .into_iter()
@@ -236,7 +256,7 @@ pub fn evaluate(
         touches.extend(in_range);
     }
     Ok(Evaluation {
-        objects: bag.objects().to_vec(),
+        objects: objects.to_vec(),
         touches,
         accuracy,
         confusion,

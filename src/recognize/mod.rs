@@ -21,6 +21,7 @@ pub mod decision;
 pub mod error;
 pub mod evaluate;
 pub mod features;
+pub mod fusion;
 pub mod gmm;
 pub mod kmeans;
 pub mod labelled;
@@ -35,8 +36,11 @@ pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 pub use confusion::ConfusionMatrix;
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use error::RecognizeError;
-pub use evaluate::{AccuracyRow, Evaluation, ReadingRange, TouchRow, Trial, evaluate, make_trials};
+pub use evaluate::{
+    AccuracyRow, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
+};
 pub use features::FeatureMatrix;
+pub use fusion::{DescriptorChoice, FusedModel, FusedPosterior, Recognizer};
 pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
 pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
 pub use labelled::LabelledFeatures;

@@ -69,6 +69,11 @@ impl<'a> OnlinePosterior<'a> {
         }
     }
 
+    /// The pipeline it recognises with.
+    pub fn bag(&self) -> &'a BagOfFeatures {
+        self.bag
+    }
+
     /// Readings observed so far.
     pub fn readings(&self) -> usize {
         self.readings

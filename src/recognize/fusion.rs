@@ -1,0 +1,405 @@
+//! Descriptor fusion (beyond the paper): one recogniser from several descriptors of the same
+//! readings, named `a+b` wherever a descriptor name is accepted (e.g. `mnti+mn`: MNTI and
+//! Moment-Normalized).
+//!
+//! A fused model is nothing but one [`TrainedModel`] per descriptor, each trained (Fig. 4, with its
+//! own PCA, codebook and model selection) on the same training and validation datasets. Every
+//! model scores a reading on its own; the fused log-likelihood of object `O_j` is the sum of the
+//! models' `ln p(U | O_j)` (Eq. 15-16), i.e. the product of their likelihoods, as if the descriptors
+//! were independent given the object, and the posterior is its softmax under a uniform prior. Two
+//! descriptors that err on different objects then correct each other: MNTI drops the translation
+//! that Moment-Normalized keeps (Sec. IV-B4, IV-B6).
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::{Dataset, write_atomic};
+use crate::describe::{Descriptor, DescriptorKind, Feature};
+use crate::recognize::RecognizeError;
+use crate::recognize::decision::Decision;
+use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
+use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor};
+use crate::recognize::posterior::{Belief, OnlinePosterior};
+use crate::recognize::selection::{TrainConfig, TrainProgress};
+
+/// One descriptor or several fused: the parsed form of a descriptor name such as `mnti` or
+/// `mnti+mn`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct DescriptorChoice {
+    kinds: Vec<DescriptorKind>,
+}
+
+impl DescriptorChoice {
+    /// One descriptor.
+    pub fn single(kind: DescriptorKind) -> Self {
+        Self { kinds: vec![kind] }
+    }
+
+    /// Several descriptors fused; at least one, no repeats.
+    pub fn fused(kinds: Vec<DescriptorKind>) -> Result<Self, String> {
+        if kinds.is_empty() {
+            return Err("no descriptor named".into());
+        }
+        if let Some(i) = (0..kinds.len()).find(|&i| kinds[..i].contains(&kinds[i])) {
+            return Err(format!("'{}' is named twice", kinds[i].name()));
+        }
+        Ok(Self { kinds })
+    }
+
+    /// Parses `name` or `name+name+...` (each a [`DescriptorKind::from_name`] name).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let kinds = text
+            .split('+')
+            .map(|part| {
+                DescriptorKind::from_name(part.trim()).ok_or_else(|| {
+                    let known: Vec<&str> = DescriptorKind::ALL.iter().map(|k| k.name()).collect();
+                    format!(
+                        "unknown descriptor '{part}' in '{text}'; expected one of {} (short: mn, pf), \
+                         or several joined by '+' (e.g. mnti+mn)",
+                        known.join(", ")
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::fused(kinds).map_err(|e| format!("descriptor '{text}': {e}"))
+    }
+
+    pub fn kinds(&self) -> &[DescriptorKind] {
+        &self.kinds
+    }
+
+    /// Whether more than one descriptor is fused.
+    pub fn is_fused(&self) -> bool {
+        self.kinds.len() > 1
+    }
+
+    /// The canonical name: the short names joined by `+`.
+    pub fn name(&self) -> String {
+        self.kinds
+            .iter()
+            .map(|k| k.short_name())
+            .collect::<Vec<_>>()
+            .join("+")
+    }
+}
+
+/// One trained model per descriptor, over the same objects in the same order and the same sensor
+/// (the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FusedModel {
+    pub format_version: u32,
+    /// The models, in the order of the fused name.
+    pub fused: Vec<TrainedModel>,
+}
+
+impl FusedModel {
+    /// Checks that the models can be fused: at least two, distinct descriptors, the same objects in
+    /// the same order, the same sensor.
+    pub fn new(models: Vec<TrainedModel>) -> Result<Self, RecognizeError> {
+        let invalid = |what: String| RecognizeError::InvalidParameter {
+            name: "fused models",
+            what,
+        };
+        let Some(first) = models.first() else {
+            return Err(invalid("no model".into()));
+        };
+        if models.len() < 2 {
+            return Err(invalid("fusion needs at least two models".into()));
+        }
+        DescriptorChoice::fused(models.iter().map(|m| m.descriptor.kind()).collect()).map_err(invalid)?;
+        for m in &models[1..] {
+            if m.bag.objects() != first.bag.objects() {
+                return Err(invalid(format!(
+                    "{} and {} models know different objects ({:?} vs {:?})",
+                    first.descriptor.kind().name(),
+                    m.descriptor.kind().name(),
+                    first.bag.objects(),
+                    m.bag.objects()
+                )));
+            }
+            check_same_sensor(&first.sensor, &m.sensor)?;
+        }
+        Ok(Self {
+            format_version: MODEL_FORMAT_VERSION,
+            fused: models,
+        })
+    }
+
+    /// Trains one model per descriptor of `choice` on the same datasets ([`TrainedModel::fit`]),
+    /// each choosing its own codebook size.
+    pub fn fit(
+        training: &Dataset,
+        validation: Option<&Dataset>,
+        choice: &DescriptorChoice,
+        config: TrainConfig,
+        progress: &mut dyn FnMut(TrainProgress),
+    ) -> Result<Self, RecognizeError> {
+        let models = choice
+            .kinds()
+            .iter()
+            .map(|kind| {
+                TrainedModel::fit(
+                    training,
+                    validation,
+                    kind.build().as_ref(),
+                    config.clone(),
+                    progress,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::new(models)
+    }
+
+    /// The objects, in the models' (common) order.
+    pub fn objects(&self) -> &[String] {
+        self.fused[0].bag.objects()
+    }
+
+    /// The fused descriptor name.
+    pub fn choice(&self) -> DescriptorChoice {
+        DescriptorChoice {
+            kinds: self.fused.iter().map(|m| m.descriptor.kind()).collect(),
+        }
+    }
+
+    /// A posterior that takes one feature list per model for every reading.
+    pub fn posterior(&self) -> FusedPosterior<'_> {
+        FusedPosterior {
+            parts: self.fused.iter().map(|m| m.bag.posterior()).collect(),
+        }
+    }
+
+    /// Writes the model as JSON, atomically.
+    pub fn save(&self, path: &Path) -> Result<(), RecognizeError> {
+        let json = serde_json::to_vec(self).map_err(|e| RecognizeError::NotAModel {
+            path: path.display().to_string(),
+            what: format!("cannot encode: {e}"),
+        })?;
+        write_atomic(path, &json)?;
+        Ok(())
+    }
+
+    /// Parses a fused model file: every part is checked as a model file of its own
+    /// ([`TrainedModel::from_json`]), then the parts against each other ([`new`](Self::new)).
+    pub fn from_json(value: &serde_json::Value, origin: &str) -> Result<Self, RecognizeError> {
+        let parts = value
+            .get("fused")
+            .and_then(serde_json::Value::as_array)
+            .ok_or_else(|| RecognizeError::NotAModel {
+                path: origin.to_string(),
+                what: "'fused' is not a list of models".into(),
+            })?;
+        let models = parts
+            .iter()
+            .enumerate()
+            .map(|(i, part)| {
+                let bytes = serde_json::to_vec(part).map_err(|e| RecognizeError::NotAModel {
+                    path: origin.to_string(),
+                    what: e.to_string(),
+                })?;
+                TrainedModel::from_json(&bytes, &format!("{origin} (fused model {})", i + 1))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::new(models).map_err(|e| RecognizeError::Inconsistent {
+            path: origin.to_string(),
+            what: e.to_string(),
+        })
+    }
+
+    /// Each reading of `dataset` described by every model's descriptor, as trials of up to
+    /// `readings_per_trial` readings ([`make_trials`]).
+    pub fn trials(
+        &self,
+        dataset: &Dataset,
+        readings_per_trial: usize,
+    ) -> Result<Vec<Trial<Vec<Vec<Feature>>>>, RecognizeError> {
+        let mut per_model = Vec::with_capacity(self.fused.len());
+        for model in &self.fused {
+            model.check_sensor(&dataset.header().sensor)?;
+            let descriptor: Box<dyn Descriptor> = model.build_descriptor()?;
+            let features = LabelledFeatures::from_dataset(dataset, descriptor.as_ref());
+            per_model.push(make_trials(&features, self.objects(), readings_per_trial)?);
+        }
+        Ok(zip_trials(per_model))
+    }
+
+    /// Recognition touch by touch over `trials` (as [`evaluate`](crate::recognize::evaluate)).
+    pub fn evaluate(
+        &self,
+        trials: &[Trial<Vec<Vec<Feature>>>],
+        range: ReadingRange,
+    ) -> Result<Evaluation, RecognizeError> {
+        evaluate_with(self.objects(), trials, range, || {
+            let mut posterior = self.posterior();
+            move |reading: &Vec<Vec<Feature>>| posterior.observe(reading)
+        })
+    }
+}
+
+/// Trials of the same readings described by several descriptors, zipped reading by reading. The
+/// lists come from one dataset, so they agree in objects and lengths.
+fn zip_trials(per_model: Vec<Vec<Trial>>) -> Vec<Trial<Vec<Vec<Feature>>>> {
+    let mut models = per_model.into_iter();
+    let Some(first) = models.next() else {
+        return Vec::new();
+    };
+    let mut zipped: Vec<Trial<Vec<Vec<Feature>>>> = first
+        .into_iter()
+        .map(|t| Trial {
+            object: t.object,
+            readings: t.readings.into_iter().map(|r| vec![r]).collect(),
+        })
+        .collect();
+    for trials in models {
+        for (z, t) in zipped.iter_mut().zip(trials) {
+            for (reading, features) in z.readings.iter_mut().zip(t.readings) {
+                reading.push(features);
+            }
+        }
+    }
+    zipped
+}
+
+/// The fused belief after each reading (the module docs).
+#[derive(Debug, Clone)]
+pub struct FusedPosterior<'a> {
+    parts: Vec<OnlinePosterior<'a>>,
+}
+
+impl FusedPosterior<'_> {
+    /// Adds one reading, `features[m]` being its features under model `m`'s descriptor. On error
+    /// (a count or length that does not match) the state is unchanged.
+    pub fn observe(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
+        if features.len() != self.parts.len() {
+            return Err(RecognizeError::InvalidParameter {
+                name: "fused reading",
+                what: format!(
+                    "{} feature lists for {} fused models",
+                    features.len(),
+                    self.parts.len()
+                ),
+            });
+        }
+        let mut updated = self.parts.clone();
+        for (part, f) in updated.iter_mut().zip(features) {
+            part.observe(f)?;
+        }
+        self.parts = updated;
+        Ok(self.belief())
+    }
+
+    /// The fused belief now: the softmax of the summed log-likelihoods.
+    pub fn belief(&self) -> Belief {
+        let mut log_likelihood: Vec<f64> = Vec::new();
+        let mut features = 0;
+        for part in &self.parts {
+            let models = part.bag().models();
+            let l = models.log_likelihoods(part.histogram());
+            if log_likelihood.is_empty() {
+                log_likelihood = l;
+            } else {
+                for (sum, x) in log_likelihood.iter_mut().zip(l) {
+                    *sum += x;
+                }
+            }
+            features += part.histogram().features();
+        }
+        Belief {
+            readings: self.parts.first().map_or(0, OnlinePosterior::readings),
+            decision: Decision::from_log_likelihoods(log_likelihood, features),
+        }
+    }
+}
+
+/// A model file of either kind, as `taction recognize` takes it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Recognizer {
+    Single(TrainedModel),
+    Fused(FusedModel),
+}
+
+impl Recognizer {
+    /// Reads a model written by `taction train`, fused (a `fused` list) or not.
+    pub fn load(path: &Path) -> Result<Self, RecognizeError> {
+        let name = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|source| RecognizeError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        let fused = serde_json::from_slice::<serde_json::Value>(&bytes)
+            .ok()
+            .filter(|v| v.get("fused").is_some());
+        match fused {
+            Some(value) => {
+                check_version(&value, &name)?;
+                Ok(Self::Fused(FusedModel::from_json(&value, &name)?))
+            }
+            None => Ok(Self::Single(TrainedModel::from_json(&bytes, &name)?)),
+        }
+    }
+
+    /// The descriptor name (`mnti`, `mnti+mn`).
+    pub fn choice(&self) -> DescriptorChoice {
+        match self {
+            Self::Single(m) => DescriptorChoice::single(m.descriptor.kind()),
+            Self::Fused(f) => f.choice(),
+        }
+    }
+
+    pub fn objects(&self) -> &[String] {
+        match self {
+            Self::Single(m) => m.bag.objects(),
+            Self::Fused(f) => f.objects(),
+        }
+    }
+
+    /// Each model's chosen codebook size, in order.
+    pub fn chosen_ks(&self) -> Vec<usize> {
+        match self {
+            Self::Single(m) => vec![m.selection.chosen_k],
+            Self::Fused(f) => f.fused.iter().map(|m| m.selection.chosen_k).collect(),
+        }
+    }
+
+    /// Recognises `dataset` in trials of `range.last()` readings per object; also returns the number
+    /// of trials.
+    pub fn evaluate(
+        &self,
+        dataset: &Dataset,
+        range: ReadingRange,
+    ) -> Result<(Evaluation, usize), RecognizeError> {
+        match self {
+            Self::Single(model) => {
+                model.check_sensor(&dataset.header().sensor)?;
+                let descriptor = model.build_descriptor()?;
+                let features = LabelledFeatures::from_dataset(dataset, descriptor.as_ref());
+                let trials = make_trials(&features, model.bag.objects(), range.last())?;
+                Ok((
+                    crate::recognize::evaluate(&model.bag, &trials, range)?,
+                    trials.len(),
+                ))
+            }
+            Self::Fused(fused) => {
+                let trials = fused.trials(dataset, range.last())?;
+                Ok((fused.evaluate(&trials, range)?, trials.len()))
+            }
+        }
+    }
+}
+
+fn check_version(value: &serde_json::Value, origin: &str) -> Result<(), RecognizeError> {
+    match value.get("format_version").and_then(serde_json::Value::as_u64) {
+        Some(v) if v == u64::from(MODEL_FORMAT_VERSION) => Ok(()),
+        Some(found) => Err(RecognizeError::Version {
+            path: origin.to_string(),
+            found,
+            expected: MODEL_FORMAT_VERSION,
+        }),
+        None => Err(RecognizeError::NotAModel {
+            path: origin.to_string(),
+            what: "no unsigned 'format_version' field".into(),
+        }),
+    }
+}
