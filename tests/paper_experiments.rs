@@ -163,6 +163,10 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     );
     assert_eq!(values("resolution").len(), 3);
     assert_eq!(values("noise").len(), 4);
+    assert_eq!(
+        values("training-size"),
+        BTreeSet::from(["100".into(), "300".into(), "1000".into()])
+    );
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");

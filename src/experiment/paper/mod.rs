@@ -15,6 +15,7 @@
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
 //! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
+//! | `training-size` | beyond | training readings per object (100, 300, 1000) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` ([`data`]).
@@ -51,11 +52,13 @@ pub enum PaperExperiment {
     Letters,
     RealFrames,
     SimToReal,
+    TrainingSize,
 }
 
 impl PaperExperiment {
-    /// Every experiment, in the order `reproduce` runs them (the paper's figure order).
-    pub const ALL: [PaperExperiment; 11] = [
+    /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
+    /// experiments beyond the paper).
+    pub const ALL: [PaperExperiment; 12] = [
         Self::Descriptors,
         Self::Strategy,
         Self::Validation,
@@ -67,6 +70,7 @@ impl PaperExperiment {
         Self::Letters,
         Self::RealFrames,
         Self::SimToReal,
+        Self::TrainingSize,
     ];
 
     /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve, and
@@ -83,6 +87,7 @@ impl PaperExperiment {
             Self::Convergence | Self::RealFrames => return None,
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
+            Self::TrainingSize => figures::training_size(),
         })
     }
 

@@ -80,6 +80,9 @@ pub struct Setting {
     pub label: String,
     pub sensor: SensorConfig,
     pub sampler: SamplerConfig,
+    /// Share of the scale's training readings per object this setting trains on (1 in the paper's
+    /// figures; the training-size experiment varies it).
+    pub training_fraction: f64,
     pub curves: Vec<Curve>,
 }
 
@@ -96,6 +99,7 @@ impl Setting {
             label: value.clone(),
             sensor,
             sampler,
+            training_fraction: 1.0,
             curves: vec![Curve { value, test }],
         }
     }
@@ -158,6 +162,7 @@ impl RecognitionSweep {
         let counts = context.scale.counts();
         let training = training_config(context.seed, counts, objects.specs.len());
         let plans = self.unit_plans()?;
+        let setting_counts = |setting: usize| self.setting_counts(setting, counts);
 
         let name = SafeName::new(self.name)?;
         let dir = ExperimentDir::new(&context.options.out, &name);
@@ -169,7 +174,7 @@ impl RecognitionSweep {
             .collect();
         let mut requests = Vec::new();
         for plan in &pending {
-            requests.extend(self.requests(context, &objects, plan.setting, counts));
+            requests.extend(self.requests(context, &objects, plan.setting, setting_counts(plan.setting)));
         }
         context.store.prepare(&requests)?;
 
@@ -181,7 +186,8 @@ impl RecognitionSweep {
             .iter()
             .map(|plan| {
                 let objects = Arc::clone(&objects);
-                let training = training.clone();
+                let counts = setting_counts(plan.setting);
+                let training = training_config(context.seed, counts, objects.specs.len());
                 let real = real.clone();
                 let setting = plan.setting;
                 let descriptor = plan.descriptor;
@@ -241,6 +247,15 @@ impl RecognitionSweep {
     }
 
     /// The sensor of a setting with the run's noise stream.
+    /// The scale's data counts with `setting`'s share of the training readings (at least one).
+    fn setting_counts(&self, setting: usize, counts: DataCounts) -> DataCounts {
+        let fraction = self.settings[setting].training_fraction;
+        DataCounts {
+            training_per_object: ((counts.training_per_object as f64 * fraction).round() as usize).max(1),
+            ..counts
+        }
+    }
+
     fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
         SensorConfig {
             noise_seed: rng::substream(context.seed, NOISE_STREAM),
@@ -493,4 +508,34 @@ fn real_trials(
             (trial_seed, object_trials)
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::figures;
+    use super::*;
+
+    #[test]
+    fn training_size_settings_train_on_their_share_of_the_readings() {
+        let sweep = figures::training_size();
+        let paper = DataCounts {
+            training_per_object: 1000,
+            validation_per_object: 100,
+            test_per_object: 100,
+            trials: 3,
+        };
+        let trained: Vec<usize> = (0..sweep.settings.len())
+            .map(|s| sweep.setting_counts(s, paper).training_per_object)
+            .collect();
+        assert_eq!(trained, figures::TRAINING_SIZES);
+        // Everything but the training readings is the scale's; a tiny scale still trains on one.
+        assert_eq!(sweep.setting_counts(0, paper).test_per_object, 100);
+        let tiny = DataCounts {
+            training_per_object: 2,
+            ..paper
+        };
+        assert_eq!(sweep.setting_counts(0, tiny).training_per_object, 1);
+        let labels: Vec<&str> = sweep.settings.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(labels, ["100", "300", "1000"]);
+    }
 }
