@@ -298,13 +298,16 @@ fn python_reads_the_shipped_scene_as_rust_does_for_the_same_qpos() {
     };
     let lib = plugin_library();
     let (mut scene, sensor) = shipped_scene_at_touch();
-    // The keyframe, and the forearm tilted 0.01 rad further down (a deeper, tilted press).
+    // The keyframe, and the forearm turned 2 mrad back up: the pad tilts, slides 0.4 mm off the
+    // cylinder's centre and presses 0.08 mm deeper.
     let forearm_y = 5;
-    for tilt_rad in [0.0, 0.01] {
+    let mut previous: Option<Vec<f64>> = None;
+    for tilt_rad in [0.0, -0.002] {
         scene.data_mut().qpos_mut()[forearm_y] += tilt_rad;
         scene.forward();
         let qpos = scene.data().qpos().to_vec();
         let rust = scene.data().sensordata().to_vec();
+        assert_ne!(previous.replace(rust.clone()), Some(rust.clone()), "the tilt changes the image");
         let image = sensor.read(scene.data()).unwrap();
         assert!(image.max() > 0.3 && image.values().iter().all(|v| (0.0..=1.0).contains(v)));
         let (values, tiles) = python_reading(&python, &lib, &repo().join("mjcf/scene.xml"), &qpos);
