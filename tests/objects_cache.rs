@@ -28,7 +28,11 @@ fn text(bytes: &[u8]) -> String {
 
 fn entries(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
         .unwrap_or_default();
     names.sort();
     names
@@ -37,10 +41,7 @@ fn entries(dir: &Path) -> Vec<String> {
 #[test]
 fn the_cache_folder_follows_taction_cache_then_xdg_then_home() {
     let os = |s: &'static str| Some(OsStr::new(s));
-    assert_eq!(
-        cache_root_from(os("/c"), os("/x"), os("/h")),
-        PathBuf::from("/c")
-    );
+    assert_eq!(cache_root_from(os("/c"), os("/x"), os("/h")), PathBuf::from("/c"));
     assert_eq!(
         cache_root_from(None, os("/x"), os("/h")),
         PathBuf::from("/x/taction")
@@ -79,12 +80,23 @@ fn two_working_folders_share_one_announced_download() {
 
     let second = fetch_in(two.path(), &[("XDG_CACHE_HOME", &xdg)], &[]);
     assert!(second.status.success(), "{}", text(&second.stderr));
-    assert!(text(&second.stdout).contains("already present"), "{}", text(&second.stdout));
-    assert!(!text(&second.stderr).contains("downloading"), "{}", text(&second.stderr));
+    assert!(
+        text(&second.stdout).contains("already present"),
+        "{}",
+        text(&second.stdout)
+    );
+    assert!(
+        !text(&second.stderr).contains("downloading"),
+        "{}",
+        text(&second.stderr)
+    );
     assert_eq!(std::fs::metadata(&deb).unwrap().modified().unwrap(), downloaded);
     // Nothing landed in either working folder.
     assert!(entries(one.path()).is_empty() && entries(two.path()).is_empty());
-    assert_eq!(entries(&objects), vec!["cgal-5.5.1-2".to_string(), DEB_FILE.to_string()]);
+    assert_eq!(
+        entries(&objects),
+        vec!["cgal-5.5.1-2".to_string(), DEB_FILE.to_string()]
+    );
 
     // TACTION_CACHE overrides XDG: the package given with --deb, no download, no announcement.
     let own = cache.path().join("own");
@@ -94,7 +106,11 @@ fn two_working_folders_share_one_announced_download() {
         &["--deb", deb.to_str().unwrap()],
     );
     assert!(third.status.success(), "{}", text(&third.stderr));
-    assert!(!text(&third.stderr).contains("downloading"), "{}", text(&third.stderr));
+    assert!(
+        !text(&third.stderr).contains("downloading"),
+        "{}",
+        text(&third.stderr)
+    );
     ObjectCache::new(own.join("objects")).verify().unwrap();
 }
 

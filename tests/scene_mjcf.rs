@@ -10,8 +10,8 @@ use std::process::Command;
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtCatBit, mjtGeom, mjtObj};
 use mujoco_rs::prelude::*;
-use taction::tactile::plugin::{taxel_rgba, taxel_tiles};
 use sensor_support::shipped_scene_at_touch;
+use taction::tactile::plugin::{taxel_rgba, taxel_tiles};
 use taction::tactile::{CoveringSensor, SensorConfig, ensure_registered};
 
 #[test]
@@ -102,11 +102,20 @@ fn visualize_draws_each_taxel_in_front_of_the_pad_coloured_by_its_value() {
         assert!((center - want.center_m).length() < 1e-6, "taxel {k}");
         // In front of the pad: inside the covering, half its thickness along the normal.
         let depth = (center - pose.center_m).dot(pose.normal);
-        assert!((depth - 0.5 * config.thickness_m).abs() < 1e-6, "taxel {k}: {depth}");
+        assert!(
+            (depth - 0.5 * config.thickness_m).abs() < 1e-6,
+            "taxel {k}: {depth}"
+        );
     }
     // Row 0 is the pad's up edge, column 0 its left edge seen from behind (right = normal x up).
     let right = pose.normal.cross(pose.up);
-    let c = |k: usize| DVec3::new(tiles[k].pos[0] as f64, tiles[k].pos[1] as f64, tiles[k].pos[2] as f64);
+    let c = |k: usize| {
+        DVec3::new(
+            tiles[k].pos[0] as f64,
+            tiles[k].pos[1] as f64,
+            tiles[k].pos[2] as f64,
+        )
+    };
     assert!((c(0) - c(6)).dot(pose.up) > 1.9e-3);
     assert!((c(1) - c(0)).dot(right) > 1.9e-3);
     // A zero taxel and a pressed one get different colours.
@@ -182,7 +191,10 @@ fn scene_export_names_the_flag_of_an_unknown_object_or_bad_sensor() {
     let run = taction(&["scene", "export", "--object", "no_such_thing", "--out", out]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(stderr.contains("--object") && stderr.contains("no_such_thing"), "{stderr}");
+    assert!(
+        stderr.contains("--object") && stderr.contains("no_such_thing"),
+        "{stderr}"
+    );
     let run = taction(&["scene", "export", "--object", "pawn", "--rows", "0", "--out", out]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);

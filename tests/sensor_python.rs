@@ -124,7 +124,13 @@ fn plugin_library() -> PathBuf {
         String::from_utf8_lossy(&out.stderr)
     );
     let lib = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
-    assert_eq!(lib, target_dir().join("release/libtaction_covering.so").canonicalize().unwrap());
+    assert_eq!(
+        lib,
+        target_dir()
+            .join("release/libtaction_covering.so")
+            .canonicalize()
+            .unwrap()
+    );
     lib
 }
 
@@ -273,7 +279,11 @@ fn python_reading(python: &Path, lib: &Path, xml: &Path, qpos: &[f64]) -> (Vec<f
     let dir = tempfile::tempdir().unwrap();
     let script = dir.path().join("qpos.py");
     std::fs::write(&script, QPOS_SCRIPT).unwrap();
-    let qpos = qpos.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(",");
+    let qpos = qpos
+        .iter()
+        .map(|v| format!("{v:?}"))
+        .collect::<Vec<_>>()
+        .join(",");
     let stdout = run_python(
         python,
         dir.path(),
@@ -307,14 +317,21 @@ fn python_reads_the_shipped_scene_as_rust_does_for_the_same_qpos() {
         scene.forward();
         let qpos = scene.data().qpos().to_vec();
         let rust = scene.data().sensordata().to_vec();
-        assert_ne!(previous.replace(rust.clone()), Some(rust.clone()), "the tilt changes the image");
+        assert_ne!(
+            previous.replace(rust.clone()),
+            Some(rust.clone()),
+            "the tilt changes the image"
+        );
         let image = sensor.read(scene.data()).unwrap();
         assert!(image.max() > 0.3 && image.values().iter().all(|v| (0.0..=1.0).contains(v)));
         let (values, tiles) = python_reading(&python, &lib, &repo().join("mjcf/scene.xml"), &qpos);
         let difference = max_difference(&values, &rust);
         println!("tilt {tilt_rad} rad: Python vs Rust sensordata, largest difference {difference:e}");
         assert!(difference <= 1e-6, "Python {values:?}\nRust {rust:?}");
-        assert_eq!(tiles, 36, "the plugin draws one box per taxel in Python's MjvScene");
+        assert_eq!(
+            tiles, 36,
+            "the plugin draws one box per taxel in Python's MjvScene"
+        );
     }
 }
 
@@ -326,7 +343,9 @@ fn python_reads_an_exported_scene_as_the_rust_scene_builder_does() {
     let lib = plugin_library();
     let dir = tempfile::tempdir().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(["scene", "export", "--object", "pawn", "--rows", "8", "--cols", "8"])
+        .args([
+            "scene", "export", "--object", "pawn", "--rows", "8", "--cols", "8",
+        ])
         .args(["--thickness-m", "0.002", "--out"])
         .arg(dir.path())
         .output()
@@ -398,7 +417,11 @@ fn assert_is_the_touch_image(printed: &[Vec<f64>], decimals: i32) {
     assert_eq!(flat.len(), 36, "{printed:?}");
     assert!(flat.iter().all(|v| (0.0..=1.0).contains(v)) && flat.iter().any(|&v| v > 0.0));
     let tolerance = 0.5 * 10f64.powi(-decimals) + 1e-12;
-    assert!(max_difference(&flat, rust.values()) <= tolerance, "{flat:?}\n{:?}", rust.values());
+    assert!(
+        max_difference(&flat, rust.values()) <= tolerance,
+        "{flat:?}\n{:?}",
+        rust.values()
+    );
 }
 
 #[test]

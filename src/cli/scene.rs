@@ -90,7 +90,13 @@ fn resolve_object(object: &str) -> Result<BuiltObject, SceneExportError> {
 fn file_stem(name: &str) -> String {
     let stem: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     if stem.is_empty() { "object".into() } else { stem }
 }
@@ -100,7 +106,10 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     let config = args.sensor.config(args.seed)?;
     let built = resolve_object(&args.object)?;
     if !built.warnings.is_clean() {
-        eprintln!("taction scene export: warning: {}: {}", args.object, built.warnings);
+        eprintln!(
+            "taction scene export: warning: {}: {}",
+            args.object, built.warnings
+        );
     }
     let mesh_file = format!("{}.obj", file_stem(&built.name));
     let spec = ObjectSpec::new(built.name.clone(), built.mesh);

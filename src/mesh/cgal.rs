@@ -363,7 +363,11 @@ fn process_alive(pid: u32) -> bool {
 /// address comes from apt itself (`apt-get download --print-uris`), which may know a local mirror.
 fn announce_download(cache_root: &Path) {
     let uri = Command::new("apt-get")
-        .args(["download", "--print-uris", &format!("{PACKAGE}={PACKAGE_VERSION}")])
+        .args([
+            "download",
+            "--print-uris",
+            &format!("{PACKAGE}={PACKAGE_VERSION}"),
+        ])
         .stderr(Stdio::null())
         .output()
         .ok()

@@ -87,7 +87,10 @@ impl ObjectSpec {
             });
         }
         let asset = match mesh_file {
-            Some(file) => format!("<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>", escape_attr(file)),
+            Some(file) => format!(
+                "<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>",
+                escape_attr(file)
+            ),
             None => {
                 let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
                 let face = self

@@ -280,7 +280,11 @@ const TILE_FILL: f64 = 0.9;
 /// at full compression, so that the image reads in the viewer as it does in `taction sense` PNGs
 /// (brighter = deeper).
 pub fn taxel_rgba(value: f64) -> [f32; 4] {
-    let v = if value.is_finite() { value.clamp(0.0, 1.0) } else { 0.0 } as f32;
+    let v = if value.is_finite() {
+        value.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } as f32;
     let dark = [0.10, 0.12, 0.35];
     let bright = [1.0, 0.85, 0.25];
     [
@@ -295,7 +299,12 @@ pub fn taxel_rgba(value: f64) -> [f32; 4] {
 /// edge seen from behind the pad, as in `sensordata`), for a pad site at `site_pos_m` with
 /// world-from-site rotation `site_frame` (columns: site x, up, normal). Each tile fills the
 /// covering's depth (Sec. V-A2: the viewing volume) over its taxel.
-pub fn taxel_tiles(config: &SensorConfig, site_pos_m: DVec3, site_frame: DMat3, values: &[f64]) -> Vec<TaxelTile> {
+pub fn taxel_tiles(
+    config: &SensorConfig,
+    site_pos_m: DVec3,
+    site_frame: DMat3,
+    values: &[f64],
+) -> Vec<TaxelTile> {
     let pitch_x = config.pad_width_m / config.cols as f64;
     let pitch_y = config.pad_height_m / config.rows as f64;
     let half_size_m = [

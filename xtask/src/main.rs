@@ -102,7 +102,13 @@ fn setup() -> Result<(), String> {
 /// finds `target/release/libtaction_covering.so` after the first command. It shares the release
 /// dependency build with `demo`, `run` and `bench`; when nothing changed cargo does no work.
 fn build_plugin_library() -> Result<(), String> {
-    cargo(&os(&["build", "--release", "--quiet", "--package", "taction-plugin"]))?;
+    cargo(&os(&[
+        "build",
+        "--release",
+        "--quiet",
+        "--package",
+        "taction-plugin",
+    ]))?;
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| project_root().join("target"));
