@@ -34,6 +34,11 @@ enum Command {
     /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
     Objects(cli::objects::ObjectsArgs),
     /// Print the absolute path of the taction.covering MuJoCo plugin library (for mj_loadPluginLibrary).
+    ///
+    /// `cargo xtask setup` builds it (target/release/libtaction_covering.so). Python:
+    /// `mujoco.mj_loadPluginLibrary(path)` before loading a model that uses the sensor, or copy the
+    /// library into `mujoco.PLUGINS_DIR` (the plugin/ folder of the installed mujoco package), which
+    /// every `import mujoco` loads, `python -m mujoco.viewer` included.
     PluginPath(cli::plugin_path::PluginPathArgs),
     /// The world as MJCF for MuJoCo's own tools: `scene export` writes arm, table, an object and the sensor.
     Scene(cli::scene::SceneArgs),

@@ -86,21 +86,6 @@ fn resolve_object(object: &str) -> Result<BuiltObject, SceneExportError> {
     Err(SceneExportError::UnknownObject(object.into()))
 }
 
-/// A file name from an object name: letters, digits, `_` and `-` kept, anything else `_`.
-fn file_stem(name: &str) -> String {
-    let stem: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    if stem.is_empty() { "object".into() } else { stem }
-}
-
 /// Writes the scene and its mesh; returns the scene file's path.
 pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let config = args.sensor.config(args.seed)?;
@@ -111,7 +96,8 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
             args.object, built.warnings
         );
     }
-    let mesh_file = format!("{}.obj", file_stem(&built.name));
+    // Named as `taction objects export` names its files.
+    let mesh_file = format!("{}.obj", built.name);
     let spec = ObjectSpec::new(built.name.clone(), built.mesh);
     let builder = SceneBuilder::with_arm_and_table()
         .object(spec.clone())
