@@ -320,9 +320,7 @@ impl ObjectCache {
         std::fs::rename(&meshes, &target).map_err(io(&target))?;
         Ok(())
     }
-}
 
-impl ObjectCache {
     /// Removes the staging and damaged-cache folders of fetches whose process is gone (killed
     /// mid-fetch, so their own clean-up never ran) or that are older than an hour. Folders of
     /// live fetches are left alone: several processes may fetch at once.
@@ -345,7 +343,7 @@ impl ObjectCache {
                 .ok()
                 .and_then(|t| t.elapsed().ok())
                 .is_some_and(|age| age > STALE_AFTER);
-            if old || pid.is_some_and(|pid| !process_alive(pid)) || pid.is_none() {
+            if old || pid.is_none_or(|pid| !process_alive(pid)) {
                 let _ = std::fs::remove_dir_all(entry.path());
             }
         }
