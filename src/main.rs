@@ -33,6 +33,15 @@ enum Command {
     Merge(cli::merge::MergeArgs),
     /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
     Objects(cli::objects::ObjectsArgs),
+    /// Print the absolute path of the taction.covering MuJoCo plugin library (for mj_loadPluginLibrary).
+    ///
+    /// `cargo xtask setup` builds it (target/release/libtaction_covering.so). Python:
+    /// `mujoco.mj_loadPluginLibrary(path)` before loading a model that uses the sensor, or copy the
+    /// library into `mujoco.PLUGINS_DIR` (the plugin/ folder of the installed mujoco package), which
+    /// every `import mujoco` loads, `python -m mujoco.viewer` included.
+    PluginPath(cli::plugin_path::PluginPathArgs),
+    /// The world as MJCF for MuJoCo's own tools: `scene export` writes arm, table, an object and the sensor.
+    Scene(cli::scene::SceneArgs),
     /// One raw reading of the free-floating tactile sensor on a mesh, written as CSV or PNG.
     Sense(cli::sense::SenseArgs),
     /// Show what a dataset file holds: objects, readings per object and status, sensor configuration.
@@ -55,6 +64,8 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => cli::experiment::run_reproduce(args),
         Command::Merge(args) => cli::merge::run(args),
         Command::Objects(args) => cli::objects::run(args),
+        Command::PluginPath(args) => cli::plugin_path::run(args),
+        Command::Scene(args) => cli::scene::run(args),
         Command::Sense(args) => cli::sense::run(args),
         Command::Dataset(args) => cli::dataset::run(args),
         Command::Recognize(args) => cli::recognize::run(args),

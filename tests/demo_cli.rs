@@ -10,17 +10,13 @@ use std::process::Command;
 const TOUCHES: usize = 2;
 const HEADER: &str = "touch,object_true,object_guess,p_guess,p_true,entropy_nats";
 
-/// `taction demo ARGS` run in `cwd` (where its default `results/demo` lands), with the CGAL meshes
-/// `cargo xtask setup` fetched.
+/// `taction demo ARGS` run in `cwd` (where its default `results/demo` lands); the CGAL meshes come
+/// from the user's cache whatever `cwd` is.
 fn taction_demo(cwd: &Path, args: &[&str]) -> (bool, String, String) {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
         .arg("demo")
         .args(args)
         .current_dir(cwd)
-        .env(
-            "TACTION_OBJECTS_DIR",
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(".runtime/objects"),
-        )
         .output()
         .expect("the taction binary runs");
     (

@@ -14,7 +14,8 @@ use taction::mesh::{BuildOptions, MeshError, ObjectSet, ObjectSource, write_obj}
 pub struct ObjectsArgs {
     #[command(subcommand)]
     pub command: ObjectsCommand,
-    /// Cache of fetched meshes [default: $TACTION_OBJECTS_DIR, or .runtime/objects].
+    /// Cache of fetched meshes [default: $TACTION_CACHE/objects, else $XDG_CACHE_HOME/taction/objects,
+    /// else ~/.cache/taction/objects].
     #[arg(long, global = true, value_name = "DIR")]
     pub cache: Option<PathBuf>,
 }

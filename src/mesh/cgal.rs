@@ -1,6 +1,11 @@
 //! The ten real meshes of the 3D object set, fetched from Debian's `libcgal-demo` package (CGAL's
-//! demo data; files without a copyright notice are CC0 per the package's copyright file) into a
-//! project-local cache, pinned by checksums.
+//! demo data; files without a copyright notice are CC0 per the package's copyright file) into the
+//! user's cache folder, pinned by checksums.
+//!
+//! The cache is shared by every working folder: `$TACTION_CACHE/objects` when that variable is set,
+//! else `$XDG_CACHE_HOME/taction/objects`, else `~/.cache/taction/objects` (the XDG base directory
+//! convention), so a second checkout or a run from another folder downloads nothing. The first
+//! download says on stderr what it fetches, from where and how large.
 //!
 //! The paper used ten Princeton Shape Benchmark models (Sec. V-B, Fig. 5), which cannot be obtained
 //! here; these ten cover a similar range of surface character: organic scans (dragon, bunny, hand),
@@ -34,10 +39,14 @@ pub const DEB_FILE: &str = "libcgal-demo_5.5.1-2_all.deb";
 pub const DEB_SHA256: &str = "78b09b23d4d6d1bf15552a1060b419ab3fc09918486462faed197e5fc6ac3735";
 const DATA_TARBALL: &str = "usr/share/doc/libcgal-dev/data.tar.gz";
 const MESH_FOLDER: &str = "data/meshes/";
-/// Environment variable that overrides the cache folder.
-pub const CACHE_ENV: &str = "TACTION_OBJECTS_DIR";
-/// The default cache folder, relative to the current directory (git-ignored under `.runtime/`).
-pub const DEFAULT_CACHE_DIR: &str = ".runtime/objects";
+/// Size of [`DEB_FILE`], bytes (announced before a download).
+pub const DEB_BYTES: u64 = 24_358_884;
+/// Environment variable naming taction's cache folder; it overrides the platform's.
+pub const CACHE_ENV: &str = "TACTION_CACHE";
+/// The object meshes' folder inside taction's cache folder.
+pub const OBJECTS_SUBDIR: &str = "objects";
+/// A staging folder left by a fetch this old is abandoned whatever its process id says.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(3600);
 
 /// How to fill the cache, for messages.
 pub const FETCH_HINT: &str = "run `taction objects fetch` (or `cargo run --release -- objects fetch`) \
@@ -133,7 +142,38 @@ pub fn cgal_mesh(name: &str) -> Option<&'static CgalMesh> {
     CGAL_MESHES.iter().find(|m| m.name == name)
 }
 
-/// The project-local cache of fetched meshes.
+/// taction's cache folder from the environment's values: `taction_cache` (`$TACTION_CACHE`) when
+/// set, else `xdg_cache_home/taction` (`$XDG_CACHE_HOME`, used only when absolute, as the XDG base
+/// directory specification says), else `home/.cache/taction`, else `taction-cache` in the system's
+/// temporary folder (no home at all). Empty values count as unset.
+pub fn cache_root_from(
+    taction_cache: Option<&std::ffi::OsStr>,
+    xdg_cache_home: Option<&std::ffi::OsStr>,
+    home: Option<&std::ffi::OsStr>,
+) -> PathBuf {
+    let set = |v: Option<&std::ffi::OsStr>| v.filter(|v| !v.is_empty()).map(PathBuf::from);
+    if let Some(dir) = set(taction_cache) {
+        return dir;
+    }
+    if let Some(xdg) = set(xdg_cache_home).filter(|p| p.is_absolute()) {
+        return xdg.join("taction");
+    }
+    match set(home) {
+        Some(home) => home.join(".cache").join("taction"),
+        None => std::env::temp_dir().join("taction-cache"),
+    }
+}
+
+/// taction's cache folder for this process's environment (see [`cache_root_from`]).
+pub fn cache_root() -> PathBuf {
+    cache_root_from(
+        std::env::var_os(CACHE_ENV).as_deref(),
+        std::env::var_os("XDG_CACHE_HOME").as_deref(),
+        std::env::var_os("HOME").as_deref(),
+    )
+}
+
+/// The cache of fetched meshes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ObjectCache {
     root: PathBuf,
@@ -165,12 +205,9 @@ impl ObjectCache {
         Self { root: root.into() }
     }
 
-    /// The cache at `$TACTION_OBJECTS_DIR`, or `.runtime/objects` under the current directory.
+    /// The user's cache: the `objects` folder of [`cache_root`], whatever the current directory.
     pub fn from_env() -> Self {
-        match std::env::var_os(CACHE_ENV) {
-            Some(dir) if !dir.is_empty() => Self::new(dir),
-            _ => Self::new(DEFAULT_CACHE_DIR),
-        }
+        Self::new(cache_root().join(OBJECTS_SUBDIR))
     }
 
     pub fn root(&self) -> &Path {
@@ -241,6 +278,7 @@ impl ObjectCache {
             move |source| MeshError::Io { path, source }
         };
         std::fs::create_dir_all(&self.root).map_err(io(&self.root))?;
+        self.remove_abandoned_staging();
         let staging = Staging(self.root.join(format!(".staging-{}", unique_suffix())));
         std::fs::create_dir_all(&staging.0).map_err(io(&staging.0))?;
 
@@ -250,6 +288,7 @@ impl ObjectCache {
                 self.deb_path()
             }
             None => {
+                announce_download(&self.root);
                 apt_download(&staging.0)?;
                 let downloaded = staging.0.join(DEB_FILE);
                 check_sha256(&downloaded, &sha256_file(&downloaded)?, DEB_SHA256)?;
@@ -281,6 +320,67 @@ impl ObjectCache {
         std::fs::rename(&meshes, &target).map_err(io(&target))?;
         Ok(())
     }
+
+    /// Removes the staging and damaged-cache folders of fetches whose process is gone (killed
+    /// mid-fetch, so their own clean-up never ran) or that are older than an hour. Folders of
+    /// live fetches are left alone: several processes may fetch at once.
+    fn remove_abandoned_staging(&self) {
+        let Ok(entries) = std::fs::read_dir(&self.root) else {
+            return;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let Some(rest) = name
+                .strip_prefix(".staging-")
+                .or_else(|| name.strip_prefix(".damaged-"))
+            else {
+                continue;
+            };
+            let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
+            let old = entry
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age > STALE_AFTER);
+            if old || pid.is_none_or(|pid| !process_alive(pid)) {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+    }
+}
+
+/// Whether process `pid` is running, where `/proc` tells (Linux); elsewhere every process is
+/// assumed alive, so only age removes staging folders.
+fn process_alive(pid: u32) -> bool {
+    let proc_root = Path::new("/proc");
+    !proc_root.join("self").exists() || proc_root.join(pid.to_string()).exists()
+}
+
+/// Says on stderr, before the first download, what is fetched, from where and how large. The
+/// address comes from apt itself (`apt-get download --print-uris`), which may know a local mirror.
+fn announce_download(cache_root: &Path) {
+    let uri = Command::new("apt-get")
+        .args([
+            "download",
+            "--print-uris",
+            &format!("{PACKAGE}={PACKAGE_VERSION}"),
+        ])
+        .stderr(Stdio::null())
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| {
+            let text = String::from_utf8_lossy(&o.stdout).into_owned();
+            text.split('\'').nth(1).map(str::to_string)
+        })
+        .unwrap_or_else(|| "the Debian archive through apt (your apt sources)".into());
+    eprintln!(
+        "taction: first use of the CGAL object meshes: downloading Debian's {PACKAGE} {PACKAGE_VERSION} \
+         ({:.1} MB) from {uri} into {} (shared by every working folder; set {CACHE_ENV} to move it)",
+        DEB_BYTES as f64 / 1e6,
+        cache_root.display()
+    );
 }
 
 fn check_sha256(path: &Path, actual: &str, expected: &str) -> Result<(), MeshError> {

@@ -62,13 +62,20 @@ impl ObjectSpec {
         Ok(built.into_iter().map(|b| Self::new(b.name, b.mesh)).collect())
     }
 
-    /// Adds the mesh asset and the object body to `doc`.
+    /// Adds the mesh asset (its vertices and faces inline) and the object body to `doc`.
+    pub fn add_to(&self, doc: &mut Document) -> Result<(), SimError> {
+        self.add_to_with_mesh(doc, None)
+    }
+
+    /// Adds the mesh asset and the object body to `doc`; with `mesh_file`, the asset refers to that
+    /// file (relative to the MJCF file, which the caller writes beside it) instead of holding the
+    /// vertices inline, as a scene exported for MuJoCo users does.
     ///
     /// The geom collides with the arm and the table (MuJoCo uses the mesh's convex hull for these
     /// contacts; the tactile sensor raycasts the exact triangles). The body gets an explicit inertia (a
     /// solid sphere of the mesh's bounding radius), so that open or thin user meshes, whose volume
     /// MuJoCo cannot compute, still load.
-    pub fn add_to(&self, doc: &mut Document) -> Result<(), SimError> {
+    pub fn add_to_with_mesh(&self, doc: &mut Document, mesh_file: Option<&str>) -> Result<(), SimError> {
         let (lo, hi) = self.mesh.bounds().ok_or_else(|| SimError::Object {
             name: self.name.clone(),
             message: "the mesh has no vertices".into(),
@@ -79,19 +86,25 @@ impl ObjectSpec {
                 message: "the mesh has no triangles".into(),
             });
         }
-        let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
-        let face = self
-            .mesh
-            .triangles
-            .iter()
-            .flatten()
-            .map(|i| i.to_string())
-            .collect::<Vec<_>>()
-            .join(" ");
-        doc.add(
-            Section::Asset,
-            format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"),
-        );
+        let asset = match mesh_file {
+            Some(file) => format!(
+                "<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>",
+                escape_attr(file)
+            ),
+            None => {
+                let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
+                let face = self
+                    .mesh
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .map(|i| i.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
+            }
+        };
+        doc.add(Section::Asset, asset);
 
         // Contacts go through the shell (see `collision_shell`), the sensor reads the exact mesh.
         let mut shell = String::new();

@@ -18,6 +18,8 @@ pub struct SceneBuilder {
     arm: bool,
     table: bool,
     object: Option<ObjectSpec>,
+    /// File the object's mesh asset refers to, instead of inline vertices.
+    object_mesh_file: Option<String>,
     extra: Vec<(Section, String)>,
     timestep_s: Option<f64>,
 }
@@ -44,6 +46,15 @@ impl SceneBuilder {
 
     pub fn object(mut self, object: ObjectSpec) -> Self {
         self.object = Some(object);
+        self
+    }
+
+    /// Makes the object's mesh asset refer to `file` (relative to where the MJCF is written; the
+    /// caller writes the mesh there) instead of holding its vertices inline: for a scene written
+    /// out for MuJoCo's own tools. [`build`](Self::build) compiles from a string, which cannot
+    /// resolve the file, so such a builder is only for [`to_xml`](Self::to_xml).
+    pub fn object_mesh_file(mut self, file: impl Into<String>) -> Self {
+        self.object_mesh_file = Some(file.into());
         self
     }
 
@@ -77,7 +88,7 @@ impl SceneBuilder {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
         if let Some(object) = &self.object {
-            object.add_to(&mut doc)?;
+            object.add_to_with_mesh(&mut doc, self.object_mesh_file.as_deref())?;
         }
         for (section, xml) in &self.extra {
             doc.add(*section, xml.clone());

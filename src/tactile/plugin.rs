@@ -18,6 +18,10 @@
 //! the same noise sequence. Everything else (BVHs, buffers) lives in a [`Covering`] behind
 //! `plugin_data`, built in `init` and freed in `destroy`.
 //!
+//! The `visualize` callback draws each sensor's taxel grid as small boxes in the covering, in front
+//! of the pad, coloured by the taxel values of the last reading, so MuJoCo's viewer
+//! (`python -m mujoco.viewer`) shows the tactile image live on the arm.
+//!
 //! A bad config value fails compilation: `init` raises `mju_error` with a message naming the key
 //! and its allowed range, which MuJoCo's compiler turns into the load error (as MuJoCo's own
 //! plugins do).
@@ -25,9 +29,11 @@
 use std::ffi::{CStr, c_char, c_int, c_void};
 use std::sync::Once;
 
+use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{
     mj_getPluginConfig, mjData, mjModel, mjp_defaultPlugin, mjp_getPluginAtSlot, mjp_registerPlugin,
-    mjpPlugin, mjtNum, mjtPluginCapabilityBit, mjtSensor, mjtStage, mju_error, mju_warning,
+    mjpPlugin, mjtCatBit, mjtGeom, mjtNum, mjtObj, mjtPluginCapabilityBit, mjtSensor, mjtStage, mju_error,
+    mju_warning, mjv_initGeom, mjvOption, mjvScene,
 };
 
 use crate::tactile::config::{ConfigKey, SensorConfig};
@@ -78,6 +84,7 @@ pub fn register() {
             plugin.destroy = Some(destroy);
             plugin.reset = Some(reset);
             plugin.compute = Some(compute);
+            plugin.visualize = Some(visualize);
             mjp_registerPlugin(&plugin);
         }
     });
@@ -251,5 +258,141 @@ pub unsafe fn instance_state<'d>(m: &mjModel, d: &'d mjData, instance: usize) ->
     unsafe {
         let ptr = *d.plugin_data.add(instance) as *const Covering;
         ptr.as_ref()
+    }
+}
+
+/// One drawn taxel: a box in the covering in front of the pad, in world coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TaxelTile {
+    /// Box centre, world metres.
+    pub center_m: DVec3,
+    /// Half extents along the pad's x, up and normal axes, metres.
+    pub half_size_m: [f64; 3],
+    /// Box orientation: the pad site's frame (columns x, up, normal), world.
+    pub frame: DMat3,
+    pub rgba: [f32; 4],
+}
+
+/// Fraction of the taxel pitch a drawn tile covers, so the grid lines between taxels stay visible.
+const TILE_FILL: f64 = 0.9;
+
+/// The colour of a taxel value in [0, 1]: dark blue for no contact through orange to pale yellow
+/// at full compression, so that the image reads in the viewer as it does in `taction sense` PNGs
+/// (brighter = deeper).
+pub fn taxel_rgba(value: f64) -> [f32; 4] {
+    let v = if value.is_finite() {
+        value.clamp(0.0, 1.0)
+    } else {
+        0.0
+    } as f32;
+    let dark = [0.10, 0.12, 0.35];
+    let bright = [1.0, 0.85, 0.25];
+    [
+        dark[0] + (bright[0] - dark[0]) * v,
+        dark[1] + (bright[1] - dark[1]) * v,
+        dark[2] + (bright[2] - dark[2]) * v,
+        0.85,
+    ]
+}
+
+/// The tiles of one sensor's image (row-major `values`, row 0 the pad's up edge, column 0 its left
+/// edge seen from behind the pad, as in `sensordata`), for a pad site at `site_pos_m` with
+/// world-from-site rotation `site_frame` (columns: site x, up, normal). Each tile fills the
+/// covering's depth (Sec. V-A2: the viewing volume) over its taxel.
+pub fn taxel_tiles(
+    config: &SensorConfig,
+    site_pos_m: DVec3,
+    site_frame: DMat3,
+    values: &[f64],
+) -> Vec<TaxelTile> {
+    let pitch_x = config.pad_width_m / config.cols as f64;
+    let pitch_y = config.pad_height_m / config.rows as f64;
+    let half_size_m = [
+        0.5 * TILE_FILL * pitch_x,
+        0.5 * TILE_FILL * pitch_y,
+        0.5 * config.thickness_m,
+    ];
+    let mut tiles = Vec::with_capacity(config.taxel_count());
+    for row in 0..config.rows {
+        for col in 0..config.cols {
+            // Columns run along the pad's right = normal x up = -site x.
+            let local = DVec3::new(
+                0.5 * config.pad_width_m - (col as f64 + 0.5) * pitch_x,
+                0.5 * config.pad_height_m - (row as f64 + 0.5) * pitch_y,
+                0.5 * config.thickness_m,
+            );
+            let value = values.get(row * config.cols + col).copied().unwrap_or(0.0);
+            tiles.push(TaxelTile {
+                center_m: site_pos_m + site_frame * local,
+                half_size_m,
+                frame: site_frame,
+                rgba: taxel_rgba(value),
+            });
+        }
+    }
+    tiles
+}
+
+unsafe extern "C" fn visualize(
+    m: *const mjModel,
+    d: *mut mjData,
+    _opt: *const mjvOption,
+    scn: *mut mjvScene,
+    instance: c_int,
+) {
+    // SAFETY: MuJoCo passes valid model, data and scene pointers; plugin_data[instance] is our
+    // Covering or null; the site and sensor arrays have the sizes ModelView/PoseView assume; the
+    // scene's geoms array has maxgeom slots, of which ngeom are used.
+    unsafe {
+        let (m, d, scn) = (&*m, &mut *d, &mut *scn);
+        let covering = *d.plugin_data.add(instance as usize) as *const Covering;
+        let Some(covering) = covering.as_ref() else {
+            return;
+        };
+        let config = *covering.config();
+        let model = ModelView::new(m);
+        let poses = PoseView::new(m, d);
+        let sensordata = std::slice::from_raw_parts(d.sensordata, m.nsensordata.max(0) as usize);
+        for sensor in instance_sensors(&model, instance as usize) {
+            let site = model.sensor_objid[sensor].max(0) as usize;
+            let adr = model.sensor_adr[sensor].max(0) as usize;
+            let values = sensordata.get(adr..adr + config.taxel_count()).unwrap_or(&[]);
+            let p = &poses.site_xpos[3 * site..3 * site + 3];
+            let r = &poses.site_xmat[9 * site..9 * site + 9];
+            // site_xmat is row-major; DMat3 takes columns.
+            let frame = DMat3::from_cols(
+                DVec3::new(r[0], r[3], r[6]),
+                DVec3::new(r[1], r[4], r[7]),
+                DVec3::new(r[2], r[5], r[8]),
+            );
+            for tile in taxel_tiles(&config, DVec3::new(p[0], p[1], p[2]), frame, values) {
+                if scn.ngeom >= scn.maxgeom {
+                    if scn.status == 0 {
+                        mju_warning(
+                            c"%s".as_ptr(),
+                            c"taction.covering: the scene's geom buffer is full; some taxels are not drawn (raise maxgeom)"
+                                .as_ptr(),
+                        );
+                        scn.status = 1;
+                    }
+                    return;
+                }
+                let mat = tile.frame.transpose().to_cols_array();
+                let geom = scn.geoms.add(scn.ngeom as usize);
+                mjv_initGeom(
+                    geom,
+                    mjtGeom::mjGEOM_BOX as c_int,
+                    &tile.half_size_m,
+                    &tile.center_m.to_array(),
+                    &mat,
+                    &tile.rgba,
+                );
+                (*geom).objtype = mjtObj::mjOBJ_UNKNOWN as c_int;
+                (*geom).objid = sensor as c_int;
+                (*geom).category = mjtCatBit::mjCAT_DECOR as c_int;
+                (*geom).segid = scn.ngeom;
+                scn.ngeom += 1;
+            }
+        }
     }
 }

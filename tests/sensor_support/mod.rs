@@ -193,3 +193,20 @@ pub fn sharp(rows: usize, cols: usize) -> SensorConfig {
         ..SensorConfig::default()
     }
 }
+
+/// `mjcf/scene.xml` (the arm with the paper's sensor on its pad) compiled, put at its keyframe
+/// "touch" (the pad pressed onto the example object's cylinder rim), after `mj_forward`.
+pub fn shipped_scene_at_touch() -> (taction::sim::Scene, taction::tactile::CoveringSensor) {
+    use mujoco_rs::prelude::*;
+    taction::tactile::ensure_registered();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("mjcf/scene.xml");
+    let model = MjModel::from_xml(path).expect("mjcf/scene.xml compiles");
+    let key = model
+        .name_to_id(MjtObjBase::mjOBJ_KEY, "touch")
+        .expect("mjcf/scene.xml has the keyframe 'touch'");
+    let mut scene = taction::sim::Scene::new(model, None).expect("a scene of mjcf/scene.xml");
+    scene.data_mut().reset_keyframe(key).expect("keyframe 'touch'");
+    scene.forward();
+    let sensor = taction::tactile::CoveringSensor::first(scene.model()).expect("its covering sensor");
+    (scene, sensor)
+}

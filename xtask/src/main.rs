@@ -25,7 +25,9 @@ const USAGE: &str = "\
 usage: cargo xtask <task> [args...]
 
 tasks:
-  setup          fetch and check the MuJoCo runtime if missing (object meshes are fetched on first use)
+  setup          fetch and check the MuJoCo runtime if missing, build the MuJoCo plugin library
+                 (target/release/libtaction_covering.so, for Python and MuJoCo's viewer); object meshes
+                 are fetched on first use
   demo [args]    setup, then `cargo run --release -- demo [args]`
   test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`)
   bench [args]   setup, then `cargo bench [args]`
@@ -92,7 +94,29 @@ fn project_root() -> PathBuf {
 }
 
 fn setup() -> Result<(), String> {
-    ensure_mujoco_runtime(&project_root().join(".runtime"))
+    ensure_mujoco_runtime(&project_root().join(".runtime"))?;
+    build_plugin_library()
+}
+
+/// Builds the `taction.covering` plugin library in release, so that the README's Python recipe
+/// finds `target/release/libtaction_covering.so` after the first command. It shares the release
+/// dependency build with `demo`, `run` and `bench`; when nothing changed cargo does no work.
+fn build_plugin_library() -> Result<(), String> {
+    cargo(&os(&[
+        "build",
+        "--release",
+        "--quiet",
+        "--package",
+        "taction-plugin",
+    ]))?;
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| project_root().join("target"));
+    let library = target.join("release").join("libtaction_covering.so");
+    if !library.is_file() {
+        return Err(format!("the plugin build left no {}", library.display()));
+    }
+    Ok(())
 }
 
 fn cargo(args: &[OsString]) -> Result<(), String> {

@@ -1,0 +1,138 @@
+//! `taction scene export`: the simulated world as a self-contained MJCF for MuJoCo's own tools.
+//!
+//! The scene is the one the arm explores (`SceneBuilder`: the arm of Sec. V-A1, the table, the object
+//! with its collision shell in geom group 3) with the `taction.covering` sensor on the pad site,
+//! configured by the sensor flags. The object's mesh goes beside the MJCF as an OBJ file the mesh
+//! asset refers to. The object is a mocap body at the world origin, resting on the table.
+
+use std::path::{Path, PathBuf};
+
+use clap::{Args, Subcommand};
+use taction::mesh::object_set::BUILTIN_SETS;
+use taction::mesh::{BuildOptions, BuiltObject, MeshError, ObjectSet, write_obj};
+use taction::sim::arm::PAD_SITE;
+use taction::sim::{ObjectSpec, SceneBuilder};
+use taction::tactile::add_sensor;
+
+use crate::cli::plugin_path::PLUGIN_LIBRARY;
+use crate::cli::sensor_args::SensorArgs;
+
+#[derive(Debug, Args)]
+pub struct SceneArgs {
+    #[command(subcommand)]
+    pub command: SceneCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SceneCommand {
+    /// Write DIR/scene.xml (arm, table, object, the covering sensor on the pad) and the object's mesh
+    /// as DIR/<object>.obj; it opens in MuJoCo's viewer once the plugin library is loaded
+    /// (`taction plugin-path`).
+    Export(ExportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The object: a name from a built-in set (`taction objects list`: bunny, pawn, upper_A, ...;
+    /// CGAL meshes are fetched on first use) or an OBJ/OFF/STL file, coordinates in metres.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub object: String,
+    /// Output folder (created if missing); scene.xml and the mesh file are overwritten.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub sensor: SensorArgs,
+    /// Noise seed of the sensor.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+/// What can go wrong; each names the flag or file at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneExportError {
+    #[error("--object: '{0}' is neither an existing mesh file nor an object of the built-in sets ({sets}); `taction objects list` lists them", sets = BUILTIN_SETS.join(", "))]
+    UnknownObject(String),
+    #[error("--object: {0}")]
+    Mesh(#[from] MeshError),
+    #[error("--out: {path}: {source}")]
+    Write { path: PathBuf, source: std::io::Error },
+}
+
+/// The object `--object` names, built as `collect` builds it (resting on z = 0, centred).
+fn resolve_object(object: &str) -> Result<BuiltObject, SceneExportError> {
+    let options = BuildOptions {
+        fetch: true,
+        ..BuildOptions::default()
+    };
+    let path = Path::new(object);
+    if path.is_file() {
+        let set = ObjectSet::from_files("custom", &[path.to_path_buf()], None)?;
+        let name = set
+            .object_names()
+            .first()
+            .map(|n| n.to_string())
+            .ok_or_else(|| SceneExportError::UnknownObject(object.into()))?;
+        return Ok(set.build_object(&name, &options)?);
+    }
+    for set_name in BUILTIN_SETS {
+        // A set that cannot be listed here (the letters without their font) cannot hold the object.
+        let Ok(set) = ObjectSet::builtin(set_name, None) else {
+            continue;
+        };
+        if set.object_names().contains(&object) {
+            return Ok(set.build_object(object, &options)?);
+        }
+    }
+    Err(SceneExportError::UnknownObject(object.into()))
+}
+
+/// Writes the scene and its mesh; returns the scene file's path.
+pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
+    let config = args.sensor.config(args.seed)?;
+    let built = resolve_object(&args.object)?;
+    if !built.warnings.is_clean() {
+        eprintln!(
+            "taction scene export: warning: {}: {}",
+            args.object, built.warnings
+        );
+    }
+    // Named as `taction objects export` names its files.
+    let mesh_file = format!("{}.obj", built.name);
+    let spec = ObjectSpec::new(built.name.clone(), built.mesh);
+    let builder = SceneBuilder::with_arm_and_table()
+        .object(spec.clone())
+        .object_mesh_file(mesh_file.clone());
+    let xml = add_sensor(builder, &config, "tactile", PAD_SITE)?.to_xml()?;
+    let header = format!(
+        "<!--\n  Written by `taction scene export --object {}`: the arm, the table, the object (mesh in {mesh_file},\n  \
+         metres) and the taction.covering sensor on the pad site. Load the plugin library first:\n  \
+         mujoco.mj_loadPluginLibrary(path) with the path `taction plugin-path` prints ({PLUGIN_LIBRARY}),\n  \
+         or copy the library into the plugin/ folder of the mujoco Python package.\n-->\n",
+        args.object.replace("--", "- -")
+    );
+    let write = |path: PathBuf, text: &str| {
+        std::fs::write(&path, text).map_err(|source| SceneExportError::Write { path, source })
+    };
+    std::fs::create_dir_all(&args.out).map_err(|source| SceneExportError::Write {
+        path: args.out.clone(),
+        source,
+    })?;
+    write_obj(
+        &spec.mesh,
+        &args.out.join(&mesh_file),
+        &format!("{}: exported by taction scene export", spec.name),
+    )?;
+    let scene = args.out.join("scene.xml");
+    write(scene.clone(), &format!("{header}{xml}"))?;
+    Ok(scene)
+}
+
+pub fn run(args: &SceneArgs) -> Result<(), Box<dyn std::error::Error>> {
+    match &args.command {
+        SceneCommand::Export(export_args) => {
+            let scene = export(export_args)?;
+            println!("{}", scene.display());
+            Ok(())
+        }
+    }
+}
