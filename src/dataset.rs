@@ -853,19 +853,19 @@ impl fmt::Display for DatasetSummary {
         )?;
         writeln!(
             f,
-            "sensor: {}x{} taxels, pad {} x {} m, covering {} m, PSF sigma {} m, {} rays/taxel ({}), noise {} (seed {})",
+            "sensor: {}x{} taxels, pad {} x {}, covering {}, PSF sigma {}, {} rays/taxel ({}), noise {} (seed {})",
             s.rows,
             s.cols,
-            s.pad_width_m,
-            s.pad_height_m,
-            s.thickness_m,
-            s.psf_sigma_m,
+            crate::units::length(s.pad_width_m),
+            crate::units::length(s.pad_height_m),
+            crate::units::length(s.thickness_m),
+            crate::units::length(s.psf_sigma_m),
             s.rays_per_taxel,
             match crate::tactile::config::rays_per_side(s.rays_per_taxel) {
                 Some(k) => format!("{k}x{k} grid"),
                 None => "not a square grid".to_string(),
             },
-            s.noise_fraction,
+            crate::units::significant(s.noise_fraction),
             s.noise_seed
         )?;
         let width = h

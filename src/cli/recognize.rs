@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use clap::Args;
 use indicatif::ProgressBar;
 use taction::dataset::Dataset;
-use taction::recognize::{LabelledFeatures, ReadingRange, TrainedModel, evaluate, make_trials};
+use taction::recognize::{
+    LabelledFeatures, ReadingRange, RecognizeError, TrainedModel, evaluate, make_trials,
+};
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
@@ -35,7 +37,16 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let features = LabelledFeatures::from_dataset(&test, descriptor.as_ref());
-    let trials = make_trials(&features, model.bag.objects(), args.readings.last())?;
+    let trials = make_trials(&features, model.bag.objects(), args.readings.last()).map_err(|e| match e {
+        RecognizeError::UnknownObject { object, known } => format!(
+            "{}: object '{object}' is not one of the objects of the model {} ({}); recognise a dataset of the \
+             object set the model was trained on",
+            args.dataset.display(),
+            args.model.display(),
+            known.join(", ")
+        ),
+        other => other.to_string(),
+    })?;
     let evaluation = evaluate(&model.bag, &trials, args.readings)?;
     spinner.finish_and_clear();
     let paths = evaluation.write_csvs(&args.out)?;

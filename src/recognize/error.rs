@@ -46,9 +46,7 @@ pub enum RecognizeError {
     NotAModel { path: String, what: String },
     #[error("{path}: inconsistent model: {what}")]
     Inconsistent { path: String, what: String },
-    #[error(
-        "the model was trained with a different sensor: {differences}\n  model: {model:?}\n  data:  {data:?}"
-    )]
+    #[error("the model was trained with a different sensor: {differences}")]
     SensorMismatch {
         differences: String,
         model: Box<SensorConfig>,
