@@ -52,10 +52,10 @@ mod tests {
 
     #[test]
     fn lengths_read_as_a_person_writes_them() {
-        assert_eq!(length(0.0012000000000000001), "1.2 mm");
+        assert_eq!(length(0.1 * 0.012), "1.2 mm");
         assert_eq!(length(0.012), "12 mm");
         assert_eq!(length(0.12), "120 mm");
-        assert_eq!(length(0.00057600000000000004), "0.576 mm");
+        assert_eq!(length(0.48 * 0.0012), "0.576 mm");
         assert_eq!(length(1.5), "1.5 m");
         assert_eq!(length(3e30), "3e30 m");
         assert_eq!(length(0.0), "0 m");

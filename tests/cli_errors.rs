@@ -39,7 +39,9 @@ fn fails_with(out: &Output, code: i32) -> String {
     );
     let last = text.lines().last().unwrap_or("").to_string();
     assert!(
-        last.starts_with("taction: ") || last.starts_with("error: ") || last.starts_with("For more information"),
+        last.starts_with("taction: ")
+            || last.starts_with("error: ")
+            || last.starts_with("For more information"),
         "{text}"
     );
     if code == 2 && text.contains("For more information") {
@@ -91,7 +93,17 @@ fn threads_beyond_a_few_per_core_are_refused_and_zero_means_every_core_everywher
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("d.csv").display().to_string();
     let line = fails_with(
-        &taction(&["collect", "--objects", "chess", "--readings", "5", "--threads", "100000", "--out", &out]),
+        &taction(&[
+            "collect",
+            "--objects",
+            "chess",
+            "--readings",
+            "5",
+            "--threads",
+            "100000",
+            "--out",
+            &out,
+        ]),
         2,
     );
     assert!(line.contains("--threads") && line.contains("per core"), "{line}");
@@ -100,14 +112,21 @@ fn threads_beyond_a_few_per_core_are_refused_and_zero_means_every_core_everywher
     assert!(listed.status.success(), "{}", stderr(&listed));
     for command in ["collect", "experiment", "reproduce"] {
         let help = String::from_utf8_lossy(&taction(&[command, "--help"]).stdout).into_owned();
-        assert!(help.contains("0 uses one per core; at most 4 per core"), "{command}: {help}");
+        assert!(
+            help.contains("0 uses one per core; at most 4 per core"),
+            "{command}: {help}"
+        );
     }
 }
 
 #[test]
 fn a_mesh_of_three_vertices_is_refused_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = write(dir.path(), "triangle.obj", "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n");
+    let mesh = write(
+        dir.path(),
+        "triangle.obj",
+        "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n",
+    );
     let out = dir.path().join("r.csv").display().to_string();
     for args in [
         sense_args(&mesh, &out),
@@ -127,22 +146,37 @@ fn coordinates_that_are_not_metres_are_refused_with_the_fix() {
     let mesh = write(dir.path(), "huge.obj", &TETRA.replace("0.05", "1e30"));
     let out = dir.path().join("r.csv").display().to_string();
     let line = fails_with(&taction(&sense_args(&mesh, &out)), 1);
-    assert!(line.contains("huge.obj") && line.contains("bounding diagonal 1.732e30 m"), "{line}");
+    assert!(
+        line.contains("huge.obj") && line.contains("bounding diagonal 1.732e30 m"),
+        "{line}"
+    );
     assert!(!Path::new(&out).exists());
     let ds = dir.path().join("d.csv").display().to_string();
-    let line = fails_with(&taction(&["collect", "--objects", &mesh, "--readings", "2", "--out", &ds]), 1);
-    assert!(line.contains("huge.obj") && line.contains("use --object-size-m"), "{line}");
+    let line = fails_with(
+        &taction(&["collect", "--objects", &mesh, "--readings", "2", "--out", &ds]),
+        1,
+    );
+    assert!(
+        line.contains("huge.obj") && line.contains("use --object-size-m"),
+        "{line}"
+    );
     assert!(!Path::new(&ds).exists());
 }
 
 #[test]
 fn an_obj_index_out_of_range_is_quoted_as_the_file_writes_it() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = write(dir.path(), "idx.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 2 3 5\n");
+    let mesh = write(
+        dir.path(),
+        "idx.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 2 3 5\n",
+    );
     let out = dir.path().join("r.csv").display().to_string();
     let line = fails_with(&taction(&sense_args(&mesh, &out)), 1);
     assert!(
-        line.contains("idx.obj: line 5: vertex index 5 is out of range (the file has 4 vertices, numbered 1 to 4)"),
+        line.contains(
+            "idx.obj: line 5: vertex index 5 is out of range (the file has 4 vertices, numbered 1 to 4)"
+        ),
         "{line}"
     );
 }
@@ -168,7 +202,9 @@ fn collect_warns_about_an_open_mesh_as_sense_does() {
     let text = stderr(&out);
     assert!(out.status.success(), "{text}");
     assert!(
-        text.contains("warning: object 'open'") && text.contains("open.obj") && text.contains("open boundary"),
+        text.contains("warning: object 'open'")
+            && text.contains("open.obj")
+            && text.contains("open boundary"),
         "{text}"
     );
 }
@@ -247,7 +283,10 @@ fn recognising_data_of_another_set_or_sensor_names_both_files_without_debug_dump
         line.contains("dragons.csv: object 'bunny'") || line.contains("dragons.csv: object 'dragon'"),
         "{line}"
     );
-    assert!(line.contains("model.json") && line.contains("ridges, bumps, flat"), "{line}");
+    assert!(
+        line.contains("model.json") && line.contains("ridges, bumps, flat"),
+        "{line}"
+    );
 
     let big = SensorConfig {
         rows: 14,
@@ -281,16 +320,35 @@ fn negative_numbers_reach_the_range_check_of_their_flag() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("d.csv").display().to_string();
     let line = fails_with(
-        &taction(&["collect", "--objects", "chess", "--perturb-deg", "-10", "--out", &out]),
+        &taction(&[
+            "collect",
+            "--objects",
+            "chess",
+            "--perturb-deg",
+            "-10",
+            "--out",
+            &out,
+        ]),
         2,
     );
-    assert!(line.contains("--perturb-deg -10: is outside [0, 180] degrees"), "{line}");
+    assert!(
+        line.contains("--perturb-deg -10: is outside [0, 180] degrees"),
+        "{line}"
+    );
 }
 
 #[test]
 fn every_command_with_a_seed_documents_it_alike_with_one_default() {
     let mut lines = Vec::new();
-    for command in ["collect", "demo", "experiment", "reproduce", "sense", "touch", "train"] {
+    for command in [
+        "collect",
+        "demo",
+        "experiment",
+        "reproduce",
+        "sense",
+        "touch",
+        "train",
+    ] {
         let help = String::from_utf8_lossy(&taction(&[command, "--help"]).stdout).into_owned();
         let at = help
             .find("--seed <N>")
@@ -328,10 +386,21 @@ fn an_absurd_reading_count_is_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("d.csv").display().to_string();
     let line = fails_with(
-        &taction(&["collect", "--objects", "chess", "--readings", "100000000000", "--out", &out]),
+        &taction(&[
+            "collect",
+            "--objects",
+            "chess",
+            "--readings",
+            "100000000000",
+            "--out",
+            &out,
+        ]),
         2,
     );
-    assert!(line.contains("--readings 100000000000: want 1 to 1000000"), "{line}");
+    assert!(
+        line.contains("--readings 100000000000: want 1 to 1000000"),
+        "{line}"
+    );
 }
 
 #[test]
@@ -354,7 +423,10 @@ fn no_help_text_points_to_rust_code() {
         let mut args = command.clone();
         args.push("--help");
         let help = String::from_utf8_lossy(&taction(&args).stdout).into_owned();
-        assert!(!help.contains("::") && !help.contains("Config`"), "{command:?}: {help}");
+        assert!(
+            !help.contains("::") && !help.contains("Config`"),
+            "{command:?}: {help}"
+        );
     }
     let help = String::from_utf8_lossy(&taction(&["experiment", "--help"]).stdout).into_owned();
     assert!(help.contains("a header `label,r0c0,r0c1,...`"), "{help}");
@@ -396,10 +468,16 @@ fn a_second_run_into_a_locked_output_folder_names_the_holder() {
         1,
     );
     assert!(
-        line.contains(&format!("--out {out}: another taction run (pid 4242) is writing there")),
+        line.contains(&format!(
+            "--out {out}: another taction run (pid 4242) is writing there"
+        )),
         "{line}"
     );
-    assert_eq!(std::fs::read_dir(&results).unwrap().count(), 1, "only the lock file");
+    assert_eq!(
+        std::fs::read_dir(&results).unwrap().count(),
+        1,
+        "only the lock file"
+    );
 }
 
 #[test]
@@ -409,7 +487,14 @@ fn a_failed_export_leaves_no_folder() {
     let bad = write(dir.path(), "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
     let out: PathBuf = dir.path().join("exported");
     let line = fails_with(
-        &taction(&["objects", "export", &good, &bad, "--out", &out.display().to_string()]),
+        &taction(&[
+            "objects",
+            "export",
+            &good,
+            &bad,
+            "--out",
+            &out.display().to_string(),
+        ]),
         1,
     );
     assert!(line.contains("bad.obj: line 4"), "{line}");
@@ -419,7 +504,9 @@ fn a_failed_export_leaves_no_folder() {
 #[test]
 fn an_unknown_sim_to_real_label_is_named_with_its_line() {
     let dir = tempfile::tempdir().unwrap();
-    let header: Vec<String> = (0..4).flat_map(|r| (0..4).map(move |c| format!("r{r}c{c}"))).collect();
+    let header: Vec<String> = (0..4)
+        .flat_map(|r| (0..4).map(move |c| format!("r{r}c{c}")))
+        .collect();
     let frame = vec!["1"; 16].join(",");
     let csv = format!(
         "label,{}\n# a comment\nA,{frame}\nbanana,{frame}\nA,{frame}\n",
@@ -428,7 +515,16 @@ fn an_unknown_sim_to_real_label_is_named_with_its_line() {
     let real = write(dir.path(), "real.csv", &csv);
     let out = dir.path().join("results").display().to_string();
     let line = fails_with(
-        &taction(&["experiment", "sim-to-real", "--real", &real, "--scale", "0.01", "--out", &out]),
+        &taction(&[
+            "experiment",
+            "sim-to-real",
+            "--real",
+            &real,
+            "--scale",
+            "0.01",
+            "--out",
+            &out,
+        ]),
         1,
     );
     assert!(

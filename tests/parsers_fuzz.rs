@@ -66,7 +66,7 @@ const TOKENS: &[&str] = &[
 /// One input: arbitrary bytes for even `case`, a mutation of one of `valid` for odd.
 fn input(valid: &[Vec<u8>], seed: u64, case: u64) -> Vec<u8> {
     let mut rng = stream(seed, case);
-    if case % 2 == 0 {
+    if case.is_multiple_of(2) {
         let len = rng.random_range(0..400);
         return (0..len).map(|_| rng.random::<u8>()).collect();
     }
@@ -124,7 +124,12 @@ fn text(bytes: &[u8]) -> String {
 }
 
 fn fixture(name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/broken_meshes").join(name)).unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/broken_meshes")
+            .join(name),
+    )
+    .unwrap()
 }
 
 #[test]
@@ -163,7 +168,9 @@ fn dataset_parser_never_panics() {
 
 #[test]
 fn recorded_frame_and_image_parsers_never_panic() {
-    let header: Vec<String> = (0..4).flat_map(|r| (0..4).map(move |c| format!("r{r}c{c}"))).collect();
+    let header: Vec<String> = (0..4)
+        .flat_map(|r| (0..4).map(move |c| format!("r{r}c{c}")))
+        .collect();
     let frame = |v: usize| (0..16).map(|i| (i * v).to_string()).collect::<Vec<_>>().join(",");
     let real = vec![
         format!(
