@@ -647,7 +647,10 @@ fn parse_reading(
         let (f, v) = field(0);
         return Err((
             f,
-            format!("'{v}' is not one of the header's objects {:?}", header.objects),
+            format!(
+                "'{v}' is not one of the header's objects ({})",
+                header.objects.join(", ")
+            ),
         ));
     }
     let status = ContactStatus::from_name(&record[1]).ok_or_else(|| {

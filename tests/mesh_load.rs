@@ -156,7 +156,7 @@ fn unusable_meshes_are_errors_naming_file_and_place() {
     ));
     let message = load_err("index_out_of_range.obj").to_string();
     assert!(
-        message.contains("line 7") && message.contains("index 8"),
+        message.contains("line 7: vertex index 9 is out of range (the file has 4 vertices, numbered 1 to 4)"),
         "{message}"
     );
     assert!(load_err("nan_facet.stl").to_string().contains("facet 2"));

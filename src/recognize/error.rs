@@ -34,7 +34,7 @@ pub enum RecognizeError {
     SingularCovariance { component: usize },
     #[error("object '{object}' has no training readings")]
     EmptyObject { object: String },
-    #[error("object '{object}' is not one of the model's objects {known:?}")]
+    #[error("object '{object}' is not one of the model's objects ({})", known.join(", "))]
     UnknownObject { object: String, known: Vec<String> },
     #[error("{path}: {source}")]
     Io { path: String, source: std::io::Error },
