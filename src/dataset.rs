@@ -226,8 +226,9 @@ impl Dataset {
         let index = self.readings.len();
         if self.header.object_index(&reading.object).is_none() {
             return Err(DatasetError::Invalid(format!(
-                "reading {index}: object '{}' is not in the header's objects {:?}",
-                reading.object, self.header.objects
+                "reading {index}: object '{}' is not in the header's objects ({})",
+                reading.object,
+                self.header.objects.join(", ")
             )));
         }
         let (rows, cols) = (self.header.sensor.rows, self.header.sensor.cols);
