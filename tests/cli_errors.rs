@@ -57,6 +57,15 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
     path.display().to_string()
 }
 
+/// `taction collect --objects chess FLAGS --out <temp>` fails with `code`; its message line.
+fn chess_collect_fails(flags: &[&str], code: i32) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d.csv").display().to_string();
+    let mut args = vec!["collect", "--objects", "chess", "--out", &out];
+    args.extend(flags);
+    fails_with(&taction(&args), code)
+}
+
 const TETRA: &str = "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
 
 /// The sense flags that put the pad 5 cm above the origin looking down.
@@ -90,22 +99,7 @@ fn a_closed_stdout_ends_the_program_quietly_with_success() {
 
 #[test]
 fn threads_beyond_a_few_per_core_are_refused_and_zero_means_every_core_everywhere() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("d.csv").display().to_string();
-    let line = fails_with(
-        &taction(&[
-            "collect",
-            "--objects",
-            "chess",
-            "--readings",
-            "5",
-            "--threads",
-            "100000",
-            "--out",
-            &out,
-        ]),
-        2,
-    );
+    let line = chess_collect_fails(&["--readings", "5", "--threads", "100000"], 2);
     assert!(line.contains("--threads") && line.contains("per core"), "{line}");
     // 0 is one meaning in both commands that have the flag: one thread per core.
     let listed = taction(&["experiment", "list", "--threads", "0"]);
@@ -317,20 +311,7 @@ fn recognising_data_of_another_set_or_sensor_names_both_files_without_debug_dump
 
 #[test]
 fn negative_numbers_reach_the_range_check_of_their_flag() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("d.csv").display().to_string();
-    let line = fails_with(
-        &taction(&[
-            "collect",
-            "--objects",
-            "chess",
-            "--perturb-deg",
-            "-10",
-            "--out",
-            &out,
-        ]),
-        2,
-    );
+    let line = chess_collect_fails(&["--perturb-deg", "-10"], 2);
     assert!(
         line.contains("--perturb-deg -10: is outside [0, 180] degrees"),
         "{line}"
@@ -383,20 +364,7 @@ fn a_covering_thicker_than_half_the_pad_is_refused_with_the_reason() {
 
 #[test]
 fn an_absurd_reading_count_is_refused_before_any_work() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("d.csv").display().to_string();
-    let line = fails_with(
-        &taction(&[
-            "collect",
-            "--objects",
-            "chess",
-            "--readings",
-            "100000000000",
-            "--out",
-            &out,
-        ]),
-        2,
-    );
+    let line = chess_collect_fails(&["--readings", "100000000000"], 2);
     assert!(
         line.contains("--readings 100000000000: want 1 to 1000000"),
         "{line}"
