@@ -64,6 +64,7 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if closed_stdout(e.as_ref()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("taction: {e}");
             if cli::is_usage_error(e.as_ref()) {
@@ -92,4 +93,21 @@ fn quiet_on_closed_stdout() {
         }
         default(info);
     }));
+}
+
+/// Whether `e` (or what caused it) is a write into a pipe whose reader has gone: the commands
+/// that write their output through a buffer (`describe`) report it as an error rather than a
+/// panic, and it ends them as quietly as a `println!`.
+fn closed_stdout(e: &(dyn std::error::Error + 'static)) -> bool {
+    let mut next = Some(e);
+    while let Some(error) = next {
+        if error
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        {
+            return true;
+        }
+        next = error.source();
+    }
+    false
 }

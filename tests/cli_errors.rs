@@ -85,16 +85,24 @@ fn sense_args<'a>(mesh: &'a str, out: &'a str) -> Vec<&'a str> {
 
 #[test]
 fn a_closed_stdout_ends_the_program_quietly_with_success() {
-    let (reader, writer) = std::io::pipe().unwrap();
-    drop(reader);
-    let out = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(["experiment", "list"])
-        .stdout(writer)
-        .stderr(Stdio::piped())
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    assert_eq!(stderr(&out), "");
+    let dir = tempfile::tempdir().unwrap();
+    let image = write(dir.path(), "image.csv", "0,0.5,1\n0.25,0.75,0\n");
+    // `println!` (experiment list) and a buffered writer (describe) alike.
+    for args in [
+        vec!["experiment", "list"],
+        vec!["describe", "--descriptor", "vectorize", "--image", &image],
+    ] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(&args)
+            .stdout(writer)
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
+        assert_eq!(stderr(&out), "", "{args:?}");
+    }
 }
 
 #[test]
