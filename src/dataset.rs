@@ -226,8 +226,9 @@ impl Dataset {
         let index = self.readings.len();
         if self.header.object_index(&reading.object).is_none() {
             return Err(DatasetError::Invalid(format!(
-                "reading {index}: object '{}' is not in the header's objects {:?}",
-                reading.object, self.header.objects
+                "reading {index}: object '{}' is not in the header's objects ({})",
+                reading.object,
+                self.header.objects.join(", ")
             )));
         }
         let (rows, cols) = (self.header.sensor.rows, self.header.sensor.cols);
@@ -647,7 +648,10 @@ fn parse_reading(
         let (f, v) = field(0);
         return Err((
             f,
-            format!("'{v}' is not one of the header's objects {:?}", header.objects),
+            format!(
+                "'{v}' is not one of the header's objects ({})",
+                header.objects.join(", ")
+            ),
         ));
     }
     let status = ContactStatus::from_name(&record[1]).ok_or_else(|| {
@@ -853,19 +857,19 @@ impl fmt::Display for DatasetSummary {
         )?;
         writeln!(
             f,
-            "sensor: {}x{} taxels, pad {} x {} m, covering {} m, PSF sigma {} m, {} rays/taxel ({}), noise {} (seed {})",
+            "sensor: {}x{} taxels, pad {} x {}, covering {}, PSF sigma {}, {} rays/taxel ({}), noise {} (seed {})",
             s.rows,
             s.cols,
-            s.pad_width_m,
-            s.pad_height_m,
-            s.thickness_m,
-            s.psf_sigma_m,
+            crate::units::length(s.pad_width_m),
+            crate::units::length(s.pad_height_m),
+            crate::units::length(s.thickness_m),
+            crate::units::length(s.psf_sigma_m),
             s.rays_per_taxel,
             match crate::tactile::config::rays_per_side(s.rays_per_taxel) {
                 Some(k) => format!("{k}x{k} grid"),
                 None => "not a square grid".to_string(),
             },
-            s.noise_fraction,
+            crate::units::significant(s.noise_fraction),
             s.noise_seed
         )?;
         let width = h

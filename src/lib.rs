@@ -19,6 +19,7 @@
 //! datasets, so recorded data from a real sensor can be fed to them.
 
 pub mod rng;
+pub mod units;
 
 pub mod mesh;
 pub mod sim;

@@ -55,6 +55,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_on_closed_stdout();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Collect(args) => cli::collect::run(args),
@@ -74,9 +75,50 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if closed_stdout(e.as_ref()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("taction: {e}");
-            ExitCode::FAILURE
+            if cli::is_usage_error(e.as_ref()) {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
+}
+
+/// A reader that stops reading (`taction experiment list | head -1`) ends the program quietly and
+/// successfully, as it ends any Unix filter: `println!` reports the closed pipe by panicking, so
+/// that one panic exits 0 without a message; every other panic keeps the default report.
+fn quiet_on_closed_stdout() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to stdout") && message.contains("Broken pipe") {
+            std::process::exit(0);
+        }
+        default(info);
+    }));
+}
+
+/// Whether `e` (or what caused it) is a write into a pipe whose reader has gone: the commands
+/// that write their output through a buffer (`describe`) report it as an error rather than a
+/// panic, and it ends them as quietly as a `println!`.
+fn closed_stdout(e: &(dyn std::error::Error + 'static)) -> bool {
+    let mut next = Some(e);
+    while let Some(error) = next {
+        if error
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        {
+            return true;
+        }
+        next = error.source();
+    }
+    false
 }

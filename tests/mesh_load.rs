@@ -73,8 +73,9 @@ fn unusable_meshes_are_errors_naming_file_and_place() {
         load_err("index_out_of_range.obj"),
         MeshError::IndexOutOfRange {
             at: Location::Line(7),
-            index: 8,
+            index: 9,
             count: 4,
+            first: 1,
             ..
         }
     ));
@@ -82,8 +83,9 @@ fn unusable_meshes_are_errors_naming_file_and_place() {
         load_err("negative_index_out_of_range.obj"),
         MeshError::IndexOutOfRange {
             at: Location::Line(4),
-            index: -1,
+            index: -4,
             count: 3,
+            first: 1,
             ..
         }
     ));
@@ -93,6 +95,7 @@ fn unusable_meshes_are_errors_naming_file_and_place() {
             at: Location::Line(9),
             index: 4,
             count: 4,
+            first: 0,
             ..
         }
     ));
@@ -153,7 +156,7 @@ fn unusable_meshes_are_errors_naming_file_and_place() {
     ));
     let message = load_err("index_out_of_range.obj").to_string();
     assert!(
-        message.contains("line 7") && message.contains("index 8"),
+        message.contains("line 7: vertex index 9 is out of range (the file has 4 vertices, numbered 1 to 4)"),
         "{message}"
     );
     assert!(load_err("nan_facet.stl").to_string().contains("facet 2"));

@@ -11,10 +11,16 @@ use taction::experiment::progress::CollectionProgress;
 use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::PerturbationBounds;
 use taction::tactile::image::write_contact_sheet;
 
+use crate::cli::common::{SeedArg, ThreadsArg, flag_error};
+use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
+
+/// Most converged readings per object one run collects: a thousand times the paper's training
+/// sets (Sec. V-B); a larger count is a typo, not a plan.
+pub const MAX_READINGS: usize = 1_000_000;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum Mode {
@@ -30,33 +36,32 @@ pub struct CollectArgs {
     #[arg(long, num_args = 1.., required = true, value_name = "DIR|FILES|SET")]
     pub objects: Vec<PathBuf>,
     /// Rescale user meshes to this bounding diagonal, metres (centred, resting on the table).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub object_size_m: Option<f64>,
     #[arg(long, value_enum, default_value_t = Mode::Sampler)]
     pub mode: Mode,
-    /// Converged readings per object.
-    #[arg(long, default_value_t = 100)]
+    /// Converged readings per object (at most 1000000; the paper trains on 1000).
+    #[arg(long, default_value_t = 100, allow_hyphen_values = true)]
     pub readings: usize,
     /// Planner: probability L of the local strategy.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub local_prob: f64,
     /// Planner: iterations allowed per object before it gives up short of `--readings`.
-    #[arg(long, default_value_t = PlannerConfig::default().max_iterations)]
+    #[arg(long, default_value_t = PlannerConfig::default().max_iterations, allow_hyphen_values = true)]
     pub max_iterations: usize,
     /// Sampler: approach only from above (raised letters, Sec. V-D).
     #[arg(long)]
     pub from_above: bool,
-    /// Perturb the object after every reading: largest rotation, degrees.
-    #[arg(long, default_value_t = 0.0)]
+    /// Perturb the object after every reading: largest rotation, degrees, in [0, 180].
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_deg: f64,
-    /// Perturb the object after every reading: largest translation, fraction of its width.
-    #[arg(long, default_value_t = 0.0)]
+    /// Perturb the object after every reading: largest translation, fraction of its width, in [0, 1].
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_frac: f64,
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Worker threads (0: all cores); never changes the output.
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
     #[command(flatten)]
     pub sensor: SensorArgs,
     /// Dataset file to write.
@@ -73,19 +78,47 @@ pub struct CollectArgs {
 }
 
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if args.readings == 0 {
-        return Err("--readings: want 1 or more".into());
+    if !(1..=MAX_READINGS).contains(&args.readings) {
+        return Err(flag_error(
+            "readings",
+            args.readings,
+            format!("want 1 to {MAX_READINGS} per object"),
+        )
+        .into());
     }
     if args.max_iterations == 0 {
-        return Err("--max-iterations: want 1 or more".into());
+        return Err(flag_error("max-iterations", 0, "want 1 or more").into());
     }
     if !(0.0..=1.0).contains(&args.local_prob) {
-        return Err(format!("--local-prob: {} is outside [0, 1]", args.local_prob).into());
+        return Err(flag_error("local-prob", args.local_prob, "is outside [0, 1]").into());
+    }
+    if !(0.0..=180.0).contains(&args.perturb_deg) {
+        return Err(flag_error("perturb-deg", args.perturb_deg, "is outside [0, 180] degrees").into());
+    }
+    if !(0.0..=1.0).contains(&args.perturb_frac) {
+        return Err(flag_error(
+            "perturb-frac",
+            args.perturb_frac,
+            "is outside [0, 1] of the object's width",
+        )
+        .into());
+    }
+    if let Some(size) = args.object_size_m.filter(|d| !(d.is_finite() && *d > 0.0)) {
+        return Err(flag_error("object-size-m", size, "want a positive number of metres").into());
     }
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
-    let sensor = args.sensor.config(args.seed)?;
+    let sensor = args.sensor.config(args.seed.seed)?;
     let set = ObjectSet::resolve(&args.objects, None, args.object_size_m)?;
-    let objects = ObjectSpec::all_of(&set)?;
+    let carrier = match args.mode {
+        Mode::Sampler => Carrier::FreePad,
+        Mode::Planner => Carrier::Arm,
+    };
+    let objects = build_objects(
+        &set,
+        "collect",
+        carrier,
+        "use --object-size-m to rescale the meshes to a bounding diagonal in metres",
+    )?;
     let (mode, generator) = match args.mode {
         Mode::Sampler => {
             let config = SamplerConfig {
@@ -113,17 +146,24 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         control: ControlConfig::default(),
         perturbation,
         readings_per_object: args.readings,
-        seed: args.seed,
+        seed: args.seed.seed,
     };
+    eprintln!(
+        "taction collect: {} objects x {} converged readings, {} threads, into {}",
+        objects.len(),
+        args.readings,
+        args.threads.count(),
+        args.out.display()
+    );
     let progress = CollectionProgress::new(&format!("collect {}", set.name), objects.len(), args.readings);
-    let reports = plan.collect_reporting(&objects, args.threads, &|| progress.converged())?;
+    let reports = plan.collect_reporting(&objects, args.threads.count().get(), &|| progress.converged())?;
     progress.finish(reports.iter().map(ExplorationReport::converged).sum());
     let header = DatasetHeader::new(
         sensor,
         set.id(),
         objects.iter().map(|o| o.name.clone()).collect(),
         generator,
-        args.seed,
+        args.seed.seed,
     );
     let planner_lines: Vec<String> = match args.mode {
         Mode::Planner => objects

@@ -22,9 +22,12 @@ use taction::recognize::model::TrainedModel;
 use taction::recognize::selection::{TrainConfig, codebook_sizes};
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
-use taction::sim::{ObjectSpec, PerturbationBounds, SceneBuilder};
+use taction::sim::{PerturbationBounds, SceneBuilder};
 use taction::tactile::image::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
+
+use crate::cli::common::{OutputLock, SeedArg, flag_error};
+use crate::cli::plausible::{Carrier, build_objects};
 
 #[derive(Debug, Args)]
 pub struct DemoArgs {
@@ -40,21 +43,34 @@ pub struct DemoArgs {
     /// Converged touches of the unknown object.
     #[arg(long, default_value_t = 20)]
     pub touches: usize,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
     /// Output folder.
     #[arg(long, default_value = "results/demo")]
     pub out: PathBuf,
 }
 
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if args.touches == 0 || args.training_readings < 11 {
-        return Err("--touches must be 1 or more and --training-readings 11 or more".into());
+    if args.touches == 0 {
+        return Err(flag_error("touches", 0, "want 1 or more").into());
     }
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    if args.training_readings < 11 {
+        return Err(flag_error(
+            "training-readings",
+            args.training_readings,
+            "want 11 or more (1 of every 11 is held out for validation)",
+        )
+        .into());
+    }
+    let _lock = OutputLock::acquire(&args.out, "out")?;
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, None)?;
-    let objects = ObjectSpec::all_of(&set)?;
+    let objects = build_objects(
+        &set,
+        "demo",
+        Carrier::Arm,
+        "rescale the meshes to metres (or collect them with `taction collect --object-size-m`)",
+    )?;
     let descriptor_kind = DescriptorKind::PolarFourier;
     let descriptor = descriptor_kind.build();
 
@@ -63,7 +79,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         "model-{}-{}-{}.json",
         set.id(),
         args.training_readings,
-        args.seed
+        args.seed.seed
     ));
     let model = match TrainedModel::load(&model_path) {
         Ok(model) if model.check_sensor(&sensor).is_ok() => {
@@ -87,7 +103,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 control: ControlConfig::default(),
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: args.training_readings,
-                seed: args.seed,
+                seed: args.seed.seed,
             };
             let progress = CollectionProgress::new("training data", objects.len(), args.training_readings);
             let dataset =
@@ -99,7 +115,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
             let mut config = TrainConfig {
                 restarts: 1,
-                seed: args.seed,
+                seed: args.seed.seed,
                 ..TrainConfig::default()
             };
             // The hold-out keeps about `holdout` of each object's readings for validation; one
@@ -123,7 +139,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let names = model.bag.objects().to_vec();
 
     // 2. The unknown object, at a pose the planner is not told.
-    let mut r = rng::stream(args.seed, 0xDE30);
+    let mut r = rng::stream(args.seed.seed, 0xDE30);
     let index = match &args.object {
         Some(name) => objects
             .iter()
@@ -158,7 +174,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         ControlConfig::default(),
         sensor,
         PerturbationBounds::NONE,
-        rng::stream(args.seed, 0xE7),
+        rng::stream(args.seed.seed, 0xE7),
         reader,
     )?;
     let mut posterior = OnlinePosterior::new(&model.bag);

@@ -11,15 +11,19 @@ use taction::experiment::paper::{PaperContext, PaperExperiment, RealRecording, S
 use taction::experiment::real_data::Calibration;
 use taction::mesh::ObjectSet;
 
+use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError};
+
 /// What every paper experiment takes.
 #[derive(Debug, Args)]
 pub struct PaperArgs {
     /// Fraction of the paper's data sizes (1.0: 1000 + 100 training readings and 3 x 100 test
     /// readings per object; 0.1 for a quick look).
-    #[arg(long, default_value = "1.0")]
+    #[arg(long, default_value = "1.0", allow_hyphen_values = true)]
     pub scale: Scale,
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
     #[command(flatten)]
     pub run: RunOptions,
     /// The 3D objects: a built-in set, a folder of meshes, a manifest, or mesh files.
@@ -42,17 +46,22 @@ pub struct PaperArgs {
     pub calibration: Option<PathBuf>,
     /// real-frames (Fig. 16b): frames whose largest taxel is below this fraction of the sensing
     /// range are dropped as non-contacts before the split; the counts per label go to config.json.
-    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION")]
+    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION", allow_hyphen_values = true)]
     pub contact_threshold: f64,
     /// real-frames (Fig. 16b): trials of the whole split-train-test process.
-    #[arg(long, default_value_t = PAPER_TRIALS, value_name = "N")]
+    #[arg(long, default_value_t = PAPER_TRIALS, value_name = "N", allow_hyphen_values = true)]
     pub trials: usize,
     /// real-frames (Fig. 16b): square root of every taxel before describing (Sec. V-F; off because
     /// training and test frames come from the same sensor).
     #[arg(long)]
     pub square_root: bool,
     /// real-frames (Fig. 16b): Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
-    #[arg(long, default_value_t = 0.0, value_name = "TAXELS")]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "TAXELS",
+        allow_hyphen_values = true
+    )]
     pub blur_sigma: f64,
 }
 
@@ -73,9 +82,13 @@ impl PaperArgs {
             blur_sigma_taxels: self.blur_sigma,
             trials: self.trials,
         };
-        real_frames.validate()?;
+        real_frames.validate().map_err(UsageError)?;
+        let run = RunOptions {
+            threads: Some(self.threads.count()),
+            ..self.run.clone()
+        };
         Ok(
-            PaperContext::new(self.scale, self.seed, self.run.clone(), shapes, letters, real)
+            PaperContext::new(self.scale, self.seed.seed, run, shapes, letters, real)
                 .with_real_frames(real_frames),
         )
     }
@@ -117,6 +130,7 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
     }
     let experiment = parse_experiment(&args.name)?;
     let context = args.paper.context()?;
+    let _lock = OutputLock::acquire(&context.options.out, "out")?;
     let report = experiment.run(&context).map_err(|e| e.to_string())?;
     println!("{report}");
     Ok(())
@@ -132,6 +146,7 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
             .collect::<Result<_, _>>()?
     };
     let context = args.paper.context()?;
+    let _lock = OutputLock::acquire(&context.options.out, "out")?;
     let started = Instant::now();
     for experiment in &experiments {
         let begun = Instant::now();

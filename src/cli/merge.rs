@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use crate::cli::common::OutputLock;
+
 #[derive(Debug, Args)]
 pub struct MergeArgs {
     /// Output roots of the shard runs (their `--out`), each holding `<experiment>/` directories.
@@ -16,6 +18,7 @@ pub struct MergeArgs {
 
 /// Merges, assembles and plots every experiment found, then rewrites `<out>/README.md`.
 pub fn run(args: &MergeArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let _lock = OutputLock::acquire(&args.out, "out")?;
     let report = taction::experiment::merge(&args.dirs, &args.out)?;
     println!("copied {} unit files into {}", report.copied, args.out.display());
     for (name, finished) in &report.experiments {

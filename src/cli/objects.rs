@@ -135,7 +135,7 @@ fn list(cache: &ObjectCache, font: Option<&Path>) -> Result<(), Box<dyn std::err
         };
         let size = set
             .diagonal_m
-            .map(|d| format!(", {} m diagonal", d))
+            .map(|d| format!(", {} diagonal", taction::units::length(d)))
             .unwrap_or_default();
         println!(
             "{} v{} (id {}): {} objects{size}",
@@ -147,11 +147,11 @@ fn list(cache: &ObjectCache, font: Option<&Path>) -> Result<(), Box<dyn std::err
         if let Some(first) = set.objects.first().filter(|_| set.objects.len() > LIST_IN_FULL) {
             let summary = match &first.source {
                 ObjectSource::Letter { font, style, .. } => format!(
-                    "raised letters in {} (capitals {} mm tall, raised {} mm on a {} mm plate)",
+                    "raised letters in {} (capitals {} tall, raised {} on a {} plate)",
                     font.path.display(),
-                    style.cap_height_m * 1e3,
-                    style.raise_m * 1e3,
-                    style.plate_thickness_m * 1e3
+                    taction::units::length(style.cap_height_m),
+                    taction::units::length(style.raise_m),
+                    taction::units::length(style.plate_thickness_m)
                 ),
                 other => other.to_string(),
             };
@@ -178,19 +178,43 @@ fn list(cache: &ObjectCache, font: Option<&Path>) -> Result<(), Box<dyn std::err
     Ok(())
 }
 
+/// Writes every object of `set` into `out`; on failure removes what it wrote (the folder too when
+/// it made it), so that a failed export leaves nothing that looks like a set.
 fn export(set: &ObjectSet, options: &BuildOptions, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let objects = set.build(options)?;
+    let made_folder = !out.exists();
     std::fs::create_dir_all(out).map_err(|source| MeshError::Write {
         path: out.to_path_buf(),
         source,
     })?;
+    let mut written = Vec::new();
+    let result = write_export(set, objects, out, &mut written);
+    if result.is_err() {
+        for path in &written {
+            let _ = std::fs::remove_file(path);
+        }
+        if made_folder {
+            let _ = std::fs::remove_dir(out);
+        }
+    }
+    result
+}
+
+fn write_export(
+    set: &ObjectSet,
+    objects: Vec<taction::mesh::BuiltObject>,
+    out: &Path,
+    written: &mut Vec<PathBuf>,
+) -> Result<(), Box<dyn std::error::Error>> {
     let id = set.id();
-    for object in set.build(options)? {
+    for object in objects {
         let path = out.join(format!("{}.obj", object.name));
         let comment = format!(
             "taction object '{}' of set {} v{} (id {id})",
             object.name, set.name, set.version
         );
         write_obj(&object.mesh, &path, &comment)?;
+        written.push(path.clone());
         let flipped = if object.flipped {
             ", flipped to face outward"
         } else {
@@ -203,7 +227,9 @@ fn export(set: &ObjectSet, options: &BuildOptions, out: &Path) -> Result<(), Box
             object.warnings
         );
     }
-    set.save_manifest(&out.join("manifest.json"))?;
+    let manifest = out.join("manifest.json");
+    set.save_manifest(&manifest)?;
+    written.push(manifest);
     println!(
         "{} v{} (id {id}): {} objects in {}",
         set.name,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 use indicatif::ProgressBar;
 use taction::dataset::Dataset;
-use taction::recognize::{ReadingRange, Recognizer};
+use taction::recognize::{ReadingRange, RecognizeError, Recognizer};
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
@@ -30,9 +30,16 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     let test = Dataset::read(&args.dataset)?;
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-    let (evaluation, trials) = model
-        .evaluate(&test, args.readings)
-        .map_err(|e| format!("{}: {e}", args.dataset.display()))?;
+    let (evaluation, trials) = model.evaluate(&test, args.readings).map_err(|e| match e {
+        RecognizeError::UnknownObject { object, known } => format!(
+            "{}: object '{object}' is not one of the objects of the model {} ({}); recognise a dataset of the \
+             object set the model was trained on",
+            args.dataset.display(),
+            args.model.display(),
+            known.join(", ")
+        ),
+        other => format!("{}: {other}", args.dataset.display()),
+    })?;
     spinner.finish_and_clear();
     let paths = evaluation.write_csvs(&args.out)?;
     let ks: Vec<String> = model.chosen_ks().iter().map(usize::to_string).collect();

@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
 
+use crate::cli::common::SeedArg;
+use crate::cli::plausible::Carrier;
 use crate::cli::sensor_args::{PadArgs, PadFrameError, SensorArgs, SensorFlagError};
 
 #[derive(Debug, Args)]
@@ -20,9 +22,8 @@ pub struct SenseArgs {
     pub pad: PadArgs,
     #[command(flatten)]
     pub sensor: SensorArgs,
-    /// Noise seed.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
     /// Output image: FILE.csv (values) or FILE.png (grey levels, upscaled).
     #[arg(long, value_name = "FILE.csv|FILE.png")]
     pub out: PathBuf,
@@ -48,7 +49,7 @@ pub enum SenseError {
 impl SenseArgs {
     /// The sensor configuration the flags describe, validated.
     pub fn config(&self) -> Result<SensorConfig, SenseError> {
-        Ok(self.sensor.config(self.seed)?)
+        Ok(self.sensor.config(self.seed.seed)?)
     }
 
     /// The pad pose the flags describe.
@@ -76,7 +77,7 @@ pub fn run(args: &SenseArgs) -> Result<(), Box<dyn std::error::Error>> {
     let config = args.config()?;
     let pose = args.pad_pose()?;
     let png = wants_png(&args.out)?;
-    let object = args.pad.load_object("sense").map_err(SenseError::from)?;
+    let object = args.pad.load_object("sense", Carrier::FreePad)?;
     let mut sensor = FreeFloatingSensor::new(object, &config).map_err(SenseError::from)?;
     let image = sensor.read_at(&pose).map_err(SenseError::from)?;
     if png {

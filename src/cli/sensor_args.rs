@@ -8,6 +8,8 @@ use glam::DVec3;
 use taction::sim::ObjectSpec;
 use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
 
+use crate::cli::plausible::{Carrier, check_mesh};
+
 #[derive(Debug, Clone, Args)]
 pub struct SensorArgs {
     /// Taxel rows.
@@ -78,6 +80,20 @@ impl SensorArgs {
             value: e.value.clone(),
             allowed: e.key.allowed(),
         })?;
+        // A covering thicker than half the pad is no thin skin on a fingertip: its point spread
+        // (sigma 0.48 t, Sec. V-B5) would blur the whole pad into one value.
+        let half_pad_m = 0.5 * self.pad_m;
+        if thickness_m > half_pad_m {
+            return Err(SensorFlagError {
+                flag: "thickness-m",
+                value: taction::units::significant(thickness_m),
+                allowed: format!(
+                    "at most half the {} pad side, {} (a thicker covering's point spread blurs the whole pad)",
+                    taction::units::length(self.pad_m),
+                    taction::units::length(half_pad_m)
+                ),
+            });
+        }
         Ok(config)
     }
 }
@@ -136,10 +152,20 @@ impl PadArgs {
     }
 
     /// Loads `--mesh` as the object (named after the file), warning on stderr (prefixed with
-    /// `command`) about validation problems, and reversing inward-wound faces: the sensor tells
-    /// inside from outside by the winding.
-    pub fn load_object(&self, command: &str) -> Result<ObjectSpec, taction::mesh::MeshError> {
+    /// `command`) about validation problems, reversing inward-wound faces (the sensor tells inside
+    /// from outside by the winding), and refusing a mesh `carrier` cannot explore.
+    pub fn load_object(
+        &self,
+        command: &str,
+        carrier: Carrier,
+    ) -> Result<ObjectSpec, Box<dyn std::error::Error>> {
         let loaded = taction::mesh::load(&self.mesh)?;
+        check_mesh(
+            &self.mesh.display().to_string(),
+            &loaded.mesh,
+            carrier,
+            "the mesh is placed as given: write its coordinates in metres",
+        )?;
         if !loaded.warnings.is_clean() {
             eprintln!(
                 "taction {command}: warning: {}: {}",

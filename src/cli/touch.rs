@@ -24,6 +24,8 @@ use taction::sim::arm::PAD_SITE;
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
 use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
 
+use crate::cli::common::SeedArg;
+use crate::cli::plausible::Carrier;
 use crate::cli::sensor_args::{PadArgs, PadFrameError, SensorArgs, SensorFlagError};
 
 #[derive(Debug, Args)]
@@ -32,9 +34,8 @@ pub struct TouchArgs {
     pub pad: PadArgs,
     #[command(flatten)]
     pub sensor: SensorArgs,
-    /// Noise seed.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
     /// Drive the arm in the MuJoCo world (object on the table at its origin) instead of the
     /// free-floating pad. The arm's IK leaves the pad's rotation about its normal free, so
     /// `--pad-up` has no effect.
@@ -44,8 +45,9 @@ pub struct TouchArgs {
     /// [default: the controller config's, 0.3].
     #[arg(long, allow_hyphen_values = true)]
     pub target_pressure: Option<f64>,
-    /// Controller configuration as JSON (the fields of `ControlConfig`, any subset; units in their
-    /// names). `expected_noise_fraction` is always taken from `--noise`.
+    /// Controller configuration as JSON: any subset of the controllers' fields, units in their
+    /// names (e.g. `{"target_mean_pressure": 0.4}`); an unknown field is an error naming it.
+    /// `expected_noise_fraction` is always taken from `--noise`.
     #[arg(long, value_name = "FILE.json")]
     pub control: Option<PathBuf>,
 }
@@ -174,7 +176,7 @@ fn touch_arm(
 
 /// Runs the controllers once and prints the outcome as one JSON object.
 pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let sensor = args.sensor.config(args.seed).map_err(TouchError::from)?;
+    let sensor = args.sensor.config(args.seed.seed).map_err(TouchError::from)?;
     let start = args.pad.pad_pose().map_err(TouchError::from)?;
     let control = args.control_config(&sensor)?;
     if args.arm && args.pad.pad_up.is_some() {
@@ -182,7 +184,8 @@ pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
             "taction touch: note: --pad-up has no effect with --arm (the IK leaves the pad's roll free)"
         );
     }
-    let object = args.pad.load_object("touch").map_err(TouchError::from)?;
+    let carrier = if args.arm { Carrier::Arm } else { Carrier::FreePad };
+    let object = args.pad.load_object("touch", carrier)?;
     let outcome = if args.arm {
         touch_arm(object, sensor, &control, &start)?
     } else {

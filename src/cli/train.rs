@@ -14,9 +14,12 @@ use taction::recognize::{
     TrainedModel, VarianceFraction, codebook_sizes,
 };
 
+use crate::cli::common::SeedArg;
+
 #[derive(Debug, Args)]
 pub struct TrainArgs {
-    /// Training dataset (the format of `taction::dataset`); only converged readings are used.
+    /// Training dataset, as `taction collect` writes it (`taction dataset show` lists what it
+    /// holds); only converged readings are used.
     #[arg(long, value_name = "FILE")]
     pub dataset: PathBuf,
     /// Validation dataset for model selection; without it the last 1/11 of each object's
@@ -39,14 +42,18 @@ pub struct TrainArgs {
     /// Seeded restarts per cluster count.
     #[arg(long, default_value_t = 3)]
     pub restarts: usize,
-    /// Seed of the codebook fits.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
     /// Fraction of the training variance the kept principal components explain.
-    #[arg(long, default_value_t = 0.9, value_name = "FRACTION")]
+    #[arg(
+        long,
+        default_value_t = 0.9,
+        value_name = "FRACTION",
+        allow_hyphen_values = true
+    )]
     pub variance_kept: f64,
     /// Pseudo-count added to every cluster bin of every object histogram.
-    #[arg(long, default_value_t = 1.0, value_name = "ALPHA")]
+    #[arg(long, default_value_t = 1.0, value_name = "ALPHA", allow_hyphen_values = true)]
     pub pseudo_count: f64,
     /// Readings per validation trial.
     #[arg(long, default_value_t = 10, value_name = "N")]
@@ -79,7 +86,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         codebook: args.codebook,
         ks,
         restarts: args.restarts,
-        seed: args.seed,
+        seed: args.seed.seed,
         variance_kept: VarianceFraction::new(args.variance_kept)?,
         pseudo_count: PseudoCount::new(args.pseudo_count)?,
         trial_readings: args.trial_readings,

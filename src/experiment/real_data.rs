@@ -245,6 +245,11 @@ impl RealData {
     pub fn labels(&self) -> BTreeSet<&str> {
         self.readings.iter().map(|r| r.label.as_str()).collect()
     }
+
+    /// The line of the first frame labelled `label`, for messages about the label.
+    pub fn first_line_of(&self, label: &str) -> Option<u64> {
+        self.readings.iter().find(|r| r.label == label).map(|r| r.line)
+    }
 }
 
 /// What is wrong with a real-data file; `origin` is its path, `line` 1-based.

@@ -26,8 +26,9 @@ pub struct RunOptions {
     /// Output root; the experiment writes into `<out>/<experiment>/`.
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
-    /// Worker threads; results do not depend on it. Default: one per core.
-    #[arg(long)]
+    /// Worker threads; results do not depend on it. Default: one per core. (The command line's
+    /// `--threads` is defined with the other shared flags of the `taction` binary.)
+    #[arg(skip)]
     pub threads: Option<NonZeroUsize>,
     /// Run only the k-th of n disjoint slices of the units (`1 <= k <= n`), e.g. `2/3`; combine the
     /// shards' output directories with `taction merge`.

@@ -38,12 +38,19 @@ pub enum MeshError {
     Truncated { path: PathBuf, what: String },
     #[error("{}: {at}: coordinate {value} is not finite", path.display())]
     NonFinite { path: PathBuf, at: Location, value: f64 },
-    #[error("{}: {at}: vertex index {index} is out of range (the file has {count} vertices)", path.display())]
+    #[error(
+        "{}: {at}: vertex index {index} is out of range (the file has {count} vertices, numbered {first} to {})",
+        path.display(),
+        *first + *count as i64 - 1
+    )]
     IndexOutOfRange {
         path: PathBuf,
         at: Location,
+        /// The index as the file writes it (1-based or negative in OBJ, 0-based in OFF).
         index: i64,
         count: usize,
+        /// The index of the file's first vertex in its format.
+        first: i64,
     },
     #[error("{}: the mesh has no vertices", path.display())]
     NoVertices { path: PathBuf },

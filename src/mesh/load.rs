@@ -73,9 +73,11 @@ pub fn parse(bytes: &[u8], format: MeshFormat, path: &Path) -> Result<LoadedMesh
 pub(crate) struct MeshBuilder {
     path: PathBuf,
     vertices: Vec<DVec3>,
-    /// Polygons as resolved 0-based indices, with where they were read; checked in `finish`, since
-    /// an OBJ face may name a vertex defined further down.
-    polygons: Vec<(Location, Vec<i64>)>,
+    /// Polygons as (resolved 0-based index, index as written) pairs, with where they were read;
+    /// checked in `finish`, since an OBJ face may name a vertex defined further down.
+    polygons: Vec<(Location, Vec<(i64, i64)>)>,
+    /// The index the file's format gives its first vertex (1 in OBJ, 0 in OFF), for messages.
+    first_index: i64,
 }
 
 impl MeshBuilder {
@@ -84,6 +86,16 @@ impl MeshBuilder {
             path: path.to_path_buf(),
             vertices: Vec::new(),
             polygons: Vec::new(),
+            first_index: 0,
+        }
+    }
+
+    /// A builder for a format that numbers its vertices from 1 (OBJ), so that messages quote
+    /// indices as the file writes them.
+    pub(crate) fn one_based(path: &Path) -> Self {
+        Self {
+            first_index: 1,
+            ..Self::new(path)
         }
     }
 
@@ -121,8 +133,18 @@ impl MeshBuilder {
         (self.vertices.len() - 1) as u32
     }
 
-    /// Adds a polygon of 0-based indices (possibly out of range: checked in `finish`).
+    /// Adds a polygon of 0-based indices (possibly out of range: checked in `finish`), written
+    /// 0-based in the file.
     pub(crate) fn push_polygon(&mut self, at: Location, indices: Vec<i64>) -> Result<(), MeshError> {
+        self.push_polygon_as_written(at, indices.into_iter().map(|i| (i, i)).collect())
+    }
+
+    /// Adds a polygon of (0-based index, index as the file writes it) pairs.
+    pub(crate) fn push_polygon_as_written(
+        &mut self,
+        at: Location,
+        indices: Vec<(i64, i64)>,
+    ) -> Result<(), MeshError> {
         if indices.len() < 3 {
             return Err(self.parse_error(
                 at,
@@ -144,15 +166,16 @@ impl MeshBuilder {
         let count = self.vertices.len();
         let mut triangles = Vec::with_capacity(self.polygons.len());
         for (at, polygon) in &self.polygons {
-            if let Some(&index) = polygon.iter().find(|&&i| i < 0 || i >= count as i64) {
+            if let Some(&(_, index)) = polygon.iter().find(|&&(i, _)| i < 0 || i >= count as i64) {
                 return Err(MeshError::IndexOutOfRange {
                     path: self.path,
                     at: *at,
                     index,
                     count,
+                    first: self.first_index,
                 });
             }
-            let p: Vec<u32> = polygon.iter().map(|&i| i as u32).collect();
+            let p: Vec<u32> = polygon.iter().map(|&(i, _)| i as u32).collect();
             triangles.extend((1..p.len() - 1).map(|i| [p[0], p[i], p[i + 1]]));
         }
         Ok(TriMesh {

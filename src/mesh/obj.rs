@@ -12,7 +12,7 @@ use super::load::{MeshBuilder, content_lines};
 /// Parses OBJ text. Face corners may be `i`, `i/t`, `i//n` or `i/t/n`, 1-based or negative
 /// (relative to the vertices read so far); records other than `v` and `f` are ignored.
 pub(crate) fn parse(text: &str, path: &Path) -> Result<TriMesh, MeshError> {
-    let mut builder = MeshBuilder::new(path);
+    let mut builder = MeshBuilder::one_based(path);
     for (line_no, line) in content_lines(text) {
         let at = Location::Line(line_no);
         let mut tokens = line.split_whitespace();
@@ -38,12 +38,12 @@ pub(crate) fn parse(text: &str, path: &Path) -> Result<TriMesh, MeshError> {
                         })?;
                         match i {
                             0 => Err(builder.parse_error(at, "vertex index 0 (OBJ indices start at 1)")),
-                            i if i > 0 => Ok(i - 1),
-                            i => Ok(count + i),
+                            i if i > 0 => Ok((i - 1, i)),
+                            i => Ok((count.saturating_add(i), i)),
                         }
                     })
-                    .collect::<Result<Vec<i64>, MeshError>>()?;
-                builder.push_polygon(at, indices)?;
+                    .collect::<Result<Vec<(i64, i64)>, MeshError>>()?;
+                builder.push_polygon_as_written(at, indices)?;
             }
             _ => {}
         }

@@ -34,7 +34,7 @@ pub enum RecognizeError {
     SingularCovariance { component: usize },
     #[error("object '{object}' has no training readings")]
     EmptyObject { object: String },
-    #[error("object '{object}' is not one of the model's objects {known:?}")]
+    #[error("object '{object}' is not one of the model's objects ({})", known.join(", "))]
     UnknownObject { object: String, known: Vec<String> },
     #[error("{path}: {source}")]
     Io { path: String, source: std::io::Error },
@@ -46,9 +46,7 @@ pub enum RecognizeError {
     NotAModel { path: String, what: String },
     #[error("{path}: inconsistent model: {what}")]
     Inconsistent { path: String, what: String },
-    #[error(
-        "the model was trained with a different sensor: {differences}\n  model: {model:?}\n  data:  {data:?}"
-    )]
+    #[error("the model was trained with a different sensor: {differences}")]
     SensorMismatch {
         differences: String,
         model: Box<SensorConfig>,

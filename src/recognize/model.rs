@@ -264,7 +264,7 @@ pub fn check_same_sensor(model: &SensorConfig, data: &SensorConfig) -> Result<()
         d.noise_fraction.to_string(),
     );
     if differences.is_empty() {
-        differences.push("a field differs (see below)".into());
+        differences.push("a field differs".into());
     }
     Err(RecognizeError::SensorMismatch {
         differences: differences.join(", "),

@@ -154,8 +154,9 @@ impl PaperContext {
             }
             .ok_or_else(|| {
                 format!(
-                    "{}: label '{label}' names no letter (labels are single letters such as 'A' or names such as 'upper_A')",
-                    self.real.origin
+                    "{}: line {}: label '{label}' names no letter (labels are single letters such as 'A' or names such as 'upper_A')",
+                    self.real.origin,
+                    real.first_line_of(label).unwrap_or(0)
                 )
             })?;
             // A letter the set lacks is drawn like the set's other letters.

@@ -1,0 +1,66 @@
+//! Numbers for people: lengths and plain values with four significant digits, so that a message
+//! says `covering 1.2 mm` rather than the shortest round-trip form `0.0012000000000000001 m`
+//! (files keep the round-trip form; see `dataset::format_f64`).
+
+/// `v` with at most four significant digits, trailing zeros dropped: `1.2`, `0.576`, `12`, and
+/// exponent form outside [1e-4, 1e6): `3e30`.
+pub fn significant(v: f64) -> String {
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    let magnitude = v.abs().log10().floor() as i32;
+    if !(-4..6).contains(&magnitude) {
+        let text = format!("{v:.3e}");
+        return match text.split_once('e') {
+            Some((mantissa, exponent)) => format!("{}e{exponent}", trim_zeros(mantissa)),
+            None => text,
+        };
+    }
+    let decimals = (3 - magnitude).max(0) as usize;
+    trim_zeros(&format!("{v:.decimals$}"))
+}
+
+fn trim_zeros(text: &str) -> String {
+    let trimmed = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        text
+    };
+    if trimmed == "-0" {
+        "0".to_string()
+    } else {
+        trimmed.to_string()
+    }
+}
+
+/// A length given in metres, in millimetres below one metre (`1.2 mm`, `120 mm`) and in metres
+/// from there on (`1.5 m`, `3e30 m`).
+pub fn length(m: f64) -> String {
+    if m != 0.0 && m.abs() < 1.0 {
+        format!("{} mm", significant(m * 1e3))
+    } else {
+        format!("{} m", significant(m))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lengths_read_as_a_person_writes_them() {
+        assert_eq!(length(0.1 * 0.012), "1.2 mm");
+        assert_eq!(length(0.012), "12 mm");
+        assert_eq!(length(0.12), "120 mm");
+        assert_eq!(length(0.48 * 0.0012), "0.576 mm");
+        assert_eq!(length(1.5), "1.5 m");
+        assert_eq!(length(3e30), "3e30 m");
+        assert_eq!(length(0.0), "0 m");
+        assert_eq!(significant(-0.00001234567), "-1.235e-5");
+        assert_eq!(significant(9.99996), "10");
+        assert_eq!(significant(f64::INFINITY), "inf");
+    }
+}

@@ -1,0 +1,510 @@
+//! The bad inputs and inconsistent flags a new user runs into, one test each, through the built
+//! binary on real files in a temporary folder: each ends in one line naming the file or flag and
+//! what is wrong (exit code 2 for a flag, 1 for a failure), never a panic or a backtrace, or in
+//! what a Unix user expects.
+
+mod recognize_toy;
+
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use taction::control::ContactStatus;
+use taction::dataset::{Dataset, DatasetHeader, Reading};
+use taction::explore::Strategy;
+use taction::sim::Pose;
+use taction::tactile::{SensorConfig, TactileImage};
+
+fn taction(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The run failed with `code` and one `taction: ...` line (after any warnings), no panic; returns
+/// that line.
+fn fails_with(out: &Output, code: i32) -> String {
+    let text = stderr(out);
+    assert_eq!(out.status.code(), Some(code), "{text}");
+    assert!(
+        !text.contains("panicked") && !text.contains("RUST_BACKTRACE"),
+        "{text}"
+    );
+    let last = text.lines().last().unwrap_or("").to_string();
+    assert!(
+        last.starts_with("taction: ")
+            || last.starts_with("error: ")
+            || last.starts_with("For more information"),
+        "{text}"
+    );
+    if code == 2 && text.contains("For more information") {
+        // clap's own refusal: the first line is the message.
+        return text.lines().next().unwrap_or("").to_string();
+    }
+    last
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// `taction collect --objects chess FLAGS --out <temp>` fails with `code`; its message line.
+fn chess_collect_fails(flags: &[&str], code: i32) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d.csv").display().to_string();
+    let mut args = vec!["collect", "--objects", "chess", "--out", &out];
+    args.extend(flags);
+    fails_with(&taction(&args), code)
+}
+
+const TETRA: &str = "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nv 0 0 0.05\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+/// The sense flags that put the pad 5 cm above the origin looking down.
+fn sense_args<'a>(mesh: &'a str, out: &'a str) -> Vec<&'a str> {
+    vec![
+        "sense",
+        "--mesh",
+        mesh,
+        "--pad-center",
+        "0.01,0.01,0.1",
+        "--pad-normal",
+        "0,0,-1",
+        "--out",
+        out,
+    ]
+}
+
+#[test]
+fn a_closed_stdout_ends_the_program_quietly_with_success() {
+    let dir = tempfile::tempdir().unwrap();
+    let image = write(dir.path(), "image.csv", "0,0.5,1\n0.25,0.75,0\n");
+    // `println!` (experiment list) and a buffered writer (describe) alike.
+    for args in [
+        vec!["experiment", "list"],
+        vec!["describe", "--descriptor", "vectorize", "--image", &image],
+    ] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(&args)
+            .stdout(writer)
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
+        assert_eq!(stderr(&out), "", "{args:?}");
+    }
+}
+
+#[test]
+fn threads_beyond_a_few_per_core_are_refused_and_zero_means_every_core_everywhere() {
+    let line = chess_collect_fails(&["--readings", "5", "--threads", "100000"], 2);
+    assert!(line.contains("--threads") && line.contains("per core"), "{line}");
+    // 0 is one meaning in both commands that have the flag: one thread per core.
+    let listed = taction(&["experiment", "list", "--threads", "0"]);
+    assert!(listed.status.success(), "{}", stderr(&listed));
+    for command in ["collect", "experiment", "reproduce"] {
+        let help = String::from_utf8_lossy(&taction(&[command, "--help"]).stdout).into_owned();
+        assert!(
+            help.contains("0 uses one per core; at most 4 per core"),
+            "{command}: {help}"
+        );
+    }
+}
+
+#[test]
+fn a_mesh_of_three_vertices_is_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(
+        dir.path(),
+        "triangle.obj",
+        "v 0 0 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3\n",
+    );
+    let out = dir.path().join("r.csv").display().to_string();
+    for args in [
+        sense_args(&mesh, &out),
+        vec!["collect", "--objects", &mesh, "--readings", "2", "--out", &out],
+    ] {
+        let line = fails_with(&taction(&args), 1);
+        assert!(
+            line.contains("triangle.obj") && line.contains("at least 4") && !line.contains("MJCF"),
+            "{line}"
+        );
+    }
+}
+
+#[test]
+fn coordinates_that_are_not_metres_are_refused_with_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "huge.obj", &TETRA.replace("0.05", "1e30"));
+    let out = dir.path().join("r.csv").display().to_string();
+    let line = fails_with(&taction(&sense_args(&mesh, &out)), 1);
+    assert!(
+        line.contains("huge.obj") && line.contains("bounding diagonal 1.732e30 m"),
+        "{line}"
+    );
+    assert!(!Path::new(&out).exists());
+    let ds = dir.path().join("d.csv").display().to_string();
+    let line = fails_with(
+        &taction(&["collect", "--objects", &mesh, "--readings", "2", "--out", &ds]),
+        1,
+    );
+    assert!(
+        line.contains("huge.obj") && line.contains("use --object-size-m"),
+        "{line}"
+    );
+    assert!(!Path::new(&ds).exists());
+}
+
+#[test]
+fn an_obj_index_out_of_range_is_quoted_as_the_file_writes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(
+        dir.path(),
+        "idx.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 2 3 5\n",
+    );
+    let out = dir.path().join("r.csv").display().to_string();
+    let line = fails_with(&taction(&sense_args(&mesh, &out)), 1);
+    assert!(
+        line.contains(
+            "idx.obj: line 5: vertex index 5 is out of range (the file has 4 vertices, numbered 1 to 4)"
+        ),
+        "{line}"
+    );
+}
+
+#[test]
+fn collect_warns_about_an_open_mesh_as_sense_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let open = TETRA.rsplit_once("f 2 3 4").unwrap().0.to_string();
+    let mesh = write(dir.path(), "open.obj", &open);
+    let ds = dir.path().join("d.csv").display().to_string();
+    let out = taction(&[
+        "collect",
+        "--objects",
+        &mesh,
+        "--readings",
+        "2",
+        "--contact-sheet",
+        "0",
+        "--allow-short",
+        "--out",
+        &ds,
+    ]);
+    let text = stderr(&out);
+    assert!(out.status.success(), "{text}");
+    assert!(
+        text.contains("warning: object 'open'")
+            && text.contains("open.obj")
+            && text.contains("open boundary"),
+        "{text}"
+    );
+}
+
+/// `per_object` readings of each of `objects`, every one the same flat image of `sensor`'s size.
+fn flat_dataset(sensor: SensorConfig, objects: &[&str], per_object: usize) -> Dataset {
+    let header = DatasetHeader::new(
+        sensor,
+        "flat",
+        objects.iter().map(|s| s.to_string()).collect(),
+        "test",
+        1,
+    );
+    let image = TactileImage::new(sensor.rows, sensor.cols, vec![0.5; sensor.rows * sensor.cols]).unwrap();
+    let readings = (0..per_object)
+        .flat_map(|_| objects.iter())
+        .map(|object| Reading {
+            image: image.clone(),
+            object: object.to_string(),
+            object_pose: Pose::IDENTITY,
+            status: ContactStatus::Converged,
+            iterations: 3,
+            strategy: Strategy::Sampler,
+            cause: None,
+        })
+        .collect();
+    Dataset::new(header, readings).unwrap()
+}
+
+/// A model trained on the toy set (8x8 taxels: ridges, bumps, flat), in `dir`.
+fn toy_model(dir: &Path) -> String {
+    let train = dir.join("train.csv");
+    recognize_toy::dataset(20, 1).write(&train).unwrap();
+    let model = dir.join("model.json").display().to_string();
+    let out = taction(&[
+        "train",
+        "--dataset",
+        &train.display().to_string(),
+        "--descriptor",
+        "vectorize",
+        "--k",
+        "3",
+        "--restarts",
+        "1",
+        "--out",
+        &model,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    model
+}
+
+#[test]
+fn recognising_data_of_another_set_or_sensor_names_both_files_without_debug_dumps() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = toy_model(dir.path());
+    let other_set = dir.path().join("dragons.csv");
+    flat_dataset(recognize_toy::sensor(), &["dragon", "bunny"], 12)
+        .write(&other_set)
+        .unwrap();
+    let out_dir = dir.path().join("out").display().to_string();
+    let line = fails_with(
+        &taction(&[
+            "recognize",
+            "--model",
+            &model,
+            "--dataset",
+            &other_set.display().to_string(),
+            "--readings",
+            "3",
+            "--out",
+            &out_dir,
+        ]),
+        1,
+    );
+    assert!(
+        line.contains("dragons.csv: object 'bunny'") || line.contains("dragons.csv: object 'dragon'"),
+        "{line}"
+    );
+    assert!(
+        line.contains("model.json") && line.contains("ridges, bumps, flat"),
+        "{line}"
+    );
+
+    let big = SensorConfig {
+        rows: 14,
+        cols: 14,
+        ..recognize_toy::sensor()
+    };
+    let other_sensor = dir.path().join("14x14.csv");
+    flat_dataset(big, &recognize_toy::OBJECTS, 4)
+        .write(&other_sensor)
+        .unwrap();
+    let out = taction(&[
+        "recognize",
+        "--model",
+        &model,
+        "--dataset",
+        &other_sensor.display().to_string(),
+        "--out",
+        &out_dir,
+    ]);
+    let line = fails_with(&out, 1);
+    assert!(
+        line.contains("14x14.csv") && line.contains("rows 8 (model) vs 14 (data)"),
+        "{line}"
+    );
+    assert!(!stderr(&out).contains("SensorConfig"), "{}", stderr(&out));
+    assert_eq!(stderr(&out).lines().count(), 1, "{}", stderr(&out));
+}
+
+#[test]
+fn negative_numbers_reach_the_range_check_of_their_flag() {
+    let line = chess_collect_fails(&["--perturb-deg", "-10"], 2);
+    assert!(
+        line.contains("--perturb-deg -10: is outside [0, 180] degrees"),
+        "{line}"
+    );
+}
+
+#[test]
+fn every_command_with_a_seed_documents_it_alike_with_one_default() {
+    let mut lines = Vec::new();
+    for command in [
+        "collect",
+        "demo",
+        "experiment",
+        "reproduce",
+        "sense",
+        "touch",
+        "train",
+    ] {
+        let help = String::from_utf8_lossy(&taction(&[command, "--help"]).stdout).into_owned();
+        let at = help
+            .find("--seed <N>")
+            .unwrap_or_else(|| panic!("{command} has no --seed: {help}"));
+        // The flag's own line (clap puts a short help beside the flag, a long one below it)
+        // and the lines up to the next flag.
+        let rest = &help[at + "--seed <N>".len()..];
+        let (first, below) = rest.split_once('\n').unwrap_or((rest, ""));
+        let entry: String = std::iter::once(first)
+            .chain(below.lines().take_while(|l| !l.trim_start().starts_with('-')))
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(entry.contains("[default: 1]"), "{command}: {entry}");
+        lines.push(entry.split_whitespace().collect::<Vec<_>>().join(" "));
+    }
+    assert!(lines.windows(2).all(|w| w[0] == w[1]), "{lines:#?}");
+}
+
+#[test]
+fn a_covering_thicker_than_half_the_pad_is_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "t.obj", TETRA);
+    let out = dir.path().join("r.csv").display().to_string();
+    let mut args = sense_args(&mesh, &out);
+    args.extend(["--thickness-m", "0.5"]);
+    let line = fails_with(&taction(&args), 2);
+    assert!(
+        line.contains("--thickness-m") && line.contains("half the 12 mm pad side, 6 mm"),
+        "{line}"
+    );
+}
+
+#[test]
+fn an_absurd_reading_count_is_refused_before_any_work() {
+    let line = chess_collect_fails(&["--readings", "100000000000"], 2);
+    assert!(
+        line.contains("--readings 100000000000: want 1 to 1000000"),
+        "{line}"
+    );
+}
+
+#[test]
+fn no_help_text_points_to_rust_code() {
+    for command in [
+        vec!["collect"],
+        vec!["demo"],
+        vec!["describe"],
+        vec!["experiment"],
+        vec!["reproduce"],
+        vec!["merge"],
+        vec!["objects", "export"],
+        vec!["objects", "letters"],
+        vec!["sense"],
+        vec!["dataset", "show"],
+        vec!["recognize"],
+        vec!["touch"],
+        vec!["train"],
+    ] {
+        let mut args = command.clone();
+        args.push("--help");
+        let help = String::from_utf8_lossy(&taction(&args).stdout).into_owned();
+        assert!(
+            !help.contains("::") && !help.contains("Config`"),
+            "{command:?}: {help}"
+        );
+    }
+    let help = String::from_utf8_lossy(&taction(&["experiment", "--help"]).stdout).into_owned();
+    assert!(help.contains("a header `label,r0c0,r0c1,...`"), "{help}");
+}
+
+#[test]
+fn dataset_show_prints_lengths_in_millimetres() {
+    let dir = tempfile::tempdir().unwrap();
+    let sensor = SensorConfig::square(6, 6, 0.012, 0.1 * 0.012);
+    assert_eq!(sensor.thickness_m.to_string(), "0.0012000000000000001");
+    let path = dir.path().join("d.csv");
+    flat_dataset(sensor, &["a", "b"], 2).write(&path).unwrap();
+    let out = taction(&["dataset", "show", &path.display().to_string()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        text.contains("pad 12 mm x 12 mm, covering 1.2 mm, PSF sigma 0.5761 mm"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_second_run_into_a_locked_output_folder_names_the_holder() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("results");
+    std::fs::create_dir_all(&results).unwrap();
+    let mut holder: File = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .open(results.join(".taction.lock"))
+        .unwrap();
+    holder.try_lock().unwrap();
+    writeln!(holder, "4242").unwrap();
+    let out = results.display().to_string();
+    let line = fails_with(
+        &taction(&["experiment", "descriptors", "--scale", "0.01", "--out", &out]),
+        1,
+    );
+    assert!(
+        line.contains(&format!(
+            "--out {out}: another taction run (pid 4242) is writing there"
+        )),
+        "{line}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&results).unwrap().count(),
+        1,
+        "only the lock file"
+    );
+}
+
+#[test]
+fn a_failed_export_leaves_no_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write(dir.path(), "good.obj", TETRA);
+    let bad = write(dir.path(), "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
+    let out: PathBuf = dir.path().join("exported");
+    let line = fails_with(
+        &taction(&[
+            "objects",
+            "export",
+            &good,
+            &bad,
+            "--out",
+            &out.display().to_string(),
+        ]),
+        1,
+    );
+    assert!(line.contains("bad.obj: line 4"), "{line}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn an_unknown_sim_to_real_label_is_named_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let header: Vec<String> = (0..4)
+        .flat_map(|r| (0..4).map(move |c| format!("r{r}c{c}")))
+        .collect();
+    let frame = vec!["1"; 16].join(",");
+    let csv = format!(
+        "label,{}\n# a comment\nA,{frame}\nbanana,{frame}\nA,{frame}\n",
+        header.join(",")
+    );
+    let real = write(dir.path(), "real.csv", &csv);
+    let out = dir.path().join("results").display().to_string();
+    let line = fails_with(
+        &taction(&[
+            "experiment",
+            "sim-to-real",
+            "--real",
+            &real,
+            "--scale",
+            "0.01",
+            "--out",
+            &out,
+        ]),
+        1,
+    );
+    assert!(
+        line.contains("real.csv: line 4: label 'banana' names no letter"),
+        "{line}"
+    );
+}
