@@ -9,7 +9,7 @@ use std::process::Command;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
     DescriptorChoice, FusedModel, LabelledFeatures, ReadingRange, Recognizer, TrainConfig, TrainedModel,
-    evaluate, make_trials,
+    make_trials,
 };
 
 fn config() -> TrainConfig {

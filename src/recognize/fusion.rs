@@ -316,7 +316,7 @@ impl FusedPosterior<'_> {
 /// A model file of either kind, as `taction recognize` takes it.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Recognizer {
-    Single(TrainedModel),
+    Single(Box<TrainedModel>),
     Fused(FusedModel),
 }
 
@@ -336,7 +336,7 @@ impl Recognizer {
                 check_version(&value, &name)?;
                 Ok(Self::Fused(FusedModel::from_json(&value, &name)?))
             }
-            None => Ok(Self::Single(TrainedModel::from_json(&bytes, &name)?)),
+            None => Ok(Self::Single(Box::new(TrainedModel::from_json(&bytes, &name)?))),
         }
     }
 
