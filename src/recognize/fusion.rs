@@ -14,13 +14,13 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::{Dataset, write_atomic};
+use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::decision::Decision;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
-use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor};
+use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, save_json};
 use crate::recognize::posterior::{Belief, OnlinePosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
 
@@ -173,12 +173,7 @@ impl FusedModel {
 
     /// Writes the model as JSON, atomically.
     pub fn save(&self, path: &Path) -> Result<(), RecognizeError> {
-        let json = serde_json::to_vec(self).map_err(|e| RecognizeError::NotAModel {
-            path: path.display().to_string(),
-            what: format!("cannot encode: {e}"),
-        })?;
-        write_atomic(path, &json)?;
-        Ok(())
+        save_json(self, path)
     }
 
     /// Parses a fused model file: every part is checked as a model file of its own

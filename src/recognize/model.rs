@@ -113,12 +113,7 @@ impl TrainedModel {
 
     /// Writes the model as JSON, atomically.
     pub fn save(&self, path: &Path) -> Result<(), RecognizeError> {
-        let json = serde_json::to_vec(self).map_err(|e| RecognizeError::NotAModel {
-            path: path.display().to_string(),
-            what: format!("cannot encode: {e}"),
-        })?;
-        write_atomic(path, &json)?;
-        Ok(())
+        save_json(self, path)
     }
 
     /// Reads a model written by [`save`](Self::save); see the module docs for the checks.
@@ -271,4 +266,14 @@ pub fn check_same_sensor(model: &SensorConfig, data: &SensorConfig) -> Result<()
         model: Box::new(*m),
         data: Box::new(*d),
     })
+}
+
+/// Writes a model file (`value` as JSON) atomically: a reader never sees half of it.
+pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), RecognizeError> {
+    let json = serde_json::to_vec(value).map_err(|e| RecognizeError::NotAModel {
+        path: path.display().to_string(),
+        what: format!("cannot encode: {e}"),
+    })?;
+    write_atomic(path, &json)?;
+    Ok(())
 }
