@@ -26,19 +26,21 @@ pub struct PluginNotBuilt {
     pub searched: Vec<PathBuf>,
 }
 
-/// The folders searched for the library, in order: the binary's own folder (cargo puts both in
-/// `target/<profile>/`), then the release folder beside it (a debug `taction` finds the library the
-/// set-up built in release).
+/// The folders searched for the library, in order: the release folder of the binary's target
+/// directory (`target/release/`, where the set-up builds it and the README points), then the
+/// binary's own folder (an installed `taction` with the library beside it). A debug build of the
+/// plugin (e.g. left by `cargo build --workspace`) reads the same but is slower and ten times
+/// larger, so it is found only when there is no release one.
 pub fn search_dirs(exe: &Path) -> Vec<PathBuf> {
     let mut dirs = Vec::new();
     if let Some(dir) = exe.parent() {
-        dirs.push(dir.to_path_buf());
         if let Some(profiles) = dir.parent() {
             let release = profiles.join("release");
             if release != dir {
                 dirs.push(release);
             }
         }
+        dirs.push(dir.to_path_buf());
     }
     dirs
 }
@@ -57,4 +59,24 @@ pub fn plugin_library() -> Result<PathBuf, Box<dyn std::error::Error>> {
 pub fn run(_args: &PluginPathArgs) -> Result<(), Box<dyn std::error::Error>> {
     println!("{}", plugin_library()?.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_release_build_is_searched_first() {
+        assert_eq!(
+            search_dirs(Path::new("/w/target/debug/taction")),
+            [
+                PathBuf::from("/w/target/release"),
+                PathBuf::from("/w/target/debug")
+            ]
+        );
+        assert_eq!(
+            search_dirs(Path::new("/w/target/release/taction")),
+            [PathBuf::from("/w/target/release")]
+        );
+    }
 }
