@@ -20,7 +20,9 @@ use crate::recognize::RecognizeError;
 use crate::recognize::decision::Decision;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
-use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, save_json};
+use crate::recognize::model::{
+    MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, read_model_file, save_json,
+};
 use crate::recognize::posterior::{Belief, OnlinePosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
 
@@ -318,11 +320,7 @@ pub enum Recognizer {
 impl Recognizer {
     /// Reads a model written by `taction train`, fused (a `fused` list) or not.
     pub fn load(path: &Path) -> Result<Self, RecognizeError> {
-        let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| RecognizeError::Io {
-            path: name.clone(),
-            source,
-        })?;
+        let (bytes, name) = read_model_file(path)?;
         let fused = serde_json::from_slice::<serde_json::Value>(&bytes)
             .ok()
             .filter(|v| v.get("fused").is_some());

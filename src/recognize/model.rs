@@ -118,11 +118,7 @@ impl TrainedModel {
 
     /// Reads a model written by [`save`](Self::save); see the module docs for the checks.
     pub fn load(path: &Path) -> Result<Self, RecognizeError> {
-        let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| RecognizeError::Io {
-            path: name.clone(),
-            source,
-        })?;
+        let (bytes, name) = read_model_file(path)?;
         Self::from_json(&bytes, &name)
     }
 
@@ -266,6 +262,15 @@ pub fn check_same_sensor(model: &SensorConfig, data: &SensorConfig) -> Result<()
         model: Box::new(*m),
         data: Box::new(*d),
     })
+}
+
+/// The bytes of a model file and its name for error messages.
+pub(crate) fn read_model_file(path: &Path) -> Result<(Vec<u8>, String), RecognizeError> {
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => Ok((bytes, name)),
+        Err(source) => Err(RecognizeError::Io { path: name, source }),
+    }
 }
 
 /// Writes a model file (`value` as JSON) atomically: a reader never sees half of it.
