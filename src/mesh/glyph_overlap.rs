@@ -198,7 +198,8 @@ pub struct LetterPair {
     pub iou: f64,
 }
 
-/// Every pair of the generated letters of `set` (each in its own font and style), most alike first.
+/// Every pair of the generated letters of `set` (each in its own font and style, the font checked
+/// against the set's checksum), most alike first.
 /// Objects of other kinds are left out.
 pub fn letter_pairs(set: &ObjectSet) -> Result<Vec<LetterPair>, MeshError> {
     let mut fonts: BTreeMap<PathBuf, Font> = BTreeMap::new();
@@ -206,10 +207,7 @@ pub fn letter_pairs(set: &ObjectSet) -> Result<Vec<LetterPair>, MeshError> {
     let mut outlines = Vec::new();
     for object in &set.objects {
         if let ObjectSource::Letter { glyph, font, style } = &object.source {
-            if !fonts.contains_key(&font.path) {
-                fonts.insert(font.path.clone(), Font::load(&font.path)?);
-            }
-            outlines.push(letter_outline(&fonts[&font.path], *glyph, style)?);
+            outlines.push(letter_outline(font.load_into(&mut fonts)?, *glyph, style)?);
             names.push(object.name.clone());
         }
     }

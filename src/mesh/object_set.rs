@@ -39,6 +39,26 @@ pub struct FontRef {
     pub sha256: String,
 }
 
+impl FontRef {
+    /// The font this reference pins, read once into `fonts` (keyed by path) and checked against the
+    /// recorded checksum: a set's letters are only rebuilt from the font they were made with.
+    pub fn load_into<'a>(&self, fonts: &'a mut BTreeMap<PathBuf, Font>) -> Result<&'a Font, MeshError> {
+        if !fonts.contains_key(&self.path) {
+            fonts.insert(self.path.clone(), Font::load(&self.path)?);
+        }
+        let loaded = &fonts[&self.path];
+        if loaded.sha256() != self.sha256 {
+            return Err(MeshError::Checksum {
+                path: self.path.clone(),
+                expected: self.sha256.clone(),
+                actual: loaded.sha256().into(),
+                hint: "the font changed since the set was made; use the same font file".into(),
+            });
+        }
+        Ok(loaded)
+    }
+}
+
 /// Where an object's mesh comes from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -430,19 +450,7 @@ impl ObjectSet {
                 (mesh, warnings)
             }
             ObjectSource::Letter { glyph, font, style } => {
-                if !fonts.contains_key(&font.path) {
-                    fonts.insert(font.path.clone(), Font::load(&font.path)?);
-                }
-                let loaded = &fonts[&font.path];
-                if loaded.sha256() != font.sha256 {
-                    return Err(MeshError::Checksum {
-                        path: font.path.clone(),
-                        expected: font.sha256.clone(),
-                        actual: loaded.sha256().into(),
-                        hint: "the font changed since the set was made; use the same font file".into(),
-                    });
-                }
-                let mesh = raised_letter(loaded, *glyph, style)?;
+                let mesh = raised_letter(font.load_into(fonts)?, *glyph, style)?;
                 let warnings = ValidationReport::of(&mesh);
                 (mesh, warnings)
             }
