@@ -21,6 +21,25 @@ fn taction(args: &[&str]) -> Output {
         .expect("the taction binary runs")
 }
 
+/// The rows of `experiment real-frames --trials 2` on the recording `text`.
+fn two_trials_of(text: &str) -> Vec<AccuracyRow> {
+    let dir = tempfile::tempdir().unwrap();
+    let real = dir.path().join("recording.csv");
+    std::fs::write(&real, text).unwrap();
+    let out = dir.path().join("out");
+    run_ok(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        real.to_str().unwrap(),
+        "--trials",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    rows(&out)
+}
+
 fn run_ok(args: &[&str]) {
     let output = taction(args);
     assert!(
@@ -121,22 +140,7 @@ fn two_labels_with_disjoint_constant_frames_are_told_apart_after_one_reading() {
     let cross: Vec<f64> = (0..36)
         .map(|k| if k / 6 == 2 || k % 6 == 2 { 500.0 } else { 0.0 })
         .collect();
-    let text = recording(&[("A", vec![bar(0..3); 14]), ("B", vec![cross; 14])]);
-    let dir = tempfile::tempdir().unwrap();
-    let real = dir.path().join("two.csv");
-    std::fs::write(&real, text).unwrap();
-    let out = dir.path().join("out");
-    run_ok(&[
-        "experiment",
-        "real-frames",
-        "--real",
-        real.to_str().unwrap(),
-        "--trials",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let rows = rows(&out);
+    let rows = two_trials_of(&recording(&[("A", vec![bar(0..3); 14]), ("B", vec![cross; 14])]));
     for r in rows.iter().filter(|r| r.n_readings == 1) {
         assert_eq!(r.accuracy, 1.0, "{} trial {}", r.descriptor, r.trial);
     }
@@ -147,21 +151,7 @@ fn labels_sharing_the_same_frames_stay_at_chance() {
     let frame: Vec<f64> = (0..36).map(|k| (k % 7) as f64 * 100.0).collect();
     let labels = ["A", "E", "I", "O"];
     let frames: Vec<(&str, Vec<Vec<f64>>)> = labels.iter().map(|l| (*l, vec![frame.clone(); 14])).collect();
-    let dir = tempfile::tempdir().unwrap();
-    let real = dir.path().join("same.csv");
-    std::fs::write(&real, recording(&frames)).unwrap();
-    let out = dir.path().join("out");
-    run_ok(&[
-        "experiment",
-        "real-frames",
-        "--real",
-        real.to_str().unwrap(),
-        "--trials",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let rows = rows(&out);
+    let rows = two_trials_of(&recording(&frames));
     // Identical evidence for every label: the belief stays at the uniform prior.
     for n in 1..=4 {
         let (_, reliability) = mean_at(&rows, n);
