@@ -42,6 +42,17 @@ fn python_with_mujoco() -> Result<PathBuf, String> {
     if has_mujoco(&python) {
         return Ok(python);
     }
+    // The tests of this file run in parallel threads (or processes, under nextest); one of them
+    // makes the venv while the others wait on this lock, then find it made. Without it, concurrent
+    // `pip install`s into one venv fail each other.
+    std::fs::create_dir_all(target_dir()).map_err(|e| format!("{}: {e}", target_dir().display()))?;
+    let lock_path = target_dir().join("sensor-python-venv.lock");
+    let lock = std::fs::File::create(&lock_path).map_err(|e| format!("{}: {e}", lock_path.display()))?;
+    lock.lock()
+        .map_err(|e| format!("locking {}: {e}", lock_path.display()))?;
+    if has_mujoco(&python) {
+        return Ok(python);
+    }
     let made = Command::new("python3")
         .arg("-m")
         .arg("venv")
@@ -68,7 +79,9 @@ fn python_with_mujoco() -> Result<PathBuf, String> {
         .map_err(|e| format!("pip: {e}"))?;
     if !pip.status.success() || !has_mujoco(&python) {
         return Err(format!(
-            "pip install mujoco==3.17.0 matplotlib failed: {}",
+            "pip install mujoco==3.17.0 matplotlib failed ({}): {}{}",
+            pip.status,
+            String::from_utf8_lossy(&pip.stdout),
             String::from_utf8_lossy(&pip.stderr)
         ));
     }
