@@ -593,7 +593,8 @@ fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
                         parameter: "noise_fraction".into(),
                         value: noise.to_string(),
                         trial,
-                        seed,
+                        seed: 42,
+                        stream_seed: seed,
                     };
                     Ok(curve.rows((1..=100).map(|n| {
                         let a =
@@ -607,10 +608,10 @@ fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
     let spec = ExperimentSpec {
         name: SafeName::new("noise").unwrap(),
         description: "Fig. 13: accuracy under additive noise.".into(),
-        plots: vec![PlotSpec::accuracy(
-            SafeName::new("noise").unwrap(),
-            "Robustness to noise (Fig. 13)",
-        )],
+        plots: vec![
+            PlotSpec::accuracy(SafeName::new("noise").unwrap(), "Robustness to noise (Fig. 13)")
+                .with_chance(12),
+        ],
     };
     Experiment {
         spec,
@@ -706,8 +707,9 @@ fn plots_are_valid_svg_and_png_and_the_index_quotes_headlines() {
     assert_valid_svg(
         &noise.join("noise.svg"),
         &[
-            "accuracy (%)",
+            "accuracy (fraction correct)",
             "number of readings",
+            "chance (1/12)",
             "Robustness to noise",
             "polar-fourier",
             "noise_fraction = 0.2",
@@ -723,7 +725,21 @@ fn plots_are_valid_svg_and_png_and_the_index_quotes_headlines() {
         (first.label.as_str(), first.points.len()),
         ("noise_fraction = 0", 100)
     );
-    assert!(first.points.iter().all(|&(_, y)| (0.0..=100.0).contains(&y)));
+    // Plotted as in the CSV (a fraction), with chance level and the two trials as a band around
+    // their mean, at integer readings only.
+    assert!(first.points.iter().all(|&(_, y)| (0.0..=1.0).contains(&y)));
+    let panel = &figure.panels[0];
+    assert!(panel.integer_x);
+    assert_eq!(panel.reference.as_ref().map(|r| r.y), Some(1.0 / 12.0));
+    assert_eq!(first.band.len(), first.points.len());
+    for (&(x, mean), &(bx, low, high)) in first.points.iter().zip(&first.band) {
+        assert_eq!(x, bx);
+        assert!(low <= mean && mean <= high, "{low} <= {mean} <= {high}");
+    }
+    assert!(
+        first.band.iter().any(|&(_, low, high)| high > low),
+        "two trials differ somewhere"
+    );
 
     let conv = dir.path().join("convergence");
     assert_valid_svg(
@@ -769,6 +785,7 @@ fn accuracy_rows_out_of_range_are_named() {
         value: String::new(),
         trial: 0,
         seed: 0,
+        stream_seed: 0,
     };
     let units = vec![Unit::new(SafeName::new("u").unwrap(), move || {
         Ok(curve.rows([(0.5, 0.5), (1.5, 0.5)]))

@@ -14,7 +14,7 @@ use taction::mesh::glyph::Font;
 use taction::mesh::letters::LetterStyle;
 
 const ACCURACY_HEADER: &str =
-    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
+    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";
 
 fn taction(args: &[&str]) -> Output {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
@@ -56,7 +56,11 @@ fn assert_svg_and_png(stem: &Path) {
     let svg = std::fs::read_to_string(stem.with_extension("svg")).expect("SVG written");
     let tree = resvg::usvg::Tree::from_str(&svg, &resvg::usvg::Options::default());
     assert!(tree.is_ok(), "{}: not a valid SVG", stem.display());
-    assert!(svg.contains("number of readings") && svg.contains("accuracy (%)"));
+    assert!(
+        svg.contains("number of readings")
+            && svg.contains("accuracy (fraction correct)")
+            && svg.contains("chance (1/")
+    );
     let png = std::fs::read(stem.with_extension("png")).expect("PNG written");
     let decoded = png::Decoder::new(std::io::Cursor::new(png)).read_info();
     assert!(decoded.is_ok(), "{}: not a valid PNG", stem.display());
@@ -118,6 +122,8 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
                 r.reliability
             );
             assert!(r.n_readings >= 1);
+            // `seed` is the run's --seed; each trial's derived stream is its own column.
+            assert_eq!(r.seed, 1, "{name}: seed column");
             curves.insert((r.descriptor.clone(), r.value.clone(), r.trial));
         }
         // Every curve starts at one reading and counts up without gaps.

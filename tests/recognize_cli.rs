@@ -79,7 +79,7 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     let mut lines = posterior.lines();
     assert_eq!(
         lines.next(),
-        Some("trial,object_true,n_readings,object_guess,p_true,entropy")
+        Some("trial,object_true,n_readings,object_guess,p_true,entropy_nats")
     );
     assert_eq!(lines.count(), 3 * 30);
     let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
@@ -89,9 +89,32 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     );
     let confusion = std::fs::read_to_string(dir.path().join("out/confusion.csv")).unwrap();
     assert!(
-        confusion.contains("ridges,ridges,1\n") && confusion.contains("flat,ridges,0\n"),
+        confusion.starts_with("n_readings,object_true,object_guess,count\n")
+            && confusion.contains("30,ridges,ridges,1\n")
+            && confusion.contains("30,flat,ridges,0\n"),
         "{confusion}"
     );
+    // The whole posterior, one row per (trial, reading, object); each touch's row sums to one and
+    // its true object's probability is the wide file's p_true.
+    let long = std::fs::read_to_string(dir.path().join("out/posterior_long.csv")).unwrap();
+    let mut lines = long.lines();
+    assert_eq!(
+        lines.next(),
+        Some("trial,object_true,n_readings,object,probability")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3 * 30 * 3);
+    for touch in rows.chunks(3) {
+        let total: f64 = touch.iter().map(|r| r[4].parse::<f64>().unwrap()).sum();
+        assert!((total - 1.0).abs() < 1e-9, "{touch:?}");
+    }
+    let p_true_wide: Vec<&str> = posterior
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(4).unwrap())
+        .collect();
+    let p_true_long: Vec<&str> = rows.iter().filter(|r| r[1] == r[3]).map(|r| r[4]).collect();
+    assert_eq!(p_true_wide, p_true_long);
 }
 
 #[test]

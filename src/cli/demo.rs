@@ -12,7 +12,7 @@ use rand::RngExt;
 use taction::control::{ContactStatus, ControlConfig};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::describe::DescriptorKind;
-use taction::experiment::figure::{Figure, Panel, Series};
+use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::progress::CollectionProgress;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
@@ -246,9 +246,15 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             series: vec![Series {
                 label: unknown.name.clone(),
                 points: p_true_series,
+                band: Vec::new(),
             }],
             markers: true,
-            legend: false,
+            legend: true,
+            integer_x: true,
+            reference: Some(ReferenceLine {
+                y: 1.0 / names.len() as f64,
+                label: format!("chance (1/{})", names.len()),
+            }),
         }],
     };
     figure.write_svg(&args.out.join("posterior.svg"))?;

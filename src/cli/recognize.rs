@@ -20,7 +20,7 @@ pub struct RecognizeArgs {
     /// Reading counts to report, `A..B` (both included) or `N` (= `1..N`).
     #[arg(long, default_value = "1..100", value_name = "A..B")]
     pub readings: ReadingRange,
-    /// Directory for posterior.csv, accuracy.csv and confusion.csv.
+    /// Directory for posterior.csv (p(true) per touch), posterior_long.csv (the whole posterior per touch, one row per object), accuracy.csv and confusion.csv.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }

@@ -15,7 +15,8 @@ use serde::{Deserialize, Serialize};
 /// | `n_readings` | number of readings of the unknown object used so far (1-based) |
 /// | `accuracy` | fraction of test objects whose most probable identity after `n_readings` readings is correct, in [0, 1] (the "empirical probability of correctly identifying any unknown object", Sec. V-B2) |
 /// | `reliability` | mean posterior probability given to the correct object, in [0, 1] (Sec. V-B1) |
-/// | `seed` | the seed the trial's randomness was drawn from |
+/// | `seed` | the run's seed, as given with `--seed` |
+/// | `stream_seed` | the seed the trial's randomness was drawn from (derived from `seed`), its 64 bits read as a signed integer so that every CSV reader takes it as an int64 (`as u64` gives it back) |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AccuracyRow {
     pub experiment: String,
@@ -27,6 +28,7 @@ pub struct AccuracyRow {
     pub accuracy: f64,
     pub reliability: f64,
     pub seed: u64,
+    pub stream_seed: i64,
 }
 
 /// Everything an [`AccuracyRow`] holds but the point itself: one curve of one trial.
@@ -37,7 +39,10 @@ pub struct AccuracyCurve {
     pub parameter: String,
     pub value: String,
     pub trial: u32,
+    /// The run's seed (`--seed`).
     pub seed: u64,
+    /// The seed the trial's randomness was drawn from.
+    pub stream_seed: u64,
 }
 
 impl AccuracyCurve {
@@ -56,6 +61,7 @@ impl AccuracyCurve {
                 accuracy,
                 reliability,
                 seed: self.seed,
+                stream_seed: self.stream_seed as i64,
             })
             .collect()
     }
@@ -74,6 +80,7 @@ mod tests {
             value: "0.1".into(),
             trial: 2,
             seed: 9,
+            stream_seed: u64::MAX - 1,
         };
         let rows = curve.rows([(0.2, 0.3), (0.4, 0.5)]);
         assert_eq!(rows.len(), 2);
@@ -87,5 +94,8 @@ mod tests {
             ),
             (2, 0.5, 2, 9)
         );
+        // A derived seed above i64::MAX is written as a negative int64 and read back unchanged.
+        assert_eq!(rows[0].stream_seed, -2);
+        assert_eq!(rows[0].stream_seed as u64, u64::MAX - 1);
     }
 }

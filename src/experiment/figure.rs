@@ -10,11 +10,21 @@ use super::atomic::write_if_changed;
 use super::error::ExperimentError;
 use super::font::{FAMILY, plot_fonts};
 
-/// One line: `points` sorted by x.
+/// One line: `points` sorted by x, with an optional band around it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
+    /// `(x, low, high)` sorted by x: the spread of the values averaged into each point (the
+    /// lowest and highest trial), drawn as a shaded band; empty for none.
+    pub band: Vec<(f64, f64, f64)>,
+}
+
+/// A horizontal reference line drawn dashed, e.g. chance level (1 / number of objects).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceLine {
+    pub y: f64,
+    pub label: String,
 }
 
 /// One set of axes.
@@ -31,6 +41,9 @@ pub struct Panel {
     pub markers: bool,
     /// Draw a legend (not for a lone unnamed line).
     pub legend: bool,
+    /// Label the x axis at integers only (counts, such as the number of readings).
+    pub integer_x: bool,
+    pub reference: Option<ReferenceLine>,
 }
 
 /// A titled figure of one or more panels, laid out two per row.
@@ -161,17 +174,57 @@ fn draw_panel<DB: DrawingBackend>(
     let (x0, x1) = panel.x_range;
     let (y0, y1) = panel.y_range;
     let mut chart = builder.build_cartesian_2d(x0..x1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc(&panel.x_label)
+    let integer_label = |v: &f64| {
+        if v.fract() == 0.0 {
+            format_number(*v)
+        } else {
+            String::new()
+        }
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(&panel.x_label)
         .y_desc(&panel.y_label)
         .label_style((FAMILY, 14))
         .axis_desc_style((FAMILY, 16))
-        .x_label_formatter(&|v| format_number(*v))
         .y_label_formatter(&|v| format_number(*v))
         .light_line_style(RGBColor(242, 242, 242))
-        .bold_line_style(RGBColor(205, 205, 205))
-        .draw()?;
+        .bold_line_style(RGBColor(205, 205, 205));
+    if panel.integer_x {
+        // As many labels as integers in the range (at most 11): plotters puts its ticks at round
+        // values, and the formatter leaves any fractional one blank.
+        let integers = (x1.floor() - x0.ceil() + 1.0).clamp(2.0, 11.0) as usize;
+        mesh.x_labels(integers).x_label_formatter(&integer_label);
+    } else {
+        mesh.x_label_formatter(&|v| format_number(*v));
+    }
+    mesh.draw()?;
+    for (i, series) in panel.series.iter().enumerate() {
+        if series.band.len() < 2 {
+            continue;
+        }
+        let color = PALETTE[i % PALETTE.len()];
+        let outline: Vec<(f64, f64)> = series
+            .band
+            .iter()
+            .map(|&(x, _, high)| (x, high))
+            .chain(series.band.iter().rev().map(|&(x, low, _)| (x, low)))
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.1).filled())))?;
+    }
+    if let Some(reference) = &panel.reference {
+        let style = ShapeStyle::from(RGBColor(90, 90, 90)).stroke_width(1);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, reference.y), (x1, reference.y)],
+                6,
+                4,
+                style,
+            ))?
+            .label(reference.label.as_str())
+            .legend(move |(x, y)| {
+                plotters::element::DashedPathElement::new(vec![(x, y), (x + 22, y)], 6, 4, style)
+            });
+    }
     for (i, series) in panel.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
         let line = ShapeStyle::from(color).stroke_width(2);

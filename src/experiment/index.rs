@@ -83,7 +83,7 @@ fn accuracy_table(text: &mut String, panel: &Panel) {
         for n in HEADLINE_READINGS {
             match series.points.iter().find(|(x, _)| *x == n as f64) {
                 Some((_, y)) => {
-                    let _ = write!(text, " {y:.1} |");
+                    let _ = write!(text, " {:.1} |", 100.0 * y);
                 }
                 None => text.push_str(" - |"),
             }

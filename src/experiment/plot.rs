@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::accuracy::AccuracyRow;
 use super::error::ExperimentError;
-use super::figure::{Figure, Panel, Series};
+use super::figure::{Figure, Panel, ReferenceLine, Series};
 use super::layout::ExperimentDir;
 use super::name::SafeName;
 
@@ -33,8 +33,9 @@ impl Axis {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlotKind {
-    /// Accuracy (%) against the number of readings from [`AccuracyRow`] columns: one line per
-    /// (descriptor, value), the mean over trials at each `n_readings`. When both the descriptor
+    /// Accuracy (the fraction correct, as in the CSV) against the number of readings from
+    /// [`AccuracyRow`] columns: one line per (descriptor, value), the mean over trials at each
+    /// `n_readings` with the lowest and highest trial as a band. When both the descriptor
     /// and the value vary, one panel per descriptor with one line per value (the layout of Fig.
     /// 11-13); otherwise one panel.
     Accuracy,
@@ -54,6 +55,10 @@ pub struct PlotSpec {
     pub stem: SafeName,
     pub title: String,
     pub kind: PlotKind,
+    /// The number of objects told apart, when the plot shows accuracy: chance level (1 / objects)
+    /// is drawn as a dashed line. Absent in manifests written before it existed.
+    #[serde(default)]
+    pub objects: Option<usize>,
 }
 
 impl PlotSpec {
@@ -62,7 +67,14 @@ impl PlotSpec {
             stem,
             title: title.to_string(),
             kind: PlotKind::Accuracy,
+            objects: None,
         }
+    }
+
+    /// Draws chance level for `objects` objects (none for fewer than two).
+    pub fn with_chance(mut self, objects: usize) -> Self {
+        self.objects = (objects >= 2).then_some(objects);
+        self
     }
 
     pub fn lines(stem: SafeName, title: &str, x: Axis, y: Vec<Axis>, series: &[&str]) -> Self {
@@ -71,6 +83,7 @@ impl PlotSpec {
             stem,
             title: title.to_string(),
             kind: PlotKind::Lines { x, y, series },
+            objects: None,
         }
     }
 }
@@ -92,7 +105,7 @@ pub fn render_plot(
 /// The figure `spec` describes, from the rows of `csv`.
 pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentError> {
     let panels = match &spec.kind {
-        PlotKind::Accuracy => accuracy_panels(csv)?,
+        PlotKind::Accuracy => accuracy_panels(csv, spec.objects)?,
         PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series)?,
     };
     Ok(Figure {
@@ -101,27 +114,57 @@ pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentErr
     })
 }
 
-/// Means of `y` per x (keyed by the bits of x, which come from the same text for the same setting).
+/// Means of `y` per x, with the lowest and highest y (keyed by the bits of x, which come from the
+/// same text for the same setting).
 #[derive(Default)]
 struct Means {
-    sums: BTreeMap<u64, (f64, f64, usize)>,
+    sums: BTreeMap<u64, Sum>,
+}
+
+#[derive(Clone, Copy)]
+struct Sum {
+    x: f64,
+    total: f64,
+    n: usize,
+    low: f64,
+    high: f64,
 }
 
 impl Means {
     fn add(&mut self, x: f64, y: f64) {
-        let entry = self.sums.entry(x.to_bits()).or_insert((x, 0.0, 0));
-        entry.1 += y;
-        entry.2 += 1;
+        let entry = self.sums.entry(x.to_bits()).or_insert(Sum {
+            x,
+            total: 0.0,
+            n: 0,
+            low: f64::INFINITY,
+            high: f64::NEG_INFINITY,
+        });
+        entry.total += y;
+        entry.n += 1;
+        entry.low = entry.low.min(y);
+        entry.high = entry.high.max(y);
     }
 
-    fn points(&self) -> Vec<(f64, f64)> {
-        let mut points: Vec<(f64, f64)> = self
-            .sums
-            .values()
-            .map(|&(x, sum, n)| (x, sum / n as f64))
-            .collect();
-        points.sort_by(|a, b| a.0.total_cmp(&b.0));
-        points
+    fn sorted(&self) -> Vec<Sum> {
+        let mut sums: Vec<Sum> = self.sums.values().copied().collect();
+        sums.sort_by(|a, b| a.x.total_cmp(&b.x));
+        sums
+    }
+
+    /// The series `label`: the means, and the band from lowest to highest when some point averages
+    /// values that differ.
+    fn series(&self, label: String) -> Series {
+        let sums = self.sorted();
+        let spread = sums.iter().any(|s| s.high > s.low);
+        Series {
+            label,
+            points: sums.iter().map(|s| (s.x, s.total / s.n as f64)).collect(),
+            band: if spread {
+                sums.iter().map(|s| (s.x, s.low, s.high)).collect()
+            } else {
+                Vec::new()
+            },
+        }
     }
 }
 
@@ -147,6 +190,9 @@ impl<K: PartialEq, V: Default> Ordered<K, V> {
     }
 }
 
+/// The y axis of accuracy plots: the CSVs' `accuracy` column as it is.
+pub const ACCURACY_LABEL: &str = "accuracy (fraction correct)";
+
 fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
     ExperimentError::Csv {
         path: path.to_path_buf(),
@@ -154,9 +200,9 @@ fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
     }
 }
 
-fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
+fn accuracy_panels(csv: &Path, objects: Option<usize>) -> Result<Vec<Panel>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
-    // (descriptor, parameter, value) -> means of accuracy (%) per n_readings
+    // (descriptor, parameter, value) -> accuracy over trials per n_readings
     let mut curves: Ordered<(String, String, String), Means> = Ordered::new();
     let mut max_n = 1u32;
     for (i, row) in reader.deserialize::<AccuracyRow>().enumerate() {
@@ -179,7 +225,7 @@ fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
         max_n = max_n.max(row.n_readings);
         curves
             .entry((row.descriptor, row.parameter, row.value))
-            .add(row.n_readings as f64, 100.0 * row.accuracy);
+            .add(row.n_readings as f64, row.accuracy);
     }
     if curves.items.is_empty() {
         return Err(csv_error(csv, "no rows to plot"));
@@ -204,16 +250,21 @@ fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
     let panel = |title: String, series: Vec<Series>| Panel {
         title,
         x_label: "number of readings".to_string(),
-        y_label: "accuracy (%)".to_string(),
+        y_label: ACCURACY_LABEL.to_string(),
         x_range: if max_n > 1 {
             (1.0, max_n as f64)
         } else {
             (0.5, 1.5)
         },
-        y_range: (0.0, 100.0),
+        y_range: (0.0, 1.0),
         series,
         markers: max_n <= 12,
         legend: true,
+        integer_x: true,
+        reference: objects.map(|n| ReferenceLine {
+            y: 1.0 / n as f64,
+            label: format!("chance (1/{n})"),
+        }),
     };
     if descriptors.len() > 1 && values.len() > 1 {
         Ok(descriptors
@@ -223,10 +274,7 @@ fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
                     .items
                     .iter()
                     .filter(|((d, _, _), _)| d == descriptor)
-                    .map(|((_, p, v), m)| Series {
-                        label: setting(p, v),
-                        points: m.points(),
-                    })
+                    .map(|((_, p, v), m)| m.series(setting(p, v)))
                     .collect();
                 panel(descriptor.to_string(), series)
             })
@@ -235,13 +283,12 @@ fn accuracy_panels(csv: &Path) -> Result<Vec<Panel>, ExperimentError> {
         let series = curves
             .items
             .iter()
-            .map(|((d, p, v), m)| Series {
-                label: if values.len() > 1 {
+            .map(|((d, p, v), m)| {
+                m.series(if values.len() > 1 {
                     setting(p, v)
                 } else {
                     d.clone()
-                },
-                points: m.points(),
+                })
             })
             .collect();
         Ok(vec![panel(String::new(), series)])
@@ -310,10 +357,7 @@ fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<V
             let series: Vec<Series> = acc
                 .items
                 .into_iter()
-                .map(|(label, m)| Series {
-                    label: if label.is_empty() { y.label.clone() } else { label },
-                    points: m.points(),
-                })
+                .map(|(label, m)| m.series(if label.is_empty() { y.label.clone() } else { label }))
                 .collect();
             let all = || series.iter().flat_map(|s| s.points.iter());
             let (xmin, xmax) = bounds(all().map(|p| p.0));
@@ -331,6 +375,8 @@ fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<V
                 series,
                 markers: true,
                 legend: !series_cols.is_empty(),
+                integer_x: false,
+                reference: None,
             }
         })
         .collect())

@@ -2,21 +2,29 @@
 
 use serde::{Deserialize, Serialize};
 
-/// `counts[true][guess]`: how often an object was recognised as each object.
+/// `counts[true][guess]`: how often an object was recognised as each object, after
+/// `n_readings` readings of it (or all of a trial's readings, when it has fewer).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ConfusionMatrix {
     objects: Vec<String>,
     counts: Vec<Vec<u64>>,
+    n_readings: usize,
 }
 
 impl ConfusionMatrix {
-    /// An all-zero matrix over `objects`.
-    pub fn new(objects: Vec<String>) -> Self {
+    /// An all-zero matrix over `objects` of the decisions after `n_readings` readings.
+    pub fn new(objects: Vec<String>, n_readings: usize) -> Self {
         let n = objects.len();
         Self {
             objects,
             counts: vec![vec![0; n]; n],
+            n_readings,
         }
+    }
+
+    /// The number of readings the decisions were taken after.
+    pub fn n_readings(&self) -> usize {
+        self.n_readings
     }
 
     /// Records one decision. Indices are object indices of the model, known to be in range.
@@ -48,12 +56,13 @@ impl ConfusionMatrix {
         }
     }
 
-    /// Tidy CSV (`object_true,object_guess,count`, every pair including zeros).
+    /// Tidy CSV (`n_readings,object_true,object_guess,count`, every pair including zeros).
     pub fn to_csv_string(&self) -> String {
-        let mut out = String::from("object_true,object_guess,count\n");
+        let mut out = String::from("n_readings,object_true,object_guess,count\n");
+        let n = self.n_readings.to_string();
         for (i, t) in self.objects.iter().enumerate() {
             for (j, g) in self.objects.iter().enumerate() {
-                out.push_str(&csv_row(&[t, g, &self.counts[i][j].to_string()]));
+                out.push_str(&csv_row(&[&n, t, g, &self.counts[i][j].to_string()]));
             }
         }
         out
@@ -81,7 +90,7 @@ mod tests {
 
     #[test]
     fn counts_and_accuracy() {
-        let mut m = ConfusionMatrix::new(vec!["a".into(), "b,c".into()]);
+        let mut m = ConfusionMatrix::new(vec!["a".into(), "b,c".into()], 30);
         m.add(0, 0);
         m.add(0, 1);
         m.add(1, 1);
@@ -91,7 +100,7 @@ mod tests {
         let csv = m.to_csv_string();
         assert_eq!(
             csv,
-            "object_true,object_guess,count\na,a,1\na,\"b,c\",1\n\"b,c\",a,0\n\"b,c\",\"b,c\",2\n"
+            "n_readings,object_true,object_guess,count\n30,a,a,1\n30,a,\"b,c\",1\n30,\"b,c\",a,0\n30,\"b,c\",\"b,c\",2\n"
         );
     }
 }

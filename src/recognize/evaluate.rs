@@ -132,6 +132,8 @@ pub struct TouchRow {
     pub p_true: f64,
     /// Entropy of the posterior, nats.
     pub entropy_nats: f64,
+    /// The whole posterior, one probability per object of the model.
+    pub probabilities: Vec<f64>,
 }
 
 /// Accuracy after `n_readings` readings over every trial: the one definition `taction recognize`
@@ -215,6 +217,7 @@ where
                     object_guess: belief.guess(),
                     p_true: belief.probabilities()[trial.object],
                     entropy_nats: belief.entropy_nats(),
+                    probabilities: belief.probabilities().to_vec(),
                 });
             }
             Ok(beliefs)
@@ -244,7 +247,7 @@ where
         });
     }
     let mut touches = Vec::new();
-    let mut confusion = ConfusionMatrix::new(objects.to_vec());
+    let mut confusion = ConfusionMatrix::new(objects.to_vec(), range.last);
     for (trial, beliefs) in trials.iter().zip(per_trial) {
         let in_range: Vec<TouchRow> = beliefs
             .into_iter()
@@ -272,7 +275,7 @@ impl Evaluation {
             .map(AccuracyRow::accuracy)
     }
 
-    /// `trial,object_true,n_readings,object_guess,p_true,entropy` (entropy in nats).
+    /// `trial,object_true,n_readings,object_guess,p_true,entropy_nats`.
     pub fn posterior_csv(&self) -> String {
         let mut rows = vec![csv_row(&[
             "trial",
@@ -280,7 +283,7 @@ impl Evaluation {
             "n_readings",
             "object_guess",
             "p_true",
-            "entropy",
+            "entropy_nats",
         ])];
         for r in &self.touches {
             rows.push(csv_row(&[
@@ -291,6 +294,30 @@ impl Evaluation {
                 &r.p_true.to_string(),
                 &r.entropy_nats.to_string(),
             ]));
+        }
+        rows.concat()
+    }
+
+    /// The whole posterior after every reading, long format:
+    /// `trial,object_true,n_readings,object,probability`, one row per object, so that any object's
+    /// curve is one filter away.
+    pub fn posterior_long_csv(&self) -> String {
+        let mut rows = vec![csv_row(&[
+            "trial",
+            "object_true",
+            "n_readings",
+            "object",
+            "probability",
+        ])];
+        for r in &self.touches {
+            let (trial, truth, n) = (
+                r.trial.to_string(),
+                &self.objects[r.object_true],
+                r.n_readings.to_string(),
+            );
+            for (object, p) in self.objects.iter().zip(&r.probabilities) {
+                rows.push(csv_row(&[&trial, truth, &n, object, &p.to_string()]));
+            }
         }
         rows.concat()
     }
@@ -311,11 +338,12 @@ impl Evaluation {
         out
     }
 
-    /// Writes `posterior.csv`, `accuracy.csv` and `confusion.csv` into `dir` (created if missing),
-    /// each atomically; returns their paths.
+    /// Writes `posterior.csv`, `posterior_long.csv`, `accuracy.csv` and `confusion.csv` into `dir`
+    /// (created if missing), each atomically; returns their paths.
     pub fn write_csvs(&self, dir: &Path) -> Result<Vec<PathBuf>, RecognizeError> {
         let files = [
             ("posterior.csv", self.posterior_csv()),
+            ("posterior_long.csv", self.posterior_long_csv()),
             ("accuracy.csv", self.accuracy_csv()),
             ("confusion.csv", self.confusion.to_csv_string()),
         ];

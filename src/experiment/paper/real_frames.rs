@@ -252,10 +252,10 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         spec: ExperimentSpec {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
-            plots: vec![PlotSpec::accuracy(
-                name,
-                "Trained and tested on real sensor frames",
-            )],
+            plots: vec![
+                PlotSpec::accuracy(name, "Trained and tested on real sensor frames")
+                    .with_chance(labels.len()),
+            ],
         },
         config: RealFramesConfig {
             recording: &context.real.origin,
@@ -295,7 +295,7 @@ pub fn trial_split(
     )?)
 }
 
-/// The seed of trial `trial`'s split (also the `seed` column of its rows).
+/// The seed of trial `trial`'s split (also the `stream_seed` column of its rows).
 fn trial_seed(seed: u64, trial: usize) -> u64 {
     rng::substream(rng::substream(seed, SPLIT_STREAM), trial as u64)
 }
@@ -352,7 +352,8 @@ fn descriptor_rows(
             parameter: String::new(),
             value: CURVE_VALUE.to_string(),
             trial: trial as u32,
-            seed: trial_seed(seed, trial),
+            seed,
+            stream_seed: trial_seed(seed, trial),
         };
         // One definition of accuracy (`AccuracyRow`): every label counts.
         rows.extend(meta.rows(evaluation.accuracy.iter().map(|r| (r.accuracy(), r.mean_p_true))));

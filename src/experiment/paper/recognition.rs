@@ -208,7 +208,7 @@ impl RecognitionSweep {
             spec: ExperimentSpec {
                 name: name.clone(),
                 description: self.description.to_string(),
-                plots: vec![PlotSpec::accuracy(name, self.title)],
+                plots: vec![PlotSpec::accuracy(name, self.title).with_chance(objects.specs.len())],
             },
             config: SweepConfig {
                 sweep: self,
@@ -422,7 +422,8 @@ impl RecognitionSweep {
                     parameter: self.parameter.to_string(),
                     value: curve.value.clone(),
                     trial: trial as u32,
-                    seed: *seed,
+                    seed: context.seed,
+                    stream_seed: *seed,
                 };
                 // One definition of accuracy (`AccuracyRow`): every object counts, an unread one as
                 // a miss.
