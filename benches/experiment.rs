@@ -7,7 +7,8 @@ use std::path::Path;
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
-use taction::experiment::figure::{Figure, Panel, Series};
+use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
+use taction::experiment::plot::ACCURACY_LABEL;
 use taction::experiment::{
     Experiment, ExperimentSpec, RealImport, RunOptions, SafeName, SimToRealPreprocess, Unit, import_real_csv,
     run,
@@ -83,21 +84,34 @@ fn runner(c: &mut Criterion) {
 
 /// A two-panel accuracy figure of 4 x 100 points, drawn as SVG text and as PNG bytes.
 fn figure(c: &mut Criterion) {
+    let accuracy = |n: f64, k: f64| 1.0 - (-n / (10.0 + 40.0 * k)).exp();
     let series = |k: f64| Series {
         label: format!("noise_fraction = {k}"),
-        points: (1..=100)
-            .map(|n| (n as f64, 100.0 * (1.0 - (-(n as f64) / (10.0 + 40.0 * k)).exp())))
+        points: (1..=100).map(|n| (n as f64, accuracy(n as f64, k))).collect(),
+        band: (1..=100)
+            .map(|n| {
+                (
+                    n as f64,
+                    0.9 * accuracy(n as f64, k),
+                    accuracy(n as f64, k).powf(0.9),
+                )
+            })
             .collect(),
     };
     let panel = |title: &str| Panel {
         title: title.to_string(),
         x_label: "number of readings".into(),
-        y_label: "accuracy (%)".into(),
+        y_label: ACCURACY_LABEL.into(),
         x_range: (1.0, 100.0),
-        y_range: (0.0, 100.0),
+        y_range: (0.0, 1.0),
         series: vec![series(0.0), series(0.2)],
         markers: false,
         legend: true,
+        integer_x: true,
+        reference: Some(ReferenceLine {
+            y: 1.0 / 12.0,
+            label: "chance (1/12)".into(),
+        }),
     };
     let figure = Figure {
         title: "bench".into(),
