@@ -296,7 +296,7 @@ impl Covering {
             let n = self.config.taxel_count();
             let out = &mut sensordata[sensor.adr..sensor.adr + n];
             self.formation
-                .form(&mut self.nearest_m, sensor.noise_seed, reading, out);
+                .form(&self.nearest_m, sensor.noise_seed, reading, out);
         }
         self.stats.readings += 1;
     }
