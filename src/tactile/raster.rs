@@ -28,6 +28,10 @@ use crate::tactile::grid::SampleGrid;
 /// give the same depth there), so rounding never opens a crack between neighbours.
 const EDGE_EPS: f64 = 1e-12;
 
+/// Faces spanning more sample columns than this are scanned row by row over the span their
+/// edges cut out of the row (cheaper than testing every sample of their bounding box).
+const SPAN_MIN_COLUMNS: usize = 4;
+
 /// The nearest surface crossing behind the pad plane at one sample, for the inside test.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Crossing {
@@ -145,11 +149,51 @@ pub fn rasterise_triangle(
     );
     let tol = -EDGE_EPS;
     let entering = area < 0.0;
+    // w_c = 1 - w_a - w_b = cx x + (1 - w_a,row - w_b,row).
+    let cx = -(ax + bx);
+    // Narrow faces are scanned over their bounding columns; wider ones over each row's span.
+    let spans = (cols.len() > SPAN_MIN_COLUMNS).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
+    let widen_m = grid.dx_m();
     for i in rows {
         let y = grid.y(i);
         let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+        let mut scan = cols.clone();
+        if let Some(slopes) = &spans {
+            // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is a
+            // half-line. Widened by a sample on each side, the span only skips samples the exact
+            // test below rejects, whatever the rounding of its bounds.
+            let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+            let at_zero = [wa_row, wb_row, 1.0 - wa_row - wb_row];
+            for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
+                let bound = (tol - w0) * inv_slope;
+                if *slope > 0.0 {
+                    span.0 = span.0.max(bound);
+                } else if *slope < 0.0 {
+                    span.1 = span.1.min(bound);
+                } else if w0 < tol {
+                    span = (f64::INFINITY, f64::NEG_INFINITY);
+                }
+            }
+            let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
+            let first = in_span.start.max(cols.start);
+            scan = first..in_span.end.min(cols.end).max(first);
+        }
         let row = i * grid.cols;
-        for j in cols.clone() {
+        if !behind_possible {
+            // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
+            let (first, last) = (scan.start, scan.end);
+            for (j, nearest) in (first..last).zip(&mut nearest_m[row + first..row + last]) {
+                let x = grid.x(j);
+                let wa = ax * x + wa_row;
+                let wb = bx * x + wb_row;
+                let z = zx * x + z_row;
+                let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
+                let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
+                *nearest = if covers & nearer { z } else { *nearest };
+            }
+            continue;
+        }
+        for j in scan {
             let x = grid.x(j);
             let wa = ax * x + wa_row;
             let wb = bx * x + wb_row;
