@@ -290,6 +290,58 @@ mod tests {
     }
 
     #[test]
+    fn folded_kernel_equals_blur_then_average() {
+        use rand::RngExt;
+        // The definition, step by step: the 2D border-normalised Gaussian over all samples, then
+        // the mean over each taxel's samples, then the clamp.
+        let config = SensorConfig {
+            rows: 5,
+            cols: 7,
+            psf_sigma_m: 0.0009,
+            rays_per_taxel: 9,
+            ..SensorConfig::default()
+        };
+        let (grid, mut f) = setup(&config);
+        let t = config.thickness_m;
+        let mut rng = crate::rng::rng(3);
+        let p: Vec<f64> = (0..grid.len()).map(|_| rng.random_range(0.0..t)).collect();
+        let (sr, sc, k) = (grid.rows as i64, grid.cols as i64, 3);
+        let (sx, sy) = (config.psf_sigma_m / grid.dx_m(), config.psf_sigma_m / grid.dy_m());
+        let (rx, ry) = ((4.0 * sx).ceil() as i64, (4.0 * sy).ceil() as i64);
+        let mut q = vec![0.0; grid.len()];
+        for i in 0..sr {
+            for j in 0..sc {
+                let (mut num, mut den) = (0.0, 0.0);
+                for u in (i - ry).max(0)..=(i + ry).min(sr - 1) {
+                    for v in (j - rx).max(0)..=(j + rx).min(sc - 1) {
+                        let g =
+                            (-0.5 * (((u - i) as f64 / sy).powi(2) + ((v - j) as f64 / sx).powi(2))).exp();
+                        num += g * p[(u * sc + v) as usize];
+                        den += g;
+                    }
+                }
+                q[(i * sc + j) as usize] = num / den;
+            }
+        }
+        let mut out = vec![0.0; config.taxel_count()];
+        f.form(&p, 0, 0, &mut out);
+        for r in 0..config.rows as i64 {
+            for c in 0..config.cols as i64 {
+                let mean = (0..k)
+                    .flat_map(|a| (0..k).map(move |b| ((r * k + a) * sc + c * k + b) as usize))
+                    .map(|s| q[s])
+                    .sum::<f64>()
+                    / (k * k) as f64;
+                let got = out[(r * config.cols as i64 + c) as usize];
+                assert!(
+                    (got - (mean / t).clamp(0.0, 1.0)).abs() < 1e-12,
+                    "({r}, {c}): {got} vs {mean}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn noise_is_zero_mean_bounded_and_seeded() {
         let config = SensorConfig {
             rows: 32,

@@ -111,15 +111,8 @@ pub fn rasterise_triangle(
     nearest_m: &mut [f64],
     behind: &mut Behind,
 ) {
-    let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    let scale = (b - a)
-        .truncate()
-        .length_squared()
-        .max((c - a).truncate().length_squared());
-    if !area.is_finite() || area.abs() <= 1e-9 * scale {
-        // Edge-on to the rays (or degenerate): a ray grazes it at most along a line.
-        return;
-    }
+    // The cheap rejections first: most faces near the pad lie beyond the covering or cover no
+    // sample (at 6x6 taxels the samples are 1 mm apart, about a face's size).
     let zmin = a.z.min(b.z).min(c.z);
     if zmin > far_m {
         return;
@@ -127,6 +120,15 @@ pub fn rasterise_triangle(
     let cols = grid.col_range(a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
     let rows = grid.row_range(a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
     if cols.is_empty() || rows.is_empty() {
+        return;
+    }
+    let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    let scale = (b - a)
+        .truncate()
+        .length_squared()
+        .max((c - a).truncate().length_squared());
+    if !area.is_finite() || area.abs() <= 1e-9 * scale {
+        // Edge-on to the rays (or degenerate): a ray grazes it at most along a line.
         return;
     }
     let behind_possible = zmin < 0.0;
@@ -241,6 +243,50 @@ mod tests {
         for i in 0..g.rows {
             for j in 0..g.cols {
                 assert!((nearest[i * g.cols + j] - z(g.x(j), g.y(i))).abs() < 1e-15);
+            }
+        }
+    }
+
+    #[test]
+    fn wide_faces_write_exactly_the_samples_they_cover() {
+        use rand::RngExt;
+        // Random faces in front of the pad, wide and narrow, against a per-sample barycentric
+        // test over the whole grid: the row spans must not drop a covered sample.
+        let g = SampleGrid::new(&SensorConfig {
+            rows: 10,
+            cols: 10,
+            rays_per_taxel: 16,
+            ..SensorConfig::default()
+        });
+        let mut rng = crate::rng::rng(11);
+        for _ in 0..300 {
+            let mut corner = || {
+                DVec3::new(
+                    rng.random_range(-0.008..0.008),
+                    rng.random_range(-0.008..0.008),
+                    rng.random_range(0.0..0.002),
+                )
+            };
+            let tri = [corner(), corner(), corner()];
+            let mut nearest = vec![f64::INFINITY; g.len()];
+            let mut behind = Behind::new(g.len());
+            rasterise_triangle(&g, tri, 1.0, &mut nearest, &mut behind);
+            let [a, b, c] = tri;
+            let e = |p: DVec3, q: DVec3, x: f64, y: f64| (q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x);
+            let area = e(a, b, c.x, c.y);
+            for i in 0..g.rows {
+                for j in 0..g.cols {
+                    let (x, y) = (g.x(j), g.y(i));
+                    let w = [e(b, c, x, y) / area, e(c, a, x, y) / area, e(a, b, x, y) / area];
+                    let s = i * g.cols + j;
+                    // Clear of the edges, the sample is covered iff all weights are positive.
+                    if w.iter().all(|&w| w > 1e-9) {
+                        let z = w[0] * a.z + w[1] * b.z + w[2] * c.z;
+                        assert!((nearest[s] - z).abs() < 1e-15, "sample ({i}, {j}) of {tri:?}");
+                    } else if w.iter().any(|&w| w < -1e-9) {
+                        assert_eq!(nearest[s], f64::INFINITY, "sample ({i}, {j}) of {tri:?}");
+                    }
+                }
             }
         }
     }
