@@ -74,6 +74,18 @@ fn pad_pose(config: &SensorConfig) -> PadPose {
     PadPose::new(center, normal, DVec3::Y).unwrap()
 }
 
+/// A mesh as the flat vertex coordinates and vertex-index triples MuJoCo stores (what
+/// [`MeshBvh::new`] takes).
+fn mesh_arrays(mesh: &TriMesh) -> (Vec<f32>, Vec<i32>) {
+    let vertex_xyz = mesh
+        .vertices
+        .iter()
+        .flat_map(|v| v.as_vec3().to_array())
+        .collect();
+    let face_indices = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+    (vertex_xyz, face_indices)
+}
+
 /// The reading's stages outside MuJoCo, on the sphere mesh placed at the world origin: the BVH
 /// query for the faces that can meet the pad's rays (the box over the pad from the sphere's far
 /// side to the covering's outer surface), the orthographic rasterisation of those faces with the
@@ -84,12 +96,7 @@ fn stages(
     config: &SensorConfig,
     pose: &PadPose,
 ) {
-    let vertex_xyz: Vec<f32> = mesh
-        .vertices
-        .iter()
-        .flat_map(|v| v.as_vec3().to_array())
-        .collect();
-    let face_indices: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+    let (vertex_xyz, face_indices) = mesh_arrays(mesh);
     let bvh = MeshBvh::new(&vertex_xyz, &face_indices).unwrap();
     let grid = SampleGrid::new(config);
     let t = config.thickness_m;
@@ -477,12 +484,7 @@ fn mesh_size(c: &mut Criterion) {
             group.sample_size(10);
         }
 
-        let vertex_xyz: Vec<f32> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| v.as_vec3().to_array())
-            .collect();
-        let face_indices: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+        let (vertex_xyz, face_indices) = mesh_arrays(&mesh);
         let bvh = MeshBvh::new(&vertex_xyz, &face_indices).unwrap();
         eprintln!("{triangles} triangles: BVH {} bytes", bvh.heap_bytes());
         record_extra(&format!("mesh_{triangles}/bvh_bytes"), bvh.heap_bytes() as f64);
@@ -637,7 +639,7 @@ fn summary(_: &mut Criterion) {
     }
     println!("\nWhere the sensor stage goes (means of this run):\n");
     println!(
-        "| image | BVH query | rasterise | form image | rest of the stage (MuJoCo, poses, copies) | sensor stage |"
+        "| image | BVH query | rasterise | form image | rest: MuJoCo's loop, poses, rigid-back test (noisy difference) | sensor stage |"
     );
     println!("|---|---|---|---|---|---|");
     for n in RESOLUTIONS {

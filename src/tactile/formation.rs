@@ -233,9 +233,9 @@ mod tests {
                 ..SensorConfig::default()
             };
             let (grid, mut f) = setup(&config);
-            let mut p = vec![0.3 * config.thickness_m; grid.len()];
+            let p = vec![0.3 * config.thickness_m; grid.len()];
             let mut out = vec![0.0; 36];
-            f.form(&mut p, 0, 0, &mut out);
+            f.form(&p, 0, 0, &mut out);
             assert!(out.iter().all(|v| (v - 0.3).abs() < 1e-12), "{sigma}: {out:?}");
         }
     }
@@ -253,9 +253,9 @@ mod tests {
         assert_eq!((grid.rows, grid.cols), (2, 4));
         let t = config.thickness_m;
         // Left taxel: samples 0,1 of both rows; right taxel: samples 2,3.
-        let mut p = vec![0.0, t, t, t, 0.0, 0.0, t, 2.0 * t];
+        let p = vec![0.0, t, t, t, 0.0, 0.0, t, 2.0 * t];
         let mut out = vec![0.0; 2];
-        f.form(&mut p, 0, 0, &mut out);
+        f.form(&p, 0, 0, &mut out);
         assert!((out[0] - 0.25).abs() < 1e-15 && out[1] == 1.0, "{out:?}");
     }
 
@@ -275,7 +275,7 @@ mod tests {
         let centre = 12 * 25 + 12;
         p[centre] = t;
         let mut out = vec![0.0; 625];
-        f.form(&mut p, 0, 0, &mut out);
+        f.form(&p, 0, 0, &mut out);
         // Far from the border the blur keeps the total; the peak drops to the Gaussian's centre weight.
         let sum: f64 = out.iter().sum();
         assert!((sum - 1.0).abs() < 1e-12, "{sum}");
@@ -354,9 +354,9 @@ mod tests {
         let (grid, mut f) = setup(&config);
         let t = config.thickness_m;
         let form = |f: &mut ImageFormation, reading| {
-            let mut p = vec![0.5 * t; grid.len()];
+            let p = vec![0.5 * t; grid.len()];
             let mut out = vec![0.0; 1024];
-            f.form(&mut p, 9, reading, &mut out);
+            f.form(&p, 9, reading, &mut out);
             out
         };
         let a = form(&mut f, 0);

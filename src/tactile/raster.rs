@@ -12,6 +12,9 @@
 //!
 //! which is the ray-triangle intersection distance. So instead of casting each ray through a
 //! BVH, each triangle near the pad is visited once and writes the samples it covers (a z-buffer).
+//! Along a sample row each weight is affine in x, so `w >= 0` holds on a half-line and the
+//! triangle covers one span of the row: a wide triangle scans only that span (widened by a sample
+//! so that rounding of its ends never drops one), a narrow one its bounding columns.
 //! `A` is twice the signed projected area: with the pad frame right-handed, the triangle's normal
 //! has z-component `A`, so `A < 0` marks a face the ray *enters* (outward normal against the ray).
 //!
