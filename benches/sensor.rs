@@ -3,8 +3,9 @@
 //! the same rays cast by MuJoCo (`mj_multiRay` from a point 1 m behind the pad through the same
 //! sample points, and `mj_ray` one by one), by plain `obvhs` closest-hit traversal, and against
 //! MuJoCo's own `tactile` sensor with one point per taxel; then the cost per reading and the BVH
-//! build time and memory on meshes of 1k to 1M triangles. The last step prints the tables (means
-//! of this run, ratios within it).
+//! build time and memory on meshes of 1k to 1M triangles. Each resolution also times the reading's
+//! stages alone (BVH query, rasterisation, image formation). The last step prints the tables
+//! (means of this run, ratios within it).
 //!
 //! `plugin/read` is what a user pays: `mj_forward` (which runs the plugin) plus the copy out of
 //! `sensordata`; `plugin/sensor_stage` is MuJoCo's position-sensor stage alone (`mj_sensorPos`,
@@ -28,7 +29,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use glam::{DVec3, Vec3A};
+use glam::{DMat3, DVec3, Vec3A};
 use mujoco_rs::mujoco_c::{mj_sensorPos, mj_sensorVel, mjData, mjModel};
 use mujoco_rs::prelude::*;
 use obvhs::BvhBuildParams;
@@ -40,9 +41,11 @@ use taction::mesh::TriMesh;
 use taction::sim::mjcf::COLLISION_GROUP;
 use taction::sim::mjcf::numbers;
 use taction::sim::{ObjectSpec, SceneBuilder};
+use taction::tactile::formation::ImageFormation;
 use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml, pad_rotation};
 use taction::tactile::grid::SampleGrid;
-use taction::tactile::mesh_bvh::MeshBvh;
+use taction::tactile::mesh_bvh::{MeshBvh, OrientedBox};
+use taction::tactile::raster::{Behind, rasterise_triangle};
 use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
 
 const RADIUS_M: f64 = 0.05;
@@ -62,11 +65,82 @@ fn config(n: usize, rays_per_taxel: usize) -> SensorConfig {
     }
 }
 
-/// The pad pressed 0.6 t into the top of the sphere, tilted 10°.
+/// The pad pressed on the top of the sphere, tilted 10°: the covering's outer surface 0.6 t inside
+/// the sphere along the pad normal, the pad plane 0.4 t outside it, so the covering is partly
+/// filled (taxel values from 0 to about 0.9) and the sensors' images differ where they should.
 fn pad_pose(config: &SensorConfig) -> PadPose {
     let normal = DVec3::new(0.17, 0.05, -1.0).normalize();
-    let center = -normal * (RADIUS_M - 0.6 * config.thickness_m);
+    let center = -normal * (RADIUS_M + 0.4 * config.thickness_m);
     PadPose::new(center, normal, DVec3::Y).unwrap()
+}
+
+/// A mesh as the flat vertex coordinates and vertex-index triples MuJoCo stores (what
+/// [`MeshBvh::new`] takes).
+fn mesh_arrays(mesh: &TriMesh) -> (Vec<f32>, Vec<i32>) {
+    let vertex_xyz = mesh
+        .vertices
+        .iter()
+        .flat_map(|v| v.as_vec3().to_array())
+        .collect();
+    let face_indices = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+    (vertex_xyz, face_indices)
+}
+
+/// The reading's stages outside MuJoCo, on the sphere mesh placed at the world origin: the BVH
+/// query for the faces that can meet the pad's rays (the box over the pad from the sphere's far
+/// side to the covering's outer surface), the orthographic rasterisation of those faces with the
+/// inside test, and image formation (folded point-spread and area average, clamp).
+fn stages(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    mesh: &TriMesh,
+    config: &SensorConfig,
+    pose: &PadPose,
+) {
+    let (vertex_xyz, face_indices) = mesh_arrays(mesh);
+    let bvh = MeshBvh::new(&vertex_xyz, &face_indices).unwrap();
+    let grid = SampleGrid::new(config);
+    let t = config.thickness_m;
+    // Pad (site) frame: x = up x normal, y = up, z = normal; the mesh sits at the world origin.
+    let to_pad = DMat3::from_cols(pose.up.cross(pose.normal), pose.up, pose.normal).transpose();
+    let o = to_pad * -pose.center_m;
+    let z_lo = (o.z - RADIUS_M).min(0.0);
+    let to_geom = to_pad.transpose();
+    let region = OrientedBox {
+        centre: to_geom * (DVec3::new(0.0, 0.0, 0.5 * (z_lo + t)) - o),
+        axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
+        half: DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * (t - z_lo)),
+    };
+    let (mut stack, mut faces) = (Vec::new(), Vec::new());
+    bvh.faces_near(&region, &mut stack, &mut faces);
+    group.bench_function(BenchmarkId::new("stage", "bvh_query"), |b| {
+        b.iter(|| {
+            faces.clear();
+            bvh.faces_near(black_box(&region), &mut stack, &mut faces);
+            black_box(faces.len())
+        })
+    });
+    let mut nearest_m = vec![f64::INFINITY; grid.len()];
+    let mut behind = Behind::new(grid.len());
+    group.bench_function(BenchmarkId::new("stage", "rasterise"), |b| {
+        b.iter(|| {
+            nearest_m.fill(f64::INFINITY);
+            for &face in &faces {
+                let corners = bvh.corners(face, &to_pad, o);
+                rasterise_triangle(&grid, corners, t, &mut nearest_m, &mut behind);
+            }
+            behind.resolve_into(&grid, &mut nearest_m);
+            black_box(nearest_m[0])
+        })
+    });
+    let penetration_m: Vec<f64> = nearest_m.iter().map(|z| (t - z).clamp(0.0, t)).collect();
+    let mut formation = ImageFormation::new(config, &grid);
+    let mut image = vec![0.0; config.taxel_count()];
+    group.bench_function(BenchmarkId::new("stage", "form"), |b| {
+        b.iter(|| {
+            formation.form(black_box(&penetration_m), 0, 0, &mut image);
+            black_box(image[0])
+        })
+    });
 }
 
 /// World points where the pad's rays pierce the pad plane.
@@ -275,6 +349,8 @@ fn sensor(c: &mut Criterion) {
                 b.iter(|| raw.sensor_pos())
             });
 
+            stages(&mut group, &mesh, &config, &pose);
+
             let mut bare = SceneBuilder::new()
                 .table(false)
                 .object(ObjectSpec::new("sphere", mesh.clone()))
@@ -408,12 +484,7 @@ fn mesh_size(c: &mut Criterion) {
             group.sample_size(10);
         }
 
-        let vertex_xyz: Vec<f32> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| v.as_vec3().to_array())
-            .collect();
-        let face_indices: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+        let (vertex_xyz, face_indices) = mesh_arrays(&mesh);
         let bvh = MeshBvh::new(&vertex_xyz, &face_indices).unwrap();
         eprintln!("{triangles} triangles: BVH {} bytes", bvh.heap_bytes());
         record_extra(&format!("mesh_{triangles}/bvh_bytes"), bvh.heap_bytes() as f64);
@@ -563,6 +634,30 @@ fn summary(_: &mut Criterion) {
                 cell(native_forward),
                 cell(native_without),
                 ratio(native_stage, stage),
+            );
+        }
+    }
+    println!("\nWhere the sensor stage goes (means of this run):\n");
+    println!(
+        "| image | BVH query | rasterise | form image | rest: MuJoCo's loop, poses, rigid-back test (noisy difference) | sensor stage |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for n in RESOLUTIONS {
+        for rays in RAYS_PER_TAXEL {
+            let g = format!("sensor/{n}x{n}x{rays}rays");
+            let stage = get(format!("{g}/plugin/sensor_stage"));
+            let parts = ["bvh_query", "rasterise", "form"].map(|s| get(format!("{g}/stage/{s}")));
+            let rest = match (stage, parts) {
+                (Some(total), [Some(a), Some(b), Some(c)]) => Some(total - a - b - c),
+                _ => None,
+            };
+            println!(
+                "| {n}x{n}, {rays} rays/taxel | {} | {} | {} | {} | {} |",
+                cell(parts[0]),
+                cell(parts[1]),
+                cell(parts[2]),
+                cell(rest),
+                cell(stage),
             );
         }
     }

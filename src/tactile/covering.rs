@@ -296,7 +296,7 @@ impl Covering {
             let n = self.config.taxel_count();
             let out = &mut sensordata[sensor.adr..sensor.adr + n];
             self.formation
-                .form(&mut self.nearest_m, sensor.noise_seed, reading, out);
+                .form(&self.nearest_m, sensor.noise_seed, reading, out);
         }
         self.stats.readings += 1;
     }
@@ -340,7 +340,9 @@ impl Covering {
                     for &face in &self.candidates {
                         let corners = mesh.corners(face, &m, o);
                         rasterise_triangle(&self.grid, corners, t, &mut self.nearest_m, &mut self.behind);
+                        // A face wholly in front of the pad plane cannot reach the back.
                         if !self.stats.last_back_touched
+                            && corners.iter().any(|p| p.z <= 0.0)
                             && triangle_overlaps_box(corners, back_center, back_half)
                         {
                             self.stats.last_back_touched = true;

@@ -12,6 +12,9 @@
 //!
 //! which is the ray-triangle intersection distance. So instead of casting each ray through a
 //! BVH, each triangle near the pad is visited once and writes the samples it covers (a z-buffer).
+//! Along a sample row each weight is affine in x, so `w >= 0` holds on a half-line and the
+//! triangle covers one span of the row: a wide triangle scans only that span (widened by a sample
+//! so that rounding of its ends never drops one), a narrow one its bounding columns.
 //! `A` is twice the signed projected area: with the pad frame right-handed, the triangle's normal
 //! has z-component `A`, so `A < 0` marks a face the ray *enters* (outward normal against the ray).
 //!
@@ -27,6 +30,10 @@ use crate::tactile::grid::SampleGrid;
 /// Relative tolerance of the edge test: samples on a shared edge belong to both triangles (both
 /// give the same depth there), so rounding never opens a crack between neighbours.
 const EDGE_EPS: f64 = 1e-12;
+
+/// Faces spanning more sample columns than this are scanned row by row over the span their
+/// edges cut out of the row (cheaper than testing every sample of their bounding box).
+const SPAN_MIN_COLUMNS: usize = 4;
 
 /// The nearest surface crossing behind the pad plane at one sample, for the inside test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,15 +114,8 @@ pub fn rasterise_triangle(
     nearest_m: &mut [f64],
     behind: &mut Behind,
 ) {
-    let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    let scale = (b - a)
-        .truncate()
-        .length_squared()
-        .max((c - a).truncate().length_squared());
-    if !area.is_finite() || area.abs() <= 1e-9 * scale {
-        // Edge-on to the rays (or degenerate): a ray grazes it at most along a line.
-        return;
-    }
+    // The cheap rejections first: most faces near the pad lie beyond the covering or cover no
+    // sample (at 6x6 taxels the samples are 1 mm apart, about a face's size).
     let zmin = a.z.min(b.z).min(c.z);
     if zmin > far_m {
         return;
@@ -123,6 +123,15 @@ pub fn rasterise_triangle(
     let cols = grid.col_range(a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
     let rows = grid.row_range(a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
     if cols.is_empty() || rows.is_empty() {
+        return;
+    }
+    let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    let scale = (b - a)
+        .truncate()
+        .length_squared()
+        .max((c - a).truncate().length_squared());
+    if !area.is_finite() || area.abs() <= 1e-9 * scale {
+        // Edge-on to the rays (or degenerate): a ray grazes it at most along a line.
         return;
     }
     let behind_possible = zmin < 0.0;
@@ -145,11 +154,51 @@ pub fn rasterise_triangle(
     );
     let tol = -EDGE_EPS;
     let entering = area < 0.0;
+    // w_c = 1 - w_a - w_b = cx x + (1 - w_a,row - w_b,row).
+    let cx = -(ax + bx);
+    // Narrow faces are scanned over their bounding columns; wider ones over each row's span.
+    let spans = (cols.len() > SPAN_MIN_COLUMNS).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
+    let widen_m = grid.dx_m();
     for i in rows {
         let y = grid.y(i);
         let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+        let mut scan = cols.clone();
+        if let Some(slopes) = &spans {
+            // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is a
+            // half-line. Widened by a sample on each side, the span only skips samples the exact
+            // test below rejects, whatever the rounding of its bounds.
+            let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+            let at_zero = [wa_row, wb_row, 1.0 - wa_row - wb_row];
+            for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
+                let bound = (tol - w0) * inv_slope;
+                if *slope > 0.0 {
+                    span.0 = span.0.max(bound);
+                } else if *slope < 0.0 {
+                    span.1 = span.1.min(bound);
+                } else if w0 < tol {
+                    span = (f64::INFINITY, f64::NEG_INFINITY);
+                }
+            }
+            let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
+            let first = in_span.start.max(cols.start);
+            scan = first..in_span.end.min(cols.end).max(first);
+        }
         let row = i * grid.cols;
-        for j in cols.clone() {
+        if !behind_possible {
+            // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
+            let (first, last) = (scan.start, scan.end);
+            for (j, nearest) in (first..last).zip(&mut nearest_m[row + first..row + last]) {
+                let x = grid.x(j);
+                let wa = ax * x + wa_row;
+                let wb = bx * x + wb_row;
+                let z = zx * x + z_row;
+                let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
+                let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
+                *nearest = if covers & nearer { z } else { *nearest };
+            }
+            continue;
+        }
+        for j in scan {
             let x = grid.x(j);
             let wa = ax * x + wa_row;
             let wb = bx * x + wb_row;
@@ -197,6 +246,50 @@ mod tests {
         for i in 0..g.rows {
             for j in 0..g.cols {
                 assert!((nearest[i * g.cols + j] - z(g.x(j), g.y(i))).abs() < 1e-15);
+            }
+        }
+    }
+
+    #[test]
+    fn wide_faces_write_exactly_the_samples_they_cover() {
+        use rand::RngExt;
+        // Random faces in front of the pad, wide and narrow, against a per-sample barycentric
+        // test over the whole grid: the row spans must not drop a covered sample.
+        let g = SampleGrid::new(&SensorConfig {
+            rows: 10,
+            cols: 10,
+            rays_per_taxel: 16,
+            ..SensorConfig::default()
+        });
+        let mut rng = crate::rng::rng(11);
+        for _ in 0..300 {
+            let mut corner = || {
+                DVec3::new(
+                    rng.random_range(-0.008..0.008),
+                    rng.random_range(-0.008..0.008),
+                    rng.random_range(0.0..0.002),
+                )
+            };
+            let tri = [corner(), corner(), corner()];
+            let mut nearest = vec![f64::INFINITY; g.len()];
+            let mut behind = Behind::new(g.len());
+            rasterise_triangle(&g, tri, 1.0, &mut nearest, &mut behind);
+            let [a, b, c] = tri;
+            let e = |p: DVec3, q: DVec3, x: f64, y: f64| (q.x - p.x) * (y - p.y) - (q.y - p.y) * (x - p.x);
+            let area = e(a, b, c.x, c.y);
+            for i in 0..g.rows {
+                for j in 0..g.cols {
+                    let (x, y) = (g.x(j), g.y(i));
+                    let w = [e(b, c, x, y) / area, e(c, a, x, y) / area, e(a, b, x, y) / area];
+                    let s = i * g.cols + j;
+                    // Clear of the edges, the sample is covered iff all weights are positive.
+                    if w.iter().all(|&w| w > 1e-9) {
+                        let z = w[0] * a.z + w[1] * b.z + w[2] * c.z;
+                        assert!((nearest[s] - z).abs() < 1e-15, "sample ({i}, {j}) of {tri:?}");
+                    } else if w.iter().any(|&w| w < -1e-9) {
+                        assert_eq!(nearest[s], f64::INFINITY, "sample ({i}, {j}) of {tri:?}");
+                    }
+                }
             }
         }
     }
