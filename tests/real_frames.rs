@@ -12,7 +12,7 @@ use taction::experiment::paper::real_frames::{prune, scaled_split_sizes, trial_s
 use taction::experiment::real_data::{Calibration, RealImport, parse_real_csv};
 
 const ACCURACY_HEADER: &str =
-    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed";
+    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";
 
 fn taction(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_taction"))
