@@ -106,6 +106,7 @@ impl CollectPlan {
     /// The arm's scene with `object` and the planner that explores it as object `index` of this
     /// plan (its sensor noise stream and random stream), for callers that drive the planner
     /// themselves (active exploration, `recognize::active`).
+    #[allow(clippy::type_complexity)]
     pub fn planner_for(
         &self,
         object: &ObjectSpec,
