@@ -13,7 +13,12 @@
 //!   `cargo xtask setup` fetches, and the two chess pieces), `SHAPES_READINGS` converged readings of
 //!   each, one thread, the workspace fitted to the set as `taction collect` does; the summary
 //!   reports converged readings per second per core and the fraction of attempts that converge,
-//!   per object and over the set.
+//!   per object and over the set;
+//! - `active/score_12_candidates`: the active strategy's extra work per planner iteration, the
+//!   expected-information-gain scores of 12 candidate targets (`recognize::active`) for a model of
+//!   12 objects and 50 clusters after 30 readings; the summary reports it per iteration against a
+//!   plain kinematic planner iteration on the pawn (total time / iterations of `planner/kinematic`
+//!   runs), the baseline.
 //!
 //! Scenes are compiled once per configuration, outside the timed loops (a collection run compiles one
 //! per object). After criterion's own report a summary prints readings/s and the ratios, measured
@@ -24,10 +29,13 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group};
 use glam::DVec3;
+use rand::RngExt;
 use taction::control::ControlConfig;
+use taction::explore::TouchScorer;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig, SamplerConfig, sample_readings};
 use taction::mesh::{BuildOptions, ObjectSet};
+use taction::recognize::{ClusterHistogram, InformationGain, ObjectModels, PseudoCount};
 use taction::sim::arm::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use taction::tactile::sensor::{CoveringSensor, add_sensor};
@@ -112,6 +120,57 @@ fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u
     report
 }
 
+const SCORED_OBJECTS: usize = 12;
+const SCORED_CLUSTERS: usize = 50;
+const SCORED_READINGS: usize = 30;
+const CANDIDATES: usize = 12;
+
+/// Object models of `SCORED_OBJECTS` objects over `SCORED_CLUSTERS` clusters (random histograms).
+fn scored_models() -> ObjectModels {
+    let mut rng = taction::rng::rng(5);
+    let histograms: Vec<ClusterHistogram> = (0..SCORED_OBJECTS)
+        .map(|_| {
+            let mut h = ClusterHistogram::new(SCORED_CLUSTERS);
+            for _ in 0..200 {
+                let mut m = vec![0.0; SCORED_CLUSTERS];
+                m[rng.random_range(0..SCORED_CLUSTERS)] = 1.0;
+                h.add(&m);
+            }
+            h
+        })
+        .collect();
+    let names = (0..SCORED_OBJECTS).map(|o| format!("object{o}")).collect();
+    ObjectModels::fit(names, &histograms, PseudoCount::LAPLACE).expect("models")
+}
+
+/// The scorer after `SCORED_READINGS` readings spread over the pawn's neighbourhood, and
+/// `CANDIDATES` targets around them.
+fn scorer_and_candidates(models: &ObjectModels) -> (InformationGain<'_>, Vec<DVec3>) {
+    let mut rng = taction::rng::rng(6);
+    let mut point = || {
+        DVec3::new(
+            rng.random_range(-0.06..0.06),
+            rng.random_range(-0.06..0.06),
+            rng.random_range(0.02..0.14),
+        )
+    };
+    let mut gain = InformationGain::new(models, 0.03);
+    let objects = models.objects().len();
+    let mut posterior = vec![1.0 / objects as f64; objects];
+    for r in 0..SCORED_READINGS {
+        let mut h = ClusterHistogram::new(models.clusters());
+        let mut m = vec![0.0; models.clusters()];
+        m[(r * 7) % models.clusters()] = 1.0;
+        h.add(&m);
+        posterior[r % objects] += 0.1;
+        let total: f64 = posterior.iter().sum();
+        let normalised: Vec<f64> = posterior.iter().map(|p| p / total).collect();
+        gain.record(Some(point()), &h, &normalised);
+    }
+    let candidates = (0..CANDIDATES).map(|_| point()).collect();
+    (gain, candidates)
+}
+
 fn shapes() -> Vec<ObjectSpec> {
     ObjectSpec::all_of(&ObjectSet::shapes()).expect("the shapes (fetched by `cargo xtask setup`)")
 }
@@ -157,6 +216,12 @@ fn benches(c: &mut Criterion) {
             seed += 1;
             planner_run(&mut scene, Execution::Kinematic, PLANNER_READINGS, seed)
         })
+    });
+    let models = scored_models();
+    let (gain, candidates) = scorer_and_candidates(&models);
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("active/score_12_candidates", |b| {
+        b.iter(|| black_box(gain.score(black_box(&candidates))))
     });
     let objects = shapes();
     group.throughput(Throughput::Elements((SHAPES_READINGS * objects.len()) as u64));
@@ -213,6 +278,29 @@ fn summary() {
         "  planner, kinematic        {kinematic:9.1} /s  = {:.1} x servo, {:.4} x bare reading; {kinematic_attempts:.1} attempts/s, {kc}/{ka} converged",
         kinematic / servo,
         kinematic / bare
+    );
+    // The active strategy's scoring per iteration against a plain planner iteration.
+    let (mut iterations, start) = (0, Instant::now());
+    for seed in 0..5 {
+        iterations += planner_run(&mut scene, Execution::Kinematic, PLANNER_READINGS, 3000 + seed).iterations;
+    }
+    let per_iteration_s = start.elapsed().as_secs_f64() / iterations.max(1) as f64;
+    let models = scored_models();
+    let (gain, candidates) = scorer_and_candidates(&models);
+    let scores = 20_000;
+    let start = Instant::now();
+    for _ in 0..scores {
+        black_box(gain.score(black_box(&candidates)));
+    }
+    let per_score_s = start.elapsed().as_secs_f64() / scores as f64;
+    println!(
+        "  planner iteration (plain) {:9.1} us  (baseline; {iterations} iterations of 5 runs)",
+        1e6 * per_iteration_s
+    );
+    println!(
+        "  active scoring, {CANDIDATES} cand.  {:9.2} us  = {:.4} x a plain iteration ({SCORED_OBJECTS} objects, k = {SCORED_CLUSTERS}, {SCORED_READINGS} readings)",
+        1e6 * per_score_s,
+        per_score_s / per_iteration_s
     );
     // The whole `shapes` set: per object and over the set, three seeds.
     let objects = shapes();

@@ -156,3 +156,57 @@ fn demo_on_the_chess_pieces_writes_its_outputs_and_reuses_its_model() {
     );
     assert_eq!(check_touches(&out), first, "same arguments, same touches");
 }
+
+/// `demo --strategy active` on the chess pieces in `out` with `extra` flags: its stdout and the
+/// rows of its `touches.csv`.
+fn active_demo(out: &Path, extra: &[&str]) -> (String, Vec<Vec<String>>) {
+    let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["demo", "--objects", "chess", "--training-readings", "12"])
+        .args(["--strategy", "active", "--touches", "8", "--seed", "3", "--out"])
+        .arg(out)
+        .args(extra)
+        .output()
+        .expect("the taction binary runs");
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        output.status.success(),
+        "active demo failed\nstdout:\n{stdout}\nstderr:\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    (stdout, touch_rows(out))
+}
+
+/// The confidence stop fires at the first touch whose best guess reaches the threshold, and the
+/// stopped run is the run without the stop cut short there (the stop changes no random draw).
+#[test]
+fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let out = dir.path().join("demo");
+    let (stdout, full) = active_demo(&out, &[]);
+    assert_eq!(full.len(), 8, "no stop: the whole budget\n{stdout}");
+    let p_guess: Vec<f64> = full.iter().map(|r| r[3].parse().expect("p_guess")).collect();
+    // A threshold strictly between two touches' confidences, crossed after the first touch.
+    let crossing = (1..p_guess.len())
+        .find(|&i| p_guess[i] > p_guess[..i].iter().cloned().fold(0.0, f64::max) + 1e-6)
+        .unwrap_or_else(|| panic!("confidence never rises after touch 1: {p_guess:?}"));
+    let below = p_guess[..crossing].iter().cloned().fold(0.0, f64::max);
+    let threshold = 0.5 * (below + p_guess[crossing]);
+    let (stdout, stopped) = active_demo(&out, &["--stop-at-confidence", &threshold.to_string()]);
+    assert_eq!(
+        stopped.len(),
+        crossing + 1,
+        "threshold {threshold}, {p_guess:?}\n{stdout}"
+    );
+    assert_eq!(
+        stopped[..],
+        full[..=crossing],
+        "the stopped run is a prefix of the full run"
+    );
+    assert!(stdout.contains("stopped: confident"), "{stdout}");
+    assert!(
+        stdout.contains(&format!("after {} touches", crossing + 1)),
+        "the touches used are reported:\n{stdout}"
+    );
+    let (_, _, stderr) = taction_demo(dir.path(), &["--stop-at-confidence", "1.5"]);
+    assert!(stderr.contains("--stop-at-confidence"), "{stderr}");
+}

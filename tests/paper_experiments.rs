@@ -45,7 +45,13 @@ fn two_letters(dir: &Path) -> PathBuf {
 
 fn rows(csv: &Path) -> Vec<AccuracyRow> {
     let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
-    assert_eq!(text.lines().next(), Some(ACCURACY_HEADER), "{}", csv.display());
+    // `active` adds the confidence stop's columns after the accuracy ones.
+    let header = text.lines().next().unwrap_or_default();
+    assert!(
+        header == ACCURACY_HEADER || header == format!("{ACCURACY_HEADER},confident,correct_at_stop"),
+        "{}: {header}",
+        csv.display()
+    );
     csv::Reader::from_reader(text.as_bytes())
         .deserialize()
         .collect::<Result<Vec<AccuracyRow>, _>>()
@@ -172,6 +178,17 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     assert_eq!(
         values("training-size"),
         BTreeSet::from(["100".into(), "300".into(), "1000".into()])
+    );
+    assert_eq!(
+        values("active"),
+        BTreeSet::from([
+            "L=1 fixed".into(),
+            "L=1 perturbed".into(),
+            "L=0.5 fixed".into(),
+            "L=0.5 perturbed".into(),
+            "active fixed".into(),
+            "active perturbed".into(),
+        ])
     );
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
@@ -311,4 +328,42 @@ fn bad_flags_and_unknown_experiments_are_clear_errors() {
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
+}
+
+/// The active experiment explores with the model in the loop inside its unit, in parallel over
+/// objects: one thread and two give the same rows, bit for bit, and the confidence columns are
+/// cumulative fractions.
+#[test]
+fn the_active_experiment_is_the_same_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = run_experiment("active", &dir.path().join("one"), &["--threads", "1"]);
+    let two = run_experiment("active", &dir.path().join("two"), &["--threads", "2"]);
+    assert!(one == two, "--threads 1 and 2 differ");
+    let text = String::from_utf8(one).expect("UTF-8 CSV");
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let headers = reader.headers().expect("a header").clone();
+    let column = |name: &str| headers.iter().position(|h| h == name).expect(name);
+    let (value, trial, confident, correct) = (
+        column("value"),
+        column("trial"),
+        column("confident"),
+        column("correct_at_stop"),
+    );
+    let mut last: Option<(String, String, f64)> = None;
+    let mut active_rows = 0;
+    for record in reader.records() {
+        let record = record.expect("a CSV record");
+        let c: f64 = record[confident].parse().expect("confident");
+        let r: f64 = record[correct].parse().expect("correct_at_stop");
+        assert!((0.0..=1.0).contains(&c) && r <= c + 1e-12, "{record:?}");
+        let curve = (record[value].to_string(), record[trial].to_string());
+        if let Some((v, t, previous)) = &last
+            && (v, t) == (&curve.0, &curve.1)
+        {
+            assert!(c >= *previous, "confident falls along a curve: {record:?}");
+        }
+        active_rows += usize::from(curve.0.starts_with("active"));
+        last = Some((curve.0, curve.1, c));
+    }
+    assert!(active_rows > 0, "no active rows:\n{text}");
 }

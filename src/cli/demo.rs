@@ -2,7 +2,9 @@
 //! readings (or reuses the model it cached), then lets the arm explore one object whose identity and
 //! pose it does not know, printing after every converged touch the best guess, its probability and
 //! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
-//! the posterior over touches and a contact sheet of the tactile images.
+//! the posterior over touches and a contact sheet of the tactile images. `--strategy active` chooses
+//! each touch by expected information gain (`recognize::active`); `--stop-at-confidence P` ends the
+//! exploration once the best guess has probability P.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -14,10 +16,12 @@ use taction::dataset::{Dataset, describe_shortfalls};
 use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::progress::CollectionProgress;
+use taction::explore::Probability;
+use taction::explore::active::DEFAULT_CANDIDATES;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
-use taction::recognize::OnlinePosterior;
+use taction::recognize::active::{ActiveRecognition, TouchPlan, explore_recognizing};
 use taction::recognize::model::TrainedModel;
 use taction::recognize::selection::{TrainConfig, codebook_sizes};
 use taction::rng;
@@ -48,6 +52,22 @@ pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "results/demo")]
     pub out: PathBuf,
+    /// How the arm chooses where to touch: `blind`, the paper's planner (local strategy with
+    /// probability 0.8, else global), or `active`, the candidate touch with the largest expected
+    /// information gain about the object's identity.
+    #[arg(long, value_enum, default_value_t = DemoStrategy::Blind)]
+    pub strategy: DemoStrategy,
+    /// Stop exploring once the best guess's probability reaches P, a probability in (0, 1]
+    /// (e.g. 0.95) [default: spend all --touches].
+    #[arg(long, value_name = "P")]
+    pub stop_at_confidence: Option<Probability>,
+}
+
+/// How the demo's arm chooses its touches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoStrategy {
+    Blind,
+    Active,
 }
 
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -164,72 +184,76 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     );
 
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+    let planner_config = PlannerConfig {
+        local_probability: match args.strategy {
+            DemoStrategy::Blind => 0.8,
+            // Candidates half local, half global: the scorer picks among both kinds.
+            DemoStrategy::Active => 0.5,
+        },
+        ..PlannerConfig::default()
+    }
+    .fitted_to(&objects);
     let mut planner = Planner::new(
         &scene,
-        PlannerConfig {
-            local_probability: 0.8,
-            ..PlannerConfig::default()
-        }
-        .fitted_to(&objects),
+        planner_config,
         ControlConfig::default(),
         sensor,
         PerturbationBounds::NONE,
         rng::stream(args.seed.seed, 0xE7),
         reader,
     )?;
-    let mut posterior = OnlinePosterior::new(&model.bag);
+    let mut recognition = ActiveRecognition::new(&model.bag, descriptor.as_ref(), planner_config.grid_cell_m);
     let mut csv = String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n");
-    let mut images = Vec::new();
     let mut p_true_series = Vec::new();
     println!(
         "{:>5}  {:<12} {:>8} {:>8} {:>9}",
         "touch", "best guess", "p(guess)", "p(true)", "entropy"
     );
-    let mut attempts = 0;
-    while images.len() < args.touches {
-        let report = planner.explore(&mut scene, &unknown.name, 1)?;
-        attempts += report.readings.len();
-        if report.converged() == 0 {
-            return Err(format!(
-                "the planner found no converged reading of '{}' after {attempts} attempts ({} iterations, \
-                 {} collisions, {} unreachable steps); `taction collect --objects {} --mode planner` \
-                 prints why its attempts fail, per object; try another --seed or --object",
-                unknown.name,
-                report.iterations,
-                report.collisions(),
-                report.unreachable_steps,
-                args.objects.display()
-            )
-            .into());
-        }
-        for reading in report
-            .readings
-            .into_iter()
-            .filter(|r| r.status == ContactStatus::Converged)
-        {
-            let belief = posterior.observe(&descriptor.describe(&reading.image))?;
+    let run = explore_recognizing(
+        &mut planner,
+        &mut scene,
+        &unknown.name,
+        &mut recognition,
+        TouchPlan {
+            budget: args.touches,
+            active_candidates: (args.strategy == DemoStrategy::Active).then_some(DEFAULT_CANDIDATES),
+            stop_at_confidence: args.stop_at_confidence,
+        },
+        &mut |touch| {
+            let belief = &touch.belief;
             let guess = belief.guess();
             let p = belief.probabilities();
-            let touch = images.len() + 1;
+            let n = belief.readings;
             println!(
-                "{touch:>5}  {:<12} {:>8.3} {:>8.3} {:>9.3}",
+                "{n:>5}  {:<12} {:>8.3} {:>8.3} {:>9.3}",
                 names[guess],
                 p[guess],
                 p[index],
                 belief.entropy_nats()
             );
             csv.push_str(&format!(
-                "{touch},{},{},{},{},{}\n",
+                "{n},{},{},{},{},{}\n",
                 unknown.name,
                 names[guess],
                 p[guess],
                 p[index],
                 belief.entropy_nats()
             ));
-            p_true_series.push((touch as f64, p[index]));
-            images.push(reading.image);
-        }
+            p_true_series.push((n as f64, p[index]));
+        },
+    )?;
+    let attempts = run.attempts;
+    if run.touches.is_empty() {
+        return Err(format!(
+            "the planner found no converged reading of '{}' after {attempts} attempts; \
+             `taction collect --objects {} --mode planner` prints why its attempts fail, per object; \
+             try another --seed or --object",
+            unknown.name,
+            args.objects.display()
+        )
+        .into());
     }
+    let images: Vec<_> = run.touches.iter().map(|t| t.reading.image.clone()).collect();
     std::io::stdout().flush()?;
 
     // 3. Outputs.
@@ -260,9 +284,14 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     figure.write_svg(&args.out.join("posterior.svg"))?;
     figure.write_png(&args.out.join("posterior.png"))?;
     write_contact_sheet(&images, 10, 12, &args.out.join("contact_sheet.png"))?;
-    let belief = posterior.belief();
+    let belief = recognition.belief();
+    let ending = if run.stopped_confident {
+        "stopped: confident"
+    } else {
+        "touch budget spent or planner out of iterations"
+    };
     println!(
-        "after {} touches ({} attempts): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png}}",
+        "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png}}",
         images.len(),
         attempts,
         names[belief.guess()],

@@ -97,23 +97,44 @@ impl CollectPlan {
                 )
             }
             CollectMode::Planner(config) => {
-                let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-                let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
-                    .map_err(crate::tactile::sensor::TactileError::from)?
-                    .build()?;
-                let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-                let mut planner = Planner::new(
-                    &scene,
-                    config,
-                    self.control,
-                    sensor,
-                    self.perturbation,
-                    rng,
-                    reader,
-                )?;
+                let (mut scene, mut planner) = self.planner_for(object, index, config)?;
                 planner.explore_reporting(&mut scene, &object.name, self.readings_per_object, on_converged)
             }
         }
+    }
+
+    /// The arm's scene with `object` and the planner that explores it as object `index` of this
+    /// plan (its sensor noise stream and random stream), for callers that drive the planner
+    /// themselves (active exploration, `recognize::active`).
+    #[allow(clippy::type_complexity)]
+    pub fn planner_for(
+        &self,
+        object: &ObjectSpec,
+        index: usize,
+        config: PlannerConfig,
+    ) -> Result<
+        (
+            Scene,
+            Planner<impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> + use<>>,
+        ),
+        ControlError,
+    > {
+        let sensor = self.sensor_for(index);
+        let builder = SceneBuilder::with_arm_and_table().object(object.clone());
+        let scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
+            .map_err(crate::tactile::sensor::TactileError::from)?
+            .build()?;
+        let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+        let planner = Planner::new(
+            &scene,
+            config,
+            self.control,
+            sensor,
+            self.perturbation,
+            rng::stream(self.seed, index as u64),
+            reader,
+        )?;
+        Ok((scene, planner))
     }
 
     /// Collects every object on a pool of `threads` threads (0: all cores), results in object order.

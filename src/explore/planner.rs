@@ -7,6 +7,9 @@
 //! - local: a target p in a small ball around a reading location drawn from a sparsely read grid cell
 //!   ([`ReadingGrid`]), expanded from the nearest vertex.
 //!
+//! - active (beyond the paper, [`crate::explore::active`]): several targets drawn by the rule above,
+//!   the one a [`TouchScorer`](crate::explore::TouchScorer) expects to be most informative expanded.
+//!
 //! Expansion takes small steps: from the pad toward p to a nearby point p', inverse kinematics for p',
 //! a slow guarded `move_to` while the sensor is watched. When the sensor feels the object on the way,
 //! surface contact control takes over (Sec. III-B) and its reading is recorded; a converged reading's
@@ -42,6 +45,7 @@ use serde::{Deserialize, Serialize};
 use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
 use crate::control::carrier::covering_back_check;
 use crate::control::{ContactStatus, ControlConfig, ControlError, settle};
+use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
 use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
 use crate::explore::strategy::Strategy;
@@ -318,31 +322,48 @@ where
         converged_target: usize,
         on_converged: &mut dyn FnMut(),
     ) -> Result<ExplorationReport, ControlError> {
+        self.explore_guided(scene, object, converged_target, None, on_converged)
+    }
+
+    /// [`explore_reporting`](Self::explore_reporting) with the active strategy when `guidance` is
+    /// given ([`crate::explore::active`]): each iteration draws `guidance.candidates` targets by the
+    /// local/global rule and expands toward the one the scorer rates highest; the readings are
+    /// tagged [`Strategy::Active`].
+    pub fn explore_guided(
+        &mut self,
+        scene: &mut Scene,
+        object: &str,
+        converged_target: usize,
+        guidance: Option<ActiveGuidance<'_>>,
+        on_converged: &mut dyn FnMut(),
+    ) -> Result<ExplorationReport, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let mut report = ExplorationReport::default();
         let threshold = self.control.effective_contact_threshold();
         while report.converged() < converged_target && report.iterations < self.config.max_iterations {
             report.iterations += 1;
-            let strategy =
-                if !self.grid.is_empty() && self.rng.random_range(0.0..1.0) < self.config.local_probability {
-                    Strategy::Local
-                } else {
-                    Strategy::Global
-                };
-            let target = match strategy {
-                Strategy::Local => match self.grid.local_target(self.config.local_radius_m, &mut self.rng) {
-                    // Targets stay in the workspace, above the table.
-                    Some(p) => p.clamp(self.config.workspace_min_m, self.config.workspace_max_m),
+            let (strategy, target) = match guidance {
+                None => match self.propose() {
+                    Some(proposal) => proposal,
                     None => continue,
                 },
-                _ => {
-                    let (lo, hi) = (self.config.workspace_min_m, self.config.workspace_max_m);
-                    DVec3::new(
-                        self.rng.random_range(lo.x..=hi.x),
-                        self.rng.random_range(lo.y..=hi.y),
-                        self.rng.random_range(lo.z..=hi.z),
-                    )
+                Some(guide) => {
+                    let proposals: Vec<(Strategy, DVec3)> = (0..guide.candidates.max(1))
+                        .filter_map(|_| self.propose())
+                        .collect();
+                    let targets: Vec<DVec3> = proposals.iter().map(|p| p.1).collect();
+                    let Some(best) = best_candidate(&guide.scorer.score(&targets)) else {
+                        continue;
+                    };
+                    proposals[best]
                 }
+            };
+            // How the pad is carried toward the target follows the proposal's kind; the reading
+            // is tagged with the strategy that chose it.
+            let label = if guidance.is_some() {
+                Strategy::Active
+            } else {
+                strategy
             };
             let mut vertex = self.tree.nearest(target);
             arm.place(scene, &self.tree.vertices()[vertex].q.clone());
@@ -406,7 +427,7 @@ where
                         .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
                     continue;
                 }
-                let mut reading = self.settle_here(scene, object, strategy)?;
+                let mut reading = self.settle_here(scene, object, label)?;
                 if reading.status == ContactStatus::Converged
                     && covering_meets_table(&reading.image, &self.sensor)
                 {
@@ -442,6 +463,31 @@ where
             }
         }
         Ok(report)
+    }
+
+    /// One target by the paper's rule (Sec. III-A): local with probability L once a reading exists
+    /// (a point near a reading of a sparsely read cell, kept in the workspace), else global (uniform
+    /// in the workspace). `None` when the local draw found no cell.
+    fn propose(&mut self) -> Option<(Strategy, DVec3)> {
+        if !self.grid.is_empty() && self.rng.random_range(0.0..1.0) < self.config.local_probability {
+            let p = self
+                .grid
+                .local_target(self.config.local_radius_m, &mut self.rng)?;
+            // Targets stay in the workspace, above the table.
+            return Some((
+                Strategy::Local,
+                p.clamp(self.config.workspace_min_m, self.config.workspace_max_m),
+            ));
+        }
+        let (lo, hi) = (self.config.workspace_min_m, self.config.workspace_max_m);
+        Some((
+            Strategy::Global,
+            DVec3::new(
+                self.rng.random_range(lo.x..=hi.x),
+                self.rng.random_range(lo.y..=hi.y),
+                self.rng.random_range(lo.z..=hi.z),
+            ),
+        ))
     }
 
     /// One guarded expansion motion to `q`, watching the sensor: the motion's outcome and whether the

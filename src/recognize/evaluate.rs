@@ -130,6 +130,8 @@ pub struct TouchRow {
     pub object_guess: usize,
     /// Probability the posterior gives the true object.
     pub p_true: f64,
+    /// Probability the posterior gives its guess, its largest (what a confidence stop watches).
+    pub p_guess: f64,
     /// Entropy of the posterior, nats.
     pub entropy_nats: f64,
     /// The whole posterior, one probability per object of the model.
@@ -216,6 +218,7 @@ where
                     n_readings: belief.readings,
                     object_guess: belief.guess(),
                     p_true: belief.probabilities()[trial.object],
+                    p_guess: belief.probabilities()[belief.guess()],
                     entropy_nats: belief.entropy_nats(),
                     probabilities: belief.probabilities().to_vec(),
                 });

@@ -16,10 +16,12 @@
 //! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //! | `training-size` | beyond | training readings per object (100, 300, 1000) |
+//! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence ([`active`]) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` ([`data`]).
 
+pub mod active;
 pub mod context;
 pub mod data;
 pub mod figures;
@@ -53,12 +55,13 @@ pub enum PaperExperiment {
     RealFrames,
     SimToReal,
     TrainingSize,
+    Active,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
     /// experiments beyond the paper).
-    pub const ALL: [PaperExperiment; 12] = [
+    pub const ALL: [PaperExperiment; 13] = [
         Self::Descriptors,
         Self::Strategy,
         Self::Validation,
@@ -71,6 +74,7 @@ impl PaperExperiment {
         Self::RealFrames,
         Self::SimToReal,
         Self::TrainingSize,
+        Self::Active,
     ];
 
     /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve, and
@@ -84,15 +88,15 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
-            Self::Convergence | Self::RealFrames => return None,
+            Self::Convergence | Self::RealFrames | Self::Active => return None,
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
             Self::TrainingSize => figures::training_size(),
         })
     }
 
-    /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]);
-    /// Fig. 14's are convergence statistics.
+    /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]'s
+    /// columns; `active` adds the confidence stop's); Fig. 14's are convergence statistics.
     pub fn is_recognition(self) -> bool {
         self != Self::Convergence
     }
@@ -101,13 +105,16 @@ impl PaperExperiment {
     pub fn name(self) -> &'static str {
         match self {
             Self::RealFrames => real_frames::EXPERIMENT_NAME,
+            Self::Active => active::EXPERIMENT_NAME,
             _ => self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name),
         }
     }
 
     pub fn description(self) -> &'static str {
-        if self == Self::RealFrames {
-            return real_frames::DESCRIPTION;
+        match self {
+            Self::RealFrames => return real_frames::DESCRIPTION,
+            Self::Active => return active::DESCRIPTION,
+            _ => {}
         }
         self.sweep().map_or(
             "Fig. 14: controller convergence and iterations against noise 0-150% (the dragon, or every 3D object without one)",
@@ -124,6 +131,7 @@ impl PaperExperiment {
         match self.sweep() {
             Some(sweep) => sweep.run(context),
             None if self == Self::RealFrames => real_frames::run_real_frames(context),
+            None if self == Self::Active => active::run_active(context),
             None => run_convergence(context),
         }
     }

@@ -256,7 +256,7 @@ impl RecognitionSweep {
         }
     }
 
-    fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
+    pub(super) fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
         SensorConfig {
             noise_seed: rng::substream(context.seed, NOISE_STREAM),
             ..self.settings[setting].sensor
@@ -265,7 +265,7 @@ impl RecognitionSweep {
 
     /// The controllers, told the sensor's noise width as a real controller knows its sensor's
     /// noise floor (see [`ControlConfig::expected_noise_fraction`]).
-    fn control(&self, setting: usize) -> ControlConfig {
+    pub(super) fn control(&self, setting: usize) -> ControlConfig {
         ControlConfig {
             expected_noise_fraction: self.settings[setting].sensor.noise_fraction,
             ..ControlConfig::default()
@@ -293,16 +293,28 @@ impl RecognitionSweep {
         )
     }
 
-    fn training_request(&self, c: &PaperContext, o: &Arc<Objects>, s: usize, n: DataCounts) -> DataRequest {
+    pub(super) fn training_request(
+        &self,
+        c: &PaperContext,
+        o: &Arc<Objects>,
+        s: usize,
+        n: DataCounts,
+    ) -> DataRequest {
         self.sampler_request(c, o, s, n.training_per_object, TRAINING_STREAM)
     }
 
-    fn validation_request(&self, c: &PaperContext, o: &Arc<Objects>, s: usize, n: DataCounts) -> DataRequest {
+    pub(super) fn validation_request(
+        &self,
+        c: &PaperContext,
+        o: &Arc<Objects>,
+        s: usize,
+        n: DataCounts,
+    ) -> DataRequest {
         self.sampler_request(c, o, s, n.validation_per_object, VALIDATION_STREAM)
     }
 
     /// The datasets of curve `test` of `setting`, one per trial (none for real frames).
-    fn test_requests(
+    pub(super) fn test_requests(
         &self,
         context: &PaperContext,
         objects: &Arc<Objects>,
@@ -347,7 +359,7 @@ impl RecognitionSweep {
     }
 
     /// Every dataset a unit of `setting` reads.
-    fn requests(
+    pub(super) fn requests(
         &self,
         context: &PaperContext,
         objects: &Arc<Objects>,
@@ -389,22 +401,16 @@ impl RecognitionSweep {
                     let real = real.ok_or("internal: the real recording was not loaded")?;
                     real_trials(real, descriptor.as_ref(), &model, context.seed, counts.trials)?
                 }
-                test => self
-                    .test_requests(context, objects, setting, test, counts)
-                    .iter()
-                    .map(|request| {
-                        let data = context.store.dataset(request)?;
-                        model
-                            .check_sensor(&data.header().sensor)
-                            .map_err(|e| format!("test data of '{}': {e}", curve.value))?;
-                        let features = LabelledFeatures::from_dataset(&data, descriptor.as_ref());
-                        let readings = counts.test_per_object.max(counts.validation_per_object);
-                        Ok((
-                            request.plan.seed,
-                            make_trials(&features, model.bag.objects(), readings)?,
-                        ))
-                    })
-                    .collect::<Result<Vec<_>, BoxError>>()?,
+                test => self.dataset_trials(
+                    context,
+                    objects,
+                    setting,
+                    test,
+                    counts,
+                    &model,
+                    descriptor.as_ref(),
+                    &curve.value,
+                )?,
             };
             for (trial, (seed, object_trials)) in trials.iter().enumerate() {
                 let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
@@ -434,9 +440,42 @@ impl RecognitionSweep {
     }
 }
 
+impl RecognitionSweep {
+    /// The trials of a curve read from datasets (every kind but real frames): per trial its seed
+    /// and one [`Trial`] per object, the features of its converged readings in order.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn dataset_trials(
+        &self,
+        context: &PaperContext,
+        objects: &Arc<Objects>,
+        setting: usize,
+        test: TestData,
+        counts: DataCounts,
+        model: &TrainedModel,
+        descriptor: &dyn Descriptor,
+        curve: &str,
+    ) -> Result<Vec<(u64, Vec<Trial>)>, BoxError> {
+        self.test_requests(context, objects, setting, test, counts)
+            .iter()
+            .map(|request| {
+                let data = context.store.dataset(request)?;
+                model
+                    .check_sensor(&data.header().sensor)
+                    .map_err(|e| format!("test data of '{curve}': {e}"))?;
+                let features = LabelledFeatures::from_dataset(&data, descriptor);
+                let readings = counts.test_per_object.max(counts.validation_per_object);
+                Ok((
+                    request.plan.seed,
+                    make_trials(&features, model.bag.objects(), readings)?,
+                ))
+            })
+            .collect()
+    }
+}
+
 /// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
 /// problem ([`codebook_sizes`], counting one feature per training reading).
-fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
+pub(super) fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
     selection_config(
         rng::substream(seed, MODEL_STREAM),
         counts.training_per_object,

@@ -1,0 +1,366 @@
+//! Beyond the paper: active touch by expected information gain (`recognize::active`) against the
+//! paper's blind exploration with L = 1 (its best, Fig. 8) and L = 0.5, on the 3D set with the
+//! object fixed and perturbed after every reading (Sec. V-B4), and how many touches each needs
+//! before a confidence stop would fire.
+//!
+//! The L curves recognise the same planner datasets as Figs. 8 and 10 (shared through `<out>/data`),
+//! with the same model as Fig. 8's Polar-Fourier curve. The active curves cannot come from a
+//! dataset collected beforehand: where the arm touches next depends on the model's belief, so each
+//! unit explores with the trained model in the loop, with the random streams and sensor of the
+//! L = 0.5 datasets (common random numbers) and no stop, `test_per_object` touches per object.
+//!
+//! The confidence stop needs no second run: the planner's draws do not depend on it, so a run with
+//! the stop is the run without it cut at the first touch whose posterior's largest probability
+//! reaches [`STOP_AT_CONFIDENCE`]. Each row adds the fraction of objects stopped by then
+//! (`confident`, the cumulative distribution of touches-to-confidence) and the fraction stopped
+//! with the right guess (`correct_at_stop`).
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::context::PaperContext;
+use super::data::Objects;
+use super::figures::default_sensor;
+use super::recognition::{Curve, Family, RecognitionSweep, Setting, TestData, training_config};
+use super::scale::DataCounts;
+use crate::describe::{Descriptor, DescriptorKind};
+use crate::experiment::layout::ExperimentDir;
+use crate::experiment::name::SafeName;
+use crate::experiment::plot::{Axis, PlotSpec};
+use crate::experiment::runner::{Experiment, RunReport, run};
+use crate::experiment::spec::ExperimentSpec;
+use crate::experiment::unit::{BoxError, Unit};
+use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
+use crate::explore::collect::CollectMode;
+use crate::explore::{PlannerConfig, SamplerConfig};
+use crate::recognize::active::{ActiveRecognition, TouchPlan, explore_recognizing};
+use crate::recognize::{Evaluation, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate};
+use crate::sim::PerturbationBounds;
+
+pub const EXPERIMENT_NAME: &str = "active";
+pub const DESCRIPTION: &str = "Beyond the paper: active touch by expected information gain vs L = 1 and L = 0.5 (3D set, fixed and perturbed; PF), with touches to 95% confidence";
+
+/// The confidence stop the `confident` column applies.
+pub const STOP_AT_CONFIDENCE: f64 = 0.95;
+
+/// The descriptor: Polar-Fourier, one of the paper's top three (Sec. V-B2) and the demo's.
+const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
+
+/// L of the active strategy's proposals: half local, half global candidates.
+const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
+
+/// One point of one curve: the columns of [`crate::experiment::AccuracyRow`] (so the accuracy plot
+/// and the headline table read it) and the confidence stop's.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `value` | `L=1 fixed`, `L=0.5 perturbed`, `active fixed`, ... |
+/// | `confident` | fraction of objects whose posterior's largest probability reached the stop threshold within `n_readings` readings |
+/// | `correct_at_stop` | fraction of objects stopped within `n_readings` readings whose guess at the stop was right |
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ActiveRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub parameter: String,
+    pub value: String,
+    pub trial: u32,
+    pub n_readings: u32,
+    pub accuracy: f64,
+    pub reliability: f64,
+    pub seed: u64,
+    pub confident: f64,
+    pub correct_at_stop: f64,
+}
+
+fn perturbed() -> PerturbationBounds {
+    PerturbationBounds::new(10.0, 0.1).unwrap_or(PerturbationBounds::NONE)
+}
+
+fn object_states() -> [(&'static str, PerturbationBounds); 2] {
+    [("fixed", PerturbationBounds::NONE), ("perturbed", perturbed())]
+}
+
+/// The L curves, as a sweep whose datasets are those of Figs. 8 and 10.
+pub fn sweep() -> RecognitionSweep {
+    let mut curves = Vec::new();
+    for l in [1.0, 0.5] {
+        for (state, perturbation) in object_states() {
+            curves.push(Curve {
+                value: format!("L={l} {state}"),
+                test: TestData::Planner {
+                    local_probability: l,
+                    perturbation,
+                },
+            });
+        }
+    }
+    RecognitionSweep {
+        name: EXPERIMENT_NAME,
+        description: DESCRIPTION,
+        title: "Active touch (expected information gain) vs blind exploration",
+        parameter: "strategy",
+        family: Family::Shapes,
+        descriptors: vec![DESCRIPTOR],
+        settings: vec![Setting {
+            label: "active".into(),
+            sensor: default_sensor(),
+            sampler: SamplerConfig::default(),
+            training_fraction: 1.0,
+            curves,
+        }],
+    }
+}
+
+#[derive(Serialize)]
+struct ActiveConfig<'a> {
+    sweep: &'a RecognitionSweep,
+    active_local_probability: f64,
+    active_candidates: usize,
+    neighbourhood_m: f64,
+    stop_at_confidence: f64,
+    scale: f64,
+    counts: DataCounts,
+    seed: u64,
+    object_set_id: String,
+    objects: Vec<String>,
+    training: TrainConfig,
+}
+
+/// Runs the experiment in `context` (one unit: the model, the L curves and the active curves).
+pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
+    let sweep = sweep();
+    let objects = context.objects(Family::Shapes)?;
+    let counts = context.scale.counts();
+    let training = training_config(context.seed, counts, objects.specs.len());
+    let name = SafeName::new(EXPERIMENT_NAME)?;
+    let key = SafeName::builder(DESCRIPTOR.name()).build()?;
+    let dir = ExperimentDir::new(&context.options.out, &name);
+    if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
+        context
+            .store
+            .prepare(&sweep.requests(context, &objects, 0, counts))?;
+    }
+    let neighbourhood_m = PlannerConfig::default().grid_cell_m;
+    let unit = {
+        let (sweep, objects, training) = (&sweep, Arc::clone(&objects), training.clone());
+        Unit::new(key, move || {
+            unit_rows(context, sweep, &objects, counts, &training, neighbourhood_m)
+        })
+    };
+    let experiment = Experiment {
+        spec: ExperimentSpec {
+            name: name.clone(),
+            description: DESCRIPTION.to_string(),
+            plots: vec![
+                PlotSpec::accuracy(name, sweep.title),
+                PlotSpec::lines(
+                    SafeName::new("active-confidence")?,
+                    "Objects recognised with 95% confidence (the stop's touches, cumulative)",
+                    Axis::new("n_readings", "number of readings"),
+                    vec![Axis::new("confident", "objects confident (fraction)")],
+                    &["value"],
+                ),
+            ],
+        },
+        config: ActiveConfig {
+            sweep: &sweep,
+            active_local_probability: ACTIVE_LOCAL_PROBABILITY,
+            active_candidates: DEFAULT_CANDIDATES,
+            neighbourhood_m,
+            stop_at_confidence: STOP_AT_CONFIDENCE,
+            scale: context.scale.fraction(),
+            counts,
+            seed: context.seed,
+            object_set_id: objects.set.id(),
+            objects: objects.names(),
+            training: training.clone(),
+        },
+        units: vec![unit],
+    };
+    Ok(run(&experiment, &context.options)?)
+}
+
+fn unit_rows(
+    context: &PaperContext,
+    sweep: &RecognitionSweep,
+    objects: &Arc<Objects>,
+    counts: DataCounts,
+    training: &TrainConfig,
+    neighbourhood_m: f64,
+) -> Result<Vec<ActiveRow>, BoxError> {
+    let descriptor = DESCRIPTOR.build();
+    let model = context.store.model(
+        &sweep.training_request(context, objects, 0, counts),
+        &sweep.validation_request(context, objects, 0, counts),
+        descriptor.as_ref(),
+        training,
+    )?;
+    let mut rows = Vec::new();
+    for curve in &sweep.settings[0].curves {
+        let trials = sweep.dataset_trials(
+            context,
+            objects,
+            0,
+            curve.test,
+            counts,
+            &model,
+            descriptor.as_ref(),
+            &curve.value,
+        )?;
+        rows.extend(curve_rows(sweep, &model, &curve.value, &trials, counts)?);
+    }
+    for (state, perturbation) in object_states() {
+        // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
+        let base = sweep.test_requests(
+            context,
+            objects,
+            0,
+            TestData::Planner {
+                local_probability: ACTIVE_LOCAL_PROBABILITY,
+                perturbation,
+            },
+            counts,
+        );
+        let jobs: Vec<(usize, usize)> = (0..base.len())
+            .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
+            .collect();
+        let explored: Vec<Trial> = jobs
+            .par_iter()
+            .map(|&(t, o)| {
+                active_trial(
+                    &base[t].plan,
+                    objects,
+                    o,
+                    &model,
+                    descriptor.as_ref(),
+                    counts.test_per_object,
+                    neighbourhood_m,
+                )
+            })
+            .collect::<Result<_, BoxError>>()?;
+        let per_object = objects.specs.len().max(1);
+        let trials: Vec<(u64, Vec<Trial>)> = base
+            .iter()
+            .zip(explored.chunks(per_object))
+            .map(|(request, chunk)| (request.plan.seed, chunk.to_vec()))
+            .collect();
+        rows.extend(curve_rows(
+            sweep,
+            &model,
+            &format!("active {state}"),
+            &trials,
+            counts,
+        )?);
+    }
+    Ok(rows)
+}
+
+/// Object `index` explored actively under `plan` (a planner plan) with `model` in the loop: the
+/// features of its converged touches, in order.
+fn active_trial(
+    plan: &crate::explore::collect::CollectPlan,
+    objects: &Objects,
+    index: usize,
+    model: &TrainedModel,
+    descriptor: &dyn Descriptor,
+    touches: usize,
+    neighbourhood_m: f64,
+) -> Result<Trial, BoxError> {
+    let CollectMode::Planner(config) = plan.mode else {
+        return Err("internal: the active curve's plan is not a planner plan".into());
+    };
+    let spec = &objects.specs[index];
+    let object = model
+        .bag
+        .models()
+        .object_index(&spec.name)
+        .ok_or_else(|| format!("object '{}' is not in the trained model", spec.name))?;
+    let (mut scene, mut planner) = plan.planner_for(spec, index, config)?;
+    let mut recognition = ActiveRecognition::new(&model.bag, descriptor, neighbourhood_m);
+    let run = explore_recognizing(
+        &mut planner,
+        &mut scene,
+        &spec.name,
+        &mut recognition,
+        TouchPlan {
+            budget: touches,
+            active_candidates: Some(DEFAULT_CANDIDATES),
+            stop_at_confidence: None,
+        },
+        &mut |_| {},
+    )?;
+    let readings = run
+        .touches
+        .iter()
+        .map(|t| descriptor.describe(&t.reading.image))
+        .collect();
+    Ok(Trial { object, readings })
+}
+
+/// The rows of one curve: accuracy and reliability as every recognition figure defines them
+/// ([`evaluate`]), and the confidence stop's columns.
+fn curve_rows(
+    sweep: &RecognitionSweep,
+    model: &TrainedModel,
+    value: &str,
+    trials: &[(u64, Vec<Trial>)],
+    counts: DataCounts,
+) -> Result<Vec<ActiveRow>, BoxError> {
+    let threshold = Probability::new(STOP_AT_CONFIDENCE)?;
+    let mut rows = Vec::new();
+    for (trial, (seed, object_trials)) in trials.iter().enumerate() {
+        let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
+        if longest == 0 {
+            return Err(
+                format!("curve '{value}', trial {trial}: no converged test reading of any object").into(),
+            );
+        }
+        let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
+        let stops = stops(
+            &evaluation,
+            object_trials.len(),
+            threshold,
+            counts.test_per_object,
+        );
+        for point in &evaluation.accuracy {
+            let n = point.n_readings;
+            let objects = object_trials.len().max(1) as f64;
+            let stopped: Vec<&(usize, bool)> = stops.iter().flatten().filter(|(k, _)| *k <= n).collect();
+            rows.push(ActiveRow {
+                experiment: sweep.name.to_string(),
+                descriptor: DESCRIPTOR.name().to_string(),
+                parameter: sweep.parameter.to_string(),
+                value: value.to_string(),
+                trial: trial as u32,
+                n_readings: n as u32,
+                accuracy: point.accuracy(),
+                reliability: point.mean_p_true,
+                seed: *seed,
+                confident: stopped.len() as f64 / objects,
+                correct_at_stop: stopped.iter().filter(|(_, right)| *right).count() as f64 / objects,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Per object trial: the touch at which the stop fires and whether the guess there is right;
+/// `None` when it never fires within `budget` touches.
+fn stops(
+    evaluation: &Evaluation,
+    trials: usize,
+    threshold: Probability,
+    budget: usize,
+) -> Vec<Option<(usize, bool)>> {
+    (0..trials)
+        .map(|t| {
+            let touches: Vec<_> = evaluation.touches.iter().filter(|r| r.trial == t).collect();
+            touches_to_confidence(touches.iter().map(|r| r.p_guess), threshold, budget).map(|k| {
+                let at = touches[k - 1];
+                (k, at.object_guess == at.object_true)
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,389 @@
+//! Active touch by expected information gain, and stopping when sure (beyond the paper; its Sec. VI
+//! names "expected information gain" as the planning criterion it leaves to future work).
+//!
+//! [`InformationGain`] implements the planner's [`TouchScorer`]. For a candidate target `x` it
+//! predicts the distribution of the codebook cluster `c` a touch near `x` would show, and scores
+//! `x` by the expected reduction of the entropy of the posterior over identity (Eq. 16):
+//!
+//! ```text
+//! EIG(x) = H(pi) - sum_c q_x(c) H(pi | c),   (pi | c)_j  ∝  pi_j p(c | O_j)^w
+//! ```
+//!
+//! with `pi` the current posterior, `p(c | O_j)` the trained object models (Eq. 4's histograms) and
+//! `w` the mean number of features per reading so far (1 before any reading), so that one predicted
+//! reading moves the posterior as a reading does under Eq. 15-16.
+//!
+//! The prediction `q_x` mixes two things the recogniser knows, never the object's pose or shape:
+//! - the appearance-only prediction `m(c) = sum_j pi_j p(c | O_j)`, what the current belief expects
+//!   of a touch anywhere; with `q_x = m` the score is the mutual information of identity and the
+//!   next cluster, the same for every candidate;
+//! - the clusters of the readings already taken within [`InformationGain::neighbourhood_m`] of `x`
+//!   (their per-reading normalised histograms, averaged to `e_x`): what this part of the surface
+//!   showed before.
+//!
+//! `q_x = (kappa m + n_x e_x) / (kappa + n_x)`, with `n_x` such readings and `kappa` =
+//! [`PRIOR_READINGS`]. An unexplored neighbourhood (`n_x = 0`) is predicted by the belief alone; an
+//! explored one by what it showed, so candidates near readings whose clusters tell the still
+//! likely objects apart score high (touch there again), candidates near readings of clusters all
+//! likely objects share (a flat face) score low, and unexplored places sit in between at the
+//! mutual information. The assumptions: a touch lands near its target (a global target in empty
+//! space may yield no touch, or one far away), nearby readings predict the next (the surface does
+//! not change within a neighbourhood, which a perturbation of the object breaks), and readings are
+//! independent given the object, as Eq. 15 already assumes.
+//!
+//! Cost per planner iteration: `H(pi | c)` for every cluster once, `O(k J)` for `k` clusters and
+//! `J` objects, then per candidate `O(r + k)` for `r` readings so far; no MuJoCo, no descriptor.
+//! `benches/recognize.rs` measures it against a plain planner iteration.
+//!
+//! [`explore_recognizing`] runs the planner one touch at a time, updates the posterior after each
+//! converged reading and applies the confidence stop.
+
+use glam::DVec3;
+
+use crate::control::ControlError;
+use crate::describe::Descriptor;
+use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
+use crate::explore::{Planner, Reading};
+use crate::recognize::RecognizeError;
+use crate::recognize::bag::BagOfFeatures;
+use crate::recognize::decision::entropy_nats;
+use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
+use crate::recognize::posterior::{Belief, OnlinePosterior};
+use crate::sim::Scene;
+use crate::tactile::TactileImage;
+
+/// `kappa`: how many readings' worth of weight the belief's own prediction has against the readings
+/// of a neighbourhood (see the module docs). One: a single nearby reading already counts as much as
+/// the belief, two outweigh it.
+pub const PRIOR_READINGS: f64 = 1.0;
+
+/// The expected-information-gain scorer's state: the posterior and the readings so far.
+#[derive(Debug, Clone)]
+pub struct InformationGain<'a> {
+    models: &'a ObjectModels,
+    probabilities: Vec<f64>,
+    features: usize,
+    /// Pad location and normalised cluster histogram of every reading observed.
+    readings: Vec<(DVec3, Vec<f64>)>,
+    /// Readings within this distance of a candidate predict what a touch there shows, metres.
+    pub neighbourhood_m: f64,
+}
+
+impl<'a> InformationGain<'a> {
+    /// No reading yet: a uniform posterior.
+    pub fn new(models: &'a ObjectModels, neighbourhood_m: f64) -> Self {
+        let n = models.objects().len();
+        Self {
+            models,
+            probabilities: vec![1.0 / n as f64; n],
+            features: 0,
+            readings: Vec::new(),
+            neighbourhood_m,
+        }
+    }
+
+    /// Records one reading: its cluster histogram, where it was taken (readings without a pad pose
+    /// predict nothing about places) and the posterior after it.
+    pub fn record(&mut self, location_m: Option<DVec3>, reading: &ClusterHistogram, posterior: &[f64]) {
+        self.features += reading.features();
+        if let Some(l) = location_m
+            && reading.features() > 0
+        {
+            self.readings.push((l, reading.distribution()));
+        }
+        self.probabilities = posterior.to_vec();
+    }
+
+    /// The posterior the scores start from.
+    pub fn probabilities(&self) -> &[f64] {
+        &self.probabilities
+    }
+
+    /// `m(c) = sum_j pi_j p(c | O_j)`: the cluster a touch anywhere is expected to show.
+    pub fn belief_prediction(&self) -> Vec<f64> {
+        let mut m = vec![0.0; self.models.clusters()];
+        for (j, pi) in self.probabilities.iter().enumerate() {
+            for (mc, p) in m.iter_mut().zip(self.models.probabilities(j)) {
+                *mc += pi * p;
+            }
+        }
+        m
+    }
+
+    /// `q_x`: the belief's prediction `m` mixed with the clusters of the readings near `target_m`.
+    pub fn predicted_clusters(&self, target_m: DVec3, m: &[f64]) -> Vec<f64> {
+        let mut q: Vec<f64> = m.iter().map(|v| v * PRIOR_READINGS).collect();
+        let mut weight = PRIOR_READINGS;
+        for (location, distribution) in &self.readings {
+            if location.distance(target_m) <= self.neighbourhood_m {
+                q.iter_mut().zip(distribution).for_each(|(a, b)| *a += b);
+                weight += 1.0;
+            }
+        }
+        q.iter_mut().for_each(|v| *v /= weight);
+        q
+    }
+
+    /// `H(pi | c)` for every cluster `c`, nats.
+    pub fn entropies_after(&self) -> Vec<f64> {
+        let w = if self.readings.is_empty() || self.features == 0 {
+            1.0
+        } else {
+            self.features as f64 / self.readings.len() as f64
+        };
+        let log_pi: Vec<f64> = self.probabilities.iter().map(|p| p.ln()).collect();
+        let mut log_post = vec![0.0; log_pi.len()];
+        (0..self.models.clusters())
+            .map(|c| {
+                for (j, l) in log_post.iter_mut().enumerate() {
+                    *l = log_pi[j] + w * self.models.log_probabilities(j)[c];
+                }
+                let lse = crate::recognize::gmm::log_sum_exp(&log_post);
+                let post: Vec<f64> = log_post.iter().map(|l| (l - lse).exp()).collect();
+                entropy_nats(&post)
+            })
+            .collect()
+    }
+
+    /// `EIG(x)` for a prediction `q` given [`entropies_after`](Self::entropies_after), nats.
+    pub fn expected_gain_nats(&self, q: &[f64], entropies_after: &[f64]) -> f64 {
+        let expected: f64 = q.iter().zip(entropies_after).map(|(q, h)| q * h).sum();
+        entropy_nats(&self.probabilities) - expected
+    }
+}
+
+impl TouchScorer for InformationGain<'_> {
+    fn score(&self, candidates_m: &[DVec3]) -> Vec<f64> {
+        let m = self.belief_prediction();
+        let after = self.entropies_after();
+        candidates_m
+            .iter()
+            .map(|&x| self.expected_gain_nats(&self.predicted_clusters(x, &m), &after))
+            .collect()
+    }
+}
+
+/// A recogniser that also scores where to touch next: the online posterior (Eq. 16) and the
+/// [`InformationGain`] state fed with the same readings.
+pub struct ActiveRecognition<'a> {
+    bag: &'a BagOfFeatures,
+    descriptor: &'a dyn Descriptor,
+    posterior: OnlinePosterior<'a>,
+    gain: InformationGain<'a>,
+}
+
+impl<'a> ActiveRecognition<'a> {
+    pub fn new(bag: &'a BagOfFeatures, descriptor: &'a dyn Descriptor, neighbourhood_m: f64) -> Self {
+        Self {
+            bag,
+            descriptor,
+            posterior: bag.posterior(),
+            gain: InformationGain::new(bag.models(), neighbourhood_m),
+        }
+    }
+
+    /// Describes one converged reading's image, adds it to the posterior and returns the belief.
+    pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
+        let features = self.descriptor.describe(image);
+        let belief = self.posterior.observe(&features)?;
+        let mut reading = ClusterHistogram::new(self.bag.models().clusters());
+        self.bag.add_features(&features, &mut reading, "the reading")?;
+        self.gain
+            .record(image.pose().map(|p| p.center_m), &reading, belief.probabilities());
+        Ok(belief)
+    }
+
+    pub fn belief(&self) -> Belief {
+        self.posterior.belief()
+    }
+
+    pub fn scorer(&self) -> &InformationGain<'a> {
+        &self.gain
+    }
+}
+
+/// How [`explore_recognizing`] explores.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TouchPlan {
+    /// Converged touches at most (the budget).
+    pub budget: usize,
+    /// `Some(n)`: the active strategy with `n` candidates per iteration; `None`: the planner's
+    /// local/global rule.
+    pub active_candidates: Option<usize>,
+    /// The confidence stop: end at the first touch after which the posterior's largest
+    /// probability reaches this.
+    pub stop_at_confidence: Option<Probability>,
+}
+
+/// One converged touch and the belief after it.
+pub struct Touch {
+    pub reading: Reading,
+    pub belief: Belief,
+}
+
+/// What [`explore_recognizing`] did.
+pub struct TouchRun {
+    pub touches: Vec<Touch>,
+    /// Reading attempts, converged or not.
+    pub attempts: usize,
+    /// Whether the confidence stop ended the run (else the budget was spent, or the planner ran
+    /// out of iterations before a touch).
+    pub stopped_confident: bool,
+}
+
+/// What can end [`explore_recognizing`] early.
+#[derive(Debug, thiserror::Error)]
+pub enum TouchError {
+    #[error(transparent)]
+    Explore(#[from] ControlError),
+    #[error(transparent)]
+    Recognize(#[from] RecognizeError),
+}
+
+/// Explores `object` in `scene` one converged touch at a time, recognising as it goes: after each
+/// touch the posterior is updated (and shown to `on_touch`); the run ends when the confidence stop
+/// fires, the budget is spent, or the planner finds no touch within its iteration budget. The
+/// planner's random draws do not depend on the stop, so a run with the stop is the run without it
+/// cut short.
+pub fn explore_recognizing<R>(
+    planner: &mut Planner<R>,
+    scene: &mut Scene,
+    object: &str,
+    recognition: &mut ActiveRecognition<'_>,
+    plan: TouchPlan,
+    on_touch: &mut dyn FnMut(&Touch),
+) -> Result<TouchRun, TouchError>
+where
+    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+{
+    let mut run = TouchRun {
+        touches: Vec::new(),
+        attempts: 0,
+        stopped_confident: false,
+    };
+    while run.touches.len() < plan.budget {
+        let guidance = plan.active_candidates.map(|candidates| ActiveGuidance {
+            scorer: recognition.scorer(),
+            candidates,
+        });
+        let report = planner.explore_guided(scene, object, 1, guidance, &mut || {})?;
+        run.attempts += report.readings.len();
+        let mut converged = report
+            .readings
+            .into_iter()
+            .filter(|r| r.status == crate::control::ContactStatus::Converged)
+            .peekable();
+        if converged.peek().is_none() {
+            break;
+        }
+        for reading in converged {
+            let belief = recognition.observe(&reading.image)?;
+            let touch = Touch { reading, belief };
+            on_touch(&touch);
+            let confident = plan
+                .stop_at_confidence
+                .is_some_and(|p| max_probability(&touch.belief) >= p.get());
+            run.touches.push(touch);
+            if confident {
+                run.stopped_confident = true;
+                return Ok(run);
+            }
+        }
+    }
+    Ok(run)
+}
+
+/// The posterior's largest probability.
+pub fn max_probability(belief: &Belief) -> f64 {
+    belief.probabilities()[belief.guess()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recognize::object_model::PseudoCount;
+
+    /// Two objects that differ only in clusters 2 and 3; clusters 0 and 1 they share.
+    fn toy_models() -> ObjectModels {
+        let histogram = |counts: [f64; 4]| {
+            let mut h = ClusterHistogram::new(4);
+            for (c, n) in counts.iter().enumerate() {
+                for _ in 0..*n as usize {
+                    let mut m = [0.0; 4];
+                    m[c] = 1.0;
+                    h.add(&m);
+                }
+            }
+            h
+        };
+        ObjectModels::fit(
+            vec!["a".into(), "b".into()],
+            &[
+                histogram([40.0, 40.0, 18.0, 2.0]),
+                histogram([40.0, 40.0, 2.0, 18.0]),
+            ],
+            PseudoCount::new(1e-9).unwrap(),
+        )
+        .unwrap()
+    }
+
+    fn one_feature(c: usize) -> ClusterHistogram {
+        let mut h = ClusterHistogram::new(4);
+        let mut m = [0.0; 4];
+        m[c] = 1.0;
+        h.add(&m);
+        h
+    }
+
+    /// With no reading every candidate scores the mutual information of identity and one cluster,
+    /// computed by hand: H(pi) = ln 2; clusters 0, 1 (p = 0.4 each) leave the posterior uniform;
+    /// clusters 2, 3 (p = 0.1 each) move it to (0.9, 0.1).
+    #[test]
+    fn without_readings_every_candidate_scores_the_mutual_information() {
+        let models = toy_models();
+        let gain = InformationGain::new(&models, 0.01);
+        let h09 = -(0.9f64 * 0.9f64.ln() + 0.1 * 0.1f64.ln());
+        let expected = 2f64.ln() - (0.8 * 2f64.ln() + 0.2 * h09);
+        let scores = gain.score(&[DVec3::ZERO, DVec3::X]);
+        for s in scores {
+            assert!((s - expected).abs() < 1e-6, "{s} vs {expected}");
+        }
+    }
+
+    /// The known answer: a candidate beside a reading of a discriminating cluster beats one beside a
+    /// reading of a shared cluster, and an unexplored one lies between.
+    #[test]
+    fn the_candidate_whose_predicted_clusters_discriminate_wins() {
+        let models = toy_models();
+        let mut gain = InformationGain::new(&models, 0.01);
+        let uniform = [0.5, 0.5];
+        let shared = DVec3::new(0.1, 0.0, 0.0);
+        let telling = DVec3::new(-0.1, 0.0, 0.0);
+        for _ in 0..3 {
+            gain.record(Some(shared), &one_feature(0), &uniform);
+        }
+        gain.record(Some(telling), &one_feature(2), &uniform);
+        let candidates = [
+            shared + DVec3::splat(0.002),
+            DVec3::new(0.0, 0.1, 0.0),
+            telling + DVec3::splat(0.002),
+        ];
+        let scores = gain.score(&candidates);
+        assert!(scores[2] > scores[1] && scores[1] > scores[0], "{scores:?}");
+        assert_eq!(crate::explore::active::best_candidate(&scores), Some(2));
+        // Near the shared readings the prediction is 3/4 cluster 0, which says nothing.
+        let q = gain.predicted_clusters(candidates[0], &gain.belief_prediction());
+        assert!((q[0] - (0.4 + 3.0) / 4.0).abs() < 1e-6, "{q:?}");
+    }
+
+    /// Once the posterior is certain nothing is left to learn anywhere.
+    #[test]
+    fn a_certain_posterior_expects_no_gain() {
+        let models = toy_models();
+        let mut gain = InformationGain::new(&models, 0.01);
+        gain.record(Some(DVec3::ZERO), &one_feature(2), &[1.0, 0.0]);
+        for s in gain.score(&[DVec3::ZERO, DVec3::ONE]) {
+            assert!(s.abs() < 1e-12, "{s}");
+        }
+    }
+}
