@@ -70,6 +70,7 @@ pub struct ActiveRow {
     pub accuracy: f64,
     pub reliability: f64,
     pub seed: u64,
+    pub stream_seed: i64,
     pub confident: f64,
     pub correct_at_stop: f64,
 }
@@ -154,7 +155,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                PlotSpec::accuracy(name, sweep.title),
+                PlotSpec::accuracy(name, sweep.title).with_chance(objects.specs.len()),
                 PlotSpec::lines(
                     SafeName::new("active-confidence")?,
                     "Objects recognised with 95% confidence (the stop's touches, cumulative)",
@@ -209,7 +210,14 @@ fn unit_rows(
             descriptor.as_ref(),
             &curve.value,
         )?;
-        rows.extend(curve_rows(sweep, &model, &curve.value, &trials, counts)?);
+        rows.extend(curve_rows(
+            sweep,
+            &model,
+            &curve.value,
+            &trials,
+            counts,
+            context.seed,
+        )?);
     }
     for (state, perturbation) in object_states() {
         // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
@@ -252,6 +260,7 @@ fn unit_rows(
             &format!("active {state}"),
             &trials,
             counts,
+            context.seed,
         )?);
     }
     Ok(rows)
@@ -307,6 +316,7 @@ fn curve_rows(
     value: &str,
     trials: &[(u64, Vec<Trial>)],
     counts: DataCounts,
+    run_seed: u64,
 ) -> Result<Vec<ActiveRow>, BoxError> {
     let threshold = Probability::new(STOP_AT_CONFIDENCE)?;
     let mut rows = Vec::new();
@@ -337,7 +347,8 @@ fn curve_rows(
                 n_readings: n as u32,
                 accuracy: point.accuracy(),
                 reliability: point.mean_p_true,
-                seed: *seed,
+                seed: run_seed,
+                stream_seed: *seed as i64,
                 confident: stopped.len() as f64 / objects,
                 correct_at_stop: stopped.iter().filter(|(_, right)| *right).count() as f64 / objects,
             });
