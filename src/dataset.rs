@@ -39,11 +39,12 @@
 use std::collections::BTreeMap;
 use std::fmt;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
+use crate::atomic::{FileError, write_atomic};
 use crate::control::ContactStatus;
 pub use crate::explore::Reading;
 use crate::explore::collect::{CollectMode, CollectPlan};
@@ -128,6 +129,15 @@ pub enum DatasetError {
     Invalid(String),
     #[error("collecting readings: {0}")]
     Collect(#[from] crate::control::ControlError),
+}
+
+impl From<FileError> for DatasetError {
+    fn from(e: FileError) -> Self {
+        Self::Io {
+            path: e.path.display().to_string(),
+            source: e.source,
+        }
+    }
 }
 
 /// What a dataset holds and how it was made.
@@ -399,7 +409,7 @@ impl Dataset {
             csv.flush().map_err(io)?;
         }
         writeln!(text, "{END_PREFIX}{}", self.readings.len()).map_err(io)?;
-        write_atomic(path, &text)
+        Ok(write_atomic(path, &text)?)
     }
 
     /// Reads a file written by [`write`](Self::write); errors name the file, line and field.
@@ -738,40 +748,6 @@ fn parse_reading(
         strategy,
         cause,
     })
-}
-
-/// Writes `bytes` to `path` atomically: to a temporary file in the same folder (created if
-/// missing), synced to disk, then renamed over `path`, so a reader sees the old file or the new
-/// one, never a partial one.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
-    let name = path.display().to_string();
-    let io = |source| DatasetError::Io {
-        path: name.clone(),
-        source,
-    };
-    let file_name = path.file_name().ok_or_else(|| DatasetError::Io {
-        path: name.clone(),
-        source: std::io::Error::other("not a file path"),
-    })?;
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    tmp_name.push(format!(".tmp-{}", std::process::id()));
-    let tmp: PathBuf = dir.join(tmp_name);
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(io)
 }
 
 /// An object that got fewer converged readings than asked.

@@ -18,6 +18,7 @@
 //! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
 //! datasets, so recorded data from a real sensor can be fed to them.
 
+pub mod atomic;
 pub mod rng;
 pub mod units;
 

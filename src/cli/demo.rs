@@ -258,7 +258,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
 
     // 3. Outputs.
     let csv_path = args.out.join("touches.csv");
-    std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    taction::atomic::write_atomic(&csv_path, csv.as_bytes())?;
     let figure = Figure {
         title: format!("Posterior of the true object ({}) over touches", unknown.name),
         panels: vec![Panel {

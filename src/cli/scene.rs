@@ -111,7 +111,10 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
         args.object.replace("--", "- -")
     );
     let write = |path: PathBuf, text: &str| {
-        std::fs::write(&path, text).map_err(|source| SceneExportError::Write { path, source })
+        taction::atomic::write_atomic(&path, text.as_bytes()).map_err(|e| SceneExportError::Write {
+            path: e.path,
+            source: e.source,
+        })
     };
     std::fs::create_dir_all(&args.out).map_err(|source| SceneExportError::Write {
         path: args.out.clone(),

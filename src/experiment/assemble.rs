@@ -3,12 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use super::atomic::{read, write_if_changed};
 use super::error::ExperimentError;
+use super::files::read;
 use super::layout::ExperimentDir;
 use super::name::UnitKey;
 use super::plot::render_plot;
 use super::spec::Manifest;
+use crate::atomic::write_if_changed;
 
 /// A unit file checked at the CSV level: a header, at least one record, every record as wide as the
 /// header, UTF-8 throughout.

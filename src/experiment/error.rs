@@ -98,3 +98,12 @@ impl ExperimentError {
         move |source| Self::Io { path, source }
     }
 }
+
+impl From<crate::atomic::FileError> for ExperimentError {
+    fn from(e: crate::atomic::FileError) -> Self {
+        Self::Io {
+            path: e.path,
+            source: e.source,
+        }
+    }
+}

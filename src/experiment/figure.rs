@@ -6,9 +6,9 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::atomic::write_if_changed;
 use super::error::ExperimentError;
 use super::font::{FAMILY, plot_fonts};
+use crate::atomic::write_if_changed;
 
 /// One line: `points` sorted by x, with an optional band around it.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,7 +94,7 @@ impl Figure {
             path: path.to_path_buf(),
             what,
         })?;
-        write_if_changed(path, svg.as_bytes())
+        Ok(write_if_changed(path, svg.as_bytes())?)
     }
 
     /// Writes the figure as PNG to `path` (atomically); see [`to_png`](Self::to_png).
@@ -103,7 +103,7 @@ impl Figure {
             path: path.to_path_buf(),
             what,
         })?;
-        write_if_changed(path, &bytes)
+        Ok(write_if_changed(path, &bytes)?)
     }
 
     /// The figure as an 8-bit RGB PNG: the SVG of [`to_svg`](Self::to_svg) rendered by `resvg`

@@ -6,13 +6,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::assemble::missing_units;
-use super::atomic::write_if_changed;
 use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
 use super::layout::ExperimentDir;
 use super::merge::experiments_in;
 use super::plot::{PlotKind, build_figure};
 use super::spec::Manifest;
+use crate::atomic::write_if_changed;
 
 /// The numbers of readings at which the index quotes accuracy.
 pub const HEADLINE_READINGS: [u32; 4] = [10, 30, 60, 100];

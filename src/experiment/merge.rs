@@ -5,12 +5,13 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use super::assemble::{Finished, UnitTable, finish};
-use super::atomic::{create_dir_all, read, remove_stale_temporaries, write_atomic};
 use super::error::ExperimentError;
+use super::files::{create_dir_all, read};
 use super::index::write_index;
 use super::layout::ExperimentDir;
 use super::name::{ExperimentName, SafeName};
 use super::spec::{Manifest, write_manifest, write_or_check};
+use crate::atomic::{remove_stale_temporaries, write_atomic};
 
 /// What a merge produced, per experiment in name order.
 #[derive(Debug, Clone, PartialEq, Eq)]

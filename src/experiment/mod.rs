@@ -14,10 +14,10 @@
 
 pub mod accuracy;
 pub mod assemble;
-pub mod atomic;
 pub mod convergence;
 pub mod error;
 pub mod figure;
+pub mod files;
 pub mod font;
 pub mod index;
 pub mod layout;

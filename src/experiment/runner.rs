@@ -11,14 +11,15 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use super::assemble::{Finished, finish, missing_units};
-use super::atomic::{create_dir_all, remove_stale_temporaries, write_atomic};
 use super::error::{ExperimentError, UnitFailure};
+use super::files::create_dir_all;
 use super::index::write_index;
 use super::layout::ExperimentDir;
 use super::progress::progress_bar;
 use super::shard::Shard;
 use super::spec::{ExperimentSpec, Manifest, to_json, write_manifest, write_or_check};
 use super::unit::{Unit, parse_rows, read_rows, rows_to_csv};
+use crate::atomic::{remove_stale_temporaries, write_atomic};
 
 /// Where and how to run: the flags every experiment command shares.
 #[derive(Debug, Clone, PartialEq, Eq, clap::Args)]

@@ -6,10 +6,11 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::atomic::{read, write_atomic, write_if_changed};
 use super::error::ExperimentError;
+use super::files::read;
 use super::name::{ExperimentName, UnitKey};
 use super::plot::PlotSpec;
+use crate::atomic::{write_atomic, write_if_changed};
 
 /// The name, a one-line description (shown in the results index) and the plots of an experiment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -69,7 +70,7 @@ pub fn write_or_check(
             dir: dir.to_path_buf(),
             what,
         }),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_atomic(path, bytes),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(write_atomic(path, bytes)?),
         Err(source) => Err(ExperimentError::Io {
             path: path.to_path_buf(),
             source,
@@ -93,5 +94,5 @@ pub fn write_manifest(
             what: "units",
         });
     }
-    write_if_changed(path, bytes)
+    Ok(write_if_changed(path, bytes)?)
 }

@@ -88,3 +88,12 @@ pub enum MeshError {
     #[error("object set: {what}")]
     ObjectSet { what: String },
 }
+
+impl From<crate::atomic::FileError> for MeshError {
+    fn from(e: crate::atomic::FileError) -> Self {
+        Self::Write {
+            path: e.path,
+            source: e.source,
+        }
+    }
+}

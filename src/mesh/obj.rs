@@ -75,8 +75,8 @@ pub fn to_obj_string(mesh: &TriMesh, comment: &str) -> String {
 
 /// Writes the mesh as an OBJ file (see [`to_obj_string`]).
 pub fn write_obj(mesh: &TriMesh, path: &Path, comment: &str) -> Result<(), MeshError> {
-    std::fs::write(path, to_obj_string(mesh, comment)).map_err(|source| MeshError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
+    Ok(crate::atomic::write_atomic(
+        path,
+        to_obj_string(mesh, comment).as_bytes(),
+    )?)
 }

@@ -487,10 +487,7 @@ impl ObjectSet {
     }
 
     pub fn save_manifest(&self, path: &Path) -> Result<(), MeshError> {
-        std::fs::write(path, self.to_json()).map_err(|source| MeshError::Write {
-            path: path.to_path_buf(),
-            source,
-        })
+        Ok(crate::atomic::write_atomic(path, self.to_json().as_bytes())?)
     }
 
     /// Reads a manifest written by [`ObjectSet::save_manifest`]; object names must be unique.

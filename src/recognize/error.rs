@@ -55,3 +55,12 @@ pub enum RecognizeError {
     #[error("{0}")]
     Dataset(#[from] crate::dataset::DatasetError),
 }
+
+impl From<crate::atomic::FileError> for RecognizeError {
+    fn from(e: crate::atomic::FileError) -> Self {
+        Self::Io {
+            path: e.path.display().to_string(),
+            source: e.source,
+        }
+    }
+}

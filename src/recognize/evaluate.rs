@@ -7,7 +7,7 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
-use crate::dataset::write_atomic;
+use crate::atomic::write_atomic;
 use crate::describe::Feature;
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;

@@ -12,7 +12,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::{Dataset, write_atomic};
+use crate::atomic::write_atomic;
+use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;

@@ -6,11 +6,12 @@
 //! sensing range, in [0, 1]: 0 is no penetration, 1 is the covering pushed through completely.
 
 use std::fmt;
-use std::io::Write;
 use std::path::Path;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
+
+use crate::atomic::{FileError, write_atomic};
 
 /// Where the pad was when it took a reading, in world coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -54,6 +55,15 @@ pub enum ImageError {
     Io { path: String, source: std::io::Error },
     #[error("{path}: cannot encode PNG: {what}")]
     Png { path: String, what: String },
+}
+
+impl From<FileError> for ImageError {
+    fn from(e: FileError) -> Self {
+        Self::Io {
+            path: e.path.display().to_string(),
+            source: e.source,
+        }
+    }
 }
 
 /// One tactile reading, `rows x cols` fractions of the sensing range (see the module docs).
@@ -150,13 +160,7 @@ impl TactileImage {
     /// Writes `rows` lines of `cols` comma-separated values (the format `taction sense` writes and
     /// `taction describe` reads).
     pub fn write_csv(&self, path: &Path) -> Result<(), ImageError> {
-        let io = |source| ImageError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-        write!(out, "{}", self.to_csv_string()).map_err(io)?;
-        out.flush().map_err(io)
+        Ok(write_atomic(path, self.to_csv_string().as_bytes())?)
     }
 
     /// The CSV text of [`write_csv`](Self::write_csv); values in shortest round-trip form.
@@ -285,14 +289,14 @@ pub fn to_gray(value: f64) -> u8 {
 /// Writes an 8-bit grayscale PNG of `width x height` row-major pixels.
 pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -> Result<(), ImageError> {
     let name = || path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|source| ImageError::Io { path: name(), source })?;
     let dims = |v: usize| {
         u32::try_from(v).map_err(|_| ImageError::Png {
             path: name(),
             what: "too large".into(),
         })
     };
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), dims(width)?, dims(height)?);
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, dims(width)?, dims(height)?);
     encoder.set_color(png::ColorType::Grayscale);
     encoder.set_depth(png::BitDepth::Eight);
     let png_err = |e: png::EncodingError| ImageError::Png {
@@ -301,7 +305,8 @@ pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -
     };
     let mut writer = encoder.write_header().map_err(png_err)?;
     writer.write_image_data(pixels).map_err(png_err)?;
-    writer.finish().map_err(png_err)
+    writer.finish().map_err(png_err)?;
+    Ok(write_atomic(path, &bytes)?)
 }
 
 impl fmt::Display for TactileImage {

@@ -159,7 +159,7 @@ impl DataStore {
                     &|| progress.converged(),
                 )?;
                 progress.finish(dataset.converged_only().len());
-                crate::experiment::atomic::create_dir_all(&self.root.join("data"))?;
+                crate::experiment::files::create_dir_all(&self.root.join("data"))?;
                 dataset.write(&path)?;
 
                 eprintln!(
@@ -240,7 +240,7 @@ impl DataStore {
             config.clone(),
             &mut |_| {},
         )?;
-        crate::experiment::atomic::create_dir_all(&self.root.join("models"))?;
+        crate::experiment::files::create_dir_all(&self.root.join("models"))?;
         model.save(&path)?;
         Ok(model)
     }

@@ -1,23 +1,44 @@
-//! Atomic file replacement: what makes a killed run safe to resume.
+//! Atomic file replacement, for every file the program writes: what makes a killed run safe to
+//! resume and a reader never see half a file.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::error::ExperimentError;
+/// A file that could not be written (or a folder that could not be read or created), named.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", path.display())]
+pub struct FileError {
+    pub path: PathBuf,
+    pub source: std::io::Error,
+}
+
+impl FileError {
+    fn at(path: &Path) -> impl FnOnce(std::io::Error) -> Self + '_ {
+        move |source| Self {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `bytes` to `path` so that, whenever the process dies, `path` holds either its previous
 /// content (or nothing) or all of `bytes`, never a part: the bytes go to a hidden temporary file in
 /// the same directory, are flushed to disk, and the temporary is renamed over `path` (rename is
-/// atomic within a POSIX file system).
+/// atomic within a POSIX file system). The directory is created if missing.
 ///
 /// Temporary names are `.<file name>.<pid>.<counter>.tmp`, unique across threads and processes, so
 /// shards writing into one directory never collide. A temporary left by a killed run is hidden,
 /// ignored by every reader, and deleted by the next run or merge there
 /// ([`remove_stale_temporaries`]).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(FileError::at(dir))?;
     let temp = temp_path(path);
     let result = write_then_rename(&temp, path, bytes);
     if result.is_err() {
@@ -28,19 +49,19 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
 
 /// [`write_atomic`] unless `path` already holds exactly `bytes`: re-assembling a finished
 /// experiment then costs reads, not flushes to disk, and leaves modification times alone.
-pub fn write_if_changed(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
+pub fn write_if_changed(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     match std::fs::read(path) {
         Ok(existing) if existing == bytes => Ok(()),
         _ => write_atomic(path, bytes),
     }
 }
 
-fn write_then_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
-    let mut file = std::fs::File::create(temp).map_err(ExperimentError::io(temp))?;
-    file.write_all(bytes).map_err(ExperimentError::io(temp))?;
-    file.sync_all().map_err(ExperimentError::io(temp))?;
+fn write_then_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    let mut file = std::fs::File::create(temp).map_err(FileError::at(temp))?;
+    file.write_all(bytes).map_err(FileError::at(temp))?;
+    file.sync_all().map_err(FileError::at(temp))?;
     drop(file);
-    std::fs::rename(temp, path).map_err(ExperimentError::io(path))
+    std::fs::rename(temp, path).map_err(FileError::at(path))
 }
 
 fn temp_path(path: &Path) -> PathBuf {
@@ -56,7 +77,7 @@ fn temp_path(path: &Path) -> PathBuf {
 /// killed run), judged by the process id in their name; returns how many. Temporaries of live
 /// processes, such as another shard writing into the same directory, are left alone. Where `/proc`
 /// does not exist nothing is deleted (the temporaries stay hidden and ignored).
-pub fn remove_stale_temporaries(dir: &Path) -> Result<usize, ExperimentError> {
+pub fn remove_stale_temporaries(dir: &Path) -> Result<usize, FileError> {
     let proc = Path::new("/proc");
     if !proc.join("self").exists() {
         return Ok(0);
@@ -64,16 +85,11 @@ pub fn remove_stale_temporaries(dir: &Path) -> Result<usize, ExperimentError> {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(0),
-        Err(source) => {
-            return Err(ExperimentError::Io {
-                path: dir.to_path_buf(),
-                source,
-            });
-        }
+        Err(source) => return Err(FileError::at(dir)(source)),
     };
     let mut removed = 0;
     for entry in entries {
-        let entry = entry.map_err(ExperimentError::io(dir))?;
+        let entry = entry.map_err(FileError::at(dir))?;
         let name = entry.file_name();
         let Some(pid) = name.to_str().and_then(temporary_pid) else {
             continue;
@@ -82,12 +98,7 @@ pub fn remove_stale_temporaries(dir: &Path) -> Result<usize, ExperimentError> {
             match std::fs::remove_file(entry.path()) {
                 Ok(()) => removed += 1,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(source) => {
-                    return Err(ExperimentError::Io {
-                        path: entry.path(),
-                        source,
-                    });
-                }
+                Err(source) => return Err(FileError::at(&entry.path())(source)),
             }
         }
     }
@@ -101,16 +112,6 @@ fn temporary_pid(name: &str) -> Option<u32> {
     let _counter: u64 = parts.next()?.parse().ok()?;
     let pid = parts.next()?.parse().ok()?;
     parts.next().filter(|file| !file.is_empty()).map(|_| pid)
-}
-
-/// Creates `dir` and its parents, naming `dir` on failure (e.g. an unwritable output root).
-pub fn create_dir_all(dir: &Path) -> Result<(), ExperimentError> {
-    std::fs::create_dir_all(dir).map_err(ExperimentError::io(dir))
-}
-
-/// Reads a whole file, naming it on failure.
-pub fn read(path: &Path) -> Result<Vec<u8>, ExperimentError> {
-    std::fs::read(path).map_err(ExperimentError::io(path))
 }
 
 #[cfg(test)]
@@ -161,10 +162,14 @@ mod tests {
     }
 
     #[test]
-    fn failure_names_the_path() {
+    fn missing_folders_are_made_and_failure_names_the_path() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("missing-dir").join("a.csv");
-        let e = write_atomic(&path, b"x").unwrap_err().to_string();
-        assert!(e.contains("missing-dir"), "{e}");
+        let path = dir.path().join("new-dir").join("a.csv");
+        write_atomic(&path, b"x").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"x");
+        // A regular file where a folder should be.
+        let blocked = dir.path().join("new-dir").join("a.csv").join("b.csv");
+        let e = write_atomic(&blocked, b"x").unwrap_err().to_string();
+        assert!(e.contains("a.csv"), "{e}");
     }
 }
