@@ -16,7 +16,11 @@
 //! ```
 //!
 //! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
-//! datasets, so recorded data from a real sensor can be fed to them.
+//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units` and `atomic`
+//! (the one writer of files) serve every module.
+//!
+//! `ARCHITECTURE.md` at the repository's root holds the module map, the decisions the code relies on
+//! and the paper's errata.
 
 pub mod atomic;
 pub mod rng;
