@@ -116,7 +116,7 @@ fn fused_models_save_load_and_are_checked() {
     let (b, trials) = Recognizer::Fused(loaded).evaluate(&test, range).unwrap();
     assert_eq!(trials, 3);
     let bits = |e: &taction::recognize::Evaluation| -> Vec<u64> {
-        e.touches.iter().map(|t| t.p_true.to_bits()).collect()
+        e.touches.iter().map(|t| t.p_true().to_bits()).collect()
     };
     assert_eq!(bits(&a), bits(&b));
 

@@ -360,7 +360,7 @@ fn accuracy_counts_every_object_an_unread_one_as_a_miss() {
             .touches
             .iter()
             .find(|r| r.trial == t && r.n_readings == n)
-            .map(|r| r.p_true)
+            .map(|r| r.p_true())
             .unwrap()
     };
     let expected = (p_true(0, 10) + p_true(1, 2) + 1.0 / 3.0) / 3.0;

@@ -56,7 +56,7 @@ fn save_then_load_gives_identical_predictions() {
         let bits = |e: &taction::recognize::Evaluation| -> Vec<u64> {
             e.touches
                 .iter()
-                .flat_map(|t| [t.p_true.to_bits(), t.entropy_nats.to_bits()])
+                .flat_map(|t| [t.p_true().to_bits(), t.entropy_nats.to_bits()])
                 .collect()
         };
         assert_eq!(bits(&before), bits(&after));

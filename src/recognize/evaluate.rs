@@ -128,14 +128,22 @@ pub struct TouchRow {
     pub object_true: usize,
     pub n_readings: usize,
     pub object_guess: usize,
-    /// Probability the posterior gives the true object.
-    pub p_true: f64,
-    /// Probability the posterior gives its guess, its largest (what a confidence stop watches).
-    pub p_guess: f64,
     /// Entropy of the posterior, nats.
     pub entropy_nats: f64,
     /// The whole posterior, one probability per object of the model.
     pub probabilities: Vec<f64>,
+}
+
+impl TouchRow {
+    /// Probability the posterior gives the true object.
+    pub fn p_true(&self) -> f64 {
+        self.probabilities[self.object_true]
+    }
+
+    /// Probability the posterior gives its guess, its largest (what a confidence stop watches).
+    pub fn p_guess(&self) -> f64 {
+        self.probabilities[self.object_guess]
+    }
 }
 
 /// Accuracy after `n_readings` readings over every trial: the one definition `taction recognize`
@@ -217,8 +225,6 @@ where
                     object_true: trial.object,
                     n_readings: belief.readings,
                     object_guess: belief.guess(),
-                    p_true: belief.probabilities()[trial.object],
-                    p_guess: belief.probabilities()[belief.guess()],
                     entropy_nats: belief.entropy_nats(),
                     probabilities: belief.probabilities().to_vec(),
                 });
@@ -237,7 +243,7 @@ where
             match n.min(beliefs.len()).checked_sub(1).map(|i| &beliefs[i]) {
                 Some(b) => {
                     correct += usize::from(b.object_guess == b.object_true);
-                    p_true += b.p_true;
+                    p_true += b.p_true();
                 }
                 None => p_true += prior,
             }
@@ -294,7 +300,7 @@ impl Evaluation {
                 &self.objects[r.object_true],
                 &r.n_readings.to_string(),
                 &self.objects[r.object_guess],
-                &r.p_true.to_string(),
+                &r.p_true().to_string(),
                 &r.entropy_nats.to_string(),
             ]));
         }

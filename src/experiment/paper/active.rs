@@ -368,7 +368,7 @@ fn stops(
     (0..trials)
         .map(|t| {
             let touches: Vec<_> = evaluation.touches.iter().filter(|r| r.trial == t).collect();
-            touches_to_confidence(touches.iter().map(|r| r.p_guess), threshold, budget).map(|k| {
+            touches_to_confidence(touches.iter().map(|r| r.p_guess()), threshold, budget).map(|k| {
                 let at = touches[k - 1];
                 (k, at.object_guess == at.object_true)
             })
