@@ -194,6 +194,24 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");
     }
+    // Fig. 1: the pawn explored by the planner, its placements as CSV, the picture in the index.
+    let placements = std::fs::read_to_string(out.join("exploration/exploration.csv")).expect("Fig. 1 CSV");
+    let mut lines = placements.lines();
+    assert_eq!(
+        lines.next(),
+        Some("object,reading,center_x_m,center_y_m,center_z_m,normal_x,normal_y,normal_z,max_taxel,seed")
+    );
+    let placed: Vec<&str> = lines.collect();
+    assert_eq!(placed.len(), 100, "Fig. 1's 100 converged readings");
+    assert!(placed.iter().all(|l| l.starts_with("pawn,")));
+    let png = std::fs::read(out.join("exploration/exploration.png")).expect("Fig. 1 picture");
+    let decoder = png::Decoder::new(std::io::Cursor::new(png));
+    let info = decoder.read_info().expect("a PNG").info().clone();
+    assert!(
+        info.width > info.height,
+        "the object panel with the images to its right"
+    );
+    assert!(index.contains("## exploration") && index.contains("exploration/exploration.png"));
     assert!(
         stdout.contains("| descriptors | polar-fourier |"),
         "headline table printed:\n{stdout}"

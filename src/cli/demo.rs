@@ -2,7 +2,8 @@
 //! readings (or reuses the model it cached), then lets the arm explore one object whose identity and
 //! pose it does not know, printing after every converged touch the best guess, its probability and
 //! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
-//! the posterior over touches and a contact sheet of the tactile images. `--strategy active` chooses
+//! the posterior over touches, a contact sheet of the tactile images and the paper's Fig. 1: the object
+//! with a patch at every converged touch, the images beside it. `--strategy active` chooses
 //! each touch by expected information gain (`recognize::active`); `--stop-at-confidence P` ends the
 //! exploration once the best guess has probability P.
 
@@ -14,6 +15,7 @@ use rand::RngExt;
 use taction::control::{ContactStatus, ControlConfig};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::describe::DescriptorKind;
+use taction::experiment::exploration::{Placement, write_exploration_png};
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::progress::CollectionProgress;
 use taction::explore::Probability;
@@ -284,6 +286,15 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     figure.write_svg(&args.out.join("posterior.svg"))?;
     figure.write_png(&args.out.join("posterior.png"))?;
     write_contact_sheet(&images, 10, 12, &args.out.join("contact_sheet.png"))?;
+    let placements = Placement::from_readings(run.touches.iter().map(|t| &t.reading));
+    let shown_pose = scene.object_pose().unwrap_or(unknown.pose);
+    write_exploration_png(
+        &args.out.join("exploration.png"),
+        &unknown.mesh,
+        &shown_pose,
+        &placements,
+        &sensor,
+    )?;
     let belief = recognition.belief();
     let ending = if run.stopped_confident {
         "stopped: confident"
@@ -291,7 +302,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         "touch budget spent or planner out of iterations"
     };
     println!(
-        "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png}}",
+        "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png, exploration.png}}",
         images.len(),
         attempts,
         names[belief.guess()],

@@ -27,6 +27,7 @@ pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
          (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
          per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
     );
+    picture_sections(&mut text, out)?;
     for dir in experiments_in(out)? {
         let manifest = Manifest::read(&dir.manifest())?;
         section(&mut text, &dir, &manifest)?;
@@ -65,22 +66,83 @@ fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Resul
     Ok(())
 }
 
+/// A picture experiment (Fig. 1) is one drawing, not a run of units: its folder holds
+/// `<name>.png`, the `<name>.csv` it was drawn from and [`PICTURE_FILE`] with its description.
+pub const PICTURE_FILE: &str = "picture.json";
+
+/// What [`PICTURE_FILE`] holds.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PictureSpec {
+    pub description: String,
+    pub title: String,
+}
+
+fn picture_sections(text: &mut String, out: &Path) -> Result<(), ExperimentError> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(());
+    };
+    let mut dirs: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join(PICTURE_FILE).is_file())
+        .collect();
+    dirs.sort();
+    for dir in dirs {
+        let spec_path = dir.join(PICTURE_FILE);
+        let spec: PictureSpec =
+            serde_json::from_slice(&super::files::read(&spec_path)?).map_err(|e| ExperimentError::Json {
+                path: spec_path.clone(),
+                what: e.to_string(),
+            })?;
+        let name = dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let _ = write!(
+            text,
+            "\n## {name}\n\n{}\n\nData: [{name}.csv]({name}/{name}.csv)\n\n![{}]({name}/{name}.png)\n",
+            spec.description, spec.title
+        );
+    }
+    Ok(())
+}
+
 fn table_title(text: &mut String, panel: &Panel) {
     if !panel.title.is_empty() {
         let _ = write!(text, "\n{}:\n\n", panel.title);
     }
 }
 
+/// The headline readings a panel reaches, plus its last number of readings when that is not one of
+/// them (a run below the paper's scale stops short of 100).
+fn headline_columns(panel: &Panel) -> Vec<u32> {
+    let reached = |n: f64| panel.series.iter().any(|s| s.points.iter().any(|(x, _)| *x == n));
+    let mut columns: Vec<u32> = HEADLINE_READINGS
+        .into_iter()
+        .filter(|&n| reached(n as f64))
+        .collect();
+    let last = panel
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .fold(0.0, f64::max);
+    if last >= 1.0 && last.fract() == 0.0 && !columns.contains(&(last as u32)) {
+        columns.push(last as u32);
+        columns.sort_unstable();
+    }
+    columns
+}
+
 fn accuracy_table(text: &mut String, panel: &Panel) {
     table_title(text, panel);
+    let columns = headline_columns(panel);
     let _ = write!(text, "| accuracy (%) at n readings |");
-    for n in HEADLINE_READINGS {
+    for n in &columns {
         let _ = write!(text, " {n} |");
     }
-    let _ = write!(text, "\n|---|{}\n", "---:|".repeat(HEADLINE_READINGS.len()));
+    let _ = write!(text, "\n|---|{}\n", "---:|".repeat(columns.len()));
     for series in &panel.series {
         let _ = write!(text, "| {} |", series.label);
-        for n in HEADLINE_READINGS {
+        for &n in &columns {
             match series.points.iter().find(|(x, _)| *x == n as f64) {
                 Some((_, y)) => {
                     let _ = write!(text, " {:.1} |", 100.0 * y);

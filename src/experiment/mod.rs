@@ -16,6 +16,7 @@ pub mod accuracy;
 pub mod assemble;
 pub mod convergence;
 pub mod error;
+pub mod exploration;
 pub mod figure;
 pub mod files;
 pub mod font;

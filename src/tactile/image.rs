@@ -288,6 +288,21 @@ pub fn to_gray(value: f64) -> u8 {
 
 /// Writes an 8-bit grayscale PNG of `width x height` row-major pixels.
 pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -> Result<(), ImageError> {
+    write_png(path, width, height, png::ColorType::Grayscale, pixels)
+}
+
+/// Writes an 8-bit RGB PNG of `width x height` row-major pixels, three bytes each.
+pub fn write_rgb_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -> Result<(), ImageError> {
+    write_png(path, width, height, png::ColorType::Rgb, pixels)
+}
+
+fn write_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    color: png::ColorType,
+    pixels: &[u8],
+) -> Result<(), ImageError> {
     let name = || path.display().to_string();
     let dims = |v: usize| {
         u32::try_from(v).map_err(|_| ImageError::Png {
@@ -297,7 +312,7 @@ pub fn write_gray_png(path: &Path, width: usize, height: usize, pixels: &[u8]) -
     };
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, dims(width)?, dims(height)?);
-    encoder.set_color(png::ColorType::Grayscale);
+    encoder.set_color(color);
     encoder.set_depth(png::BitDepth::Eight);
     let png_err = |e: png::EncodingError| ImageError::Png {
         path: name(),

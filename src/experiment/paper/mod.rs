@@ -4,6 +4,7 @@
 //!
 //! | name | figure | varies |
 //! |---|---|---|
+//! | `exploration` | 1 | - (one planner run on the chess piece, drawn; [`figure1`]) |
 //! | `descriptors` | 7 | the six descriptors |
 //! | `strategy` | 8 | L, the probability of local exploration |
 //! | `validation` | 9 | validation (sampler) vs exploration (planner) test data |
@@ -24,6 +25,8 @@
 pub mod active;
 pub mod context;
 pub mod data;
+pub mod estimate;
+pub mod figure1;
 pub mod figures;
 pub mod headline;
 pub mod real_frames;

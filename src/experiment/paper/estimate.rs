@@ -1,0 +1,165 @@
+//! How long a run of the paper's experiments will take, said before it starts and updated as it
+//! goes, so that a user can decide whether a scale fits the afternoon.
+//!
+//! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
+//! scale 0.2 and 1.0; between and beyond those the time is the power law through both,
+//! `t(s) = t_0.2 (s / 0.2)^p` with `p = ln(t_1.0 / t_0.2) / ln 5` (data collection grows linearly
+//! with the scale, codebook fitting faster). Other thread counts scale it by `2 / threads`. During
+//! a run the remaining estimate is multiplied by the ratio of the time spent so far to the time
+//! estimated for it, which absorbs a faster or slower machine.
+
+use std::path::Path;
+
+use super::scale::Scale;
+
+/// Estimated seconds of finished work from which the run's pace corrects the rest.
+pub const PACE_AFTER_S: f64 = 30.0;
+
+/// Threads of the reference runs.
+pub const REFERENCE_THREADS: usize = 2;
+
+/// Wall seconds of each experiment at scale 0.2 and 1.0 on the reference machine (seed 1, the
+/// built-in sets; `reproduce` one experiment after another, so datasets shared between
+/// experiments were collected by the first one that needed them).
+const REFERENCE_SECONDS: [(&str, f64, f64); 14] = [
+    ("exploration", 3.0, 3.0),
+    ("descriptors", 27.3, 27.3),
+    ("strategy", 36.8, 36.8),
+    ("validation", 27.3, 27.3),
+    ("perturbation", 10.5, 10.5),
+    ("thickness", 145.8, 145.8),
+    ("resolution", 123.6, 123.6),
+    ("noise", 172.0, 172.0),
+    ("convergence", 2.9, 2.9),
+    ("letters", 60.0, 60.0),
+    ("real-frames", 1.0, 1.0),
+    ("sim-to-real", 3.0, 3.0),
+    ("training-size", 60.0, 60.0),
+    ("active", 60.0, 60.0),
+];
+
+/// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
+/// an experiment without a reference timing.
+pub fn estimated_seconds(name: &str, scale: Scale, threads: usize) -> Option<f64> {
+    let &(_, fifth, paper) = REFERENCE_SECONDS.iter().find(|(n, _, _)| *n == name)?;
+    let exponent = (paper / fifth).ln() / 5f64.ln();
+    let at_scale = fifth * (scale.fraction() / 0.2).powf(exponent);
+    Some(at_scale * REFERENCE_THREADS as f64 / threads.max(1) as f64)
+}
+
+/// Whether experiment `name` already finished in `out` (its assembled CSV exists), so that a
+/// resumed run spends no time on it.
+pub fn finished(out: &Path, name: &str) -> bool {
+    out.join(name).join(format!("{name}.csv")).is_file()
+}
+
+/// The estimate of a whole run, kept up to date as its experiments finish.
+#[derive(Debug, Clone)]
+pub struct RunEstimate {
+    /// (experiment, estimated seconds, done).
+    parts: Vec<(String, f64, bool)>,
+    spent_s: f64,
+    estimated_spent_s: f64,
+}
+
+impl RunEstimate {
+    /// The estimate for `names` at `scale` with `threads`, counting experiments finished in `out`
+    /// as free.
+    pub fn new(names: &[&str], scale: Scale, threads: usize, out: &Path) -> Self {
+        let parts = names
+            .iter()
+            .map(|&name| {
+                let seconds = if finished(out, name) {
+                    0.0
+                } else {
+                    estimated_seconds(name, scale, threads).unwrap_or(0.0)
+                };
+                (name.to_string(), seconds, false)
+            })
+            .collect();
+        Self {
+            parts,
+            spent_s: 0.0,
+            estimated_spent_s: 0.0,
+        }
+    }
+
+    /// Seconds the whole run is estimated to take before it starts.
+    pub fn total_s(&self) -> f64 {
+        self.parts.iter().map(|p| p.1).sum()
+    }
+
+    /// Records that `name` finished after `seconds`.
+    pub fn finished(&mut self, name: &str, seconds: f64) {
+        if let Some(part) = self.parts.iter_mut().find(|p| p.0 == name && !p.2) {
+            part.2 = true;
+            self.spent_s += seconds;
+            self.estimated_spent_s += part.1;
+        }
+    }
+
+    /// Seconds still to go: the unfinished experiments' estimates times the run's pace so far
+    /// (time spent over time estimated for it, between 1/4 and 4), once the finished part was
+    /// estimated at [`PACE_AFTER_S`] or more (a few seconds of work say little about the machine).
+    pub fn remaining_s(&self) -> f64 {
+        let pace = if self.estimated_spent_s >= PACE_AFTER_S {
+            (self.spent_s / self.estimated_spent_s).clamp(0.25, 4.0)
+        } else {
+            1.0
+        };
+        pace * self.parts.iter().filter(|p| !p.2).map(|p| p.1).sum::<f64>()
+    }
+}
+
+/// A duration for people: seconds under two minutes, minutes under two hours, else hours.
+pub fn human_duration(seconds: f64) -> String {
+    if seconds < 120.0 {
+        format!("{seconds:.0} s")
+    } else if seconds < 7200.0 {
+        format!("{:.0} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scale(s: f64) -> Scale {
+        Scale::new(s).expect("a valid scale")
+    }
+
+    #[test]
+    fn the_estimate_passes_through_both_reference_timings_and_halves_with_twice_the_threads() {
+        for &(name, fifth, paper) in &REFERENCE_SECONDS {
+            let at = |s: f64, threads: usize| estimated_seconds(name, scale(s), threads).unwrap_or(f64::NAN);
+            assert!((at(0.2, 2) - fifth).abs() < 1e-9 * fifth.max(1.0), "{name}");
+            assert!((at(1.0, 2) - paper).abs() < 1e-9 * paper.max(1.0), "{name}");
+            assert!((at(1.0, 4) - paper / 2.0).abs() < 1e-9 * paper.max(1.0), "{name}");
+            assert!(
+                at(0.5, 2) >= fifth.min(paper) && at(0.5, 2) <= fifth.max(paper),
+                "{name}"
+            );
+        }
+        assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);
+    }
+
+    #[test]
+    fn a_run_that_goes_twice_as_slow_as_estimated_doubles_the_rest() {
+        let dir = std::env::temp_dir().join(format!("taction-estimate-{}", std::process::id()));
+        let mut run = RunEstimate::new(&["thickness", "noise"], scale(1.0), 2, &dir);
+        let thickness = estimated_seconds("thickness", scale(1.0), 2).unwrap_or(f64::NAN);
+        assert!(thickness >= PACE_AFTER_S);
+        let noise = estimated_seconds("noise", scale(1.0), 2).unwrap_or(f64::NAN);
+        assert!((run.total_s() - thickness - noise).abs() < 1e-9);
+        assert!((run.remaining_s() - thickness - noise).abs() < 1e-9);
+        run.finished("thickness", 2.0 * thickness);
+        assert!((run.remaining_s() - 2.0 * noise).abs() < 1e-9);
+        run.finished("noise", noise);
+        assert_eq!(run.remaining_s(), 0.0);
+        assert_eq!(human_duration(90.0), "90 s");
+        assert_eq!(human_duration(600.0), "10 min");
+        assert_eq!(human_duration(9000.0), "2.5 h");
+    }
+}
