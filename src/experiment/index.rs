@@ -27,6 +27,9 @@ pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
          (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
          per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
     );
+    if out.join("PAPER.md").is_file() {
+        text.push_str("\nThe paper's claims beside these numbers, figure by figure, with a verdict each: [PAPER.md](PAPER.md).\n");
+    }
     picture_sections(&mut text, out)?;
     for dir in experiments_in(out)? {
         let manifest = Manifest::read(&dir.manifest())?;

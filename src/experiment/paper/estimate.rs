@@ -2,9 +2,11 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scale 0.2 and 1.0; between and beyond those the time is the power law through both,
-//! `t(s) = t_0.2 (s / 0.2)^p` with `p = ln(t_1.0 / t_0.2) / ln 5` (data collection grows linearly
-//! with the scale, codebook fitting faster). Other thread counts scale it by `2 / threads`. During
+//! scales 0.2 and 0.5; at any other scale it is the power law through the 0.5 timing,
+//! `t(s) = t_0.5 (s / 0.5)^p`, with the exponent the two timings give, `p = ln(t_0.5 / t_0.2) /
+//! ln 2.5`, held in [1, 3]: data collection grows linearly with the scale and codebook fitting
+//! faster, so a smaller `p` only says that the 0.2 timing was inflated by set-up or by datasets
+//! other experiments had collected. Beyond 0.5 it is an extrapolation (1.0: about 110 minutes). Other thread counts scale it by `2 / threads`. During
 //! a run the remaining estimate is multiplied by the ratio of the time spent so far to the time
 //! estimated for it, which absorbs a faster or slower machine.
 
@@ -18,32 +20,32 @@ pub const PACE_AFTER_S: f64 = 30.0;
 /// Threads of the reference runs.
 pub const REFERENCE_THREADS: usize = 2;
 
-/// Wall seconds of each experiment at scale 0.2 and 1.0 on the reference machine (seed 1, the
+/// Wall seconds of each experiment at scale 0.2 and 0.5 on the reference machine (seed 1, the
 /// built-in sets; `reproduce` one experiment after another, so datasets shared between
 /// experiments were collected by the first one that needed them).
 const REFERENCE_SECONDS: [(&str, f64, f64); 14] = [
-    ("exploration", 3.0, 3.0),
-    ("descriptors", 27.3, 27.3),
-    ("strategy", 36.8, 36.8),
-    ("validation", 27.3, 27.3),
-    ("perturbation", 10.5, 10.5),
-    ("thickness", 145.8, 145.8),
-    ("resolution", 123.6, 123.6),
-    ("noise", 172.0, 172.0),
-    ("convergence", 2.9, 2.9),
-    ("letters", 60.0, 60.0),
-    ("real-frames", 1.0, 1.0),
-    ("sim-to-real", 3.0, 3.0),
-    ("training-size", 60.0, 60.0),
-    ("active", 60.0, 60.0),
+    ("exploration", 1.3, 1.3),
+    ("descriptors", 27.3, 196.7),
+    ("strategy", 36.8, 113.0),
+    ("validation", 27.3, 212.8),
+    ("perturbation", 10.5, 82.3),
+    ("thickness", 145.8, 276.0),
+    ("resolution", 123.6, 134.3),
+    ("noise", 172.0, 254.9),
+    ("convergence", 2.9, 1.5),
+    ("letters", 378.6, 986.4),
+    ("real-frames", 0.1, 0.1),
+    ("sim-to-real", 3.0, 16.3),
+    ("training-size", 13.5, 14.6),
+    ("active", 126.7, 281.2),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
 /// an experiment without a reference timing.
 pub fn estimated_seconds(name: &str, scale: Scale, threads: usize) -> Option<f64> {
-    let &(_, fifth, paper) = REFERENCE_SECONDS.iter().find(|(n, _, _)| *n == name)?;
-    let exponent = (paper / fifth).ln() / 5f64.ln();
-    let at_scale = fifth * (scale.fraction() / 0.2).powf(exponent);
+    let &(_, fifth, half) = REFERENCE_SECONDS.iter().find(|(n, _, _)| *n == name)?;
+    let exponent = ((half / fifth).ln() / 2.5f64.ln()).clamp(1.0, 3.0);
+    let at_scale = half * (scale.fraction() / 0.5).powf(exponent);
     Some(at_scale * REFERENCE_THREADS as f64 / threads.max(1) as f64)
 }
 
@@ -113,6 +115,8 @@ impl RunEstimate {
 
 /// A duration for people: seconds under two minutes, minutes under two hours, else hours.
 pub fn human_duration(seconds: f64) -> String {
+    // `+ 0.0` turns the -0 an empty sum gives into 0.
+    let seconds = seconds.max(0.0) + 0.0;
     if seconds < 120.0 {
         format!("{seconds:.0} s")
     } else if seconds < 7200.0 {
@@ -131,17 +135,29 @@ mod tests {
     }
 
     #[test]
-    fn the_estimate_passes_through_both_reference_timings_and_halves_with_twice_the_threads() {
-        for &(name, fifth, paper) in &REFERENCE_SECONDS {
+    fn the_estimate_passes_through_the_half_scale_timing_and_halves_with_twice_the_threads() {
+        for &(name, fifth, half) in &REFERENCE_SECONDS {
             let at = |s: f64, threads: usize| estimated_seconds(name, scale(s), threads).unwrap_or(f64::NAN);
-            assert!((at(0.2, 2) - fifth).abs() < 1e-9 * fifth.max(1.0), "{name}");
-            assert!((at(1.0, 2) - paper).abs() < 1e-9 * paper.max(1.0), "{name}");
-            assert!((at(1.0, 4) - paper / 2.0).abs() < 1e-9 * paper.max(1.0), "{name}");
+            assert!((at(0.5, 2) - half).abs() < 1e-9 * half.max(1.0), "{name}");
+            assert!((at(0.5, 4) - half / 2.0).abs() < 1e-9 * half.max(1.0), "{name}");
+            // At least linear in the scale, at most cubic.
             assert!(
-                at(0.5, 2) >= fifth.min(paper) && at(0.5, 2) <= fifth.max(paper),
+                at(1.0, 2) >= 2.0 * half - 1e-9 && at(1.0, 2) <= 8.0 * half + 1e-9,
                 "{name}"
             );
+            // Where the timings grew between linearly and cubically, it passes through both.
+            if fifth * 2.5 <= half && half <= fifth * 2.5f64.powi(3) {
+                assert!((at(0.2, 2) - fifth).abs() < 1e-9 * fifth.max(1.0), "{name}");
+            }
         }
+        let whole_run: f64 = REFERENCE_SECONDS
+            .iter()
+            .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
+            .sum();
+        assert!(
+            (100.0 * 60.0..120.0 * 60.0).contains(&whole_run),
+            "{whole_run} s at scale 1.0"
+        );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);
     }
 
@@ -159,6 +175,7 @@ mod tests {
         run.finished("noise", noise);
         assert_eq!(run.remaining_s(), 0.0);
         assert_eq!(human_duration(90.0), "90 s");
+        assert_eq!(human_duration(-0.0), "0 s");
         assert_eq!(human_duration(600.0), "10 min");
         assert_eq!(human_duration(9000.0), "2.5 h");
     }
