@@ -9,8 +9,8 @@ use recognize_toy::{OBJECTS, normal};
 use taction::describe::{DescriptorKind, Feature};
 use taction::recognize::{
     ClusterHistogram, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, KMeans, KMeansConfig,
-    LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, cross_entropy, evaluate,
-    kmeans_plus_plus, make_trials, train,
+    LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, TrainProgress, cross_entropy,
+    evaluate, kmeans_plus_plus, make_trials, train,
 };
 use taction::rng::stream;
 
@@ -379,6 +379,47 @@ fn training_is_seeded_and_deterministic() {
     assert_eq!(a, b);
     let json = |t: &taction::recognize::Trained| serde_json::to_string(&t.bag).unwrap();
     assert_eq!(json(&a), json(&b));
+}
+
+#[test]
+fn candidates_fitted_in_parallel_give_the_model_of_one_thread_and_report_each_once() {
+    let training = toy_features(30, 4);
+    let train_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut events = Vec::new();
+        let trained = pool.install(|| {
+            train(&training, None, &toy_config(CodebookKind::Gmm), &mut |e| {
+                events.push(e)
+            })
+            .unwrap()
+        });
+        (trained, events)
+    };
+    let (one, one_events) = train_on(1);
+    let (three, three_events) = train_on(3);
+    assert_eq!(one, three);
+    // The candidates are listed in grid order (k, then restart) whatever finished first.
+    let order: Vec<(usize, usize)> = three
+        .selection
+        .candidates
+        .iter()
+        .map(|c| (c.k, c.restart))
+        .collect();
+    assert_eq!(order, vec![(3, 0), (3, 1), (6, 0), (6, 1)]);
+    for events in [one_events, three_events] {
+        let fitting = events
+            .iter()
+            .filter(|e| matches!(e, TrainProgress::Fitting { .. }))
+            .count();
+        let scored = events
+            .iter()
+            .filter(|e| matches!(e, TrainProgress::Scored(_)))
+            .count();
+        assert_eq!((fitting, scored), (4, 4));
+    }
 }
 
 #[test]

@@ -136,7 +136,7 @@ impl FusedModel {
         validation: Option<&Dataset>,
         choice: &DescriptorChoice,
         config: TrainConfig,
-        progress: &mut dyn FnMut(TrainProgress),
+        progress: &mut (dyn FnMut(TrainProgress) + Send),
     ) -> Result<Self, RecognizeError> {
         let models = choice
             .kinds()

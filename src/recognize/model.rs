@@ -74,7 +74,7 @@ impl TrainedModel {
         validation: Option<&Dataset>,
         descriptor: &dyn Descriptor,
         config: TrainConfig,
-        progress: &mut dyn FnMut(TrainProgress),
+        progress: &mut (dyn FnMut(TrainProgress) + Send),
     ) -> Result<Self, RecognizeError> {
         let header = training.header();
         if let Some(v) = validation {

@@ -2,6 +2,9 @@
 //! restarts, keep the model with the best validation accuracy, ties broken by reliability (the
 //! probability the posterior puts on the correct object).
 
+use std::sync::{Mutex, PoisonError};
+
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
@@ -210,7 +213,7 @@ pub fn train(
     training: &LabelledFeatures,
     validation: Option<&LabelledFeatures>,
     config: &TrainConfig,
-    progress: &mut dyn FnMut(TrainProgress),
+    progress: &mut (dyn FnMut(TrainProgress) + Send),
 ) -> Result<Trained, RecognizeError> {
     config.validate()?;
     let held_out;
@@ -259,51 +262,52 @@ pub fn train(
         total,
     });
 
-    let mut best: Option<(CandidateScore, CodebookModel, ObjectModels)> = None;
-    let mut candidates = Vec::with_capacity(total);
-    let mut first_error = None;
-    for (ki, &k) in config.ks.iter().enumerate() {
-        for restart in 0..config.restarts {
-            progress(TrainProgress::Fitting {
-                index: ki * config.restarts + restart,
+    // Every (k, restart) candidate is fitted and scored on its own random stream, in parallel;
+    // the choice then walks them in grid order, so the model is the same for any thread count.
+    let jobs: Vec<(usize, usize)> = config
+        .ks
+        .iter()
+        .flat_map(|&k| (0..config.restarts).map(move |restart| (k, restart)))
+        .collect();
+    let progress = Mutex::new(progress);
+    let report = |event: TrainProgress| {
+        let mut progress = progress.lock().unwrap_or_else(PoisonError::into_inner);
+        (*progress)(event);
+    };
+    let fitted: Vec<Candidate> = jobs
+        .par_iter()
+        .enumerate()
+        .map(|(index, &(k, restart))| {
+            report(TrainProgress::Fitting {
+                index,
                 total,
                 k,
                 restart,
             });
-            let mut rng = stream(substream(config.seed, k as u64), restart as u64);
-            let fitted = CodebookModel::fit(config.codebook, &reduced, k, &config.fitting, &mut rng)
-                .and_then(|cb| {
-                    let histograms: Vec<ClusterHistogram> =
-                        blocks.iter().map(|b| reduced_histogram(&cb, b)).collect();
-                    let models = ObjectModels::fit(objects.clone(), &histograms, config.pseudo_count)?;
-                    Ok((cb, models))
-                });
-            let (score, fitted) = match fitted {
-                Ok((cb, models)) => (
-                    score_candidate(&cb, &models, &trials, k, restart),
-                    Some((cb, models)),
-                ),
-                Err(e) => {
-                    let score = CandidateScore {
-                        k,
-                        restart,
-                        correct: 0,
-                        trials: trials.len(),
-                        reliability: 0.0,
-                        failure: Some(e.to_string()),
-                    };
-                    first_error.get_or_insert(e);
-                    (score, None)
+            let candidate = fit_candidate(config, &reduced, &blocks, &objects, &trials, k, restart);
+            report(TrainProgress::Scored(candidate.score.clone()));
+            candidate
+        })
+        .collect();
+
+    let mut best: Option<(CandidateScore, CodebookModel, ObjectModels)> = None;
+    let mut candidates = Vec::with_capacity(total);
+    let mut first_error = None;
+    for candidate in fitted {
+        match candidate.fitted {
+            Ok((cb, models)) => {
+                if best
+                    .as_ref()
+                    .is_none_or(|(b, _, _)| candidate.score.is_better_than(b))
+                {
+                    best = Some((candidate.score.clone(), cb, models));
                 }
-            };
-            progress(TrainProgress::Scored(score.clone()));
-            if let Some((cb, models)) = fitted
-                && best.as_ref().is_none_or(|(b, _, _)| score.is_better_than(b))
-            {
-                best = Some((score.clone(), cb, models));
             }
-            candidates.push(score);
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
         }
+        candidates.push(candidate.score);
     }
     let Some((chosen, codebook, models)) = best else {
         return Err(
@@ -324,6 +328,44 @@ pub fn train(
         bag: BagOfFeatures::new(pca, codebook, models)?,
         selection,
     })
+}
+
+/// One fitted and scored candidate of model selection; `fitted` is the error when the codebook or
+/// the object models could not be fitted (then the candidate is never chosen).
+struct Candidate {
+    score: CandidateScore,
+    fitted: Result<(CodebookModel, ObjectModels), RecognizeError>,
+}
+
+/// Fits the codebook of `k` clusters on restart `restart`'s random stream, the objects' histograms
+/// over it, and scores the pair on the validation trials.
+fn fit_candidate(
+    config: &TrainConfig,
+    reduced: &FeatureMatrix,
+    blocks: &[FeatureMatrix],
+    objects: &[String],
+    trials: &[ReducedTrial],
+    k: usize,
+    restart: usize,
+) -> Candidate {
+    let mut rng = stream(substream(config.seed, k as u64), restart as u64);
+    let fitted = CodebookModel::fit(config.codebook, reduced, k, &config.fitting, &mut rng).and_then(|cb| {
+        let histograms: Vec<ClusterHistogram> = blocks.iter().map(|b| reduced_histogram(&cb, b)).collect();
+        let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?;
+        Ok((cb, models))
+    });
+    let score = match &fitted {
+        Ok((cb, models)) => score_candidate(cb, models, trials, k, restart),
+        Err(e) => CandidateScore {
+            k,
+            restart,
+            correct: 0,
+            trials: trials.len(),
+            reliability: 0.0,
+            failure: Some(e.to_string()),
+        },
+    };
+    Candidate { score, fitted }
 }
 
 /// A validation trial with its features already PCA-reduced, one matrix per reading.
