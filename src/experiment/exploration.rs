@@ -366,32 +366,11 @@ mod tests {
 
     /// A closed axis-aligned cube of side `s` with a corner at the origin.
     fn cube(s: f64) -> TriMesh {
-        let v = |x: f64, y: f64, z: f64| DVec3::new(x * s, y * s, z * s);
-        let vertices = vec![
-            v(0.0, 0.0, 0.0),
-            v(1.0, 0.0, 0.0),
-            v(1.0, 1.0, 0.0),
-            v(0.0, 1.0, 0.0),
-            v(0.0, 0.0, 1.0),
-            v(1.0, 0.0, 1.0),
-            v(1.0, 1.0, 1.0),
-            v(0.0, 1.0, 1.0),
-        ];
-        let triangles = vec![
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
-        TriMesh { vertices, triangles }
+        let mut mesh = TriMesh::cuboid(DVec3::splat(s / 2.0));
+        for v in &mut mesh.vertices {
+            *v += s / 2.0;
+        }
+        mesh
     }
 
     fn image(value: f64) -> TactileImage {

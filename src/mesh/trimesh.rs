@@ -11,6 +11,34 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
+    /// A closed box centred at the origin with half-sizes `half_m`, two triangles per face,
+    /// counter-clockwise from outside: vertex `i` has the sign of `half_m.x` from bit 0 of `i`,
+    /// `y` from bit 1, `z` from bit 2.
+    pub fn cuboid(half_m: DVec3) -> TriMesh {
+        let vertices = (0..8)
+            .map(|i| {
+                DVec3::new(
+                    if i & 1 == 0 { -half_m.x } else { half_m.x },
+                    if i & 2 == 0 { -half_m.y } else { half_m.y },
+                    if i & 4 == 0 { -half_m.z } else { half_m.z },
+                )
+            })
+            .collect();
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let triangles = quads
+            .iter()
+            .flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]])
+            .collect();
+        TriMesh { vertices, triangles }
+    }
+
     /// The three corners of triangle `t`.
     pub fn corners(&self, t: usize) -> [DVec3; 3] {
         let [a, b, c] = self.triangles[t];
@@ -91,5 +119,33 @@ impl TriMesh {
         self.vertices.extend_from_slice(&other.vertices);
         self.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cuboid_is_closed_and_faces_outward() {
+        let half = DVec3::new(0.01, 0.02, 0.03);
+        let mesh = TriMesh::cuboid(half);
+        assert_eq!(mesh.bounds(), Some((-half, half)));
+        // The divergence theorem: sum of a . (b x c) / 6 over outward triangles is the volume.
+        let volume: f64 = (0..mesh.triangles.len())
+            .map(|t| {
+                let [a, b, c] = mesh.corners(t);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        assert!((volume - 8.0 * half.x * half.y * half.z).abs() < 1e-15);
+        // Closed: every edge is shared by exactly two triangles, in opposite directions.
+        let mut directed = std::collections::HashSet::new();
+        for &[a, b, c] in &mesh.triangles {
+            for edge in [(a, b), (b, c), (c, a)] {
+                assert!(directed.insert(edge), "edge {edge:?} twice in one direction");
+            }
+        }
+        assert!(directed.iter().all(|&(a, b)| directed.contains(&(b, a))));
     }
 }

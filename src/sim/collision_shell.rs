@@ -150,35 +150,9 @@ fn thickened_points(mesh: &TriMesh, triangles: &[usize], thickness_m: f64) -> Ve
 mod tests {
     use super::*;
 
-    /// A closed box of half-sizes `h`, two triangles per face, counter-clockwise from outside.
-    fn cuboid(h: DVec3) -> TriMesh {
-        let vertices = (0..8)
-            .map(|i| {
-                DVec3::new(
-                    if i & 1 == 0 { -h.x } else { h.x },
-                    if i & 2 == 0 { -h.y } else { h.y },
-                    if i & 4 == 0 { -h.z } else { h.z },
-                )
-            })
-            .collect();
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let triangles = quads
-            .iter()
-            .flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]])
-            .collect();
-        TriMesh { vertices, triangles }
-    }
-
     #[test]
     fn a_convex_solid_is_one_piece() {
-        let mesh = cuboid(DVec3::new(0.01, 0.008, 0.005));
+        let mesh = TriMesh::cuboid(DVec3::new(0.01, 0.008, 0.005));
         let pieces = collision_shell(&mesh, &ShellOptions::default());
         assert_eq!(pieces.len(), 1);
     }
@@ -187,7 +161,7 @@ mod tests {
     fn a_concave_solid_is_split_and_no_piece_spans_the_notch() {
         // Two boxes side by side with a 2 cm gap between them, as one mesh: the hull of the whole
         // would fill the gap.
-        let left = cuboid(DVec3::splat(0.01));
+        let left = TriMesh::cuboid(DVec3::splat(0.01));
         let mut mesh = left.clone();
         let offset = mesh.vertices.len() as u32;
         mesh.vertices
@@ -224,7 +198,7 @@ mod tests {
 
     #[test]
     fn pieces_cover_every_vertex() {
-        let mut mesh = cuboid(DVec3::splat(0.02));
+        let mut mesh = TriMesh::cuboid(DVec3::splat(0.02));
         // A dent: push the top face's corner vertex in, making the top concave.
         mesh.vertices[7].z -= 0.015;
         let pieces = collision_shell(&mesh, &ShellOptions::default());
