@@ -35,6 +35,11 @@ use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use crate::cli::common::{OutputLock, SeedArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 
+/// The random stream that draws the unknown object and its pose, and the planner's own stream
+/// (ids of [`rng::stream`], fixed so that a seed always gives the same demo).
+const UNKNOWN_OBJECT_STREAM: u64 = 0xDE30;
+const PLANNER_STREAM: u64 = 0xE7;
+
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// The object set to learn (a built-in set, a folder of meshes, or mesh files).
@@ -161,7 +166,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let names = model.bag.objects().to_vec();
 
     // 2. The unknown object, at a pose the planner is not told.
-    let mut r = rng::stream(args.seed.seed, 0xDE30);
+    let mut r = rng::stream(args.seed.seed, UNKNOWN_OBJECT_STREAM);
     let index = match &args.object {
         Some(name) => objects
             .iter()
@@ -201,7 +206,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         ControlConfig::default(),
         sensor,
         PerturbationBounds::NONE,
-        rng::stream(args.seed.seed, 0xE7),
+        rng::stream(args.seed.seed, PLANNER_STREAM),
         reader,
     )?;
     let mut recognition = ActiveRecognition::new(&model.bag, descriptor.as_ref(), planner_config.grid_cell_m);
