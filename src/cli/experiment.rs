@@ -6,12 +6,10 @@ use std::time::Instant;
 use clap::Args;
 use taction::experiment::RunOptions;
 use taction::experiment::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
-use taction::experiment::paper::figure1;
 use taction::experiment::paper::headline::headline_table;
 use taction::experiment::paper::real_frames::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
 use taction::experiment::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 use taction::experiment::real_data::Calibration;
-use taction::experiment::write_index;
 use taction::mesh::ObjectSet;
 
 use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError};
@@ -118,8 +116,7 @@ fn parse_experiment(name: &str) -> Result<PaperExperiment, String> {
     PaperExperiment::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = PaperExperiment::ALL.iter().map(|e| e.name()).collect();
         format!(
-            "no experiment '{name}' (the experiments are {}, {})",
-            figure1::EXPERIMENT_NAME,
+            "no experiment '{name}' (the experiments are {})",
             names.join(", ")
         )
     })
@@ -127,18 +124,9 @@ fn parse_experiment(name: &str) -> Result<PaperExperiment, String> {
 
 pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.name == "list" {
-        println!("{:<14} {}", figure1::EXPERIMENT_NAME, figure1::DESCRIPTION);
         for experiment in PaperExperiment::ALL {
             println!("{:<14} {}", experiment.name(), experiment.description());
         }
-        return Ok(());
-    }
-    if args.name == figure1::EXPERIMENT_NAME {
-        let context = args.paper.context()?;
-        let _lock = OutputLock::acquire(&context.options.out, "out")?;
-        let picture = figure1::run_figure1(&context).map_err(|e| e.to_string())?;
-        write_index(&context.options.out)?;
-        println!("wrote {}", picture.display());
         return Ok(());
     }
     let experiment = parse_experiment(&args.name)?;
@@ -168,50 +156,30 @@ fn announce_estimate(names: &[&str], context: &PaperContext) -> RunEstimate {
 }
 
 pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let figure1_asked =
-        args.only.is_empty() || args.only.iter().any(|n| n.trim() == figure1::EXPERIMENT_NAME);
     let experiments: Vec<PaperExperiment> = if args.only.is_empty() {
         PaperExperiment::ALL.to_vec()
     } else {
         args.only
             .iter()
-            .filter(|n| n.trim() != figure1::EXPERIMENT_NAME)
             .map(|n| parse_experiment(n.trim()))
             .collect::<Result<_, _>>()?
     };
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
     let started = Instant::now();
-    let mut names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
-    if figure1_asked {
-        names.insert(0, figure1::EXPERIMENT_NAME);
-    }
+    let names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
     let mut estimate = announce_estimate(&names, &context);
-    let finished = |name: &str, seconds: f64, estimate: &mut RunEstimate| {
-        estimate.finished(name, seconds);
-        eprintln!(
-            "== {name} done in {seconds:.1} s; about {} to go",
-            human_duration(estimate.remaining_s())
-        );
-    };
-    if figure1_asked {
-        let begun = Instant::now();
-        eprintln!("== {}: {}", figure1::EXPERIMENT_NAME, figure1::DESCRIPTION);
-        let picture = figure1::run_figure1(&context).map_err(|e| e.to_string())?;
-        write_index(&context.options.out)?;
-        println!("wrote {}", picture.display());
-        finished(
-            figure1::EXPERIMENT_NAME,
-            begun.elapsed().as_secs_f64(),
-            &mut estimate,
-        );
-    }
     for experiment in &experiments {
         let begun = Instant::now();
         eprintln!("== {experiment}: {}", experiment.description());
         let report = experiment.run(&context).map_err(|e| e.to_string())?;
         println!("{report}");
-        finished(experiment.name(), begun.elapsed().as_secs_f64(), &mut estimate);
+        let seconds = begun.elapsed().as_secs_f64();
+        estimate.finished(experiment.name(), seconds);
+        eprintln!(
+            "== {experiment} done in {seconds:.1} s; about {} to go",
+            human_duration(estimate.remaining_s())
+        );
     }
     let names: Vec<&str> = experiments
         .iter()

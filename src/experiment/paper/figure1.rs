@@ -14,7 +14,7 @@ use super::recognition::Family;
 use crate::atomic::write_atomic;
 use crate::control::ControlConfig;
 use crate::experiment::exploration::{Placement, write_exploration_png};
-use crate::experiment::index::{PICTURE_FILE, PictureSpec};
+use crate::experiment::index::{PICTURE_FILE, PictureSpec, write_index};
 use crate::experiment::spec::to_json;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::PlannerConfig;
@@ -53,7 +53,8 @@ struct Figure1Config<'a> {
 }
 
 /// Runs the exploration and writes `<out>/exploration/{exploration.png, exploration.csv,
-/// config.json, picture.json}` (the index lists it from the last); returns the picture's path.
+/// config.json, picture.json}` (the index lists it from the last) and rewrites the results index,
+/// as the runner does after every experiment; returns the picture's path.
 pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
     let objects = context.objects(Family::Shapes)?;
     let object = objects
@@ -126,6 +127,7 @@ pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
         ),
     };
     write_atomic(&spec_path, &to_json(&spec, &spec_path)?)?;
+    write_index(&context.options.out)?;
     if placements.len() < READINGS {
         eprintln!(
             "warning: Fig. 1: {} of {READINGS} converged readings of '{}' (the planner ran out of iterations)",

@@ -34,6 +34,7 @@ pub mod recognition;
 pub mod scale;
 
 use std::fmt;
+use std::path::PathBuf;
 
 pub use context::{PaperContext, RealRecording};
 pub use recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
@@ -46,6 +47,7 @@ use crate::experiment::unit::BoxError;
 /// One experiment of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PaperExperiment {
+    Exploration,
     Descriptors,
     Strategy,
     Validation,
@@ -64,7 +66,8 @@ pub enum PaperExperiment {
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
     /// experiments beyond the paper).
-    pub const ALL: [PaperExperiment; 13] = [
+    pub const ALL: [PaperExperiment; 14] = [
+        Self::Exploration,
         Self::Descriptors,
         Self::Strategy,
         Self::Validation,
@@ -80,8 +83,9 @@ impl PaperExperiment {
         Self::Active,
     ];
 
-    /// The recognition figure's sweep; `None` for Fig. 14, which is not a recognition curve, and
-    /// Fig. 16b, which trains on recorded frames rather than on simulated readings.
+    /// The recognition figure's sweep; `None` for Fig. 1, a picture, Fig. 14, which is not a
+    /// recognition curve, and Fig. 16b, which trains on recorded frames rather than on simulated
+    /// readings.
     fn sweep(self) -> Option<RecognitionSweep> {
         Some(match self {
             Self::Descriptors => figures::descriptors(),
@@ -91,7 +95,7 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
-            Self::Convergence | Self::RealFrames | Self::Active => return None,
+            Self::Exploration | Self::Convergence | Self::RealFrames | Self::Active => return None,
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
             Self::TrainingSize => figures::training_size(),
@@ -99,14 +103,16 @@ impl PaperExperiment {
     }
 
     /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]'s
-    /// columns; `active` adds the confidence stop's); Fig. 14's are convergence statistics.
+    /// columns; `active` adds the confidence stop's); Fig. 14's are convergence statistics and
+    /// Fig. 1's the placements it draws.
     pub fn is_recognition(self) -> bool {
-        self != Self::Convergence
+        !matches!(self, Self::Exploration | Self::Convergence)
     }
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
+            Self::Exploration => figure1::EXPERIMENT_NAME,
             Self::RealFrames => real_frames::EXPERIMENT_NAME,
             Self::Active => active::EXPERIMENT_NAME,
             _ => self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name),
@@ -115,6 +121,7 @@ impl PaperExperiment {
 
     pub fn description(self) -> &'static str {
         match self {
+            Self::Exploration => return figure1::DESCRIPTION,
             Self::RealFrames => return real_frames::DESCRIPTION,
             Self::Active => return active::DESCRIPTION,
             _ => {}
@@ -130,12 +137,29 @@ impl PaperExperiment {
     }
 
     /// Runs the experiment in `context`.
-    pub fn run(self, context: &PaperContext) -> Result<RunReport, BoxError> {
-        match self.sweep() {
-            Some(sweep) => sweep.run(context),
-            None if self == Self::RealFrames => real_frames::run_real_frames(context),
-            None if self == Self::Active => active::run_active(context),
-            None => run_convergence(context),
+    pub fn run(self, context: &PaperContext) -> Result<PaperOutput, BoxError> {
+        Ok(match self.sweep() {
+            Some(sweep) => PaperOutput::Run(sweep.run(context)?),
+            None if self == Self::Exploration => PaperOutput::Picture(figure1::run_figure1(context)?),
+            None if self == Self::RealFrames => PaperOutput::Run(real_frames::run_real_frames(context)?),
+            None if self == Self::Active => PaperOutput::Run(active::run_active(context)?),
+            None => PaperOutput::Run(run_convergence(context)?),
+        })
+    }
+}
+
+/// What running a paper experiment produced: a run of units, or (Fig. 1) one picture.
+#[derive(Debug)]
+pub enum PaperOutput {
+    Run(RunReport),
+    Picture(PathBuf),
+}
+
+impl fmt::Display for PaperOutput {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Run(report) => report.fmt(f),
+            Self::Picture(path) => write!(f, "wrote {}", path.display()),
         }
     }
 }
