@@ -18,7 +18,7 @@ use crate::control::ContactStatus;
 use crate::explore::Reading;
 use crate::mesh::TriMesh;
 use crate::sim::Pose;
-use crate::tactile::image::{to_gray, write_rgb_png};
+use crate::tactile::image::{CONTACT_SHEET_GUTTER_PX, GrayPicture, contact_sheet, write_rgb_png};
 use crate::tactile::{ImageError, PadPose, SensorConfig, TactileImage};
 
 /// The paper's figure shows the first 50 tactile images of a 100-reading exploration.
@@ -118,7 +118,6 @@ const OBJECT: [f64; 3] = [150.0, 165.0, 190.0];
 const PATCH: [u8; 3] = [245, 200, 30];
 const PATCH_EDGE: [u8; 3] = [150, 105, 0];
 const AMBIENT: f64 = 0.3;
-const GUTTER_PX: usize = 4;
 
 /// The orthographic camera of the module doc.
 struct Camera {
@@ -168,15 +167,16 @@ impl Camera {
     }
 }
 
-/// Renders the object at `object_pose` with every placement's patch, and the first
-/// `view.images_shown` tactile images in a grid to its right.
+/// Renders the object at `object_pose` with every placement's patch, and the [`contact_sheet`] of
+/// the first `view.images_shown` tactile images to its right, scaled to the panel's height. Fails
+/// only when the images differ in shape.
 pub fn render_exploration(
     mesh: &TriMesh,
     object_pose: &Pose,
     placements: &[Placement],
     sensor: &SensorConfig,
     view: &ExplorationView,
-) -> RgbPicture {
+) -> Result<RgbPicture, ImageError> {
     let vertices: Vec<DVec3> = mesh
         .vertices
         .iter()
@@ -190,14 +190,14 @@ pub fn render_exploration(
     extent.extend(patches.iter().flatten());
     let camera = Camera::new(view, &extent);
 
-    let shown: Vec<&TactileImage> = placements
+    let shown: Vec<TactileImage> = placements
         .iter()
         .take(view.images_shown)
-        .map(|p| &p.image)
+        .map(|p| p.image.clone())
         .collect();
-    let grid = ImageGrid::new(&shown, view);
-    let width = view.panel_px + grid.width;
-    let mut picture = RgbPicture::filled(width, view.panel_px.max(grid.height), BACKGROUND);
+    let sheet = images_beside(&shown, view)?;
+    let (sheet_w, sheet_h) = sheet.as_ref().map_or((0, 0), |s| (s.width, s.height));
+    let mut picture = RgbPicture::filled(view.panel_px + sheet_w, view.panel_px.max(sheet_h), BACKGROUND);
     let mut depth = vec![f64::INFINITY; view.panel_px * view.panel_px];
 
     let light = (-camera.view + 0.6 * camera.up - 0.4 * camera.right).normalize();
@@ -209,20 +209,59 @@ pub fn render_exploration(
         let shade = AMBIENT + (1.0 - AMBIENT) * normal.dot(light).abs();
         let color = OBJECT.map(|c| (c * shade).round().clamp(0.0, 255.0) as u8);
         let screen = [a, b, c].map(|p| camera.project(p));
-        fill_convex(&mut picture, &mut depth, &camera, &screen, 0.0, |_| color);
+        fill_convex(
+            &mut picture,
+            &mut depth,
+            &camera,
+            &screen,
+            DepthTest::Opaque,
+            |_| color,
+        );
     }
     // A patch shows if it is at most this far behind the nearest object surface: the covering's
     // thickness plus a millimetre for the object's curvature under the pad.
-    let bias_m = sensor.thickness_m + 1e-3;
+    let overlay = DepthTest::Overlay {
+        bias_m: sensor.thickness_m + 1e-3,
+    };
     for corners in &patches {
         let screen = corners.map(|p| camera.project(p));
         let edge_px = 1.5;
-        fill_convex(&mut picture, &mut depth, &camera, &screen, bias_m, |inset_px| {
+        fill_convex(&mut picture, &mut depth, &camera, &screen, overlay, |inset_px| {
             if inset_px < edge_px { PATCH_EDGE } else { PATCH }
         });
     }
-    grid.draw(&mut picture, view.panel_px);
-    picture
+    if let Some(sheet) = sheet {
+        for y in 0..sheet.height {
+            for x in 0..sheet.width {
+                let g = sheet.pixels[y * sheet.width + x];
+                picture.set(view.panel_px + x, y, [g, g, g]);
+            }
+        }
+    }
+    Ok(picture)
+}
+
+/// The contact sheet of `images` in `view.image_columns` columns, its taxels as large as lets the
+/// sheet be no taller than the object panel; `None` without images.
+fn images_beside(images: &[TactileImage], view: &ExplorationView) -> Result<Option<GrayPicture>, ImageError> {
+    let Some(first) = images.first() else {
+        return Ok(None);
+    };
+    let columns = view.image_columns.clamp(1, images.len());
+    let rows = images.len().div_ceil(columns);
+    let free_px = view.panel_px.saturating_sub(CONTACT_SHEET_GUTTER_PX * (rows + 1));
+    let taxel_px = (free_px / (rows * first.rows())).max(1);
+    contact_sheet(images, columns, taxel_px).map(Some)
+}
+
+/// How a polygon meets the z-buffer.
+#[derive(Debug, Clone, Copy)]
+enum DepthTest {
+    /// A surface of the object: drawn where nearest, and it becomes the nearest.
+    Opaque,
+    /// A mark on the surface (a patch): drawn where at most `bias_m` behind the nearest surface,
+    /// leaving the z-buffer as it is.
+    Overlay { bias_m: f64 },
 }
 
 /// The pad's footprint on the covering's outer surface, in the world at the displayed pose.
@@ -236,15 +275,15 @@ fn patch_corners(pad: &PadPose, sensor: &SensorConfig, object_pose: &Pose) -> [D
     [centre + h + w, centre + h - w, centre - h - w, centre - h + w].map(|p| object_pose.transform_point(p))
 }
 
-/// Fills the convex polygon `screen` (pixel x, pixel y, depth m) where it is nearer than the
-/// z-buffer plus `bias_m`; `color` gets the pixel's distance in pixels to the polygon's nearest edge.
+/// Fills the convex polygon `screen` (pixel x, pixel y, depth m) where `test` passes;
+/// `color` gets the pixel's distance in pixels to the polygon's nearest edge.
 /// Depth is interpolated on the plane of the first three corners (the polygons are planar).
 fn fill_convex(
     picture: &mut RgbPicture,
     depth: &mut [f64],
     camera: &Camera,
     screen: &[DVec3],
-    bias_m: f64,
+    test: DepthTest,
     color: impl Fn(f64) -> [u8; 3],
 ) {
     let n = screen.len();
@@ -283,67 +322,12 @@ fn fill_convex(
             let wc = ((b.x - a.x) * (py - a.y) - (px - a.x) * (b.y - a.y)) / area;
             let z = a.z + wb * (b.z - a.z) + wc * (c.z - a.z);
             let slot = &mut depth[y * camera.panel_px + x];
-            if z < *slot + bias_m {
-                if bias_m == 0.0 {
-                    *slot = z;
-                }
-                picture.set(x, y, color(inset));
+            match test {
+                DepthTest::Opaque if z < *slot => *slot = z,
+                DepthTest::Overlay { bias_m } if z < *slot + bias_m => {}
+                _ => continue,
             }
-        }
-    }
-}
-
-/// The tactile images in a grid of `image_columns`, each taxel a square of gray, scaled so that
-/// the grid is as tall as the object panel.
-struct ImageGrid<'a> {
-    images: &'a [&'a TactileImage],
-    columns: usize,
-    taxel_px: usize,
-    cell: (usize, usize),
-    width: usize,
-    height: usize,
-}
-
-impl<'a> ImageGrid<'a> {
-    fn new(images: &'a [&'a TactileImage], view: &ExplorationView) -> Self {
-        let Some(first) = images.first() else {
-            return Self {
-                images,
-                columns: 0,
-                taxel_px: 0,
-                cell: (0, 0),
-                width: 0,
-                height: 0,
-            };
-        };
-        let columns = view.image_columns.clamp(1, images.len());
-        let rows = images.len().div_ceil(columns);
-        let (r, c) = (first.rows(), first.cols());
-        let taxel_px = ((view.panel_px - GUTTER_PX * (rows + 1)) / (rows * r).max(1)).max(1);
-        let cell = (c * taxel_px + GUTTER_PX, r * taxel_px + GUTTER_PX);
-        Self {
-            images,
-            columns,
-            taxel_px,
-            cell,
-            width: columns * cell.0 + GUTTER_PX,
-            height: rows * cell.1 + GUTTER_PX,
-        }
-    }
-
-    fn draw(&self, picture: &mut RgbPicture, left: usize) {
-        for (k, image) in self.images.iter().enumerate() {
-            let x0 = left + GUTTER_PX + (k % self.columns) * self.cell.0;
-            let y0 = GUTTER_PX + (k / self.columns) * self.cell.1;
-            for y in 0..image.rows() * self.taxel_px {
-                for x in 0..image.cols() * self.taxel_px {
-                    let (row, col) = (y / self.taxel_px, x / self.taxel_px);
-                    if row < image.rows() && col < image.cols() {
-                        let g = to_gray(image.get(row, col));
-                        picture.set(x0 + x, y0 + y, [g, g, g]);
-                    }
-                }
-            }
+            picture.set(x, y, color(inset));
         }
     }
 }
@@ -356,7 +340,7 @@ pub fn write_exploration_png(
     placements: &[Placement],
     sensor: &SensorConfig,
 ) -> Result<(), ImageError> {
-    render_exploration(mesh, object_pose, placements, sensor, &ExplorationView::default()).write_png(path)
+    render_exploration(mesh, object_pose, placements, sensor, &ExplorationView::default())?.write_png(path)
 }
 
 #[cfg(test)]
@@ -417,7 +401,8 @@ mod tests {
             &[near.clone(), far.clone()],
             &sensor,
             &view,
-        );
+        )
+        .expect("one shape of image");
         let camera = Camera::new(&view, &{
             let mut extent = mesh.vertices.clone();
             for p in [&near, &far] {
@@ -450,10 +435,12 @@ mod tests {
             placement(DVec3::new(0.025, 0.025, 0.05), DVec3::Z, &sensor, 0.5),
         ];
         let view = view();
-        let fixed = render_exploration(&mesh, &Pose::IDENTITY, &placements, &sensor, &view);
+        let fixed = render_exploration(&mesh, &Pose::IDENTITY, &placements, &sensor, &view)
+            .expect("one shape of image");
         // The picture fits the scene: a translated object gives the same picture, up to rounding.
         let moved = Pose::new(DVec3::new(0.3, -0.2, 0.1), DQuat::IDENTITY);
-        let shifted = render_exploration(&mesh, &moved, &placements, &sensor, &view);
+        let shifted =
+            render_exploration(&mesh, &moved, &placements, &sensor, &view).expect("one shape of image");
         let differing = (0..fixed.pixels.len())
             .step_by(3)
             .filter(|&i| fixed.pixels[i..i + 3] != shifted.pixels[i..i + 3])
@@ -467,15 +454,16 @@ mod tests {
         let turned = Pose::new(DVec3::ZERO, DQuat::from_rotation_z(0.7));
         assert_ne!(
             fixed,
-            render_exploration(&mesh, &turned, &placements, &sensor, &view)
+            render_exploration(&mesh, &turned, &placements, &sensor, &view).expect("one shape of image")
         );
-        // The grid: two 6x6 images to the right of the panel, the first white, the second mid-gray.
+        // The contact sheet: two 6x6 images to the right of the panel, the first white, the second
+        // mid-gray.
         assert!(fixed.width > view.panel_px);
-        let first = fixed.get(view.panel_px + GUTTER_PX + 1, GUTTER_PX + 1);
+        let gutter = CONTACT_SHEET_GUTTER_PX;
+        let first = fixed.get(view.panel_px + gutter + 1, gutter + 1);
         assert_eq!(first, [255, 255, 255]);
-        let shown = [&placements[0].image, &placements[1].image];
-        let grid = ImageGrid::new(&shown, &view);
-        let second = fixed.get(view.panel_px + GUTTER_PX + grid.cell.0 + 1, GUTTER_PX + 1);
+        let cell_px = (fixed.width - view.panel_px - gutter) / 2;
+        let second = fixed.get(view.panel_px + gutter + cell_px + 1, gutter + 1);
         assert_eq!(second, [128, 128, 128]);
     }
 }

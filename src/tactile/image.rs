@@ -246,14 +246,25 @@ impl TactileImage {
     }
 }
 
-/// Writes `images` (all of one shape) as a grid `columns` wide, each taxel `scale x scale` pixels with a
-/// 2-pixel dark gutter between images: a contact sheet like the strips of the paper's Fig. 1 and Fig. 5.
-pub fn write_contact_sheet(
+/// An 8-bit grayscale picture, row-major.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GrayPicture {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<u8>,
+}
+
+/// Gutter between the images of a contact sheet, pixels.
+pub const CONTACT_SHEET_GUTTER_PX: usize = 2;
+
+/// `images` (all of one shape) as a grid `columns` wide, each taxel `scale x scale` pixels with a
+/// [`CONTACT_SHEET_GUTTER_PX`] dark gutter between images: a contact sheet like the strips of the
+/// paper's Fig. 1 and Fig. 5.
+pub fn contact_sheet(
     images: &[TactileImage],
     columns: usize,
     scale: usize,
-    path: &Path,
-) -> Result<(), ImageError> {
+) -> Result<GrayPicture, ImageError> {
     let Some(first) = images.first() else {
         return Err(ImageError::Empty { rows: 0, cols: 0 });
     };
@@ -265,7 +276,7 @@ pub fn write_contact_sheet(
             got: other.values().len(),
         });
     }
-    let (columns, scale, gutter) = (columns.max(1), scale.max(1), 2);
+    let (columns, scale, gutter) = (columns.max(1), scale.max(1), CONTACT_SHEET_GUTTER_PX);
     let grid_rows = images.len().div_ceil(columns);
     let (cell_w, cell_h) = (cols * scale + gutter, rows * scale + gutter);
     let (w, h) = (columns * cell_w + gutter, grid_rows * cell_h + gutter);
@@ -278,7 +289,22 @@ pub fn write_contact_sheet(
             }
         }
     }
-    write_gray_png(path, w, h, &pixels)
+    Ok(GrayPicture {
+        width: w,
+        height: h,
+        pixels,
+    })
+}
+
+/// Writes the [`contact_sheet`] of `images` as PNG.
+pub fn write_contact_sheet(
+    images: &[TactileImage],
+    columns: usize,
+    scale: usize,
+    path: &Path,
+) -> Result<(), ImageError> {
+    let sheet = contact_sheet(images, columns, scale)?;
+    write_gray_png(path, sheet.width, sheet.height, &sheet.pixels)
 }
 
 /// A value in [0, 1] as an 8-bit gray level.
