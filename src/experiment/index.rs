@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use super::assemble::missing_units;
 use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
+use super::files::read;
 use super::layout::ExperimentDir;
-use super::merge::experiments_in;
+use super::merge::{experiments_in, folders_holding};
 use super::plot::{PlotKind, build_figure};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
@@ -81,25 +82,13 @@ pub struct PictureSpec {
 }
 
 fn picture_sections(text: &mut String, out: &Path) -> Result<(), ExperimentError> {
-    let Ok(entries) = std::fs::read_dir(out) else {
-        return Ok(());
-    };
-    let mut dirs: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.join(PICTURE_FILE).is_file())
-        .collect();
-    dirs.sort();
-    for dir in dirs {
-        let spec_path = dir.join(PICTURE_FILE);
+    for name in folders_holding(out, PICTURE_FILE)? {
+        let spec_path = out.join(name.as_str()).join(PICTURE_FILE);
         let spec: PictureSpec =
-            serde_json::from_slice(&super::files::read(&spec_path)?).map_err(|e| ExperimentError::Json {
+            serde_json::from_slice(&read(&spec_path)?).map_err(|e| ExperimentError::Json {
                 path: spec_path.clone(),
                 what: e.to_string(),
             })?;
-        let name = dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
         let _ = write!(
             text,
             "\n## {name}\n\n{}\n\nData: [{name}.csv]({name}/{name}.csv)\n\n![{}]({name}/{name}.png)\n",

@@ -56,6 +56,14 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport, ExperimentEr
 
 /// The experiment directories directly under `root`, in name order.
 pub(crate) fn experiments_in(root: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
+    Ok(folders_holding(root, "manifest.json")?
+        .iter()
+        .map(|name| ExperimentDir::new(root, name))
+        .collect())
+}
+
+/// The sub-folders of `root` with a safe name that hold a file `file`, sorted by name.
+pub(crate) fn folders_holding(root: &Path, file: &str) -> Result<Vec<SafeName>, ExperimentError> {
     let mut names = Vec::new();
     for entry in std::fs::read_dir(root).map_err(ExperimentError::io(root))? {
         let entry = entry.map_err(ExperimentError::io(root))?;
@@ -63,12 +71,12 @@ pub(crate) fn experiments_in(root: &Path) -> Result<Vec<ExperimentDir>, Experime
         let Some(name) = file_name.to_str().and_then(|n| SafeName::new(n).ok()) else {
             continue;
         };
-        if entry.path().join("manifest.json").is_file() {
+        if entry.path().join(file).is_file() {
             names.push(name);
         }
     }
     names.sort();
-    Ok(names.iter().map(|name| ExperimentDir::new(root, name)).collect())
+    Ok(names)
 }
 
 fn merge_experiment(
