@@ -266,7 +266,7 @@ enum DepthTest {
 
 /// The pad's footprint on the covering's outer surface, in the world at the displayed pose.
 fn patch_corners(pad: &PadPose, sensor: &SensorConfig, object_pose: &Pose) -> [DVec3; 4] {
-    let side = pad.normal.cross(pad.up);
+    let side = pad.right();
     let centre = pad.center_m + pad.normal * sensor.thickness_m;
     let (h, w) = (
         pad.up * sensor.pad_height_m / 2.0,
