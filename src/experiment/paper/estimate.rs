@@ -51,15 +51,22 @@ pub fn estimated_seconds(name: &str, scale: Scale, threads: usize) -> Option<f64
 
 /// Whether experiment `name` already finished in `out` (its assembled CSV exists), so that a
 /// resumed run spends no time on it.
-pub fn finished(out: &Path, name: &str) -> bool {
+pub fn already_finished(out: &Path, name: &str) -> bool {
     out.join(name).join(format!("{name}.csv")).is_file()
+}
+
+/// One experiment of a run: its estimate, and whether it has finished.
+#[derive(Debug, Clone)]
+struct Part {
+    name: String,
+    estimate_s: f64,
+    done: bool,
 }
 
 /// The estimate of a whole run, kept up to date as its experiments finish.
 #[derive(Debug, Clone)]
 pub struct RunEstimate {
-    /// (experiment, estimated seconds, done).
-    parts: Vec<(String, f64, bool)>,
+    parts: Vec<Part>,
     spent_s: f64,
     estimated_spent_s: f64,
 }
@@ -71,12 +78,16 @@ impl RunEstimate {
         let parts = names
             .iter()
             .map(|&name| {
-                let seconds = if finished(out, name) {
+                let estimate_s = if already_finished(out, name) {
                     0.0
                 } else {
                     estimated_seconds(name, scale, threads).unwrap_or(0.0)
                 };
-                (name.to_string(), seconds, false)
+                Part {
+                    name: name.to_string(),
+                    estimate_s,
+                    done: false,
+                }
             })
             .collect();
         Self {
@@ -88,15 +99,15 @@ impl RunEstimate {
 
     /// Seconds the whole run is estimated to take before it starts.
     pub fn total_s(&self) -> f64 {
-        self.parts.iter().map(|p| p.1).sum()
+        self.parts.iter().map(|p| p.estimate_s).sum()
     }
 
     /// Records that `name` finished after `seconds`.
     pub fn finished(&mut self, name: &str, seconds: f64) {
-        if let Some(part) = self.parts.iter_mut().find(|p| p.0 == name && !p.2) {
-            part.2 = true;
+        if let Some(part) = self.parts.iter_mut().find(|p| p.name == name && !p.done) {
+            part.done = true;
             self.spent_s += seconds;
-            self.estimated_spent_s += part.1;
+            self.estimated_spent_s += part.estimate_s;
         }
     }
 
@@ -109,7 +120,12 @@ impl RunEstimate {
         } else {
             1.0
         };
-        pace * self.parts.iter().filter(|p| !p.2).map(|p| p.1).sum::<f64>()
+        pace * self
+            .parts
+            .iter()
+            .filter(|p| !p.done)
+            .map(|p| p.estimate_s)
+            .sum::<f64>()
     }
 }
 
