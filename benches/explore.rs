@@ -15,7 +15,7 @@
 //!   reports converged readings per second per core and the fraction of attempts that converge,
 //!   per object and over the set;
 //! - `active/score_12_candidates`: the active strategy's extra work per planner iteration, the
-//!   expected-information-gain scores of 12 candidate targets (`recognize::active`) for a model of
+//!   expected-information-gain scores of 12 candidate targets (`active_touch`) for a model of
 //!   12 objects and 50 clusters after 30 readings; the summary reports it per iteration against a
 //!   plain kinematic planner iteration on the pawn (total time / iterations of `planner/kinematic`
 //!   runs), the baseline.
@@ -30,12 +30,13 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, Throughput, criterion_group};
 use glam::DVec3;
 use rand::RngExt;
+use taction::active_touch::InformationGain;
 use taction::control::ControlConfig;
 use taction::explore::TouchScorer;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig, SamplerConfig, sample_readings};
 use taction::mesh::{BuildOptions, ObjectSet};
-use taction::recognize::{ClusterHistogram, InformationGain, ObjectModels, PseudoCount};
+use taction::recognize::{ClusterHistogram, ObjectModels, PseudoCount};
 use taction::sim::arm::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use taction::tactile::sensor::{CoveringSensor, add_sensor};

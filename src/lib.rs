@@ -7,22 +7,26 @@
 //! mesh       objects as triangle meshes: loading, validation, object sets, raised letters
 //! sim        the MuJoCo world: arm (FK/IK/move_to), table, perturbable object (Sec. V-A1)
 //! tactile    the covering sensor: a MuJoCo sensor plugin that raycasts penetration (Sec. V-A2)
+//! dataset    the hand-off from exploration to recognition: readings and their file, no MuJoCo
 //! control    Approach / Press / Orient (Sec. III-B, Algorithm 1)
-//! explore    the planner (Sec. III-A) and the training sampler (Sec. V-A3)
-//! dataset    readings on disk: the hand-off from exploration to recognition
+//! explore    the planner (Sec. III-A), the training sampler (Sec. V-A3), collection into datasets
 //! describe   the six tactile image descriptors (Sec. IV-B)
 //! recognize  bag-of-features: PCA, codebooks, cross-entropy decision (Sec. IV-A, V-B1)
+//! active_touch  the planner steered by expected information gain (beyond the paper, Sec. VI)
 //! experiment the paper's figures as runs writing tidy CSV and plots (Sec. V)
 //! ```
 //!
 //! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
-//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units` and `atomic`
-//! (the one writer of files) serve every module.
+//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units`, `atomic` (the
+//! one writer of files), `pose` and `bodies` serve every module; `tests/architecture.rs` checks the
+//! flow.
 //!
 //! `ARCHITECTURE.md` at the repository's root holds the module map, the decisions the code relies on
 //! and the paper's errata.
 
 pub mod atomic;
+pub mod bodies;
+pub mod pose;
 pub mod rng;
 pub mod units;
 
@@ -30,12 +34,14 @@ pub mod mesh;
 pub mod sim;
 pub mod tactile;
 
+pub mod dataset;
+
 pub mod control;
 pub mod explore;
 
-pub mod dataset;
-
 pub mod describe;
 pub mod recognize;
+
+pub mod active_touch;
 
 pub mod experiment;

@@ -10,10 +10,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use taction::control::ContactStatus;
+use taction::dataset::ContactStatus;
+use taction::dataset::Strategy;
 use taction::dataset::{Dataset, DatasetHeader, Reading};
-use taction::explore::Strategy;
-use taction::sim::Pose;
+use taction::pose::Pose;
 use taction::tactile::{SensorConfig, TactileImage};
 
 fn taction(args: &[&str]) -> Output {

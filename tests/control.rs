@@ -5,10 +5,12 @@ mod common;
 use glam::{DQuat, DVec3};
 use rand::RngExt;
 use taction::control::free_pad::FreePad;
-use taction::control::{ContactStatus, ControlConfig, settle};
+use taction::control::{ControlConfig, settle};
+use taction::dataset::ContactStatus;
 use taction::explore::collect::sensor_reader;
+use taction::pose::Pose;
 use taction::rng;
-use taction::sim::{ObjectSpec, Pose};
+use taction::sim::ObjectSpec;
 use taction::tactile::free_floating::FreeFloatingSensor;
 use taction::tactile::{PadPose, SensorConfig};
 

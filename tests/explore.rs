@@ -3,9 +3,11 @@
 mod common;
 
 use glam::DVec3;
-use taction::control::{ContactStatus, ControlConfig};
+use taction::control::ControlConfig;
+use taction::dataset::ContactStatus;
+use taction::dataset::Strategy;
 use taction::explore::collect::{CollectMode, CollectPlan};
-use taction::explore::{PlannerConfig, SamplerConfig, Strategy};
+use taction::explore::{PlannerConfig, SamplerConfig};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 

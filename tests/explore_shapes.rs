@@ -10,10 +10,12 @@ mod common;
 use std::process::Command;
 
 use glam::DVec3;
-use taction::control::{ContactStatus, ControlConfig};
+use taction::control::ControlConfig;
+use taction::dataset::ContactStatus;
 use taction::dataset::Dataset;
+use taction::dataset::Reading;
+use taction::explore::PlannerConfig;
 use taction::explore::collect::{CollectMode, CollectPlan};
-use taction::explore::{PlannerConfig, Reading};
 use taction::mesh::{ObjectSet, TriMesh, write_obj};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
@@ -38,7 +40,9 @@ fn explore(local_probability: f64, perturbation: PerturbationBounds) -> (Vec<Obj
         readings_per_object: READINGS,
         seed: 11,
     };
-    let dataset = Dataset::collect(&plan, &set.id(), &objects, 0).expect("exploration runs");
+    let dataset = plan
+        .collect_dataset(&set.id(), &objects, 0, &|| {})
+        .expect("exploration runs");
     (objects, dataset)
 }
 

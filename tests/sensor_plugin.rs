@@ -83,8 +83,9 @@ fn bad_config_fails_compilation_naming_the_key_and_range() {
 }
 
 use glam::DQuat;
+use taction::pose::Pose;
 use taction::sim::mjcf::COLLISION_GROUP;
-use taction::sim::{ObjectMount, ObjectSpec, Pose};
+use taction::sim::{ObjectMount, ObjectSpec};
 use taction::tactile::{FreeFloatingSensor, PadPose, TactileImage};
 
 /// The analytic depth of the ray through pad point (x, y) to the plane z = 0 (pad above it).

@@ -221,7 +221,7 @@ pub fn write_contact_sheets(
     for (object, readings) in dataset.header().objects.iter().zip(dataset.by_object()) {
         let images: Vec<_> = readings
             .iter()
-            .filter(|r| r.status == taction::control::ContactStatus::Converged)
+            .filter(|r| r.status == taction::dataset::ContactStatus::Converged)
             .take(per_object)
             .map(|r| r.image.clone())
             .collect();

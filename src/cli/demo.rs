@@ -4,7 +4,7 @@
 //! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
 //! the posterior over touches, a contact sheet of the tactile images and the paper's Fig. 1: the object
 //! with a patch at every converged touch, the images beside it. `--strategy active` chooses
-//! each touch by expected information gain (`recognize::active`); `--stop-at-confidence P` ends the
+//! each touch by expected information gain (`active_touch`); `--stop-at-confidence P` ends the
 //! exploration once the best guess has probability P.
 
 use std::io::Write;
@@ -12,8 +12,10 @@ use std::path::PathBuf;
 
 use clap::Args;
 use rand::RngExt;
-use taction::control::{ContactStatus, ControlConfig};
-use taction::dataset::{Dataset, describe_shortfalls};
+use taction::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
+use taction::control::ControlConfig;
+use taction::dataset::ContactStatus;
+use taction::dataset::describe_shortfalls;
 use taction::describe::DescriptorKind;
 use taction::experiment::exploration::{Placement, write_exploration_png};
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
@@ -23,7 +25,6 @@ use taction::explore::active::DEFAULT_CANDIDATES;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
-use taction::recognize::active::{ActiveRecognition, TouchPlan, explore_recognizing};
 use taction::recognize::model::TrainedModel;
 use taction::recognize::selection::{TrainConfig, codebook_sizes};
 use taction::rng;
@@ -133,8 +134,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 seed: args.seed.seed,
             };
             let progress = CollectionProgress::new("training data", objects.len(), args.training_readings);
-            let dataset =
-                Dataset::collect_reporting(&plan, &set.id(), &objects, 0, &|| progress.converged())?;
+            let dataset = plan.collect_dataset(&set.id(), &objects, 0, &|| progress.converged())?;
             progress.finish(dataset.converged_only().len());
             let short = dataset.shortfalls(args.training_readings);
             if !short.is_empty() {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use taction::control::ContactStatus;
+use taction::dataset::ContactStatus;
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{

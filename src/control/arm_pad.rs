@@ -20,10 +20,9 @@
 use glam::DVec3;
 
 use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off};
+use crate::pose::Pose;
 use crate::sim::arm::Execution;
-use crate::sim::{
-    Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Pose, Scene,
-};
+use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
 
 /// The pad frame of a pad site pose: centre at the site, normal its +z, up its +y.

@@ -5,8 +5,9 @@ use mujoco_rs::prelude::*;
 
 use crate::control::arm_pad::pad_pose_of_site;
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
+use crate::pose::Pose;
 use crate::sim::arm::{PAD_SITE, site_pose};
-use crate::sim::{Pose, Scene, SimError};
+use crate::sim::{Scene, SimError};
 use crate::tactile::free_floating::pad_rotation;
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
 

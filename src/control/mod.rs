@@ -8,12 +8,10 @@ pub mod config;
 pub mod free_pad;
 pub mod orient;
 pub mod press;
-pub mod status;
 pub mod surface_contact;
 pub mod trace;
 
 pub use carrier::{ControlError, PadCarrier, PadMotion};
 pub use config::ControlConfig;
-pub use status::ContactStatus;
 pub use surface_contact::{ContactOutcome, ContactReport, settle};
 pub use trace::{Command, Trace};

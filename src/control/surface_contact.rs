@@ -9,8 +9,8 @@ use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
 use crate::control::config::ControlConfig;
 use crate::control::orient::orient_command;
 use crate::control::press::{PressOutcome, is_clipped, press, pressed_peak};
-use crate::control::status::ContactStatus;
 use crate::control::trace::{Command, Trace};
+use crate::dataset::ContactStatus;
 use crate::sim::Collision;
 use crate::tactile::{PadPose, TactileImage};
 

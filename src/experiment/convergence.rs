@@ -18,8 +18,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::control::ControlConfig;
 use crate::control::orient::surface_normal;
-use crate::control::{ContactStatus, ControlConfig};
+use crate::dataset::ContactStatus;
 use crate::explore::collect::sensor_reader;
 use crate::explore::{SamplerConfig, sample_readings};
 use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};

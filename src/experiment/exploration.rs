@@ -14,10 +14,9 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use crate::control::ContactStatus;
-use crate::explore::Reading;
+use crate::dataset::{ContactStatus, Reading};
 use crate::mesh::TriMesh;
-use crate::sim::Pose;
+use crate::pose::Pose;
 use crate::tactile::image::{CONTACT_SHEET_GUTTER_PX, GrayPicture, contact_sheet, write_rgb_png};
 use crate::tactile::{ImageError, PadPose, SensorConfig, TactileImage};
 

@@ -8,7 +8,7 @@
 //!
 //! Exploration knows nothing of descriptors or trained models (they come later in the data flow),
 //! so the planner asks a [`TouchScorer`] to score its candidate targets; the recogniser implements
-//! it (`recognize::active`). With the strategy [`Strategy::Active`](crate::explore::Strategy) the
+//! it (`active_touch`). With the strategy [`Strategy::Active`](crate::dataset::Strategy) the
 //! planner draws [`ActiveGuidance::candidates`] targets per iteration exactly as its local/global
 //! rule would (each local with probability L once a reading exists, else global), asks the scorer,
 //! and expands toward the best one (the first of equal scores, so the choice is deterministic).

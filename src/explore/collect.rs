@@ -9,8 +9,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::control::{ControlConfig, ControlError};
+use crate::dataset::{Dataset, DatasetError, DatasetHeader};
 use crate::explore::planner::{Planner, PlannerConfig};
-use crate::explore::reading::ExplorationReport;
+use crate::explore::report::ExplorationReport;
 use crate::explore::sampler::{SamplerConfig, sample_readings};
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
@@ -27,6 +28,26 @@ pub enum CollectMode {
     Sampler(SamplerConfig),
     /// The exploration planner with the arm (Sec. III-A).
     Planner(PlannerConfig),
+}
+
+impl CollectMode {
+    /// What a dataset's header says produced it: `sampler` (or `sampler from above`), `planner L=0.5`.
+    pub fn generator_name(&self) -> String {
+        match self {
+            Self::Sampler(c) if c.from_above_only => "sampler from above".to_string(),
+            Self::Sampler(_) => "sampler".to_string(),
+            Self::Planner(c) => format!("planner L={}", c.local_probability),
+        }
+    }
+}
+
+/// Why a collection run gave no dataset.
+#[derive(Debug, thiserror::Error)]
+pub enum CollectError {
+    #[error("collecting readings: {0}")]
+    Control(#[from] ControlError),
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
 }
 
 /// Everything that determines a collection run (besides the objects).
@@ -105,7 +126,7 @@ impl CollectPlan {
 
     /// The arm's scene with `object` and the planner that explores it as object `index` of this
     /// plan (its sensor noise stream and random stream), for callers that drive the planner
-    /// themselves (active exploration, `recognize::active`).
+    /// themselves (active exploration, `active_touch`).
     #[allow(clippy::type_complexity)]
     pub fn planner_for(
         &self,
@@ -165,5 +186,29 @@ impl CollectPlan {
                 .map(|(i, object)| self.collect_object_reporting(object, i, &mut || on_converged()))
                 .collect()
         })
+    }
+
+    /// Collects `objects` (of the set with id `object_set`) as [`collect_reporting`](Self::collect_reporting)
+    /// does and gathers the readings, object by object, into a dataset whose header says how they
+    /// were made.
+    pub fn collect_dataset(
+        &self,
+        object_set: &str,
+        objects: &[ObjectSpec],
+        threads: usize,
+        on_converged: &(dyn Fn() + Sync),
+    ) -> Result<Dataset, CollectError> {
+        let reports = self.collect_reporting(objects, threads, on_converged)?;
+        let header = DatasetHeader::new(
+            self.sensor,
+            object_set,
+            objects.iter().map(|o| o.name.clone()).collect(),
+            self.mode.generator_name(),
+            self.seed,
+        );
+        Ok(Dataset::new(
+            header,
+            reports.into_iter().flat_map(|r| r.readings).collect(),
+        )?)
     }
 }

@@ -44,11 +44,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
 use crate::control::carrier::covering_back_check;
-use crate::control::{ContactStatus, ControlConfig, ControlError, settle};
+use crate::control::{ControlConfig, ControlError, settle};
+use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
 use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
-use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
-use crate::explore::strategy::Strategy;
+use crate::explore::report::ExplorationReport;
 use crate::explore::tree::ExplorationTree;
 use crate::rng::Rng;
 use crate::sim::arm::{Execution, PAD_SITE, Watch};
@@ -416,7 +416,7 @@ where
                 if let MoveOutcome::Collided(c) = outcome {
                     *report
                         .expansion_collisions
-                        .entry(AttemptCause::touched(&c).kind())
+                        .entry(AttemptCause::from(&c).kind())
                         .or_insert(0) += 1;
                     break;
                 }
@@ -584,7 +584,7 @@ where
             status: outcome.status,
             iterations: outcome.iterations,
             strategy,
-            cause: outcome.collision.as_ref().map(AttemptCause::touched),
+            cause: outcome.collision.as_ref().map(AttemptCause::from),
         })
     }
 }

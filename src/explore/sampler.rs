@@ -15,9 +15,9 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use crate::control::free_pad::FreePad;
-use crate::control::{ContactStatus, ControlConfig, ControlError, settle};
-use crate::explore::reading::{AttemptCause, ExplorationReport, Reading};
-use crate::explore::strategy::Strategy;
+use crate::control::{ControlConfig, ControlError, settle};
+use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
+use crate::explore::report::ExplorationReport;
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
 use crate::rng::Rng;
@@ -119,7 +119,7 @@ where
             status: outcome.status,
             iterations: outcome.iterations,
             strategy: Strategy::Sampler,
-            cause: outcome.collision.as_ref().map(AttemptCause::touched),
+            cause: outcome.collision.as_ref().map(AttemptCause::from),
         });
         if outcome.status == ContactStatus::Converged {
             on_converged();

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use crate::control::ContactStatus;
+use crate::dataset::ContactStatus;
 use crate::dataset::{Dataset, Reading};
 use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
@@ -32,7 +32,7 @@ impl LabelledFeatures {
         Ok(Self { objects, readings })
     }
 
-    /// Describes the [`Converged`](crate::control::ContactStatus::Converged) readings of `dataset`
+    /// Describes the [`Converged`](crate::dataset::ContactStatus::Converged) readings of `dataset`
     /// (the only ones recognition uses), in parallel, keeping dataset order within each object.
     pub fn from_dataset(dataset: &Dataset, descriptor: &dyn Descriptor) -> Self {
         let readings = dataset

@@ -14,7 +14,6 @@
 //! recorded data from a real sensor can be fed in. A [`TrainedModel`] adds the descriptor, the
 //! sensor configuration and persistence.
 
-pub mod active;
 pub mod bag;
 pub mod codebook;
 pub mod confusion;
@@ -32,7 +31,6 @@ pub mod pca;
 pub mod posterior;
 pub mod selection;
 
-pub use active::{ActiveRecognition, InformationGain, TouchPlan, explore_recognizing};
 pub use bag::BagOfFeatures;
 pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 pub use confusion::ConfusionMatrix;

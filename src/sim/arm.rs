@@ -25,10 +25,11 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use serde::{Deserialize, Serialize};
 
+use crate::bodies::{ARM_BASE, OBJECT_BODY, PAD_BODY};
+use crate::pose::Pose;
+use crate::sim::SimError;
 use crate::sim::mjcf::COLLISION_GROUP;
-use crate::sim::object::OBJECT_BODY;
 use crate::sim::scene::Scene;
-use crate::sim::{Pose, SimError};
 
 /// The arm's joints, in chain order; each has a position actuator of the same name.
 pub const ARM_JOINTS: [&str; 8] = [
@@ -41,14 +42,8 @@ pub const ARM_JOINTS: [&str; 8] = [
     "wrist_y",
     "wrist_z",
 ];
-/// The arm's bodies in `mjcf/arm.xml`, base to pad: what a collision's body names are checked against.
-pub const ARM_BODIES: [&str; 5] = [ARM_BASE, "link2", "link3", "link4", PAD_BODY];
-/// The body carrying the pad (its rigid back and holder).
-pub const PAD_BODY: &str = "sensor";
 /// The site whose frame is the pad frame (+z the pad normal, +y image up).
 pub const PAD_SITE: &str = "pad";
-/// The arm's root body.
-pub const ARM_BASE: &str = "base";
 /// The pad's rigid back: a box whose front face is the pad plane (the covering lies in front of it).
 pub const PAD_BACK_GEOM: &str = "sensor_back";
 

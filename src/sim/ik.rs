@@ -102,7 +102,7 @@ impl InverseKinematics {
     }
 
     /// The pad pose at configuration `q` (forward kinematics on the scratch data).
-    pub fn forward(&mut self, q: &[f64]) -> crate::sim::Pose {
+    pub fn forward(&mut self, q: &[f64]) -> crate::pose::Pose {
         self.arm.set_q(&mut self.data, q);
         self.data.kinematics();
         self.arm.pad_pose(&self.data)

@@ -7,14 +7,12 @@ pub mod ik;
 pub mod mjcf;
 pub mod object;
 pub mod perturb;
-pub mod pose;
 pub mod scene;
 
 pub use arm::{Arm, Collision, MoveOptions, MoveOutcome};
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 pub use object::{ObjectMount, ObjectSpec};
 pub use perturb::{Perturbation, PerturbationBounds};
-pub use pose::Pose;
 pub use scene::{Scene, SceneBuilder};
 
 /// Errors of the simulated world; each says which part and what is wrong.

@@ -5,12 +5,14 @@
 //! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
 
 use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
+use crate::pose::Pose;
+use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
 use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, escape_attr, numbers};
-use crate::sim::{Pose, SimError};
 
-/// Body, geom and joint names of the object slot.
-pub const OBJECT_BODY: &str = "object";
+use crate::bodies::OBJECT_BODY;
+
+/// Geom and joint names of the object slot (its body: [`OBJECT_BODY`]).
 pub const OBJECT_GEOM: &str = "object";
 pub const OBJECT_JOINT: &str = "object_free";
 

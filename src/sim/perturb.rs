@@ -11,9 +11,10 @@ use glam::{DQuat, DVec3};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+use crate::pose::Pose;
 use crate::rng::Rng;
+use crate::sim::SimError;
 use crate::sim::scene::Scene;
-use crate::sim::{Pose, SimError};
 
 /// Bounds of a perturbation; construct with [`PerturbationBounds::new`], which checks them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

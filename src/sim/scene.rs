@@ -5,11 +5,13 @@ use std::sync::Arc;
 use glam::DVec3;
 use mujoco_rs::prelude::*;
 
+use crate::bodies::OBJECT_BODY;
 use crate::mesh::TriMesh;
+use crate::pose::Pose;
+use crate::sim::SimError;
 use crate::sim::arm::Arm;
 use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML};
-use crate::sim::object::{OBJECT_BODY, ObjectMount, ObjectSpec};
-use crate::sim::{Pose, SimError};
+use crate::sim::object::{ObjectMount, ObjectSpec};
 
 /// What goes into a scene. The arm and table come from `mjcf/`; the object and any extra parts (a
 /// sensor plugin, a free-floating pad) are added by the caller.

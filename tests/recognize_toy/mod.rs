@@ -5,11 +5,11 @@
 use std::f64::consts::PI;
 
 use rand::RngExt;
-use taction::control::ContactStatus;
+use taction::dataset::ContactStatus;
+use taction::dataset::Strategy;
 use taction::dataset::{Dataset, DatasetHeader, Reading};
-use taction::explore::Strategy;
+use taction::pose::Pose;
 use taction::rng::{Rng, stream};
-use taction::sim::Pose;
 use taction::tactile::{SensorConfig, TactileImage};
 
 pub const SIZE: usize = 8;

@@ -1,4 +1,4 @@
-//! Beyond the paper: active touch by expected information gain (`recognize::active`) against the
+//! Beyond the paper: active touch by expected information gain (`active_touch`) against the
 //! paper's blind exploration with L = 1 (its best, Fig. 8) and L = 0.5, on the 3D set with the
 //! object fixed and perturbed after every reading (Sec. V-B4), and how many touches each needs
 //! before a confidence stop would fire.
@@ -25,6 +25,7 @@ use super::data::Objects;
 use super::figures::default_sensor;
 use super::recognition::{Curve, Family, RecognitionSweep, Setting, TestData, training_config};
 use super::scale::DataCounts;
+use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
@@ -35,7 +36,6 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
-use crate::recognize::active::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::recognize::{Evaluation, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate};
 use crate::sim::PerturbationBounds;
 

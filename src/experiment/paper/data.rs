@@ -24,7 +24,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::dataset::{Dataset, describe_shortfalls, generator_name};
+use crate::dataset::{Dataset, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::CollectionProgress;
 use crate::experiment::unit::BoxError;
@@ -76,7 +76,10 @@ impl DataRequest {
     }
 
     fn file_name(&self) -> String {
-        let generator: String = generator_name(&self.plan.mode)
+        let generator: String = self
+            .plan
+            .mode
+            .generator_name()
             .chars()
             .map(|c| {
                 if c.is_ascii_alphanumeric() || c == '.' {
@@ -142,7 +145,7 @@ impl DataStore {
                     i + 1,
                     request.plan.readings_per_object,
                     request.objects.specs.len(),
-                    generator_name(&request.plan.mode),
+                    request.plan.mode.generator_name(),
                     request.plan.sensor.rows,
                     request.plan.sensor.cols,
                 );
@@ -151,8 +154,7 @@ impl DataStore {
                     request.objects.specs.len(),
                     request.plan.readings_per_object,
                 );
-                let dataset = Dataset::collect_reporting(
-                    &request.plan,
+                let dataset = request.plan.collect_dataset(
                     &request.object_set,
                     &request.objects.specs,
                     self.threads,

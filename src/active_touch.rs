@@ -41,9 +41,10 @@
 use glam::DVec3;
 
 use crate::control::ControlError;
+use crate::dataset::Reading;
 use crate::describe::Descriptor;
+use crate::explore::Planner;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
-use crate::explore::{Planner, Reading};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
@@ -271,7 +272,7 @@ where
         let mut converged = report
             .readings
             .into_iter()
-            .filter(|r| r.status == crate::control::ContactStatus::Converged)
+            .filter(|r| r.status == crate::dataset::ContactStatus::Converged)
             .peekable();
         if converged.peek().is_none() {
             break;

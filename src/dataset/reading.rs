@@ -1,14 +1,10 @@
-//! What exploration yields: one reading per settling attempt, and a summary of a run.
-
-use std::collections::BTreeMap;
+//! One reading per settling attempt: what exploration hands to recognition.
 
 use serde::{Deserialize, Serialize};
 
-use crate::control::ContactStatus;
-use crate::explore::strategy::Strategy;
-use crate::sim::arm::{ARM_BODIES, PAD_BODY};
-use crate::sim::object::OBJECT_BODY;
-use crate::sim::{Collision, Pose};
+use crate::bodies::{ARM_BODIES, OBJECT_BODY, PAD_BODY};
+use crate::dataset::{ContactStatus, Strategy};
+use crate::pose::Pose;
 use crate::tactile::TactileImage;
 
 /// One reading: the tactile image (tagged with the pad pose it was taken at) and how it was obtained.
@@ -79,17 +75,6 @@ impl CauseKind {
 }
 
 impl AttemptCause {
-    /// The collision that stopped a motion, the arm's body first.
-    pub fn touched(collision: &Collision) -> Self {
-        let (a, b) = (&collision.body_a, &collision.body_b);
-        let (body_a, body_b) = if ARM_BODIES.contains(&b.as_str()) && !ARM_BODIES.contains(&a.as_str()) {
-            (b.clone(), a.clone())
-        } else {
-            (a.clone(), b.clone())
-        };
-        Self::Touched { body_a, body_b }
-    }
-
     /// The text of the dataset's `cause` column: `covering_meets_table`, or the two bodies as
     /// `arm_body/other_body` (e.g. `sensor/object`, `link4/world`).
     pub fn name(&self) -> String {
@@ -130,68 +115,5 @@ impl AttemptCause {
                 }
             }
         }
-    }
-}
-
-/// The readings of one exploration or sampling run, and what happened on the way.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ExplorationReport {
-    /// Every settling attempt, in order.
-    pub readings: Vec<Reading>,
-    /// Planner iterations (or sampler draws) used.
-    pub iterations: usize,
-    /// Expansion steps stopped by a collision of the arm, by who touched whom.
-    pub expansion_collisions: BTreeMap<CauseKind, usize>,
-    /// Expansion steps with no inverse-kinematics solution.
-    pub unreachable_steps: usize,
-}
-
-impl ExplorationReport {
-    /// Number of converged readings.
-    pub fn converged(&self) -> usize {
-        self.readings
-            .iter()
-            .filter(|r| r.status == ContactStatus::Converged)
-            .count()
-    }
-
-    /// Expansion steps stopped by a collision of the arm.
-    pub fn collisions(&self) -> usize {
-        self.expansion_collisions.values().sum()
-    }
-
-    /// Reading attempts by status.
-    pub fn by_status(&self) -> BTreeMap<ContactStatus, usize> {
-        let mut counts = BTreeMap::new();
-        for r in &self.readings {
-            *counts.entry(r.status).or_insert(0) += 1;
-        }
-        counts
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn causes_put_the_arm_first_round_trip_and_classify() {
-        let touched = |a: &str, b: &str| {
-            AttemptCause::touched(&Collision {
-                body_a: a.into(),
-                body_b: b.into(),
-            })
-        };
-        let pad = touched("object", "sensor");
-        assert_eq!(pad.name(), "sensor/object");
-        assert_eq!(pad.kind(), CauseKind::PadOnObject);
-        assert_eq!(touched("link3", "object").kind(), CauseKind::ArmOnObject);
-        assert_eq!(touched("world", "link4").kind(), CauseKind::ArmOnTable);
-        assert_eq!(touched("base", "link3").kind(), CauseKind::ArmOnArm);
-        for cause in [pad, touched("world", "link4"), AttemptCause::CoveringMeetsTable] {
-            assert_eq!(AttemptCause::from_name(&cause.name()), Some(cause));
-        }
-        assert_eq!(AttemptCause::from_name("sensor"), None);
-        assert_eq!(AttemptCause::from_name("/object"), None);
     }
 }

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The procedure behind a reading: the planner's two growth strategies (Sec. III-A), its active
-/// choice among them (beyond the paper, [`crate::explore::active`]), the training sampler (Sec.
+/// choice among them (beyond the paper, `explore::active`), the training sampler (Sec.
 /// V-A3), or a recording from a real sensor (Sec. V-E, V-F).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -1,0 +1,559 @@
+//! The hand-off from exploration (Sec. III-A, V-A3) to recognition (Sec. IV-A): readings, and
+//! readings on disk.
+//!
+//! A [`Dataset`] is a [`DatasetHeader`] (what produced the readings, with which sensor, on which
+//! objects) and the [`Reading`]s themselves, each a tactile image with the pad pose it was taken at,
+//! the object's pose, and how the contact controllers ended ([`ContactStatus`], [`Strategy`],
+//! [`AttemptCause`]).
+//!
+//! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
+//! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
+//! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
+//! alike. The file format is in [`format`]; the counts `dataset show` prints in [`summary`].
+
+mod format;
+mod reading;
+mod status;
+mod strategy;
+mod summary;
+
+pub use format::{FORMAT_VERSION, column_names, format_f64};
+pub use reading::{AttemptCause, CauseKind, Reading};
+pub use status::ContactStatus;
+pub use strategy::Strategy;
+pub use summary::{DatasetSummary, FailureCause};
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use crate::atomic::FileError;
+use crate::tactile::SensorConfig;
+
+/// Errors from building, reading or writing a dataset; each names the file, line and field.
+#[derive(Debug, thiserror::Error)]
+pub enum DatasetError {
+    #[error("{path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: not a taction dataset: {what}")]
+    NotADataset { path: String, what: String },
+    #[error("{path}: dataset format version {found}, but this build reads version {expected}")]
+    Version { path: String, found: u64, expected: u32 },
+    #[error("{path}: line {line}: header: {what}")]
+    Header { path: String, line: usize, what: String },
+    #[error("{path}: truncated: {what}")]
+    Truncated { path: String, what: String },
+    #[error("{path}: line {line}: {fields} columns, expected {expected} ({meta} + {rows}x{cols} taxels)", meta = format::Meta::ALL.len())]
+    ColumnCount {
+        path: String,
+        line: u64,
+        fields: usize,
+        expected: usize,
+        rows: usize,
+        cols: usize,
+    },
+    #[error("{path}: line {line}: field '{field}': {what}")]
+    Field {
+        path: String,
+        line: u64,
+        field: String,
+        what: String,
+    },
+    #[error("{path}: line {line}: {what}")]
+    Csv { path: String, line: u64, what: String },
+    #[error("invalid dataset: {0}")]
+    Invalid(String),
+}
+
+impl From<FileError> for DatasetError {
+    fn from(e: FileError) -> Self {
+        Self::Io {
+            path: e.path.display().to_string(),
+            source: e.source,
+        }
+    }
+}
+
+/// What a dataset holds and how it was made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DatasetHeader {
+    /// [`FORMAT_VERSION`] when built by this crate.
+    pub format_version: u32,
+    /// The sensor every image was taken with; its `rows x cols` is every image's shape.
+    pub sensor: SensorConfig,
+    /// Name of the object set (manifest) the objects come from.
+    pub object_set: String,
+    /// Object names in index order; every reading names one of them.
+    pub objects: Vec<String>,
+    /// What produced the readings, e.g. `sampler` or `planner L=0.8`.
+    pub generator: String,
+    /// The run's seed.
+    pub seed: u64,
+}
+
+impl DatasetHeader {
+    /// A header of the current format version.
+    pub fn new(
+        sensor: SensorConfig,
+        object_set: impl Into<String>,
+        objects: Vec<String>,
+        generator: impl Into<String>,
+        seed: u64,
+    ) -> Self {
+        Self {
+            format_version: FORMAT_VERSION,
+            sensor,
+            object_set: object_set.into(),
+            objects,
+            generator: generator.into(),
+            seed,
+        }
+    }
+
+    /// Index of `object` in [`objects`](Self::objects).
+    pub fn object_index(&self, object: &str) -> Option<usize> {
+        self.objects.iter().position(|o| o == object)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        if self.format_version != FORMAT_VERSION {
+            return Err(format!(
+                "format_version {} (this build writes {FORMAT_VERSION})",
+                self.format_version
+            ));
+        }
+        self.sensor.validate().map_err(|e| format!("sensor: {e}"))?;
+        for (i, name) in self.objects.iter().enumerate() {
+            if name.is_empty() {
+                return Err(format!("object {i} has an empty name"));
+            }
+            if self.objects[..i].contains(name) {
+                return Err(format!("object '{name}' is listed twice"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A header and its readings; every reading's object is in the header and every image has the
+/// sensor's shape (checked on construction, so code holding a `Dataset` can rely on it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dataset {
+    header: DatasetHeader,
+    readings: Vec<Reading>,
+}
+
+impl Dataset {
+    /// A dataset from readings in memory.
+    pub fn new(header: DatasetHeader, readings: Vec<Reading>) -> Result<Self, DatasetError> {
+        header.validate().map_err(DatasetError::Invalid)?;
+        let mut dataset = Self {
+            header,
+            readings: Vec::with_capacity(readings.len()),
+        };
+        for reading in readings {
+            dataset.push(reading)?;
+        }
+        Ok(dataset)
+    }
+
+    /// Appends a reading, checking its object and image shape against the header.
+    pub fn push(&mut self, reading: Reading) -> Result<(), DatasetError> {
+        let index = self.readings.len();
+        if self.header.object_index(&reading.object).is_none() {
+            return Err(DatasetError::Invalid(format!(
+                "reading {index}: object '{}' is not in the header's objects ({})",
+                reading.object,
+                self.header.objects.join(", ")
+            )));
+        }
+        let (rows, cols) = (self.header.sensor.rows, self.header.sensor.cols);
+        if (reading.image.rows(), reading.image.cols()) != (rows, cols) {
+            return Err(DatasetError::Invalid(format!(
+                "reading {index}: image is {}x{}, the sensor is {rows}x{cols}",
+                reading.image.rows(),
+                reading.image.cols()
+            )));
+        }
+        self.readings.push(reading);
+        Ok(())
+    }
+
+    pub fn header(&self) -> &DatasetHeader {
+        &self.header
+    }
+
+    pub fn readings(&self) -> &[Reading] {
+        &self.readings
+    }
+
+    pub fn len(&self) -> usize {
+        self.readings.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.readings.is_empty()
+    }
+
+    /// The same header with only the [`Converged`](ContactStatus::Converged) readings: the ones
+    /// recognition uses (Sec. III-B).
+    pub fn converged_only(&self) -> Dataset {
+        Dataset {
+            header: self.header.clone(),
+            readings: self
+                .readings
+                .iter()
+                .filter(|r| r.status == ContactStatus::Converged)
+                .cloned()
+                .collect(),
+        }
+    }
+
+    /// The objects that got fewer than `wanted` converged readings, in header order: what a run
+    /// that produced less than asked must report.
+    pub fn shortfalls(&self, wanted: usize) -> Vec<Shortfall> {
+        self.by_object()
+            .iter()
+            .zip(&self.header.objects)
+            .map(|(readings, object)| Shortfall {
+                object: object.clone(),
+                converged: readings
+                    .iter()
+                    .filter(|r| r.status == ContactStatus::Converged)
+                    .count(),
+                wanted,
+            })
+            .filter(|s| s.converged < wanted)
+            .collect()
+    }
+
+    /// Readings grouped by object, in header order, each group in dataset order.
+    pub fn by_object(&self) -> Vec<Vec<&Reading>> {
+        let mut groups = vec![Vec::new(); self.header.objects.len()];
+        for r in &self.readings {
+            if let Some(i) = self.header.object_index(&r.object) {
+                groups[i].push(r);
+            }
+        }
+        groups
+    }
+}
+
+/// An object that got fewer converged readings than asked.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Shortfall {
+    pub object: String,
+    pub converged: usize,
+    pub wanted: usize,
+}
+
+impl fmt::Display for Shortfall {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {} of {}", self.object, self.converged, self.wanted)
+    }
+}
+
+/// One line naming every short object, e.g. `2 objects got fewer converged readings than asked:
+/// camel 3 of 10, homer 0 of 10`.
+pub fn describe_shortfalls(shortfalls: &[Shortfall]) -> String {
+    let list: Vec<String> = shortfalls.iter().map(Shortfall::to_string).collect();
+    format!(
+        "{} object{} got fewer converged readings than asked: {}",
+        shortfalls.len(),
+        if shortfalls.len() == 1 { "" } else { "s" },
+        list.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+    use crate::pose::Pose;
+    use crate::tactile::{PadPose, TactileImage};
+
+    #[test]
+    fn the_column_layout_lists_every_column_once_in_file_order() {
+        let names = column_names(1, 2);
+        for (i, column) in format::Meta::ALL.iter().enumerate() {
+            assert_eq!(column.index(), i, "{column:?} is out of order");
+            assert_eq!(names[i], column.name());
+        }
+        assert_eq!(&names[format::Meta::ALL.len()..], ["t_0_0", "t_0_1"]);
+        let unique: std::collections::BTreeSet<&String> = names.iter().collect();
+        assert_eq!(unique.len(), names.len());
+    }
+
+    fn sensor() -> SensorConfig {
+        SensorConfig {
+            rows: 2,
+            cols: 3,
+            pad_width_m: 0.012,
+            pad_height_m: 0.012,
+            thickness_m: 0.1 * 0.012,
+            psf_sigma_m: 0.0005,
+            rays_per_taxel: 4,
+            noise_fraction: 0.1,
+            noise_seed: 9,
+        }
+    }
+
+    fn reading(object: &str, status: ContactStatus, k: f64, with_pad: bool) -> Reading {
+        let values = vec![0.0, 1.0, 0.1 + 0.2, 1e-300, k / 7.0, 0.5];
+        let mut image = TactileImage::new(2, 3, values).unwrap();
+        if with_pad {
+            image = image.with_pose(PadPose {
+                center_m: DVec3::new(0.1, -0.0, 1e-17),
+                normal: DVec3::Z,
+                up: DVec3::Y,
+            });
+        }
+        Reading {
+            image,
+            object: object.to_string(),
+            object_pose: Pose {
+                position_m: DVec3::new(k, 2.0 / 3.0, -1e20),
+                rotation: DQuat::from_rotation_z(k),
+            },
+            status,
+            iterations: k as u32,
+            strategy: if with_pad {
+                Strategy::Local
+            } else {
+                Strategy::Recorded
+            },
+            cause: (status == ContactStatus::Collision).then(|| AttemptCause::Touched {
+                body_a: "link4".into(),
+                body_b: "world".into(),
+            }),
+        }
+    }
+
+    fn dataset() -> Dataset {
+        let header = DatasetHeader::new(sensor(), "toy", vec!["a,\"b\"".into(), "c".into()], "sampler", 42);
+        Dataset::new(
+            header,
+            vec![
+                reading("a,\"b\"", ContactStatus::Converged, 1.0, true),
+                reading("c", ContactStatus::NoContact, 2.0, false),
+                reading("c", ContactStatus::Converged, 3.0, true),
+            ],
+        )
+        .unwrap()
+    }
+
+    fn text() -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.csv");
+        dataset().write(&path).unwrap();
+        std::fs::read_to_string(path).unwrap()
+    }
+
+    fn parse_err(text: &str) -> String {
+        Dataset::parse(text, "d.csv").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn write_then_read_is_bit_exact_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sub").join("d.csv");
+        let original = dataset();
+        original.write(&path).unwrap();
+        let back = Dataset::read(&path).unwrap();
+        assert_eq!(back, original);
+        let bits = |d: &Dataset| -> Vec<u64> {
+            d.readings()
+                .iter()
+                .flat_map(|r| r.image.values().iter().map(|v| v.to_bits()))
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(&original));
+        assert_eq!(
+            back.readings()[0].image.pose().unwrap().center_m.y.to_bits(),
+            (-0.0f64).to_bits()
+        );
+        let entries: Vec<_> = std::fs::read_dir(path.parent().unwrap()).unwrap().collect();
+        assert_eq!(entries.len(), 1);
+    }
+
+    #[test]
+    fn format_f64_round_trips_and_stays_short() {
+        for v in [
+            0.0,
+            -0.0,
+            1.0,
+            0.1 + 0.2,
+            1e-300,
+            5e-324,
+            1.7976931348623157e308,
+            1e-5,
+            9.999e-6,
+            123456.789,
+        ] {
+            let s = format_f64(v);
+            assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");
+            assert!(s.len() <= 24, "{s}");
+        }
+    }
+
+    #[test]
+    fn shortfalls_name_each_object_below_the_count() {
+        let d = dataset();
+        // "a,\"b\"" has one converged reading, "c" one of two.
+        assert!(d.shortfalls(1).is_empty());
+        let short = d.shortfalls(2);
+        assert_eq!(short.len(), 2);
+        assert_eq!(
+            describe_shortfalls(&short),
+            "2 objects got fewer converged readings than asked: a,\"b\" 1 of 2, c 1 of 2"
+        );
+    }
+
+    #[test]
+    fn converged_only_summary_and_grouping() {
+        let d = dataset();
+        assert_eq!(d.converged_only().len(), 2);
+        let groups = d.by_object();
+        assert_eq!((groups[0].len(), groups[1].len()), (1, 2));
+        let s = d.summary();
+        assert_eq!(s.total(), 3);
+        assert_eq!(s.per_object[1][&ContactStatus::NoContact], 1);
+        let shown = s.to_string();
+        assert!(
+            shown.contains("2x3 taxels") && shown.contains("no_contact") && shown.contains("local 2"),
+            "{shown}"
+        );
+        // rays_per_taxel 4 is a 2x2 supersampling grid (it once printed as "4^2").
+        assert!(shown.contains("4 rays/taxel (2x2 grid)"), "{shown}");
+        let mut nine = s.clone();
+        nine.header.sensor.rays_per_taxel = 9;
+        assert!(nine.to_string().contains("9 rays/taxel (3x3 grid)"));
+    }
+
+    #[test]
+    fn push_checks_object_and_shape() {
+        let mut d = dataset();
+        let e = d
+            .push(reading("zebra", ContactStatus::Converged, 1.0, false))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("'zebra'"), "{e}");
+        let mut bad = reading("c", ContactStatus::Converged, 1.0, false);
+        bad.image = TactileImage::zeros(3, 2).unwrap();
+        let e = d.push(bad).unwrap_err().to_string();
+        assert!(e.contains("3x2") && e.contains("2x3"), "{e}");
+        assert_eq!(d.len(), 3);
+    }
+
+    #[test]
+    fn causes_round_trip_are_counted_and_a_bad_cause_is_named() {
+        let mut d = dataset();
+        d.push(reading("c", ContactStatus::Collision, 4.0, true)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.csv");
+        d.write(&path).unwrap();
+        assert_eq!(Dataset::read(&path).unwrap(), d);
+        let s = d.summary();
+        // "c": the no_contact reading after 2 iterations lost contact; the collision is link4/world.
+        assert_eq!(s.causes[1][&FailureCause::LostContact], 1);
+        assert_eq!(s.causes[1][&FailureCause::Cause(CauseKind::ArmOnTable)], 1);
+        assert!(s.causes[0].is_empty());
+        assert!(s.to_string().contains("arm_on_table"), "{s}");
+        let t = std::fs::read_to_string(&path).unwrap();
+        let e = parse_err(&t.replace(",link4/world,", ",link4,"));
+        assert!(
+            e.contains("line 7") && e.contains("'cause'") && e.contains("'link4'"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn wrong_column_count_names_the_line() {
+        let t = text();
+        let lines: Vec<&str> = t.lines().collect();
+        let short = lines[4].rsplit_once(',').unwrap().0;
+        let broken = t.replace(lines[4], short);
+        let e = parse_err(&broken);
+        assert!(
+            e.contains("d.csv: line 5") && e.contains("26 columns, expected 27 (21 + 2x3 taxels)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn nan_taxel_names_the_line_and_field() {
+        let t = text();
+        let lines: Vec<&str> = t.lines().collect();
+        let row = lines[3].rsplit_once(',').unwrap().0.to_string() + ",NaN";
+        let e = parse_err(&t.replace(lines[3], &row));
+        assert!(
+            e.contains("line 4") && e.contains("'t_1_2'") && e.contains("not finite"),
+            "{e}"
+        );
+        let row = lines[3].rsplit_once(',').unwrap().0.to_string() + ",1.5";
+        let e = parse_err(&t.replace(lines[3], &row));
+        assert!(e.contains("'t_1_2'") && e.contains("outside [0, 1]"), "{e}");
+    }
+
+    #[test]
+    fn unknown_status_strategy_and_object_are_named() {
+        let t = text();
+        let e = parse_err(&t.replace(",no_contact,", ",slipped,"));
+        assert!(
+            e.contains("line 5") && e.contains("'status'") && e.contains("'slipped'"),
+            "{e}"
+        );
+        let e = parse_err(&t.replace(",recorded,", ",teleport,"));
+        assert!(e.contains("'strategy'") && e.contains("'teleport'"), "{e}");
+        let e = parse_err(&t.replace("\nc,no_contact", "\nd,no_contact"));
+        assert!(e.contains("'object'") && e.contains("'d'"), "{e}");
+    }
+
+    #[test]
+    fn truncation_anywhere_is_detected() {
+        let t = text();
+        for cut in [t.len() - 1, t.len() - 12, t.len() / 2, t.find('\n').unwrap() + 5] {
+            let e = Dataset::parse(&t[..cut], "d.csv").unwrap_err();
+            assert!(
+                matches!(e, DatasetError::Truncated { .. } | DatasetError::Header { .. }),
+                "cut {cut}: {e}"
+            );
+        }
+        let e = parse_err(&t.replace("# end 3", "# end 2"));
+        assert!(e.contains("truncated"), "{e}");
+        let dropped: String = {
+            let lines: Vec<&str> = t.lines().collect();
+            let mut kept: Vec<&str> = lines.clone();
+            kept.remove(4);
+            kept.join("\n") + "\n"
+        };
+        let e = parse_err(&dropped);
+        assert!(e.contains("declares 3 readings, the file has 2"), "{e}");
+    }
+
+    #[test]
+    fn wrong_version_and_wrong_magic_are_named() {
+        let t = text();
+        let e = Dataset::parse(
+            &t.replace("\"format_version\":2", "\"format_version\":7"),
+            "d.csv",
+        )
+        .unwrap_err();
+        assert!(
+            matches!(
+                e,
+                DatasetError::Version {
+                    found: 7,
+                    expected: 2,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let e = parse_err(&t.replacen("# taction dataset", "object,status", 1));
+        assert!(e.contains("not a taction dataset"), "{e}");
+        let e = parse_err(&t.replace("t_0_1", "t_0_x"));
+        assert!(e.contains("line 3") && e.contains("'t_0_x'"), "{e}");
+    }
+}

@@ -1,0 +1,167 @@
+//! What `collect` and `dataset show` print about a dataset: readings per object and status, and
+//! what ended the failed attempts.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use crate::dataset::{CauseKind, ContactStatus, Dataset, DatasetHeader};
+
+impl Dataset {
+    /// Counts per object and status, for `taction dataset show`.
+    pub fn summary(&self) -> DatasetSummary {
+        let mut per_object: Vec<BTreeMap<ContactStatus, usize>> =
+            vec![BTreeMap::new(); self.header.objects.len()];
+        for r in &self.readings {
+            if let Some(i) = self.header.object_index(&r.object) {
+                *per_object[i].entry(r.status).or_insert(0) += 1;
+            }
+        }
+        let mut by_strategy = BTreeMap::new();
+        for r in &self.readings {
+            *by_strategy.entry(r.strategy.name()).or_insert(0) += 1;
+        }
+        let mut causes = vec![BTreeMap::new(); self.header.objects.len()];
+        for r in &self.readings {
+            if let Some(i) = self.header.object_index(&r.object) {
+                let kind = match (&r.cause, r.status) {
+                    (Some(cause), _) => FailureCause::Cause(cause.kind()),
+                    (None, ContactStatus::NoContact) if r.iterations > 0 => FailureCause::LostContact,
+                    _ => continue,
+                };
+                *causes[i].entry(kind).or_insert(0) += 1;
+            }
+        }
+        DatasetSummary {
+            header: self.header.clone(),
+            per_object,
+            causes,
+            by_strategy,
+        }
+    }
+}
+
+/// Counts for `taction dataset show`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DatasetSummary {
+    pub header: DatasetHeader,
+    /// Per object (header order): readings by status.
+    pub per_object: Vec<BTreeMap<ContactStatus, usize>>,
+    /// Per object (header order): failed attempts by what ended them.
+    pub causes: Vec<BTreeMap<FailureCause, usize>>,
+    /// Readings by strategy name.
+    pub by_strategy: BTreeMap<&'static str, usize>,
+}
+
+/// What ended a failed attempt, as `collect` and `dataset show` count them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FailureCause {
+    /// A recorded [`AttemptCause`], by kind.
+    Cause(CauseKind),
+    /// `no_contact` after the controllers had pressed (Orient or Press lifted the pad off a narrow
+    /// feature), as opposed to an Approach that met nothing.
+    LostContact,
+}
+
+impl FailureCause {
+    pub const ALL: [FailureCause; 6] = [
+        Self::Cause(CauseKind::PadOnObject),
+        Self::Cause(CauseKind::ArmOnObject),
+        Self::Cause(CauseKind::ArmOnTable),
+        Self::Cause(CauseKind::ArmOnArm),
+        Self::Cause(CauseKind::CoveringOnTable),
+        Self::LostContact,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Cause(kind) => kind.name(),
+            Self::LostContact => "lost_contact",
+        }
+    }
+}
+
+impl DatasetSummary {
+    pub fn total(&self) -> usize {
+        self.per_object.iter().flat_map(|m| m.values()).sum()
+    }
+}
+
+impl fmt::Display for DatasetSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let h = &self.header;
+        let s = &h.sensor;
+        writeln!(
+            f,
+            "format version {}, object set '{}', generator '{}', seed {}",
+            h.format_version, h.object_set, h.generator, h.seed
+        )?;
+        writeln!(
+            f,
+            "sensor: {}x{} taxels, pad {} x {}, covering {}, PSF sigma {}, {} rays/taxel ({}), noise {} (seed {})",
+            s.rows,
+            s.cols,
+            crate::units::length(s.pad_width_m),
+            crate::units::length(s.pad_height_m),
+            crate::units::length(s.thickness_m),
+            crate::units::length(s.psf_sigma_m),
+            s.rays_per_taxel,
+            match crate::tactile::config::rays_per_side(s.rays_per_taxel) {
+                Some(k) => format!("{k}x{k} grid"),
+                None => "not a square grid".to_string(),
+            },
+            crate::units::significant(s.noise_fraction),
+            s.noise_seed
+        )?;
+        let width = h
+            .objects
+            .iter()
+            .map(String::len)
+            .max()
+            .unwrap_or(0)
+            .max("object".len());
+        write!(f, "{:<width$} {:>8}", "object", "readings")?;
+        for status in ContactStatus::ALL {
+            write!(f, " {:>14}", status.name())?;
+        }
+        writeln!(f)?;
+        let mut totals = [0usize; ContactStatus::ALL.len()];
+        for (name, counts) in h.objects.iter().zip(&self.per_object) {
+            write!(f, "{name:<width$} {:>8}", counts.values().sum::<usize>())?;
+            for (i, status) in ContactStatus::ALL.iter().enumerate() {
+                let n = counts.get(status).copied().unwrap_or(0);
+                totals[i] += n;
+                write!(f, " {n:>14}")?;
+            }
+            writeln!(f)?;
+        }
+        write!(f, "{:<width$} {:>8}", "total", self.total())?;
+        for n in totals {
+            write!(f, " {n:>14}")?;
+        }
+        writeln!(f)?;
+        if self.causes.iter().any(|c| !c.is_empty()) {
+            write!(f, "{:<width$} {:>8}", "causes", "")?;
+            for cause in FailureCause::ALL {
+                write!(f, " {:>17}", cause.name())?;
+            }
+            writeln!(f)?;
+            for (name, counts) in h.objects.iter().zip(&self.causes) {
+                write!(f, "{name:<width$} {:>8}", "")?;
+                for cause in FailureCause::ALL {
+                    write!(f, " {:>17}", counts.get(&cause).copied().unwrap_or(0))?;
+                }
+                writeln!(f)?;
+            }
+        }
+        let strategies: Vec<String> = self.by_strategy.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        write!(
+            f,
+            "strategies: {}",
+            if strategies.is_empty() {
+                "none".to_string()
+            } else {
+                strategies.join(", ")
+            }
+        )
+    }
+}

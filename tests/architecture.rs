@@ -1,0 +1,147 @@
+//! The data flow of `src/lib.rs` and `ARCHITECTURE.md`, checked on the source: world -> sensor ->
+//! control/explore -> descriptors -> recognizer -> results. Each top-level module may name only the
+//! modules listed for it here (in code; doc comments are free to point anywhere), so a `use` that
+//! runs back up the flow (recognition reaching into MuJoCo, say) fails this test instead of
+//! growing unnoticed.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Modules every module may use: no domain, no MuJoCo.
+const LEAVES: [&str; 5] = ["atomic", "bodies", "pose", "rng", "units"];
+
+/// For each top-level module, the domain modules it may use besides [`LEAVES`].
+fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
+    BTreeMap::from([
+        ("atomic", vec![]),
+        ("bodies", vec![]),
+        ("pose", vec![]),
+        ("rng", vec![]),
+        ("units", vec![]),
+        ("mesh", vec![]),
+        ("sim", vec!["mesh"]),
+        ("tactile", vec!["mesh", "sim"]),
+        // The hand-off: readings and their file, knowing the tactile image and nothing of MuJoCo.
+        ("dataset", vec!["tactile"]),
+        ("control", vec!["mesh", "sim", "tactile", "dataset"]),
+        ("explore", vec!["mesh", "sim", "tactile", "dataset", "control"]),
+        ("describe", vec!["tactile"]),
+        ("recognize", vec!["tactile", "dataset", "describe"]),
+        (
+            "active_touch",
+            vec![
+                "mesh",
+                "sim",
+                "tactile",
+                "dataset",
+                "control",
+                "explore",
+                "describe",
+                "recognize",
+            ],
+        ),
+        (
+            "experiment",
+            vec![
+                "mesh",
+                "sim",
+                "tactile",
+                "dataset",
+                "control",
+                "explore",
+                "describe",
+                "recognize",
+                "active_touch",
+            ],
+        ),
+    ])
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).expect("src is readable") {
+        let path = entry.expect("directory entry").path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The `crate::name` paths named in `text`'s code lines (comment lines skipped).
+fn crate_paths(text: &str) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+        let mut rest = line;
+        while let Some(at) = rest.find("crate::") {
+            rest = &rest[at + "crate::".len()..];
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_lowercase() || *c == '_')
+                .collect();
+            if !name.is_empty() {
+                names.insert(name);
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn every_module_uses_only_modules_earlier_in_the_flow() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let allowed = allowed();
+    let mut violations = Vec::new();
+    let mut seen = BTreeSet::new();
+    for file in &files {
+        let relative = file.strip_prefix(&src).expect("under src");
+        let top = relative
+            .components()
+            .next()
+            .and_then(|c| c.as_os_str().to_str())
+            .map(|s| s.trim_end_matches(".rs").to_string())
+            .expect("a file name");
+        let Some(may_use) = allowed.get(top.as_str()) else {
+            // lib.rs, main.rs and the command line (`cli`, the binary) sit on top of everything.
+            assert!(
+                ["lib", "main", "cli"].contains(&top.as_str()),
+                "{}: top-level module '{top}' is not in this test's flow; add it where it belongs",
+                relative.display()
+            );
+            continue;
+        };
+        seen.insert(top.clone());
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        for used in crate_paths(&text) {
+            if used == top || LEAVES.contains(&used.as_str()) || may_use.contains(&used.as_str()) {
+                continue;
+            }
+            violations.push(format!("{} uses crate::{used}", relative.display()));
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "imports against the flow:\n{}",
+        violations.join("\n")
+    );
+    for module in allowed.keys() {
+        assert!(
+            seen.contains(*module),
+            "module '{module}' of the flow has no source file"
+        );
+    }
+}
+
+#[test]
+fn the_scan_sees_a_use_that_runs_back_up_the_flow() {
+    let text = "//! see crate::sim for the world\nuse crate::sim::Scene;\nuse crate::dataset::{Reading};\n";
+    let names = crate_paths(text);
+    assert_eq!(
+        names,
+        BTreeSet::from(["sim".to_string(), "dataset".to_string()]),
+        "code lines count, comment lines do not"
+    );
+    assert!(!allowed()["recognize"].contains(&"sim"));
+}
