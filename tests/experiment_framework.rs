@@ -18,6 +18,7 @@ use taction::experiment::{
     Normalisation, PlotSpec, RealImport, RunOptions, SafeName, Shard, SimToRealPreprocess, SplitSizes, Unit,
     import_real_csv, merge, run, split_per_label,
 };
+use taction::recognize::AccuracyPoint;
 use taction::tactile::TactileImage;
 
 // ---------------------------------------------------------------------------------------------
@@ -574,6 +575,16 @@ fn the_merge_command_merges_and_reports_errors() {
 // ---------------------------------------------------------------------------------------------
 // Plots and the index.
 
+/// An evaluation's point after `n_readings` readings: `correct` of `trials` right.
+fn point(n_readings: usize, correct: usize, trials: usize, reliability: f64) -> AccuracyPoint {
+    AccuracyPoint {
+        n_readings,
+        trials,
+        correct,
+        reliability,
+    }
+}
+
 fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
     let mut units = Vec::new();
     for descriptor in ["polar-fourier", "mnti"] {
@@ -596,11 +607,14 @@ fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
                         seed: 42,
                         stream_seed: seed,
                     };
-                    Ok(curve.rows((1..=100).map(|n| {
-                        let a =
-                            (1.0 - (-(n as f64) / (10.0 + 40.0 * noise)).exp()) * rng.random_range(0.9..1.0);
-                        (a, a * 0.8)
-                    })))
+                    let points: Vec<AccuracyPoint> = (1..=100)
+                        .map(|n| {
+                            let a = (1.0 - (-(n as f64) / (10.0 + 40.0 * noise)).exp())
+                                * rng.random_range(0.9..1.0);
+                            point(n, (a * 1000.0).round() as usize, 1000, a * 0.8)
+                        })
+                        .collect();
+                    Ok(curve.rows(&points))
                 }));
             }
         }
@@ -788,7 +802,8 @@ fn accuracy_rows_out_of_range_are_named() {
         stream_seed: 0,
     };
     let units = vec![Unit::new(SafeName::new("u").unwrap(), move || {
-        Ok(curve.rows([(0.5, 0.5), (1.5, 0.5)]))
+        // 3 of 2 trials right: an accuracy no evaluation gives, which the runner must reject.
+        Ok(curve.rows(&[point(1, 1, 2, 0.5), point(2, 3, 2, 0.5)]))
     })];
     let e = run(
         &Experiment {

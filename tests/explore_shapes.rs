@@ -11,9 +11,7 @@ use std::process::Command;
 
 use glam::DVec3;
 use taction::control::ControlConfig;
-use taction::dataset::ContactStatus;
-use taction::dataset::Dataset;
-use taction::dataset::Reading;
+use taction::dataset::{ContactStatus, Dataset, Reading};
 use taction::explore::PlannerConfig;
 use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::mesh::{ObjectSet, TriMesh, write_obj};
@@ -263,6 +261,62 @@ fn a_run_short_of_its_count_exits_non_zero_naming_the_object() {
     assert!(output.status.success(), "{stderr}");
     assert!(
         stderr.contains("warning") && stderr.contains("faraway 0 of 3"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_experiment_with_a_short_dataset_finishes_saves_and_then_exits_non_zero() {
+    // One object in reach and the same cube 1.5 m away, which the planner can never read.
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let mut meshes = Vec::new();
+    for (name, shift_m) in [("near", 0.0), ("faraway", 1.5)] {
+        let mut cube = common::box_mesh(DVec3::splat(0.06));
+        for v in &mut cube.vertices {
+            v.x += shift_m;
+        }
+        let path = dir.path().join(format!("{name}.obj"));
+        write_obj(&cube, &path, name).expect("write the mesh");
+        meshes.push(path);
+    }
+    let out = dir.path().join("results");
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(["experiment", "perturbation", "--scale", "0.001", "--objects"])
+            .args(&meshes)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .expect("the taction binary runs")
+    };
+    let output = run(&[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("short dataset of perturbation: ")
+            && stderr.contains("faraway 0 of")
+            && stderr.contains("--allow-short"),
+        "{stderr}"
+    );
+    // Every experiment finished and was written before the exit.
+    let csv =
+        std::fs::read_to_string(out.join("perturbation/perturbation.csv")).expect("the experiment's CSV");
+    assert!(csv.lines().count() > 1, "{csv}");
+    let record =
+        std::fs::read_to_string(out.join("perturbation/shortfalls.csv")).expect("the record of short data");
+    assert!(
+        record.starts_with("dataset,object,converged,wanted\n") && record.contains(",faraway,0,"),
+        "{record}"
+    );
+
+    // Resumed with the flag: nothing is left to compute, the record still says the data were
+    // short, and the flag accepts it.
+    let output = run(&["--allow-short"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: ") && stderr.contains("faraway 0 of"),
         "{stderr}"
     );
 }

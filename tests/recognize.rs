@@ -364,7 +364,7 @@ fn accuracy_counts_every_object_an_unread_one_as_a_miss() {
             .unwrap()
     };
     let expected = (p_true(0, 10) + p_true(1, 2) + 1.0 / 3.0) / 3.0;
-    assert!((evaluation.accuracy[9].mean_p_true - expected).abs() < 1e-12);
+    assert!((evaluation.accuracy[9].reliability - expected).abs() < 1e-12);
     // No row beyond the longest trial; the unread object has no touches and no confusion entry.
     assert_eq!(evaluation.accuracy.len(), 10);
     assert!(evaluation.touches.iter().all(|r| r.trial != 2));

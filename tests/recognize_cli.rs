@@ -84,7 +84,7 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     assert_eq!(lines.count(), 3 * 30);
     let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
     assert!(
-        accuracy.starts_with("n_readings,trials,correct,accuracy,mean_p_true\n1,3,"),
+        accuracy.starts_with("n_readings,trials,correct,accuracy,reliability\n1,3,"),
         "{accuracy}"
     );
     let confusion = std::fs::read_to_string(dir.path().join("out/confusion.csv")).unwrap();

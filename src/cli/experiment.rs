@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 use taction::experiment::RunOptions;
+use taction::experiment::paper::data::{SHORTFALLS_FILE, read_shortfalls};
 use taction::experiment::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::experiment::paper::headline::headline_table;
 use taction::experiment::paper::real_frames::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
@@ -56,6 +57,11 @@ pub struct PaperArgs {
     /// training and test frames come from the same sensor).
     #[arg(long)]
     pub square_root: bool,
+    /// Exit 0 even when a dataset got fewer converged readings than asked (the shortfalls are
+    /// still listed on stderr). Without it such a run finishes every experiment, saves it, and
+    /// then exits 1.
+    #[arg(long)]
+    pub allow_short: bool,
     /// real-frames (Fig. 16b): Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
     #[arg(
         long,
@@ -135,7 +141,40 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
     announce_estimate(&[experiment.name()], &context);
     let report = experiment.run(&context).map_err(|e| e.to_string())?;
     println!("{report}");
-    Ok(())
+    check_shortfalls(&context, &[experiment.name()], args.paper.allow_short)
+}
+
+/// Lists the short datasets the experiments `names` used (their `shortfalls.csv`, this run's and
+/// earlier runs' into the same folder) on stderr; without `--allow-short` they fail the run (exit
+/// 1), after every experiment finished and was saved.
+fn check_shortfalls(
+    context: &PaperContext,
+    names: &[&str],
+    allow_short: bool,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut short = Vec::new();
+    for name in names {
+        for object in read_shortfalls(&context.options.out.join(name)).map_err(|e| e.to_string())? {
+            eprintln!("short dataset of {name}: {object}");
+            short.push(object);
+        }
+    }
+    if short.is_empty() {
+        return Ok(());
+    }
+    let message = format!(
+        "{} object{} of the run's datasets got fewer converged readings than asked (listed above, and \
+         in each experiment's {SHORTFALLS_FILE}); the results are written and count such an object \
+         with the readings it has",
+        short.len(),
+        if short.len() == 1 { "" } else { "s" }
+    );
+    if allow_short {
+        eprintln!("warning: {message}");
+        Ok(())
+    } else {
+        Err(format!("{message}; pass --allow-short to accept them").into())
+    }
 }
 
 /// Prints the estimated duration of running `names` (those not finished in the output folder) and
@@ -192,5 +231,6 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
         context.scale,
         started.elapsed().as_secs_f64()
     );
-    Ok(())
+    let all: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
+    check_shortfalls(&context, &all, args.paper.allow_short)
 }

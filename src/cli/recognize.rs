@@ -53,11 +53,11 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     for n in [1, 10, 30, 100] {
         if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {
             println!(
-                "accuracy at {n:>3} readings: {:.3} ({}/{} trials, mean p(true) {:.3})",
+                "accuracy at {n:>3} readings: {:.3} ({}/{} trials, reliability {:.3})",
                 row.accuracy(),
                 row.correct,
                 row.trials,
-                row.mean_p_true
+                row.reliability
             );
         }
     }

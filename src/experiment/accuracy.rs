@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::recognize::AccuracyPoint;
+
 /// One point of one recognition curve.
 ///
 /// | column | meaning |
@@ -46,20 +48,20 @@ pub struct AccuracyCurve {
 }
 
 impl AccuracyCurve {
-    /// The rows of this curve from `(accuracy, reliability)` after 1, 2, 3, ... readings.
-    pub fn rows(&self, points: impl IntoIterator<Item = (f64, f64)>) -> Vec<AccuracyRow> {
+    /// The rows of this curve, one per point of the evaluation (`recognize::evaluate`, whose
+    /// accuracy counts every object and an unread one as a miss).
+    pub fn rows<'a>(&self, points: impl IntoIterator<Item = &'a AccuracyPoint>) -> Vec<AccuracyRow> {
         points
             .into_iter()
-            .zip(1u32..)
-            .map(|((accuracy, reliability), n_readings)| AccuracyRow {
+            .map(|point| AccuracyRow {
                 experiment: self.experiment.clone(),
                 descriptor: self.descriptor.clone(),
                 parameter: self.parameter.clone(),
                 value: self.value.clone(),
                 trial: self.trial,
-                n_readings,
-                accuracy,
-                reliability,
+                n_readings: point.n_readings as u32,
+                accuracy: point.accuracy(),
+                reliability: point.reliability,
                 seed: self.seed,
                 stream_seed: self.stream_seed as i64,
             })
@@ -72,7 +74,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn curve_rows_count_readings_from_one() {
+    fn curve_rows_carry_each_points_readings_accuracy_and_reliability() {
         let curve = AccuracyCurve {
             experiment: "noise".into(),
             descriptor: "mnti".into(),
@@ -82,7 +84,13 @@ mod tests {
             seed: 9,
             stream_seed: u64::MAX - 1,
         };
-        let rows = curve.rows([(0.2, 0.3), (0.4, 0.5)]);
+        let point = |n_readings, correct, reliability| AccuracyPoint {
+            n_readings,
+            trials: 5,
+            correct,
+            reliability,
+        };
+        let rows = curve.rows(&[point(1, 1, 0.3), point(2, 2, 0.5)]);
         assert_eq!(rows.len(), 2);
         assert_eq!((rows[0].n_readings, rows[0].accuracy), (1, 0.2));
         assert_eq!(

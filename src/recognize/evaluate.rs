@@ -153,17 +153,18 @@ impl TouchRow {
 /// Averaging only over the trials that reached n readings would flatter an exploration that
 /// fails on the hard objects.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AccuracyRow {
+pub struct AccuracyPoint {
     pub n_readings: usize,
     /// Every trial.
     pub trials: usize,
     /// Trials whose most probable object after `n_readings` readings (or their last) is the true one.
     pub correct: usize,
-    /// Mean probability on the true object (the paper's "reliability").
-    pub mean_p_true: f64,
+    /// Mean probability on the true object: the paper's reliability (Sec. V-B1), the same name in
+    /// every CSV and table.
+    pub reliability: f64,
 }
 
-impl AccuracyRow {
+impl AccuracyPoint {
     pub fn accuracy(&self) -> f64 {
         if self.trials == 0 {
             0.0
@@ -179,8 +180,8 @@ pub struct Evaluation {
     pub objects: Vec<String>,
     /// One row per trial and reading count in the range.
     pub touches: Vec<TouchRow>,
-    /// One row per reading count in the range up to the longest trial ([`AccuracyRow`]).
-    pub accuracy: Vec<AccuracyRow>,
+    /// One row per reading count in the range up to the longest trial ([`AccuracyPoint`]).
+    pub accuracy: Vec<AccuracyPoint>,
     /// Each trial's final guess (after `min(last, trial length)` readings) against the truth.
     pub confusion: ConfusionMatrix,
 }
@@ -235,7 +236,7 @@ where
     let per_trial: Vec<Vec<TouchRow>> = per_trial.into_iter().collect::<Result<_, _>>()?;
     let longest = per_trial.iter().map(Vec::len).max().unwrap_or(0);
     let prior = 1.0 / objects.len().max(1) as f64;
-    let mut accuracy: Vec<AccuracyRow> = Vec::new();
+    let mut accuracy: Vec<AccuracyPoint> = Vec::new();
     for n in range.first..=range.last.min(longest) {
         let (mut correct, mut p_true) = (0, 0.0);
         for beliefs in &per_trial {
@@ -248,11 +249,11 @@ where
                 None => p_true += prior,
             }
         }
-        accuracy.push(AccuracyRow {
+        accuracy.push(AccuracyPoint {
             n_readings: n,
             trials: per_trial.len(),
             correct,
-            mean_p_true: p_true / per_trial.len() as f64,
+            reliability: p_true / per_trial.len() as f64,
         });
     }
     let mut touches = Vec::new();
@@ -281,7 +282,7 @@ impl Evaluation {
         self.accuracy
             .iter()
             .find(|r| r.n_readings == n)
-            .map(AccuracyRow::accuracy)
+            .map(AccuracyPoint::accuracy)
     }
 
     /// `trial,object_true,n_readings,object_guess,p_true,entropy_nats`.
@@ -331,9 +332,9 @@ impl Evaluation {
         rows.concat()
     }
 
-    /// `n_readings,trials,correct,accuracy,mean_p_true`.
+    /// `n_readings,trials,correct,accuracy,reliability`.
     pub fn accuracy_csv(&self) -> String {
-        let mut out = String::from("n_readings,trials,correct,accuracy,mean_p_true\n");
+        let mut out = String::from("n_readings,trials,correct,accuracy,reliability\n");
         for r in &self.accuracy {
             out.push_str(&format!(
                 "{},{},{},{},{}\n",
@@ -341,7 +342,7 @@ impl Evaluation {
                 r.trials,
                 r.correct,
                 r.accuracy(),
-                r.mean_p_true
+                r.reliability
             ));
         }
         out

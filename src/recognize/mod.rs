@@ -37,7 +37,7 @@ pub use confusion::ConfusionMatrix;
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use error::RecognizeError;
 pub use evaluate::{
-    AccuracyRow, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
+    AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
 };
 pub use features::FeatureMatrix;
 pub use fusion::{DescriptorChoice, FusedModel, FusedPosterior, Recognizer};

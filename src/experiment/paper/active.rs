@@ -141,7 +141,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
         context
             .store
-            .prepare(&sweep.requests(context, &objects, 0, counts))?;
+            .prepare(&sweep.requests(context, &objects, 0, counts), dir.root())?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -346,7 +346,7 @@ fn curve_rows(
                 trial: trial as u32,
                 n_readings: n as u32,
                 accuracy: point.accuracy(),
-                reliability: point.mean_p_true,
+                reliability: point.reliability,
                 seed: run_seed,
                 stream_seed: *seed as i64,
                 confident: stopped.len() as f64 / objects,

@@ -17,14 +17,14 @@
 //! the units instead would make units that share a dataset wait on each other inside the thread
 //! pool.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::dataset::{Dataset, describe_shortfalls};
+use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::CollectionProgress;
 use crate::experiment::unit::BoxError;
@@ -104,6 +104,59 @@ pub struct DataStore {
     root: PathBuf,
     threads: usize,
     datasets: Mutex<HashMap<String, Arc<Dataset>>>,
+    /// The objects of each prepared dataset (by key) that got fewer converged readings than asked.
+    shortfalls: Mutex<HashMap<String, Vec<Shortfall>>>,
+}
+
+/// The file in an experiment's folder naming the datasets it used that fell short of their
+/// readings: `dataset,object,converged,wanted`, one line per short object. It outlives the run
+/// (and the git-ignored datasets), so a resumed run and a reader of shipped results see it too.
+pub const SHORTFALLS_FILE: &str = "shortfalls.csv";
+
+/// One short object of one dataset, a line of [`SHORTFALLS_FILE`].
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, serde::Deserialize)]
+pub struct ShortObject {
+    /// The dataset's file name under `<out>/data/`.
+    pub dataset: String,
+    pub object: String,
+    pub converged: usize,
+    pub wanted: usize,
+}
+
+impl std::fmt::Display for ShortObject {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: {} {} of {} converged readings",
+            self.dataset, self.object, self.converged, self.wanted
+        )
+    }
+}
+
+/// The short objects recorded in `experiment_dir` (none if it has no [`SHORTFALLS_FILE`]).
+pub fn read_shortfalls(experiment_dir: &Path) -> Result<Vec<ShortObject>, BoxError> {
+    let path = experiment_dir.join(SHORTFALLS_FILE);
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    let mut reader = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let rows: Result<Vec<ShortObject>, _> = reader.deserialize().collect();
+    Ok(rows.map_err(|e| format!("{}: {e} (delete it; a rerun writes it again)", path.display()))?)
+}
+
+/// Adds `short` to `experiment_dir`'s [`SHORTFALLS_FILE`]: the union with what an earlier run
+/// recorded, sorted, so a resumed run keeps the record of datasets it no longer needed to read.
+fn record_shortfalls(experiment_dir: &Path, short: Vec<ShortObject>) -> Result<(), BoxError> {
+    let mut all: BTreeSet<ShortObject> = read_shortfalls(experiment_dir)?.into_iter().collect();
+    all.extend(short);
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for row in &all {
+        writer.serialize(row).map_err(|e| e.to_string())?;
+    }
+    let bytes = writer.into_inner().map_err(|e| e.to_string())?;
+    crate::experiment::files::create_dir_all(experiment_dir)?;
+    crate::atomic::write_atomic(&experiment_dir.join(SHORTFALLS_FILE), &bytes)?;
+    Ok(())
 }
 
 impl DataStore {
@@ -113,6 +166,7 @@ impl DataStore {
             root: out.to_path_buf(),
             threads,
             datasets: Mutex::new(HashMap::new()),
+            shortfalls: Mutex::new(HashMap::new()),
         }
     }
 
@@ -122,8 +176,9 @@ impl DataStore {
 
     /// Makes every requested dataset available: read from disk when an earlier run wrote it,
     /// otherwise collected now (in parallel over its objects) and written. Requests are taken in
-    /// order, each distinct dataset once.
-    pub fn prepare(&self, requests: &[DataRequest]) -> Result<(), BoxError> {
+    /// order, each distinct dataset once. The short ones among them are recorded in
+    /// `experiment_dir`'s [`SHORTFALLS_FILE`].
+    pub fn prepare(&self, requests: &[DataRequest], experiment_dir: &Path) -> Result<(), BoxError> {
         let mut distinct = BTreeMap::new();
         for r in requests {
             distinct.entry(r.key()).or_insert(r);
@@ -175,11 +230,33 @@ impl DataStore {
             };
             let short = dataset.shortfalls(request.plan.readings_per_object);
             if !short.is_empty() {
-                // Accuracy counts an object read fewer times as `experiment::accuracy` defines it;
-                // the user must still know it happened.
+                // Accuracy counts an object read fewer times as `recognize::AccuracyPoint` defines
+                // it; the user must still know it happened, now and when the run ends.
                 eprintln!("  warning: {} ({})", describe_shortfalls(&short), path.display());
+                self.shortfalls
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .insert(key.clone(), short);
             }
             self.lock().insert(key, Arc::new(dataset));
+        }
+        let short: Vec<ShortObject> = {
+            let known = self.shortfalls.lock().unwrap_or_else(PoisonError::into_inner);
+            requests
+                .iter()
+                .flat_map(|request| {
+                    let shortfalls = known.get(&request.key()).map(Vec::as_slice).unwrap_or_default();
+                    shortfalls.iter().map(|s| ShortObject {
+                        dataset: request.file_name(),
+                        object: s.object.clone(),
+                        converged: s.converged,
+                        wanted: s.wanted,
+                    })
+                })
+                .collect()
+        };
+        if !short.is_empty() {
+            record_shortfalls(experiment_dir, short)?;
         }
         Ok(())
     }

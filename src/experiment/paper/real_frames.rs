@@ -355,8 +355,8 @@ fn descriptor_rows(
             seed,
             stream_seed: trial_seed(seed, trial),
         };
-        // One definition of accuracy (`AccuracyRow`): every label counts.
-        rows.extend(meta.rows(evaluation.accuracy.iter().map(|r| (r.accuracy(), r.mean_p_true))));
+        // One definition of accuracy (`recognize::AccuracyPoint`): every label counts.
+        rows.extend(meta.rows(&evaluation.accuracy));
     }
     Ok(rows)
 }

@@ -176,7 +176,7 @@ impl RecognitionSweep {
         for plan in &pending {
             requests.extend(self.requests(context, &objects, plan.setting, setting_counts(plan.setting)));
         }
-        context.store.prepare(&requests)?;
+        context.store.prepare(&requests, dir.root())?;
 
         let real = match self.family {
             Family::RealLabels => Some(context.real_data()?),
@@ -431,9 +431,9 @@ impl RecognitionSweep {
                     seed: context.seed,
                     stream_seed: *seed,
                 };
-                // One definition of accuracy (`AccuracyRow`): every object counts, an unread one as
+                // One definition of accuracy (`recognize::AccuracyPoint`): every object counts, an unread one as
                 // a miss.
-                rows.extend(meta.rows(evaluation.accuracy.iter().map(|r| (r.accuracy(), r.mean_p_true))));
+                rows.extend(meta.rows(&evaluation.accuracy));
             }
         }
         Ok(rows)
