@@ -110,6 +110,9 @@ fn every_figure_paper_md_discusses_links_its_csv_from_one_run() {
     }
     // The shipped results are the paper's data sizes, every one of them.
     for (link, scale) in &scales {
-        assert_eq!(*scale, 1.0, "{link} comes from a run at scale {scale}, not the paper's 1.0");
+        assert_eq!(
+            *scale, 1.0,
+            "{link} comes from a run at scale {scale}, not the paper's 1.0"
+        );
     }
 }

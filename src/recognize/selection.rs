@@ -209,6 +209,34 @@ pub struct Trained {
 /// codebook and the objects' histograms, scored on validation trials; keeps the best candidate.
 /// `validation` must name only training objects; without it, part of `training` is held out
 /// ([`TrainConfig::holdout`]).
+///
+/// # Example
+///
+/// Two objects whose readings give features near (0, 0) and near (5, 5) (a descriptor's output;
+/// here written by hand): after training, three readings of the second make it the most probable
+/// (the posterior of Eq. 15-16, updated after every reading).
+///
+/// ```
+/// use taction::recognize::{LabelledFeatures, TrainConfig, train};
+///
+/// // Reading `i` of object `j`: one feature, near (5 j, 5 j).
+/// let reading = |j: usize, i: usize| {
+///     let (a, b) = (0.1 * (i % 7) as f64, 0.1 * (i % 5) as f64);
+///     vec![vec![5.0 * j as f64 + a, 5.0 * j as f64 - b]]
+/// };
+/// let readings = (0..2).map(|j| (0..110).map(|i| reading(j, i)).collect()).collect();
+/// let training = LabelledFeatures::new(vec!["cube".into(), "sphere".into()], readings)?;
+/// let config = TrainConfig { ks: vec![2], restarts: 1, ..TrainConfig::default() };
+/// let trained = train(&training, None, &config, &mut |_| {})?;
+///
+/// let mut posterior = trained.bag.posterior();
+/// for i in 0..2 {
+///     posterior.observe(&reading(1, i))?;
+/// }
+/// let belief = posterior.observe(&reading(1, 2))?;
+/// assert_eq!(trained.bag.objects()[belief.guess()], "sphere");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn train(
     training: &LabelledFeatures,
     validation: Option<&LabelledFeatures>,

@@ -58,6 +58,34 @@ pub fn free_floating_builder(
 }
 
 /// A compiled free-floating sensor scene.
+///
+/// # Example
+///
+/// The pad (the paper's 6x6 taxels, 12 mm, 1.2 mm covering) pressed half the covering's
+/// thickness into the flat top of a box: the penetration is t/2 under every taxel, so every taxel
+/// reads 0.5, the penetration as a fraction of t (Sec. V-A2), to within MuJoCo's single-precision
+/// mesh vertices (the box's top at 0.02 m is stored 4.5e-10 m lower: 4e-7 of t).
+///
+/// ```
+/// use glam::DVec3;
+/// use taction::mesh::TriMesh;
+/// use taction::sim::ObjectSpec;
+/// use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+///
+/// let config = SensorConfig::default();
+/// let top_m = 0.02;
+/// let object = ObjectSpec::new("box", TriMesh::cuboid(DVec3::new(0.03, 0.03, top_m)));
+/// let mut sensor = FreeFloatingSensor::new(object, &config)?;
+/// let pressed = PadPose {
+///     center_m: DVec3::new(0.0, 0.0, top_m + 0.5 * config.thickness_m),
+///     normal: -DVec3::Z,
+///     up: DVec3::Y,
+/// };
+/// let image = sensor.read_at(&pressed)?;
+/// assert_eq!((image.rows(), image.cols()), (6, 6));
+/// assert!(image.values().iter().all(|v| (v - 0.5).abs() < 1e-6), "{:?}", image.values());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct FreeFloatingSensor {
     scene: Scene,
     sensor: CoveringSensor,
