@@ -217,16 +217,23 @@ fn every_shape_is_read_when_perturbed_after_every_reading() {
     }
 }
 
+/// Writes `<dir>/<name>.obj`: a 6 cm cube on the table, moved `shift_m` along x from the arm's
+/// object slot (1.5 m is far outside the arm's workspace).
+fn write_cube(dir: &std::path::Path, name: &str, shift_m: f64) -> std::path::PathBuf {
+    let mut cube = common::box_mesh(DVec3::splat(0.06));
+    for v in &mut cube.vertices {
+        v.x += shift_m;
+    }
+    let path = dir.join(format!("{name}.obj"));
+    write_obj(&cube, &path, name).expect("write the mesh");
+    path
+}
+
 #[test]
 fn a_run_short_of_its_count_exits_non_zero_naming_the_object() {
     // A 6 cm cube standing 1.5 m from the arm, far outside its workspace.
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let mesh = dir.path().join("faraway.obj");
-    let mut cube = common::box_mesh(DVec3::splat(0.06));
-    for v in &mut cube.vertices {
-        v.x += 1.5;
-    }
-    write_obj(&cube, &mesh, "a cube out of reach").expect("write the mesh");
+    let mesh = write_cube(dir.path(), "faraway", 1.5);
     let out = dir.path().join("faraway.tsv");
     let run = |extra: &[&str]| {
         Command::new(env!("CARGO_BIN_EXE_taction"))
@@ -269,16 +276,10 @@ fn a_run_short_of_its_count_exits_non_zero_naming_the_object() {
 fn an_experiment_with_a_short_dataset_finishes_saves_and_then_exits_non_zero() {
     // One object in reach and the same cube 1.5 m away, which the planner can never read.
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let mut meshes = Vec::new();
-    for (name, shift_m) in [("near", 0.0), ("faraway", 1.5)] {
-        let mut cube = common::box_mesh(DVec3::splat(0.06));
-        for v in &mut cube.vertices {
-            v.x += shift_m;
-        }
-        let path = dir.path().join(format!("{name}.obj"));
-        write_obj(&cube, &path, name).expect("write the mesh");
-        meshes.push(path);
-    }
+    let meshes = [
+        write_cube(dir.path(), "near", 0.0),
+        write_cube(dir.path(), "faraway", 1.5),
+    ];
     let out = dir.path().join("results");
     let run = |extra: &[&str]| {
         Command::new(env!("CARGO_BIN_EXE_taction"))
