@@ -9,10 +9,8 @@ use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_ma
 use rand::RngExt;
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::plot::ACCURACY_LABEL;
-use taction::experiment::{
-    Experiment, ExperimentSpec, RealImport, RunOptions, SafeName, SimToRealPreprocess, Unit, import_real_csv,
-    run,
-};
+use taction::experiment::{Experiment, ExperimentSpec, RunOptions, SafeName, Unit, run};
+use taction::paper::{RealImport, SimToRealPreprocess, import_real_csv};
 use taction::tactile::TactileImage;
 
 fn preprocess(c: &mut Criterion) {

@@ -13,7 +13,8 @@
 //! describe   the six tactile image descriptors (Sec. IV-B)
 //! recognize  bag-of-features: PCA, codebooks, cross-entropy decision (Sec. IV-A, V-B1)
 //! active_touch  the planner steered by expected information gain (beyond the paper, Sec. VI)
-//! experiment the paper's figures as runs writing tidy CSV and plots (Sec. V)
+//! experiment the run framework: resumable, shardable runs writing tidy CSV, plots and an index
+//! paper      the paper's figures (Sec. V) as experiments on that framework
 //! ```
 //!
 //! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
@@ -45,3 +46,4 @@ pub mod recognize;
 pub mod active_touch;
 
 pub mod experiment;
+pub mod paper;

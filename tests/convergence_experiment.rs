@@ -4,11 +4,11 @@
 use std::num::NonZeroUsize;
 use std::path::Path;
 
-use taction::experiment::convergence::{
+use taction::experiment::{RunOptions, Shard, run};
+use taction::paper::convergence::{
     ConvergencePlan, ConvergenceRow, MIN_CONVERGENCES, PAPER_NOISE_FRACTIONS, convergence_experiment,
     paper_object,
 };
-use taction::experiment::{RunOptions, Shard, run};
 
 fn options(out: &Path, threads: usize) -> RunOptions {
     RunOptions {

@@ -11,12 +11,15 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use taction::experiment::plot::build_figure;
-use taction::experiment::real_data::parse_real_csv;
-use taction::experiment::sim_to_real::square_root;
 use taction::experiment::{
-    AccuracyCurve, AccuracyRow, Axis, Experiment, ExperimentError, ExperimentSpec, GaussianBlur,
-    Normalisation, PlotSpec, RealImport, RunOptions, SafeName, Shard, SimToRealPreprocess, SplitSizes, Unit,
-    import_real_csv, merge, run, split_per_label,
+    AccuracyCurve, AccuracyRow, Axis, Experiment, ExperimentError, ExperimentSpec, PlotSpec, RunOptions,
+    SafeName, Shard, Unit, merge, run,
+};
+use taction::paper::real_data::parse_real_csv;
+use taction::paper::sim_to_real::square_root;
+use taction::paper::{
+    GaussianBlur, Normalisation, RealImport, SimToRealPreprocess, SplitSizes, import_real_csv,
+    split_per_label,
 };
 use taction::recognize::AccuracyPoint;
 use taction::tactile::TactileImage;
@@ -842,7 +845,7 @@ const VOWELS: [(&str, [&str; 6]); 5] = [
 /// rounded to whole units (seed 2024, one stream per vowel).
 fn synthetic_letters_csv() -> String {
     let mut text = String::from(
-        "# SYNTHETIC example in the real-sensor import format of taction::experiment::real_data: NOT a\n\
+        "# SYNTHETIC example in the real-sensor import format of taction::paper::real_data: NOT a\n\
          # recording. Five vowels as 6x6 taxel patterns, shifted by up to one taxel, 600-900 raw units\n\
          # plus 0-40 units of noise; made by synthetic_letters_csv() in tests/experiment_framework.rs.\n",
     );

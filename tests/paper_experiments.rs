@@ -8,10 +8,10 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use taction::experiment::AccuracyRow;
-use taction::experiment::paper::PaperExperiment;
 use taction::mesh::ObjectSet;
 use taction::mesh::glyph::Font;
 use taction::mesh::letters::LetterStyle;
+use taction::paper::PaperExperiment;
 
 const ACCURACY_HEADER: &str =
     "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";

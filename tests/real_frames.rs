@@ -7,9 +7,9 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use taction::experiment::AccuracyRow;
-use taction::experiment::paper::context::EXAMPLE_REAL_CSV;
-use taction::experiment::paper::real_frames::{prune, scaled_split_sizes, trial_split};
-use taction::experiment::real_data::{Calibration, RealImport, parse_real_csv};
+use taction::paper::context::EXAMPLE_REAL_CSV;
+use taction::paper::real_data::{Calibration, RealImport, parse_real_csv};
+use taction::paper::real_frames::{prune, scaled_split_sizes, trial_split};
 
 const ACCURACY_HEADER: &str =
     "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";
@@ -172,7 +172,7 @@ fn splits_are_disjoint_seeded_and_differ_across_trials() {
     assert!(counts.values().all(|c| (c.kept, c.dropped) == (8, 0)));
     let kept: Vec<_> = kept.into_iter().cloned().collect();
     let sizes = scaled_split_sizes(8, 1.0).unwrap();
-    let lines = |part: &[&taction::experiment::real_data::RealReading]| -> Vec<u64> {
+    let lines = |part: &[&taction::paper::real_data::RealReading]| -> Vec<u64> {
         part.iter().map(|r| r.line).collect()
     };
     let mut trials = Vec::new();

@@ -5,13 +5,13 @@ use std::time::Instant;
 
 use clap::Args;
 use taction::experiment::RunOptions;
-use taction::experiment::paper::data::{SHORTFALLS_FILE, read_shortfalls};
-use taction::experiment::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
-use taction::experiment::paper::headline::headline_table;
-use taction::experiment::paper::real_frames::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
-use taction::experiment::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
-use taction::experiment::real_data::Calibration;
 use taction::mesh::ObjectSet;
+use taction::paper::data::{SHORTFALLS_FILE, read_shortfalls};
+use taction::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
+use taction::paper::headline::headline_table;
+use taction::paper::real_data::Calibration;
+use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
+use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 
 use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError};
 

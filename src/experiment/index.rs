@@ -10,7 +10,7 @@ use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
 use super::files::read;
 use super::layout::ExperimentDir;
-use super::merge::{experiments_in, folders_holding};
+use super::layout::{experiments_in, folders_holding};
 use super::plot::{PlotKind, build_figure};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;

@@ -11,6 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::error::ExperimentError;
 use super::name::{ExperimentName, SafeName, UnitKey};
 
 /// The file names of one experiment's output directory.
@@ -61,4 +62,29 @@ impl ExperimentDir {
     pub fn plot(&self, stem: &SafeName, extension: &str) -> PathBuf {
         self.root.join(format!("{stem}.{extension}"))
     }
+}
+
+/// The experiment directories directly under `root`, in name order.
+pub(crate) fn experiments_in(root: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
+    Ok(folders_holding(root, "manifest.json")?
+        .iter()
+        .map(|name| ExperimentDir::new(root, name))
+        .collect())
+}
+
+/// The sub-folders of `root` with a safe name that hold a file `file`, sorted by name.
+pub(crate) fn folders_holding(root: &Path, file: &str) -> Result<Vec<SafeName>, ExperimentError> {
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(root).map_err(ExperimentError::io(root))? {
+        let entry = entry.map_err(ExperimentError::io(root))?;
+        let file_name = entry.file_name();
+        let Some(name) = file_name.to_str().and_then(|n| SafeName::new(n).ok()) else {
+            continue;
+        };
+        if entry.path().join(file).is_file() {
+            names.push(name);
+        }
+    }
+    names.sort();
+    Ok(names)
 }

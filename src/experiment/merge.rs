@@ -8,8 +8,8 @@ use super::assemble::{Finished, UnitTable, finish};
 use super::error::ExperimentError;
 use super::files::{create_dir_all, read};
 use super::index::write_index;
-use super::layout::ExperimentDir;
-use super::name::{ExperimentName, SafeName};
+use super::layout::{ExperimentDir, experiments_in};
+use super::name::ExperimentName;
 use super::spec::{Manifest, write_manifest, write_or_check};
 use crate::atomic::{remove_stale_temporaries, write_atomic};
 
@@ -52,31 +52,6 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<MergeReport, ExperimentEr
     }
     write_index(out)?;
     Ok(report)
-}
-
-/// The experiment directories directly under `root`, in name order.
-pub(crate) fn experiments_in(root: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
-    Ok(folders_holding(root, "manifest.json")?
-        .iter()
-        .map(|name| ExperimentDir::new(root, name))
-        .collect())
-}
-
-/// The sub-folders of `root` with a safe name that hold a file `file`, sorted by name.
-pub(crate) fn folders_holding(root: &Path, file: &str) -> Result<Vec<SafeName>, ExperimentError> {
-    let mut names = Vec::new();
-    for entry in std::fs::read_dir(root).map_err(ExperimentError::io(root))? {
-        let entry = entry.map_err(ExperimentError::io(root))?;
-        let file_name = entry.file_name();
-        let Some(name) = file_name.to_str().and_then(|n| SafeName::new(n).ok()) else {
-            continue;
-        };
-        if entry.path().join(file).is_file() {
-            names.push(name);
-        }
-    }
-    names.sort();
-    Ok(names)
 }
 
 fn merge_experiment(

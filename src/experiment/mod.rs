@@ -1,5 +1,5 @@
-//! The experiments of Sec. V as resumable, parallel, shardable runs writing tidy CSV and plots, and
-//! the import of recorded real-sensor data (Sec. V-E, V-F).
+//! The run framework of the experiments (Sec. V): resumable, parallel, shardable runs writing tidy
+//! CSV, plots and an index. The paper's experiments themselves are in `crate::paper`.
 //!
 //! An experiment is a list of [`Unit`]s, each a stable [`UnitKey`] and a deterministic function
 //! producing rows (any serde record; [`AccuracyRow`] for the recognition curves). [`run`] executes
@@ -10,13 +10,12 @@
 //! separate shards into exactly the files of one unsharded run. The on-disk layout is in
 //! [`layout`].
 //!
-//! The framework knows nothing of MuJoCo or recognition: the experiments themselves build the units.
+//! The framework knows nothing of MuJoCo, the paper or recognition beyond the accuracy row it
+//! plots: the experiments themselves (`crate::paper`) build the units.
 
 pub mod accuracy;
 pub mod assemble;
-pub mod convergence;
 pub mod error;
-pub mod exploration;
 pub mod figure;
 pub mod files;
 pub mod font;
@@ -24,15 +23,11 @@ pub mod index;
 pub mod layout;
 pub mod merge;
 pub mod name;
-pub mod paper;
 pub mod plot;
 pub mod progress;
-pub mod real_data;
 pub mod runner;
 pub mod shard;
-pub mod sim_to_real;
 pub mod spec;
-pub mod split;
 pub mod unit;
 
 pub use accuracy::{AccuracyCurve, AccuracyRow};
@@ -43,10 +38,7 @@ pub use layout::ExperimentDir;
 pub use merge::{MergeReport, merge};
 pub use name::{ExperimentName, NameError, SafeName, UnitKey};
 pub use plot::{Axis, PlotKind, PlotSpec};
-pub use real_data::{Normalisation, RealData, RealDataError, RealImport, RealReading, import_real_csv};
 pub use runner::{Experiment, RunOptions, RunReport, run};
 pub use shard::{Shard, ShardError};
-pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};
 pub use spec::{ExperimentSpec, Manifest};
-pub use split::{Split, SplitSizes, split_per_label};
 pub use unit::{BoxError, Unit};

@@ -28,11 +28,11 @@ use crate::rng;
 use crate::sim::{ObjectSpec, PerturbationBounds};
 use crate::tactile::{FreeFloatingSensor, SensorConfig};
 
-use super::name::SafeName;
-use super::plot::{Axis, PlotSpec};
-use super::runner::Experiment;
-use super::spec::ExperimentSpec;
-use super::unit::{BoxError, Unit};
+use crate::experiment::name::SafeName;
+use crate::experiment::plot::{Axis, PlotSpec};
+use crate::experiment::runner::Experiment;
+use crate::experiment::spec::ExperimentSpec;
+use crate::experiment::unit::{BoxError, Unit};
 
 /// The experiment's name: its directory and CSV stem.
 pub const EXPERIMENT_NAME: &str = "convergence";
@@ -149,7 +149,7 @@ pub enum ConvergenceError {
     #[error("convergence experiment: sensor: {0}")]
     Sensor(String),
     #[error("convergence experiment: {0}")]
-    Name(#[from] super::name::NameError),
+    Name(#[from] crate::experiment::name::NameError),
     #[error(transparent)]
     Mesh(#[from] MeshError),
     #[error(transparent)]

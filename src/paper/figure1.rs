@@ -2,23 +2,23 @@
 //! sensor placements at which local controllers converged ... The corresponding tactile images are
 //! shown to the right" (Sec. I), from "100 tactile images ... extracted using the planner, alongside
 //! depictions of the first 50" (Sec. III-A). One planner run on the set's chess piece (the pawn, else
-//! the first object), drawn by [`crate::experiment::exploration`], with the placements as CSV.
+//! the first object), drawn by [`crate::paper::exploration`], with the placements as CSV.
 
 use std::path::PathBuf;
 
 use serde::Serialize;
 
+use super::context::Family;
 use super::context::PaperContext;
 use super::figures::default_sensor;
-use super::recognition::Family;
 use crate::atomic::write_atomic;
 use crate::control::ControlConfig;
-use crate::experiment::exploration::{Placement, write_exploration_png};
 use crate::experiment::index::{PICTURE_FILE, PictureSpec, write_index};
 use crate::experiment::spec::to_json;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::PlannerConfig;
 use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::paper::exploration::{Placement, write_exploration_png};
 use crate::rng;
 use crate::sim::PerturbationBounds;
 

@@ -5,19 +5,20 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use super::data::{DataStore, Objects};
-use super::real_frames::RealFramesOptions;
-use super::recognition::Family;
+use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
-use crate::experiment::real_data::{Calibration, RealData, RealImport, parse_real_csv};
+use serde::Serialize;
+
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
 use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
 use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
+use crate::paper::real_data::{Calibration, RealData, RealImport, parse_real_csv};
 
 /// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):
 /// the sim-to-real experiment's default input, so that its whole path runs without a recording.
-pub const EXAMPLE_REAL_CSV: &str = include_str!("../../../data/real_letters_example.csv");
+pub const EXAMPLE_REAL_CSV: &str = include_str!("../../data/real_letters_example.csv");
 
 /// A recording of real sensor frames: its CSV text and where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -46,6 +47,18 @@ impl RealRecording {
             calibration: None,
         })
     }
+}
+
+/// Which objects a sweep recognises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// The 3D object set (`--objects`, default `shapes`).
+    Shapes,
+    /// The raised letters (`--letters`, default all 52).
+    Letters,
+    /// The letters named by the labels of the real recording (`--real`).
+    RealLabels,
 }
 
 /// The shared state of a run of one or more paper experiments.

@@ -20,10 +20,11 @@ use std::sync::Arc;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::context::Family;
 use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::default_sensor;
-use super::recognition::{Curve, Family, RecognitionSweep, Setting, TestData, training_config};
+use super::recognition::{Curve, RecognitionSweep, Setting, TestData, training_config};
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use rand::seq::SliceRandom;
 use serde::Serialize;
 
-use super::context::PaperContext;
+use super::context::{Family, PaperContext};
 use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
 use crate::control::ControlConfig;
@@ -22,13 +22,13 @@ use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
-use crate::experiment::real_data::RealData;
 use crate::experiment::runner::{Experiment, RunReport, run};
-use crate::experiment::sim_to_real::SimToRealPreprocess;
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
+use crate::paper::real_data::RealData;
+use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
     LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate, make_trials,
 };
@@ -103,18 +103,6 @@ impl Setting {
             curves: vec![Curve { value, test }],
         }
     }
-}
-
-/// Which objects a sweep recognises.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Family {
-    /// The 3D object set (`--objects`, default `shapes`).
-    Shapes,
-    /// The raised letters (`--letters`, default all 52).
-    Letters,
-    /// The letters named by the labels of the real recording (`--real`).
-    RealLabels,
 }
 
 /// A recognition figure.
@@ -248,7 +236,7 @@ impl RecognitionSweep {
 
     /// The sensor of a setting with the run's noise stream.
     /// The scale's data counts with `setting`'s share of the training readings (at least one).
-    fn setting_counts(&self, setting: usize, counts: DataCounts) -> DataCounts {
+    pub(crate) fn setting_counts(&self, setting: usize, counts: DataCounts) -> DataCounts {
         let fraction = self.settings[setting].training_fraction;
         DataCounts {
             training_per_object: ((counts.training_per_object as f64 * fraction).round() as usize).max(1),
@@ -548,34 +536,4 @@ fn real_trials(
             (trial_seed, object_trials)
         })
         .collect())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::figures;
-    use super::*;
-
-    #[test]
-    fn training_size_settings_train_on_their_share_of_the_readings() {
-        let sweep = figures::training_size();
-        let paper = DataCounts {
-            training_per_object: 1000,
-            validation_per_object: 100,
-            test_per_object: 100,
-            trials: 3,
-        };
-        let trained: Vec<usize> = (0..sweep.settings.len())
-            .map(|s| sweep.setting_counts(s, paper).training_per_object)
-            .collect();
-        assert_eq!(trained, figures::TRAINING_SIZES);
-        // Everything but the training readings is the scale's; a tiny scale still trains on one.
-        assert_eq!(sweep.setting_counts(0, paper).test_per_object, 100);
-        let tiny = DataCounts {
-            training_per_object: 2,
-            ..paper
-        };
-        assert_eq!(sweep.setting_counts(0, tiny).training_per_object, 1);
-        let labels: Vec<&str> = sweep.settings.iter().map(|s| s.label.as_str()).collect();
-        assert_eq!(labels, ["100", "300", "1000"]);
-    }
 }

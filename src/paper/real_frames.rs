@@ -23,78 +23,30 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use super::context::PaperContext;
+use super::real_frames_options::RealFramesOptions;
 use super::recognition::selection_config;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
-use crate::experiment::real_data::{RealData, RealReading};
 use crate::experiment::runner::{Experiment, RunReport, run};
-use crate::experiment::sim_to_real::{GaussianBlur, square_root};
 use crate::experiment::spec::ExperimentSpec;
-use crate::experiment::split::{SplitSizes, split_per_label};
 use crate::experiment::unit::{BoxError, Unit};
+use crate::paper::real_data::{RealData, RealReading};
+use crate::paper::sim_to_real::{GaussianBlur, square_root};
+use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
 use crate::rng;
 use crate::tactile::TactileImage;
 
 /// The command-line name.
 pub const EXPERIMENT_NAME: &str = "real-frames";
-/// "performances were averaged over 7 trials of this full division, training, and testing
-/// process" (Sec. V-E).
-pub const PAPER_TRIALS: usize = 7;
-/// The default contact threshold, as a fraction of the sensing range: a frame whose largest taxel
-/// stays below a tenth of the range is taken as the letter not touching the sensor. The paper
-/// prunes non-contacts without giving its criterion.
-pub const DEFAULT_CONTACT_THRESHOLD: f64 = 0.1;
-
 /// Streams of the experiment seed (see [`crate::rng::substream`]).
 const SPLIT_STREAM: u64 = 6;
 const MODEL_STREAM: u64 = 7;
 
 /// The curve's value in the rows (`parameter` is empty: the figure varies only the descriptor).
 const CURVE_VALUE: &str = "real";
-
-/// The experiment's settings beyond the context's scale and seed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RealFramesOptions {
-    /// Frames whose peak is below this fraction of the sensing range are dropped.
-    pub contact_threshold: f64,
-    /// Replace every taxel by its square root before describing (Sec. V-F).
-    pub square_root: bool,
-    /// Gaussian blur width in taxels before describing (Sec. V-F); 0 is no blur.
-    pub blur_sigma_taxels: f64,
-    /// Trials of the whole split-train-test process.
-    pub trials: usize,
-}
-
-impl Default for RealFramesOptions {
-    fn default() -> Self {
-        Self {
-            contact_threshold: DEFAULT_CONTACT_THRESHOLD,
-            square_root: false,
-            blur_sigma_taxels: 0.0,
-            trials: PAPER_TRIALS,
-        }
-    }
-}
-
-impl RealFramesOptions {
-    /// Checks the settings, naming the flag at fault.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.contact_threshold.is_finite() && (0.0..=1.0).contains(&self.contact_threshold)) {
-            return Err(format!(
-                "--contact-threshold {}: must be in [0, 1] of the sensing range",
-                self.contact_threshold
-            ));
-        }
-        GaussianBlur::new(self.blur_sigma_taxels).map_err(|e| format!("--blur-sigma: {e}"))?;
-        if self.trials == 0 {
-            return Err("--trials: must be at least 1".into());
-        }
-        Ok(())
-    }
-}
 
 /// Frames kept and dropped of one label.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -285,7 +237,7 @@ pub fn trial_split(
     sizes: SplitSizes,
     seed: u64,
     trial: usize,
-) -> Result<crate::experiment::split::Split<&RealReading>, BoxError> {
+) -> Result<crate::paper::split::Split<&RealReading>, BoxError> {
     let trial_seed = trial_seed(seed, trial);
     Ok(split_per_label(
         kept.iter().collect(),

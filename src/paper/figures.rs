@@ -7,7 +7,8 @@
 //! other figures used). The top three descriptors are PF, MNTI and MN (Sec. V-B2); Figs. 11-13 add
 //! Vectorize.
 
-use super::recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
+use super::context::Family;
+use super::recognition::{Curve, RecognitionSweep, Setting, TestData};
 use crate::describe::DescriptorKind;
 use crate::explore::SamplerConfig;
 use crate::sim::PerturbationBounds;
@@ -306,5 +307,35 @@ pub fn sim_to_real() -> RecognitionSweep {
             from_above,
             TestData::Real,
         )],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::paper::scale::DataCounts;
+
+    #[test]
+    fn training_size_settings_train_on_their_share_of_the_readings() {
+        let sweep = training_size();
+        let paper = DataCounts {
+            training_per_object: 1000,
+            validation_per_object: 100,
+            test_per_object: 100,
+            trials: 3,
+        };
+        let trained: Vec<usize> = (0..sweep.settings.len())
+            .map(|s| sweep.setting_counts(s, paper).training_per_object)
+            .collect();
+        assert_eq!(trained, TRAINING_SIZES);
+        // Everything but the training readings is the scale's; a tiny scale still trains on one.
+        assert_eq!(sweep.setting_counts(0, paper).test_per_object, 100);
+        let tiny = DataCounts {
+            training_per_object: 2,
+            ..paper
+        };
+        assert_eq!(sweep.setting_counts(0, tiny).training_per_object, 1);
+        let labels: Vec<&str> = sweep.settings.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(labels, ["100", "300", "1000"]);
     }
 }

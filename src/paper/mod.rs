@@ -12,7 +12,7 @@
 //! | `thickness` | 11 | covering thickness |
 //! | `resolution` | 12 | taxels per side |
 //! | `noise` | 13 | additive noise |
-//! | `convergence` | 14 | controller convergence against noise ([`crate::experiment::convergence`]) |
+//! | `convergence` | 14 | controller convergence against noise ([`crate::paper::convergence`]) |
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
 //! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
@@ -24,23 +24,31 @@
 
 pub mod active;
 pub mod context;
+pub mod convergence;
 pub mod data;
 pub mod estimate;
+pub mod exploration;
 pub mod figure1;
 pub mod figures;
 pub mod headline;
+pub mod real_data;
 pub mod real_frames;
+pub mod real_frames_options;
 pub mod recognition;
 pub mod scale;
+pub mod sim_to_real;
+pub mod split;
 
 use std::fmt;
 use std::path::PathBuf;
 
-pub use context::{PaperContext, RealRecording};
-pub use recognition::{Curve, Family, RecognitionSweep, Setting, TestData};
+pub use context::{Family, PaperContext, RealRecording};
+pub use real_data::{Normalisation, RealData, RealDataError, RealImport, RealReading, import_real_csv};
+pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
 pub use scale::{DataCounts, Scale};
+pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};
+pub use split::{Split, SplitSizes, split_per_label};
 
-use crate::experiment::convergence;
 use crate::experiment::runner::{RunReport, run};
 use crate::experiment::unit::BoxError;
 
