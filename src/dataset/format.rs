@@ -97,18 +97,12 @@ impl Meta {
         Self::PadUpZ,
         Self::Cause,
     ];
-    /// The pad pose: all nine set, or all nine empty (an image without a pose).
-    const PAD: [Meta; 9] = [
-        Self::PadX,
-        Self::PadY,
-        Self::PadZ,
-        Self::PadNormalX,
-        Self::PadNormalY,
-        Self::PadNormalZ,
-        Self::PadUpX,
-        Self::PadUpY,
-        Self::PadUpZ,
-    ];
+
+    /// The pad pose's nine columns, `pad_x_m` to `pad_up_z`: all set, or all empty (an image
+    /// without a pose).
+    fn pad() -> &'static [Meta] {
+        &Self::ALL[Self::PadX.index()..=Self::PadUpZ.index()]
+    }
 
     /// The column's position in a row (the taxels follow at `Meta::ALL.len()`).
     pub(super) fn index(self) -> usize {
@@ -458,16 +452,18 @@ impl Row<'_> {
         Ok(DVec3::new(self.number(x)?, self.number(y)?, self.number(z)?))
     }
 
-    /// A name one of `names` parses, or an error listing them.
-    fn named<T>(
+    /// The column's text as `parse` reads it, or an error listing the `name`s of `all` (built only
+    /// then: this runs for every row of a dataset).
+    fn named<T: Copy>(
         &self,
         column: Meta,
         what: &str,
         parse: fn(&str) -> Option<T>,
-        names: &[&str],
+        (all, name): (&[T], fn(T) -> &'static str),
     ) -> Result<T, (String, String)> {
         let text = self.text(column);
         parse(text).ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|&v| name(v)).collect();
             self.error(
                 column.index(),
                 format!("unknown {what} '{text}' (expected one of {})", names.join(", ")),
@@ -493,10 +489,18 @@ fn parse_reading(
             ),
         ));
     }
-    let status_names: Vec<&str> = ContactStatus::ALL.iter().map(|s| s.name()).collect();
-    let status = row.named(Meta::Status, "status", ContactStatus::from_name, &status_names)?;
-    let strategy_names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
-    let strategy = row.named(Meta::Strategy, "strategy", Strategy::from_name, &strategy_names)?;
+    let status = row.named(
+        Meta::Status,
+        "status",
+        ContactStatus::from_name,
+        (&ContactStatus::ALL, ContactStatus::name),
+    )?;
+    let strategy = row.named(
+        Meta::Strategy,
+        "strategy",
+        Strategy::from_name,
+        (&Strategy::ALL, Strategy::name),
+    )?;
     let iterations: u32 = row.text(Meta::Iterations).trim().parse().map_err(|_| {
         row.error(
             Meta::Iterations.index(),
@@ -512,14 +516,11 @@ fn parse_reading(
             row.number(Meta::ObjectQw)?,
         ),
     };
-    let pad_empty = Meta::PAD.map(|m| row.text(m).trim().is_empty());
-    let pad = if pad_empty.iter().all(|&e| e) {
+    let is_empty = |column: &&Meta| row.text(**column).trim().is_empty();
+    let pad = if Meta::pad().iter().all(|column| is_empty(&column)) {
         None
-    } else if let Some(k) = pad_empty.iter().position(|&e| e) {
-        return Err(row.error(
-            Meta::PAD[k].index(),
-            "empty, but other pad pose fields are set".into(),
-        ));
+    } else if let Some(column) = Meta::pad().iter().find(is_empty) {
+        return Err(row.error(column.index(), "empty, but other pad pose fields are set".into()));
     } else {
         Some(PadPose {
             center_m: row.vector([Meta::PadX, Meta::PadY, Meta::PadZ])?,

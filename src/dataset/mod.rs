@@ -504,10 +504,35 @@ mod tests {
             e.contains("line 5") && e.contains("'status'") && e.contains("'slipped'"),
             "{e}"
         );
+        assert!(e.contains("expected one of converged, no_contact,"), "{e}");
         let e = parse_err(&t.replace(",recorded,", ",teleport,"));
         assert!(e.contains("'strategy'") && e.contains("'teleport'"), "{e}");
         let e = parse_err(&t.replace("\nc,no_contact", "\nd,no_contact"));
         assert!(e.contains("'object'") && e.contains("'d'"), "{e}");
+    }
+
+    #[test]
+    fn a_pad_pose_with_one_field_missing_is_named() {
+        let t = text();
+        let mut lines: Vec<String> = t.lines().map(str::to_string).collect();
+        // A row with a pad pose whose object name holds no quoted comma, so that splitting at
+        // commas finds the columns.
+        let pad_up_y = format::Meta::PadUpY.index();
+        let row = (3..lines.len())
+            .find(|&i| {
+                !lines[i].starts_with('"') && lines[i].split(',').nth(pad_up_y).is_some_and(|v| !v.is_empty())
+            })
+            .expect("a reading with a pad pose");
+        let mut fields: Vec<&str> = lines[row].split(',').collect();
+        fields[pad_up_y] = "";
+        lines[row] = fields.join(",");
+        let e = parse_err(&(lines.join("\n") + "\n"));
+        assert!(
+            e.contains(&format!("line {}", row + 1))
+                && e.contains("'pad_up_y'")
+                && e.contains("empty, but other pad pose fields are set"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -27,7 +27,7 @@ use serde::Serialize;
 use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::CollectionProgress;
-use crate::experiment::unit::BoxError;
+use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::collect::CollectPlan;
 use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
@@ -149,13 +149,10 @@ pub fn read_shortfalls(experiment_dir: &Path) -> Result<Vec<ShortObject>, BoxErr
 fn record_shortfalls(experiment_dir: &Path, short: Vec<ShortObject>) -> Result<(), BoxError> {
     let mut all: BTreeSet<ShortObject> = read_shortfalls(experiment_dir)?.into_iter().collect();
     all.extend(short);
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    for row in &all {
-        writer.serialize(row).map_err(|e| e.to_string())?;
-    }
-    let bytes = writer.into_inner().map_err(|e| e.to_string())?;
+    let path = experiment_dir.join(SHORTFALLS_FILE);
+    let bytes = rows_to_csv(&all.into_iter().collect::<Vec<_>>(), &path)?;
     crate::experiment::files::create_dir_all(experiment_dir)?;
-    crate::atomic::write_atomic(&experiment_dir.join(SHORTFALLS_FILE), &bytes)?;
+    crate::atomic::write_atomic(&path, &bytes)?;
     Ok(())
 }
 
