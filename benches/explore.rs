@@ -31,16 +31,16 @@ use criterion::{Criterion, Throughput, criterion_group};
 use glam::DVec3;
 use rand::RngExt;
 use taction::active_touch::InformationGain;
-use taction::control::ControlConfig;
 use taction::explore::TouchScorer;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
-use taction::explore::{ExplorationReport, Planner, PlannerConfig, SamplerConfig, sample_readings};
+use taction::explore::{ExplorationReport, Planner, PlannerConfig, sample_readings};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::recognize::{ClusterHistogram, ObjectModels, PseudoCount};
 use taction::sim::arm::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use taction::tactile::sensor::{CoveringSensor, add_sensor};
 use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+use taction::valid::Valid;
 
 /// Converged readings per timed run.
 const SAMPLER_READINGS: usize = 20;
@@ -86,8 +86,8 @@ fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
         free.scene_mut(),
         "pawn",
         sensor(),
-        &ControlConfig::default(),
-        &SamplerConfig::default(),
+        &Valid::default(),
+        &Valid::default(),
         PerturbationBounds::NONE,
         SAMPLER_READINGS,
         &mut rng,
@@ -108,8 +108,8 @@ fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u
     };
     let mut planner = Planner::new(
         scene,
-        config,
-        ControlConfig::default(),
+        Valid::new(config).expect("the default planner config is valid"),
+        Valid::default(),
         sensor(),
         PerturbationBounds::NONE,
         taction::rng::rng(seed),
@@ -179,9 +179,11 @@ fn shapes() -> Vec<ObjectSpec> {
 /// `SHAPES_READINGS` converged planner readings of every object of `objects`, on one thread.
 fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
     let plan = CollectPlan {
-        mode: CollectMode::Planner(PlannerConfig::default().fitted_to(objects)),
+        mode: CollectMode::Planner(
+            Valid::new(PlannerConfig::default().fitted_to(objects)).expect("fitted config"),
+        ),
         sensor: sensor(),
-        control: ControlConfig::default(),
+        control: Valid::default(),
         perturbation: PerturbationBounds::NONE,
         readings_per_object: SHAPES_READINGS,
         seed,

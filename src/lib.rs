@@ -18,9 +18,13 @@
 //! ```
 //!
 //! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
-//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units`, `atomic` (the
-//! one writer of files), `pose` and `bodies` serve every module; `tests/architecture.rs` checks the
+//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units`, `valid` (configs
+//! checked once, at the edge), `atomic` (the one writer of files), `pose` and `bodies` serve every
+//! module; `tests/architecture.rs` checks the
 //! flow.
+//!
+//! [`prelude`] gathers the names a user needs first; each module's root re-exports its own public
+//! types, and the files behind it are private to the crate.
 //!
 //! `ARCHITECTURE.md` at the repository's root holds the module map, the decisions the code relies on
 //! and the paper's errata.
@@ -30,6 +34,7 @@ pub mod bodies;
 pub mod pose;
 pub mod rng;
 pub mod units;
+pub mod valid;
 
 pub mod mesh;
 pub mod sim;
@@ -44,6 +49,8 @@ pub mod describe;
 pub mod recognize;
 
 pub mod active_touch;
+
+pub mod prelude;
 
 pub mod experiment;
 pub mod paper;

@@ -13,6 +13,7 @@ use taction::rng;
 use taction::sim::ObjectSpec;
 use taction::tactile::free_floating::FreeFloatingSensor;
 use taction::tactile::{PadPose, SensorConfig};
+use taction::valid::Valid;
 
 fn sensor() -> SensorConfig {
     SensorConfig::square(6, 6, 0.012, 0.0012)
@@ -31,7 +32,7 @@ fn settle_from(
     let reader = sensor_reader(free.sensor().clone());
     let mut pad = FreePad::new(free.scene_mut(), sensor(), reader).unwrap();
     pad.place(start);
-    settle(&mut pad, config).unwrap()
+    settle(&mut pad, &Valid::new(*config).unwrap()).unwrap()
 }
 
 /// A 20 cm slab whose top face passes through the origin with normal `n`.
@@ -168,7 +169,7 @@ fn same_seed_same_commands_and_readings() {
         let reader = sensor_reader(free.sensor().clone());
         let mut pad = FreePad::new(free.scene_mut(), sensor, reader).unwrap();
         pad.place(&start);
-        let o = settle(&mut pad, &config).unwrap();
+        let o = settle(&mut pad, &Valid::new(config).unwrap()).unwrap();
         (o.trace, o.image, o.status)
     };
     let a = run(7);

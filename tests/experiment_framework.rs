@@ -1041,7 +1041,12 @@ fn import_normalises_by_the_file_maximum_or_the_range() {
     assert_eq!((data.readings[1].label.as_str(), data.readings[1].line), ("B", 3));
     assert_eq!("max".parse::<Normalisation>(), Ok(Normalisation::FileMax));
     assert_eq!("400".parse::<Normalisation>(), Ok(Normalisation::Range(400.0)));
-    assert!("-1".parse::<Normalisation>().unwrap_err().contains("'-1'"));
+    assert!(
+        "-1".parse::<Normalisation>()
+            .unwrap_err()
+            .to_string()
+            .contains("'-1'")
+    );
     let ranged = RealImport {
         normalisation: "400".parse().unwrap(),
         allowed_labels: None,

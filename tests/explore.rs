@@ -6,10 +6,11 @@ use glam::DVec3;
 use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::dataset::Strategy;
+use taction::explore::PlannerConfig;
 use taction::explore::collect::{CollectMode, CollectPlan};
-use taction::explore::{PlannerConfig, SamplerConfig};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
+use taction::valid::Valid;
 
 fn box_object() -> ObjectSpec {
     ObjectSpec::new("box", common::box_mesh(DVec3::new(0.10, 0.08, 0.10)))
@@ -19,7 +20,7 @@ fn plan(mode: CollectMode, readings: usize, perturbation: PerturbationBounds) ->
     CollectPlan {
         mode,
         sensor: SensorConfig::square(6, 6, 0.012, 0.0012),
-        control: ControlConfig::default(),
+        control: Valid::default(),
         perturbation,
         readings_per_object: readings,
         seed: 17,
@@ -33,11 +34,7 @@ fn planner_collects_converged_readings_on_a_box() {
         (PerturbationBounds::new(10.0, 0.1).unwrap(), 10),
     ] {
         let t0 = std::time::Instant::now();
-        let plan = plan(
-            CollectMode::Planner(PlannerConfig::default()),
-            wanted,
-            perturbation,
-        );
+        let plan = plan(CollectMode::Planner(Valid::default()), wanted, perturbation);
         let report = plan.collect_object(&box_object(), 0).unwrap();
         eprintln!(
             "planner: {} converged of {} attempts in {} iterations, {} collisions, {} unreachable, {:?} ({:?})",
@@ -141,7 +138,7 @@ fn planner_collects_converged_readings_on_a_box() {
 #[test]
 fn sampler_readings_cover_every_face_of_a_box() {
     let plan = plan(
-        CollectMode::Sampler(SamplerConfig::default()),
+        CollectMode::Sampler(Valid::default()),
         60,
         PerturbationBounds::NONE,
     );
@@ -206,7 +203,11 @@ fn datasets_are_identical_for_one_and_two_threads() {
         let mut plan = plan(mode, 3, perturbation);
         plan.seed = seed;
         plan.sensor.noise_fraction = 0.1;
-        plan.control.expected_noise_fraction = 0.1;
+        plan.control = Valid::new(ControlConfig {
+            expected_noise_fraction: 0.1,
+            ..ControlConfig::default()
+        })
+        .unwrap();
         let reports = plan.collect(&objects, threads).unwrap();
         let header = DatasetHeader::new(
             plan.sensor,
@@ -230,8 +231,8 @@ fn datasets_are_identical_for_one_and_two_threads() {
         std::fs::read(&path).unwrap()
     };
     for (name, mode) in [
-        ("sampler", CollectMode::Sampler(SamplerConfig::default())),
-        ("planner", CollectMode::Planner(PlannerConfig::default())),
+        ("sampler", CollectMode::Sampler(Valid::default())),
+        ("planner", CollectMode::Planner(Valid::default())),
     ] {
         let serial = write(mode, 5, 1, name);
         let parallel = write(mode, 5, 2, name);
@@ -273,8 +274,8 @@ fn global_strategy_covers_the_workspace() {
     };
     let mut planner = Planner::new(
         &scene,
-        config,
-        ControlConfig::default(),
+        Valid::new(config).unwrap(),
+        Valid::default(),
         sensor,
         PerturbationBounds::NONE,
         taction::rng::rng(3),
@@ -336,7 +337,7 @@ fn planner_rates() {
     }
     for object in &objects {
         let plan = plan(
-            CollectMode::Planner(PlannerConfig::default()),
+            CollectMode::Planner(Valid::default()),
             40,
             PerturbationBounds::NONE,
         );

@@ -10,13 +10,13 @@ mod common;
 use std::process::Command;
 
 use glam::DVec3;
-use taction::control::ControlConfig;
 use taction::dataset::{ContactStatus, Dataset, Reading};
 use taction::explore::PlannerConfig;
 use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::mesh::{ObjectSet, TriMesh, write_obj};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
+use taction::valid::Valid;
 
 const READINGS: usize = 10;
 
@@ -26,14 +26,17 @@ fn explore(local_probability: f64, perturbation: PerturbationBounds) -> (Vec<Obj
     let objects = ObjectSpec::all_of(&set).expect("the shapes (fetched by `cargo xtask setup`)");
     let plan = CollectPlan {
         mode: CollectMode::Planner(
-            PlannerConfig {
-                local_probability,
-                ..PlannerConfig::default()
-            }
-            .fitted_to(&objects),
+            Valid::new(
+                PlannerConfig {
+                    local_probability,
+                    ..PlannerConfig::default()
+                }
+                .fitted_to(&objects),
+            )
+            .expect("a probability in [0, 1]"),
         ),
         sensor: SensorConfig::square(6, 6, 0.012, 0.0012),
-        control: ControlConfig::default(),
+        control: Valid::default(),
         perturbation,
         readings_per_object: READINGS,
         seed: 11,

@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use taction::control::ControlConfig;
 use taction::dataset::{Dataset, DatasetHeader, describe_shortfalls};
 use taction::experiment::progress::CollectionProgress;
 use taction::explore::collect::{CollectMode, CollectPlan};
@@ -13,6 +12,7 @@ use taction::explore::{ExplorationReport, PlannerConfig, SamplerConfig};
 use taction::mesh::ObjectSet;
 use taction::sim::PerturbationBounds;
 use taction::tactile::image::write_contact_sheet;
+use taction::valid::Valid;
 
 use crate::cli::common::{SeedArg, ThreadsArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
@@ -125,7 +125,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
                 from_above_only: args.from_above,
                 ..SamplerConfig::default()
             };
-            (CollectMode::Sampler(config), "sampler".to_string())
+            (CollectMode::Sampler(Valid::new(config)?), "sampler".to_string())
         }
         Mode::Planner => {
             let config = PlannerConfig {
@@ -135,7 +135,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
             .fitted_to(&objects);
             (
-                CollectMode::Planner(config),
+                CollectMode::Planner(Valid::new(config)?),
                 format!("planner L={}", args.local_prob),
             )
         }
@@ -143,7 +143,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let plan = CollectPlan {
         mode,
         sensor,
-        control: ControlConfig::default(),
+        control: Valid::default(),
         perturbation,
         readings_per_object: args.readings,
         seed: args.seed.seed,

@@ -13,7 +13,6 @@ use std::path::PathBuf;
 use clap::Args;
 use rand::RngExt;
 use taction::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
-use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::dataset::describe_shortfalls;
 use taction::describe::DescriptorKind;
@@ -22,7 +21,7 @@ use taction::experiment::progress::CollectionProgress;
 use taction::explore::Probability;
 use taction::explore::active::DEFAULT_CANDIDATES;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
-use taction::explore::{Planner, PlannerConfig, SamplerConfig};
+use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::exploration::{Placement, write_exploration_png};
 use taction::recognize::model::TrainedModel;
@@ -32,6 +31,7 @@ use taction::sim::arm::PAD_SITE;
 use taction::sim::{PerturbationBounds, SceneBuilder};
 use taction::tactile::image::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
+use taction::valid::Valid;
 
 use crate::cli::common::{OutputLock, SeedArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
@@ -126,9 +126,9 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                     .join(", ")
             );
             let plan = CollectPlan {
-                mode: CollectMode::Sampler(SamplerConfig::default()),
+                mode: CollectMode::Sampler(Valid::default()),
                 sensor,
-                control: ControlConfig::default(),
+                control: Valid::default(),
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: args.training_readings,
                 seed: args.seed.seed,
@@ -191,19 +191,21 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     );
 
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-    let planner_config = PlannerConfig {
-        local_probability: match args.strategy {
-            DemoStrategy::Blind => 0.8,
-            // Candidates half local, half global: the scorer picks among both kinds.
-            DemoStrategy::Active => 0.5,
-        },
-        ..PlannerConfig::default()
-    }
-    .fitted_to(&objects);
+    let planner_config = Valid::new(
+        PlannerConfig {
+            local_probability: match args.strategy {
+                DemoStrategy::Blind => 0.8,
+                // Candidates half local, half global: the scorer picks among both kinds.
+                DemoStrategy::Active => 0.5,
+            },
+            ..PlannerConfig::default()
+        }
+        .fitted_to(&objects),
+    )?;
     let mut planner = Planner::new(
         &scene,
         planner_config,
-        ControlConfig::default(),
+        Valid::default(),
         sensor,
         PerturbationBounds::NONE,
         rng::stream(args.seed.seed, PLANNER_STREAM),

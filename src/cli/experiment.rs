@@ -12,6 +12,7 @@ use taction::paper::headline::headline_table;
 use taction::paper::real_data::Calibration;
 use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
+use taction::valid::Check;
 
 use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError};
 
@@ -89,7 +90,7 @@ impl PaperArgs {
             blur_sigma_taxels: self.blur_sigma,
             trials: self.trials,
         };
-        real_frames.validate().map_err(UsageError)?;
+        real_frames.check().map_err(|e| UsageError(e.to_string()))?;
         let run = RunOptions {
             threads: Some(self.threads.count()),
             ..self.run.clone()

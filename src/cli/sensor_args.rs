@@ -9,6 +9,7 @@ use taction::sim::ObjectSpec;
 use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
 
 use crate::cli::plausible::{Carrier, check_mesh};
+use taction::valid::Check;
 
 #[derive(Debug, Clone, Args)]
 pub struct SensorArgs {
@@ -75,7 +76,7 @@ impl SensorArgs {
             noise_fraction: self.noise,
             noise_seed,
         };
-        config.validate().map_err(|e| SensorFlagError {
+        config.check().map_err(|e| SensorFlagError {
             flag: flag_of(e.key),
             value: e.value.clone(),
             allowed: e.key.allowed(),

@@ -23,6 +23,7 @@ use taction::explore::planner::precise_motion;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
 use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
+use taction::valid::Valid;
 
 use crate::cli::common::SeedArg;
 use crate::cli::plausible::Carrier;
@@ -88,7 +89,7 @@ pub enum TouchError {
 impl TouchArgs {
     /// The controller configuration the flags describe, validated. The controllers expect the
     /// sensor's own noise: their contact threshold and tolerances widen with it.
-    pub fn control_config(&self, sensor: &SensorConfig) -> Result<ControlConfig, TouchError> {
+    pub fn control_config(&self, sensor: &SensorConfig) -> Result<Valid<ControlConfig>, TouchError> {
         let mut config = match &self.control {
             None => ControlConfig::default(),
             Some(path) => {
@@ -107,19 +108,16 @@ impl TouchArgs {
             config.target_mean_pressure = target;
         }
         config.expected_noise_fraction = sensor.noise_fraction;
-        config
-            .validate()
-            .map_err(|e| match (e.field, self.target_pressure) {
-                ("target_mean_pressure", Some(t)) => TouchError::TargetPressure(t),
-                _ => TouchError::ControlFile {
-                    path: self
-                        .control
-                        .as_ref()
-                        .map_or_else(|| "(defaults)".into(), |p| p.display().to_string()),
-                    what: e.to_string(),
-                },
-            })?;
-        Ok(config)
+        Valid::new(config).map_err(|e| match (e.field, self.target_pressure) {
+            ("target_mean_pressure", Some(t)) => TouchError::TargetPressure(t),
+            _ => TouchError::ControlFile {
+                path: self
+                    .control
+                    .as_ref()
+                    .map_or_else(|| "(defaults)".into(), |p| p.display().to_string()),
+                what: e.to_string(),
+            },
+        })
     }
 }
 
@@ -127,7 +125,7 @@ impl TouchArgs {
 fn touch_free(
     object: ObjectSpec,
     sensor: SensorConfig,
-    control: &ControlConfig,
+    control: &Valid<ControlConfig>,
     start: &PadPose,
 ) -> Result<ContactOutcome, TouchError> {
     let mut free = FreeFloatingSensor::new(object, &sensor)?;
@@ -142,7 +140,7 @@ fn touch_free(
 fn touch_arm(
     object: ObjectSpec,
     sensor: SensorConfig,
-    control: &ControlConfig,
+    control: &Valid<ControlConfig>,
     start: &PadPose,
 ) -> Result<ContactOutcome, TouchError> {
     let builder = SceneBuilder::with_arm_and_table().object(object);

@@ -29,8 +29,6 @@ pub enum ControlError {
     Tactile(#[from] crate::tactile::sensor::TactileError),
     #[error("cannot start the worker threads: {0}")]
     ThreadPool(String),
-    #[error(transparent)]
-    Config(#[from] crate::control::config::ControlConfigError),
 }
 
 /// A pad that can be read and moved.

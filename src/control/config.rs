@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::valid::{Check, FieldChecks, RangeError};
+
 /// Configuration of Approach, Press and Orient (Sec. III-B). Pressures are fractions of the sensing
 /// range (taxel values in [0, 1]); lengths are metres or multiples of the covering thickness t.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -68,124 +70,111 @@ impl Default for ControlConfig {
     }
 }
 
-/// A configuration value outside its allowed range.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("control config: {field} = {value} is outside {allowed}")]
-pub struct ControlConfigError {
-    pub field: &'static str,
-    pub value: f64,
-    pub allowed: &'static str,
+impl Check for ControlConfig {
+    type Error = RangeError;
+
+    /// Every field against its range (and finite); the error names the first offender.
+    fn check(&self) -> Result<(), RangeError> {
+        let Self {
+            contact_threshold,
+            expected_noise_fraction,
+            approach_step_thickness,
+            approach_max_distance_m,
+            target_mean_pressure,
+            pressure_tolerance,
+            press_kp,
+            press_kd,
+            press_max_step_thickness,
+            press_max_steps,
+            saturation_threshold,
+            orient_step,
+            orient_tolerance_rad,
+            orient_max_step_rad,
+            max_iterations,
+        } = *self;
+        FieldChecks::of("control config")
+            .real(
+                "contact_threshold",
+                contact_threshold,
+                (0.0..1.0).contains(&contact_threshold),
+                "[0, 1)",
+            )
+            .real(
+                "expected_noise_fraction",
+                expected_noise_fraction,
+                (0.0..=2.0).contains(&expected_noise_fraction),
+                "[0, 2]",
+            )
+            .real(
+                "approach_step_thickness",
+                approach_step_thickness,
+                approach_step_thickness > 0.0 && approach_step_thickness <= 1.0,
+                "(0, 1]",
+            )
+            .real(
+                "approach_max_distance_m",
+                approach_max_distance_m,
+                approach_max_distance_m > 0.0,
+                "(0, inf)",
+            )
+            .real(
+                "target_mean_pressure",
+                target_mean_pressure,
+                target_mean_pressure > 0.0 && target_mean_pressure < 1.0,
+                "(0, 1)",
+            )
+            .real(
+                "pressure_tolerance",
+                pressure_tolerance,
+                pressure_tolerance > 0.0,
+                "(0, inf)",
+            )
+            .real("press_kp", press_kp, press_kp > 0.0 && press_kp <= 2.0, "(0, 2]")
+            .real("press_kd", press_kd, (0.0..=2.0).contains(&press_kd), "[0, 2]")
+            .real(
+                "press_max_step_thickness",
+                press_max_step_thickness,
+                press_max_step_thickness > 0.0,
+                "(0, inf)",
+            )
+            .count(
+                "press_max_steps",
+                press_max_steps,
+                press_max_steps > 0,
+                "1 or more",
+            )
+            .real(
+                "saturation_threshold",
+                saturation_threshold,
+                saturation_threshold > target_mean_pressure && saturation_threshold <= 1.0,
+                "(target_mean_pressure, 1]",
+            )
+            .real(
+                "orient_step",
+                orient_step,
+                orient_step > 0.0 && orient_step <= 1.0,
+                "(0, 1]",
+            )
+            .real(
+                "orient_tolerance_rad",
+                orient_tolerance_rad,
+                orient_tolerance_rad > 0.0,
+                "(0, inf)",
+            )
+            // A negative step would turn the pad away from the surface; beyond a half turn the
+            // rotation is no longer the short way round.
+            .real(
+                "orient_max_step_rad",
+                orient_max_step_rad,
+                orient_max_step_rad > 0.0 && orient_max_step_rad <= std::f64::consts::PI,
+                "(0, pi]",
+            )
+            .count("max_iterations", max_iterations, max_iterations > 0, "1 or more")
+            .finish()
+    }
 }
 
 impl ControlConfig {
-    /// Checks every field's range (and that it is finite).
-    pub fn validate(&self) -> Result<(), ControlConfigError> {
-        let checks: [(&'static str, f64, bool, &'static str); 15] = [
-            (
-                "contact_threshold",
-                self.contact_threshold,
-                (0.0..1.0).contains(&self.contact_threshold),
-                "[0, 1)",
-            ),
-            (
-                "expected_noise_fraction",
-                self.expected_noise_fraction,
-                (0.0..=2.0).contains(&self.expected_noise_fraction),
-                "[0, 2]",
-            ),
-            (
-                "approach_step_thickness",
-                self.approach_step_thickness,
-                self.approach_step_thickness > 0.0 && self.approach_step_thickness <= 1.0,
-                "(0, 1]",
-            ),
-            (
-                "approach_max_distance_m",
-                self.approach_max_distance_m,
-                self.approach_max_distance_m > 0.0,
-                "(0, inf)",
-            ),
-            (
-                "target_mean_pressure",
-                self.target_mean_pressure,
-                self.target_mean_pressure > 0.0 && self.target_mean_pressure < 1.0,
-                "(0, 1)",
-            ),
-            (
-                "pressure_tolerance",
-                self.pressure_tolerance,
-                self.pressure_tolerance > 0.0,
-                "(0, inf)",
-            ),
-            (
-                "press_kp",
-                self.press_kp,
-                self.press_kp > 0.0 && self.press_kp <= 2.0,
-                "(0, 2]",
-            ),
-            (
-                "press_kd",
-                self.press_kd,
-                (0.0..=2.0).contains(&self.press_kd),
-                "[0, 2]",
-            ),
-            (
-                "press_max_step_thickness",
-                self.press_max_step_thickness,
-                self.press_max_step_thickness > 0.0,
-                "(0, inf)",
-            ),
-            (
-                "press_max_steps",
-                self.press_max_steps as f64,
-                self.press_max_steps > 0,
-                "1 or more",
-            ),
-            (
-                "saturation_threshold",
-                self.saturation_threshold,
-                self.saturation_threshold > self.target_mean_pressure && self.saturation_threshold <= 1.0,
-                "(target_mean_pressure, 1]",
-            ),
-            (
-                "orient_step",
-                self.orient_step,
-                self.orient_step > 0.0 && self.orient_step <= 1.0,
-                "(0, 1]",
-            ),
-            (
-                "orient_tolerance_rad",
-                self.orient_tolerance_rad,
-                self.orient_tolerance_rad > 0.0,
-                "(0, inf)",
-            ),
-            (
-                // A negative step would turn the pad away from the surface; beyond a half turn the
-                // rotation is no longer the short way round.
-                "orient_max_step_rad",
-                self.orient_max_step_rad,
-                self.orient_max_step_rad > 0.0 && self.orient_max_step_rad <= std::f64::consts::PI,
-                "(0, pi]",
-            ),
-            (
-                "max_iterations",
-                self.max_iterations as f64,
-                self.max_iterations > 0,
-                "1 or more",
-            ),
-        ];
-        for (field, value, ok, allowed) in checks {
-            if !ok || !value.is_finite() {
-                return Err(ControlConfigError {
-                    field,
-                    value,
-                    allowed,
-                });
-            }
-        }
-        Ok(())
-    }
-
     /// The taxel value that counts as contact: the threshold above the largest value noise alone gives.
     pub fn effective_contact_threshold(&self) -> f64 {
         (self.contact_threshold + self.expected_noise_fraction * 0.5).min(0.99)
@@ -251,19 +240,19 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
-        assert_eq!(ControlConfig::default().validate(), Ok(()));
+        assert_eq!(ControlConfig::default().check(), Ok(()));
         let bad = ControlConfig {
             orient_step: 1.5,
             ..ControlConfig::default()
         };
-        let e = bad.validate().unwrap_err();
+        let e = bad.check().unwrap_err();
         assert_eq!(e.field, "orient_step");
         assert!(e.to_string().contains("(0, 1]"));
         let bad = ControlConfig {
             saturation_threshold: 0.2,
             ..ControlConfig::default()
         };
-        assert_eq!(bad.validate().unwrap_err().field, "saturation_threshold");
+        assert_eq!(bad.check().unwrap_err().field, "saturation_threshold");
     }
 
     #[test]
@@ -281,14 +270,14 @@ mod tests {
             };
             bad.insert(name.clone(), out_of_range);
             let config: ControlConfig = serde_json::from_value(serde_json::Value::Object(bad)).unwrap();
-            let error = config.validate().expect_err(name);
+            let error = config.check().expect_err(name);
             assert_eq!(error.field, name.as_str());
         }
         let nan = ControlConfig {
             orient_max_step_rad: f64::NAN,
             ..ControlConfig::default()
         };
-        assert_eq!(nan.validate().unwrap_err().field, "orient_max_step_rad");
+        assert_eq!(nan.check().unwrap_err().field, "orient_max_step_rad");
     }
 
     #[test]

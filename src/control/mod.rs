@@ -1,15 +1,15 @@
 //! Surface contact control (Sec. III-B, Fig. 3, Algorithm 1): Approach, Press and Orient settle the
 //! sensor on the surface so that a patch of surface gives a consistent tactile image.
 
-pub mod approach;
+pub(crate) mod approach;
 pub mod arm_pad;
 pub mod carrier;
-pub mod config;
+pub(crate) mod config;
 pub mod free_pad;
 pub mod orient;
-pub mod press;
-pub mod surface_contact;
-pub mod trace;
+pub(crate) mod press;
+pub(crate) mod surface_contact;
+pub(crate) mod trace;
 
 pub use carrier::{ControlError, PadCarrier, PadMotion};
 pub use config::ControlConfig;

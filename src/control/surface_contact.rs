@@ -13,6 +13,7 @@ use crate::control::trace::{Command, Trace};
 use crate::dataset::ContactStatus;
 use crate::sim::Collision;
 use crate::tactile::{PadPose, TactileImage};
+use crate::valid::Valid;
 
 /// The result of one settling run.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,9 +34,9 @@ pub struct ContactOutcome {
 /// Runs the controllers on `carrier` from its current pose, approaching along the pad normal.
 pub fn settle<C: PadCarrier + ?Sized>(
     carrier: &mut C,
-    config: &ControlConfig,
+    config: &Valid<ControlConfig>,
 ) -> Result<ContactOutcome, ControlError> {
-    config.validate()?;
+    let config: &ControlConfig = config;
     let mut trace = Trace::default();
     let finish = |carrier: &mut C, status, image: TactileImage, iterations, trace, collision| {
         let pose = carrier.pad_pose();

@@ -29,6 +29,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::atomic::FileError;
 use crate::tactile::SensorConfig;
+use crate::valid::Check;
 
 /// Errors from building, reading or writing a dataset; each names the file, line and field.
 #[derive(Debug, thiserror::Error)]
@@ -122,7 +123,7 @@ impl DatasetHeader {
                 self.format_version
             ));
         }
-        self.sensor.validate().map_err(|e| format!("sensor: {e}"))?;
+        self.sensor.check().map_err(|e| format!("sensor: {e}"))?;
         for (i, name) in self.objects.iter().enumerate() {
             if name.is_empty() {
                 return Err(format!("object {i} has an empty name"));

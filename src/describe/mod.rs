@@ -9,17 +9,17 @@
 //! Descriptors that are built once and reused (as [`DescriptorKind::build`] gives them) plan their
 //! FFTs and filter banks once per image size.
 
-pub mod disc;
-pub mod fft;
-pub mod mnti;
-pub mod moment_normalized;
-pub mod moments;
-pub mod mr8;
-pub mod params;
-pub mod plane;
-pub mod polar_fourier;
-pub mod sift;
-pub mod vectorize;
+pub(crate) mod disc;
+pub(crate) mod fft;
+pub(crate) mod mnti;
+pub(crate) mod moment_normalized;
+pub(crate) mod moments;
+pub(crate) mod mr8;
+pub(crate) mod params;
+pub(crate) mod plane;
+pub(crate) mod polar_fourier;
+pub(crate) mod sift;
+pub(crate) mod vectorize;
 
 use serde::{Deserialize, Serialize};
 

@@ -13,22 +13,22 @@
 //! The framework knows nothing of MuJoCo, the paper or recognition beyond the accuracy row it
 //! plots: the experiments themselves (`crate::paper`) build the units.
 
-pub mod accuracy;
-pub mod assemble;
-pub mod error;
+pub(crate) mod accuracy;
+pub(crate) mod assemble;
+pub(crate) mod error;
 pub mod figure;
-pub mod files;
-pub mod font;
-pub mod index;
-pub mod layout;
+pub(crate) mod files;
+pub(crate) mod font;
+pub(crate) mod index;
+pub(crate) mod layout;
 pub mod merge;
-pub mod name;
+pub(crate) mod name;
 pub mod plot;
 pub mod progress;
-pub mod runner;
-pub mod shard;
-pub mod spec;
-pub mod unit;
+pub(crate) mod runner;
+pub(crate) mod shard;
+pub(crate) mod spec;
+pub(crate) mod unit;
 
 pub use accuracy::{AccuracyCurve, AccuracyRow};
 pub use assemble::Finished;
@@ -36,7 +36,7 @@ pub use error::{ExperimentError, UnitFailure};
 pub use index::write_index;
 pub use layout::ExperimentDir;
 pub use merge::{MergeReport, merge};
-pub use name::{ExperimentName, NameError, SafeName, UnitKey};
+pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
 pub use plot::{Axis, PlotKind, PlotSpec};
 pub use runner::{Experiment, RunOptions, RunReport, run};
 pub use shard::{Shard, ShardError};

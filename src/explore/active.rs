@@ -43,11 +43,11 @@ pub const DEFAULT_CANDIDATES: usize = 12;
 pub struct Probability(f64);
 
 impl Probability {
-    pub fn new(p: f64) -> Result<Self, String> {
+    pub fn new(p: f64) -> Result<Self, ProbabilityError> {
         if p > 0.0 && p <= 1.0 {
             Ok(Self(p))
         } else {
-            Err(format!("{p} is not a probability in (0, 1]"))
+            Err(ProbabilityError::OutOfRange(p))
         }
     }
 
@@ -56,9 +56,18 @@ impl Probability {
     }
 }
 
+/// A value that is not a [`Probability`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProbabilityError {
+    #[error("{0} is not a probability in (0, 1]")]
+    OutOfRange(f64),
+    #[error("'{0}' is not a number")]
+    NotANumber(String),
+}
+
 impl TryFrom<f64> for Probability {
-    type Error = String;
-    fn try_from(p: f64) -> Result<Self, String> {
+    type Error = ProbabilityError;
+    fn try_from(p: f64) -> Result<Self, ProbabilityError> {
         Self::new(p)
     }
 }
@@ -70,9 +79,12 @@ impl From<Probability> for f64 {
 }
 
 impl std::str::FromStr for Probability {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let p: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number"))?;
+    type Err = ProbabilityError;
+    fn from_str(s: &str) -> Result<Self, ProbabilityError> {
+        let p: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| ProbabilityError::NotANumber(s.to_string()))?;
         Self::new(p)
     }
 }

@@ -19,15 +19,16 @@ use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use crate::tactile::free_floating::FreeFloatingSensor;
 use crate::tactile::sensor::{CoveringSensor, add_sensor};
 use crate::tactile::{SensorConfig, TactileImage};
+use crate::valid::Valid;
 
 /// Which procedure collects the readings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "mode")]
 pub enum CollectMode {
     /// The training sampler with the free-floating pad (Sec. V-A3).
-    Sampler(SamplerConfig),
+    Sampler(Valid<SamplerConfig>),
     /// The exploration planner with the arm (Sec. III-A).
-    Planner(PlannerConfig),
+    Planner(Valid<PlannerConfig>),
 }
 
 impl CollectMode {
@@ -55,7 +56,7 @@ pub enum CollectError {
 pub struct CollectPlan {
     pub mode: CollectMode,
     pub sensor: SensorConfig,
-    pub control: ControlConfig,
+    pub control: Valid<ControlConfig>,
     pub perturbation: PerturbationBounds,
     /// Converged readings wanted per object.
     pub readings_per_object: usize,
@@ -132,7 +133,7 @@ impl CollectPlan {
         &self,
         object: &ObjectSpec,
         index: usize,
-        config: PlannerConfig,
+        config: Valid<PlannerConfig>,
     ) -> Result<
         (
             Scene,

@@ -2,14 +2,16 @@
 
 pub mod active;
 pub mod collect;
-pub mod grid;
+pub(crate) mod grid;
 pub mod planner;
-pub mod report;
-pub mod sampler;
-pub mod surface_sampling;
-pub mod tree;
+pub(crate) mod report;
+pub(crate) mod sampler;
+pub(crate) mod surface_sampling;
+pub(crate) mod tree;
 
 pub use active::{ActiveGuidance, Probability, TouchScorer};
+pub use grid::ReadingGrid;
 pub use planner::{Planner, PlannerConfig};
 pub use report::ExplorationReport;
 pub use sampler::{SamplerConfig, sample_readings};
+pub use tree::{ExplorationTree, Vertex};

@@ -58,6 +58,7 @@ use crate::sim::{
     PerturbationBounds, Scene,
 };
 use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
+use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The planner's parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -145,36 +146,72 @@ impl PlannerConfig {
             ..self
         }
     }
+}
 
-    /// Checks ranges; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(0.0..=1.0).contains(&self.local_probability) {
-            return Err(format!(
-                "local_probability {} is outside [0, 1]",
-                self.local_probability
-            ));
-        }
-        if !(self.workspace_min_m.cmplt(self.workspace_max_m).all()) {
-            return Err("workspace_min_m must be below workspace_max_m on every axis".into());
-        }
-        for (name, v) in [
-            ("step_m", self.step_m),
-            ("local_radius_m", self.local_radius_m),
-            ("grid_cell_m", self.grid_cell_m),
-            ("lift_off_m", self.lift_off_m),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(format!("{name} {v} must be a positive length"));
-            }
-        }
-        Ok(())
+impl Check for PlannerConfig {
+    type Error = RangeError;
+
+    /// Every field against its range; the error names the first offender.
+    fn check(&self) -> Result<(), RangeError> {
+        let Self {
+            workspace_min_m,
+            workspace_max_m,
+            local_probability,
+            step_m,
+            max_steps_per_iteration,
+            local_radius_m,
+            grid_cell_m,
+            lift_off_m,
+            max_turn_per_step_rad,
+            max_iterations,
+            execution: _,
+        } = *self;
+        let positive = |v: f64| v > 0.0;
+        FieldChecks::of("planner config")
+            .that(
+                "workspace_min_m",
+                workspace_min_m,
+                workspace_min_m.is_finite()
+                    && workspace_max_m.is_finite()
+                    && workspace_min_m.cmplt(workspace_max_m).all(),
+                "finite and below workspace_max_m on every axis",
+            )
+            .real(
+                "local_probability",
+                local_probability,
+                (0.0..=1.0).contains(&local_probability),
+                "[0, 1]",
+            )
+            .real("step_m", step_m, positive(step_m), "(0, inf)")
+            .count(
+                "max_steps_per_iteration",
+                max_steps_per_iteration,
+                max_steps_per_iteration > 0,
+                "1 or more",
+            )
+            .real(
+                "local_radius_m",
+                local_radius_m,
+                positive(local_radius_m),
+                "(0, inf)",
+            )
+            .real("grid_cell_m", grid_cell_m, positive(grid_cell_m), "(0, inf)")
+            .real("lift_off_m", lift_off_m, positive(lift_off_m), "(0, inf)")
+            .real(
+                "max_turn_per_step_rad",
+                max_turn_per_step_rad,
+                max_turn_per_step_rad > 0.0 && max_turn_per_step_rad <= std::f64::consts::PI,
+                "(0, pi]",
+            )
+            .count("max_iterations", max_iterations, max_iterations > 0, "1 or more")
+            .finish()
     }
 }
 
 /// The planner's state for one exploration run.
 pub struct Planner<R> {
-    config: PlannerConfig,
-    control: ControlConfig,
+    config: Valid<PlannerConfig>,
+    control: Valid<ControlConfig>,
     sensor: SensorConfig,
     perturbation: PerturbationBounds,
     /// Precise solver for the controllers' small commands.
@@ -245,17 +282,13 @@ where
     /// A planner for `scene` (which must have an arm), starting from the arm's current configuration.
     pub fn new(
         scene: &Scene,
-        config: PlannerConfig,
-        control: ControlConfig,
+        config: Valid<PlannerConfig>,
+        control: Valid<ControlConfig>,
         sensor: SensorConfig,
         perturbation: PerturbationBounds,
         rng: Rng,
         reader: R,
     ) -> Result<Self, ControlError> {
-        config
-            .validate()
-            .map_err(|message| crate::sim::SimError::BadConfiguration { message })?;
-        control.validate()?;
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let t = sensor.thickness_m;
         let (ik_options, motion, expansion_motion) = match config.execution {
@@ -620,4 +653,53 @@ pub fn turn_toward(from: DVec3, to: DVec3, max_rad: f64) -> DVec3 {
         .try_normalize()
         .unwrap_or_else(|| from.any_orthonormal_vector());
     glam::DQuat::from_axis_angle(axis, max_rad) * from
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_numeric_field_is_checked_and_named() {
+        assert_eq!(PlannerConfig::default().check(), Ok(()));
+        // Each real field in turn negative, each count zero: the error must name that field.
+        let defaults = serde_json::to_value(PlannerConfig::default()).unwrap();
+        let fields = defaults.as_object().unwrap();
+        let mut checked = 0;
+        for (name, value) in fields {
+            let out_of_range = if value.is_u64() {
+                serde_json::json!(0)
+            } else if value.is_f64() {
+                serde_json::json!(-1.0)
+            } else {
+                continue;
+            };
+            let mut bad = fields.clone();
+            bad.insert(name.clone(), out_of_range);
+            let config: PlannerConfig = serde_json::from_value(serde_json::Value::Object(bad)).unwrap();
+            assert_eq!(config.check().expect_err(name).field, name.as_str());
+            checked += 1;
+        }
+        assert_eq!(checked, 8);
+        let inverted = PlannerConfig {
+            workspace_min_m: PlannerConfig::default().workspace_max_m,
+            workspace_max_m: PlannerConfig::default().workspace_min_m,
+            ..PlannerConfig::default()
+        };
+        assert_eq!(inverted.check().unwrap_err().field, "workspace_min_m");
+        let nan_box = PlannerConfig {
+            workspace_max_m: DVec3::new(f64::NAN, 0.1, 0.2),
+            ..PlannerConfig::default()
+        };
+        assert_eq!(nan_box.check().unwrap_err().field, "workspace_min_m");
+        let certain = PlannerConfig {
+            local_probability: 1.5,
+            ..PlannerConfig::default()
+        };
+        let error = Valid::new(certain).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "planner config: local_probability = 1.5 is outside [0, 1]"
+        );
+    }
 }

@@ -23,6 +23,7 @@ use crate::mesh::TriMesh;
 use crate::rng::Rng;
 use crate::sim::{PerturbationBounds, Scene, SimError};
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The sampler's parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -50,6 +51,36 @@ impl Default for SamplerConfig {
     }
 }
 
+impl Check for SamplerConfig {
+    type Error = RangeError;
+
+    /// Every field against its range; the error names the first offender.
+    fn check(&self) -> Result<(), RangeError> {
+        let Self {
+            back_off_m,
+            orientation_noise_deg,
+            from_above_only: _,
+            max_attempts_per_reading,
+        } = *self;
+        FieldChecks::of("sampler config")
+            .real("back_off_m", back_off_m, back_off_m > 0.0, "(0, inf)")
+            // Beyond 90 degrees the pad would face away from the surface point it was aimed at.
+            .real(
+                "orientation_noise_deg",
+                orientation_noise_deg,
+                (0.0..=90.0).contains(&orientation_noise_deg),
+                "[0, 90]",
+            )
+            .count(
+                "max_attempts_per_reading",
+                max_attempts_per_reading,
+                max_attempts_per_reading > 0,
+                "1 or more",
+            )
+            .finish()
+    }
+}
+
 /// A uniformly random unit vector perpendicular to `n`.
 fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
     let (a, b) = n.any_orthonormal_pair();
@@ -65,8 +96,8 @@ pub fn sample_readings<R>(
     scene: &mut Scene,
     object: &str,
     sensor: SensorConfig,
-    control: &ControlConfig,
-    config: &SamplerConfig,
+    control: &Valid<ControlConfig>,
+    config: &Valid<SamplerConfig>,
     perturbation: PerturbationBounds,
     converged_target: usize,
     rng: &mut Rng,
@@ -132,4 +163,46 @@ where
         }
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_field_with_a_range_is_checked_and_named() {
+        assert_eq!(SamplerConfig::default().check(), Ok(()));
+        for (bad, field) in [
+            (
+                SamplerConfig {
+                    back_off_m: 0.0,
+                    ..SamplerConfig::default()
+                },
+                "back_off_m",
+            ),
+            (
+                SamplerConfig {
+                    orientation_noise_deg: 91.0,
+                    ..SamplerConfig::default()
+                },
+                "orientation_noise_deg",
+            ),
+            (
+                SamplerConfig {
+                    orientation_noise_deg: f64::NAN,
+                    ..SamplerConfig::default()
+                },
+                "orientation_noise_deg",
+            ),
+            (
+                SamplerConfig {
+                    max_attempts_per_reading: 0,
+                    ..SamplerConfig::default()
+                },
+                "max_attempts_per_reading",
+            ),
+        ] {
+            assert_eq!(bad.check().unwrap_err().field, field);
+        }
+    }
 }

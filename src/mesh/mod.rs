@@ -8,23 +8,23 @@
 //! - object sets: named, versioned manifests that datasets and models refer to ([`ObjectSet`]).
 
 pub mod cgal;
-pub mod checksum;
+pub(crate) mod checksum;
 pub mod chess;
-pub mod error;
+pub(crate) mod error;
 pub mod glyph;
 pub mod glyph_overlap;
 pub mod letters;
 pub mod load;
-pub mod normalise;
-pub mod obj;
+pub(crate) mod normalise;
+pub(crate) mod obj;
 pub mod object_set;
 mod off;
 pub mod revolution;
 mod stl;
-pub mod topology;
-pub mod triangulate;
-pub mod trimesh;
-pub mod validate;
+pub(crate) mod topology;
+pub(crate) mod triangulate;
+pub(crate) mod trimesh;
+pub(crate) mod validate;
 
 pub use cgal::{CGAL_MESHES, CgalMesh, ObjectCache, ensure_fetched};
 pub use error::{Location, MeshError};

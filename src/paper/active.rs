@@ -142,7 +142,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
         context
             .store
-            .prepare(&sweep.requests(context, &objects, 0, counts), dir.root())?;
+            .prepare(&sweep.requests(context, &objects, 0, counts)?, dir.root())?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -194,8 +194,8 @@ fn unit_rows(
 ) -> Result<Vec<ActiveRow>, BoxError> {
     let descriptor = DESCRIPTOR.build();
     let model = context.store.model(
-        &sweep.training_request(context, objects, 0, counts),
-        &sweep.validation_request(context, objects, 0, counts),
+        &sweep.training_request(context, objects, 0, counts)?,
+        &sweep.validation_request(context, objects, 0, counts)?,
         descriptor.as_ref(),
         training,
     )?;
@@ -231,7 +231,7 @@ fn unit_rows(
                 perturbation,
             },
             counts,
-        );
+        )?;
         let jobs: Vec<(usize, usize)> = (0..base.len())
             .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
             .collect();

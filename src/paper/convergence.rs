@@ -27,6 +27,7 @@ use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
 use crate::rng;
 use crate::sim::{ObjectSpec, PerturbationBounds};
 use crate::tactile::{FreeFloatingSensor, SensorConfig};
+use crate::valid::{Check, Valid};
 
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::{Axis, PlotSpec};
@@ -128,9 +129,9 @@ pub struct ConvergenceConfig {
     /// The sensor at zero noise (the letters sensor: 6x6 taxels of 2 mm, 10% covering).
     pub sensor: SensorConfig,
     /// The controllers at zero noise; each level sets `expected_noise_fraction` to its noise.
-    pub control: ControlConfig,
+    pub control: Valid<ControlConfig>,
     /// The training sampler's placement; no perturbation of the object.
-    pub sampler: SamplerConfig,
+    pub sampler: Valid<SamplerConfig>,
 }
 
 /// Why the experiment cannot be built.
@@ -152,8 +153,6 @@ pub enum ConvergenceError {
     Name(#[from] crate::experiment::name::NameError),
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    #[error(transparent)]
-    Control(#[from] crate::control::config::ControlConfigError),
 }
 
 /// Convergences per noise level at `scale` (1 = the paper's 100), at least [`MIN_CONVERGENCES`].
@@ -193,8 +192,8 @@ pub struct ConvergencePlan {
     /// The sensor at zero noise.
     pub sensor: SensorConfig,
     /// The controllers; each level sets `expected_noise_fraction` to its noise.
-    pub control: ControlConfig,
-    pub sampler: SamplerConfig,
+    pub control: Valid<ControlConfig>,
+    pub sampler: Valid<SamplerConfig>,
 }
 
 impl ConvergencePlan {
@@ -211,8 +210,8 @@ impl ConvergencePlan {
                 crate::tactile::config::DEFAULT_PAD_M,
                 crate::tactile::config::DEFAULT_THICKNESS_M,
             ),
-            control: ControlConfig::default(),
-            sampler: SamplerConfig::default(),
+            control: Valid::default(),
+            sampler: Valid::default(),
         }
     }
 
@@ -240,9 +239,8 @@ impl ConvergencePlan {
                 return Err(ConvergenceError::DuplicateObject(o.name.clone()));
             }
         }
-        self.control.validate()?;
         self.sensor
-            .validate()
+            .check()
             .map_err(|e| ConvergenceError::Sensor(e.to_string()))?;
         let config = ConvergenceConfig {
             objects: objects.iter().map(ObjectIdentity::of).collect(),
@@ -319,10 +317,10 @@ pub fn run_level(
         noise_seed: rng::substream(unit_seed, 1),
         ..config.sensor
     };
-    let control = ControlConfig {
+    let control = Valid::new(ControlConfig {
         expected_noise_fraction: noise,
-        ..config.control
-    };
+        ..*config.control
+    })?;
     let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
     let reader = sensor_reader(free.sensor().clone());
     let mut placement = rng::stream(unit_seed, 0);
@@ -392,7 +390,7 @@ fn converged_quality(
     };
     let clean_control = ControlConfig {
         expected_noise_fraction: 0.0,
-        ..config.control
+        ..*config.control
     };
     let mut clean = FreeFloatingSensor::new(object.clone(), &clean_sensor)?;
     let (mut angle_sum, mut angles, mut error_sum, mut errors) = (0.0, 0usize, 0.0, 0usize);

@@ -12,7 +12,6 @@ use super::context::Family;
 use super::context::PaperContext;
 use super::figures::default_sensor;
 use crate::atomic::write_atomic;
-use crate::control::ControlConfig;
 use crate::experiment::index::{PICTURE_FILE, PictureSpec, write_index};
 use crate::experiment::spec::to_json;
 use crate::experiment::unit::{BoxError, rows_to_csv};
@@ -21,6 +20,7 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::paper::exploration::{Placement, write_exploration_png};
 use crate::rng;
 use crate::sim::PerturbationBounds;
+use crate::valid::Valid;
 
 pub const EXPERIMENT_NAME: &str = "exploration";
 pub const DESCRIPTION: &str = "Fig. 1: one planner exploration of the chess piece (L = 0.5, 100 converged readings), a patch at every converged placement, the first 50 tactile images beside it";
@@ -64,15 +64,15 @@ pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
         .or_else(|| objects.specs.first())
         .ok_or("the 3D set has no object to explore")?;
     let plan = CollectPlan {
-        mode: CollectMode::Planner(
+        mode: CollectMode::Planner(Valid::new(
             PlannerConfig {
                 local_probability: 0.5,
                 ..PlannerConfig::default()
             }
             .fitted_to(std::slice::from_ref(object)),
-        ),
+        )?),
         sensor: default_sensor(),
-        control: ControlConfig::default(),
+        control: Valid::default(),
         perturbation: PerturbationBounds::NONE,
         readings_per_object: READINGS,
         seed: rng::substream(context.seed, STREAM),

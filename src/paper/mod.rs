@@ -22,22 +22,22 @@
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` ([`data`]).
 
-pub mod active;
+pub(crate) mod active;
 pub mod context;
 pub mod convergence;
 pub mod data;
 pub mod estimate;
 pub mod exploration;
-pub mod figure1;
-pub mod figures;
+pub(crate) mod figure1;
+pub(crate) mod figures;
 pub mod headline;
 pub mod real_data;
 pub mod real_frames;
 pub mod real_frames_options;
-pub mod recognition;
-pub mod scale;
+pub(crate) mod recognition;
+pub(crate) mod scale;
 pub mod sim_to_real;
-pub mod split;
+pub(crate) mod split;
 
 use std::fmt;
 use std::path::PathBuf;
@@ -45,9 +45,9 @@ use std::path::PathBuf;
 pub use context::{Family, PaperContext, RealRecording};
 pub use real_data::{Normalisation, RealData, RealDataError, RealImport, RealReading, import_real_csv};
 pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
-pub use scale::{DataCounts, Scale};
+pub use scale::{DataCounts, Scale, ScaleError};
 pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};
-pub use split::{Split, SplitSizes, split_per_label};
+pub use split::{Split, SplitError, SplitSizes, split_per_label};
 
 use crate::experiment::runner::{RunReport, run};
 use crate::experiment::unit::BoxError;

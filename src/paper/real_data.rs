@@ -58,20 +58,23 @@ pub enum Normalisation {
     Range(f64),
 }
 
+/// A `--range` that is neither `max` nor a full-scale value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("'{0}' is neither 'max' nor a finite positive full-scale value")]
+pub struct NormalisationError(pub String);
+
 impl std::str::FromStr for Normalisation {
-    type Err = String;
+    type Err = NormalisationError;
 
     /// `max` for [`Normalisation::FileMax`], or a full-scale value in raw units for
     /// [`Normalisation::Range`] (the `--range` flag).
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, NormalisationError> {
         if s.trim() == "max" {
             return Ok(Self::FileMax);
         }
         match s.trim().parse::<f64>() {
             Ok(range) if range.is_finite() && range > 0.0 => Ok(Self::Range(range)),
-            _ => Err(format!(
-                "'{s}' is neither 'max' nor a finite positive full-scale value"
-            )),
+            _ => Err(NormalisationError(s.to_string())),
         }
     }
 }

@@ -38,6 +38,7 @@ use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
 use crate::rng;
 use crate::tactile::TactileImage;
+use crate::valid::Check;
 
 /// The command-line name.
 pub const EXPERIMENT_NAME: &str = "real-frames";
@@ -76,13 +77,20 @@ pub fn prune(real: &RealData, contact_threshold: f64) -> (Vec<&RealReading>, BTr
     (kept, counts)
 }
 
+/// A label with fewer frames than the split's three parts.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{frames} frames of a label after pruning; the split needs at least 3 (training, validation, test)")]
+pub struct TooFewFrames {
+    pub frames: usize,
+}
+
 /// Readings per label in each part: the paper's 200 / 50 / 100 when every label keeps at least
 /// 350 frames and the scale is 1. Otherwise every label uses
 /// `n = min(smallest label's kept frames, max(7, round(350 * scale)))` frames, divided in the
 /// paper's proportions 4 : 1 : 2: validation `max(1, floor(n / 7))`, test `max(1, floor(2n / 7))`,
 /// training the rest. Every label gets the same sizes so that no label is favoured by the prior
 /// the data implies. At least 3 frames per label are needed.
-pub fn scaled_split_sizes(smallest_label: usize, scale: f64) -> Result<SplitSizes, String> {
+pub fn scaled_split_sizes(smallest_label: usize, scale: f64) -> Result<SplitSizes, TooFewFrames> {
     let paper = SplitSizes::PAPER;
     let wanted = ((paper.total() as f64 * scale).round() as usize).max(7);
     let n = smallest_label.min(wanted);
@@ -90,9 +98,7 @@ pub fn scaled_split_sizes(smallest_label: usize, scale: f64) -> Result<SplitSize
         return Ok(paper);
     }
     if n < 3 {
-        return Err(format!(
-            "{n} frames of a label after pruning; the split needs at least 3 (training, validation, test)"
-        ));
+        return Err(TooFewFrames { frames: n });
     }
     let validation = (n / 7).max(1);
     let test = (2 * n / 7).max(1);
@@ -148,7 +154,7 @@ pub const DESCRIPTION: &str = "Fig. 16b: trained and tested on recorded frames (
 /// Runs Fig. 16b on the context's recording: one unit per descriptor, each running every trial.
 pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
     let options = &context.real_frames;
-    options.validate()?;
+    options.check()?;
     let real = context.real_data()?;
     let (kept, pruning) = prune(&real, options.contact_threshold);
     let labels: Vec<String> = pruning.keys().cloned().collect();
@@ -345,11 +351,16 @@ mod tests {
             contact_threshold: 1.5,
             ..RealFramesOptions::default()
         };
-        assert!(bad.validate().unwrap_err().contains("--contact-threshold"));
+        assert!(
+            bad.check()
+                .unwrap_err()
+                .to_string()
+                .contains("--contact-threshold")
+        );
         let bad = RealFramesOptions {
             blur_sigma_taxels: -1.0,
             ..RealFramesOptions::default()
         };
-        assert!(bad.validate().unwrap_err().contains("--blur-sigma"));
+        assert!(bad.check().unwrap_err().to_string().contains("--blur-sigma"));
     }
 }

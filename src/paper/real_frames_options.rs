@@ -3,7 +3,8 @@
 
 use serde::Serialize;
 
-use super::sim_to_real::GaussianBlur;
+use super::sim_to_real::{BlurError, GaussianBlur};
+use crate::valid::Check;
 
 /// "performances were averaged over 7 trials of this full division, training, and testing
 /// process" (Sec. V-E).
@@ -37,18 +38,34 @@ impl Default for RealFramesOptions {
     }
 }
 
-impl RealFramesOptions {
-    /// Checks the settings, naming the flag at fault.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.contact_threshold.is_finite() && (0.0..=1.0).contains(&self.contact_threshold)) {
-            return Err(format!(
-                "--contact-threshold {}: must be in [0, 1] of the sensing range",
-                self.contact_threshold
-            ));
+/// A [`RealFramesOptions`] field out of range, named by its flag.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RealFramesOptionsError {
+    #[error("--contact-threshold {0}: must be in [0, 1] of the sensing range")]
+    ContactThreshold(f64),
+    #[error("--blur-sigma: {0}")]
+    BlurSigma(#[from] BlurError),
+    #[error("--trials: must be at least 1")]
+    Trials,
+}
+
+impl Check for RealFramesOptions {
+    type Error = RealFramesOptionsError;
+
+    /// Every setting against its range, naming the flag at fault.
+    fn check(&self) -> Result<(), RealFramesOptionsError> {
+        let Self {
+            contact_threshold,
+            square_root: _,
+            blur_sigma_taxels,
+            trials,
+        } = *self;
+        if !(contact_threshold.is_finite() && (0.0..=1.0).contains(&contact_threshold)) {
+            return Err(RealFramesOptionsError::ContactThreshold(contact_threshold));
         }
-        GaussianBlur::new(self.blur_sigma_taxels).map_err(|e| format!("--blur-sigma: {e}"))?;
-        if self.trials == 0 {
-            return Err("--trials: must be at least 1".into());
+        GaussianBlur::new(blur_sigma_taxels)?;
+        if trials == 0 {
+            return Err(RealFramesOptionsError::Trials);
         }
         Ok(())
     }

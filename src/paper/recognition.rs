@@ -35,6 +35,7 @@ use crate::recognize::{
 use crate::rng;
 use crate::sim::PerturbationBounds;
 use crate::tactile::SensorConfig;
+use crate::valid::{RangeError, Valid};
 
 /// Streams of the experiment seed (see [`crate::rng::substream`]); the same for every setting, so
 /// settings are compared on the same random draws where they can be (common random numbers).
@@ -162,7 +163,7 @@ impl RecognitionSweep {
             .collect();
         let mut requests = Vec::new();
         for plan in &pending {
-            requests.extend(self.requests(context, &objects, plan.setting, setting_counts(plan.setting)));
+            requests.extend(self.requests(context, &objects, plan.setting, setting_counts(plan.setting))?);
         }
         context.store.prepare(&requests, dir.root())?;
 
@@ -253,11 +254,11 @@ impl RecognitionSweep {
 
     /// The controllers, told the sensor's noise width as a real controller knows its sensor's
     /// noise floor (see [`ControlConfig::expected_noise_fraction`]).
-    pub(super) fn control(&self, setting: usize) -> ControlConfig {
-        ControlConfig {
+    pub(super) fn control(&self, setting: usize) -> Result<Valid<ControlConfig>, RangeError> {
+        Valid::new(ControlConfig {
             expected_noise_fraction: self.settings[setting].sensor.noise_fraction,
             ..ControlConfig::default()
-        }
+        })
     }
 
     fn sampler_request(
@@ -267,18 +268,18 @@ impl RecognitionSweep {
         setting: usize,
         readings: usize,
         stream: u64,
-    ) -> DataRequest {
-        DataRequest::new(
+    ) -> Result<DataRequest, RangeError> {
+        Ok(DataRequest::new(
             objects,
             CollectPlan {
-                mode: CollectMode::Sampler(self.settings[setting].sampler),
+                mode: CollectMode::Sampler(Valid::new(self.settings[setting].sampler)?),
                 sensor: self.sensor(context, setting),
-                control: self.control(setting),
+                control: self.control(setting)?,
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: readings,
                 seed: rng::substream(context.seed, stream),
             },
-        )
+        ))
     }
 
     pub(super) fn training_request(
@@ -287,7 +288,7 @@ impl RecognitionSweep {
         o: &Arc<Objects>,
         s: usize,
         n: DataCounts,
-    ) -> DataRequest {
+    ) -> Result<DataRequest, RangeError> {
         self.sampler_request(c, o, s, n.training_per_object, TRAINING_STREAM)
     }
 
@@ -297,7 +298,7 @@ impl RecognitionSweep {
         o: &Arc<Objects>,
         s: usize,
         n: DataCounts,
-    ) -> DataRequest {
+    ) -> Result<DataRequest, RangeError> {
         self.sampler_request(c, o, s, n.validation_per_object, VALIDATION_STREAM)
     }
 
@@ -309,10 +310,10 @@ impl RecognitionSweep {
         setting: usize,
         test: TestData,
         counts: DataCounts,
-    ) -> Vec<DataRequest> {
+    ) -> Result<Vec<DataRequest>, RangeError> {
         let trial_stream = |t: usize| TEST_STREAM + t as u64;
         match test {
-            TestData::Validation => vec![self.validation_request(context, objects, setting, counts)],
+            TestData::Validation => Ok(vec![self.validation_request(context, objects, setting, counts)?]),
             TestData::Sampler => (0..counts.trials)
                 .map(|t| {
                     self.sampler_request(context, objects, setting, counts.test_per_object, trial_stream(t))
@@ -323,26 +324,26 @@ impl RecognitionSweep {
                 perturbation,
             } => (0..counts.trials)
                 .map(|t| {
-                    DataRequest::new(
+                    Ok(DataRequest::new(
                         objects,
                         CollectPlan {
-                            mode: CollectMode::Planner(
+                            mode: CollectMode::Planner(Valid::new(
                                 PlannerConfig {
                                     local_probability,
                                     ..PlannerConfig::default()
                                 }
                                 .fitted_to(&objects.specs),
-                            ),
+                            )?),
                             sensor: self.sensor(context, setting),
-                            control: self.control(setting),
+                            control: self.control(setting)?,
                             perturbation,
                             readings_per_object: counts.test_per_object,
                             seed: rng::substream(context.seed, trial_stream(t)),
                         },
-                    )
+                    ))
                 })
                 .collect(),
-            TestData::Real => Vec::new(),
+            TestData::Real => Ok(Vec::new()),
         }
     }
 
@@ -353,15 +354,15 @@ impl RecognitionSweep {
         objects: &Arc<Objects>,
         setting: usize,
         counts: DataCounts,
-    ) -> Vec<DataRequest> {
+    ) -> Result<Vec<DataRequest>, RangeError> {
         let mut requests = vec![
-            self.training_request(context, objects, setting, counts),
-            self.validation_request(context, objects, setting, counts),
+            self.training_request(context, objects, setting, counts)?,
+            self.validation_request(context, objects, setting, counts)?,
         ];
         for curve in &self.settings[setting].curves {
-            requests.extend(self.test_requests(context, objects, setting, curve.test, counts));
+            requests.extend(self.test_requests(context, objects, setting, curve.test, counts)?);
         }
-        requests
+        Ok(requests)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -377,8 +378,8 @@ impl RecognitionSweep {
     ) -> Result<Vec<AccuracyRow>, BoxError> {
         let descriptor = kind.build();
         let model = context.store.model(
-            &self.training_request(context, objects, setting, counts),
-            &self.validation_request(context, objects, setting, counts),
+            &self.training_request(context, objects, setting, counts)?,
+            &self.validation_request(context, objects, setting, counts)?,
             descriptor.as_ref(),
             training,
         )?;
@@ -443,7 +444,7 @@ impl RecognitionSweep {
         descriptor: &dyn Descriptor,
         curve: &str,
     ) -> Result<Vec<(u64, Vec<Trial>)>, BoxError> {
-        self.test_requests(context, objects, setting, test, counts)
+        self.test_requests(context, objects, setting, test, counts)?
             .iter()
             .map(|request| {
                 let data = context.store.dataset(request)?;

@@ -32,13 +32,11 @@ pub struct DataCounts {
 impl Scale {
     pub const PAPER: Scale = Scale(1.0);
 
-    pub fn new(fraction: f64) -> Result<Self, String> {
+    pub fn new(fraction: f64) -> Result<Self, ScaleError> {
         if fraction.is_finite() && fraction > 0.0 && fraction <= 10.0 {
             Ok(Self(fraction))
         } else {
-            Err(format!(
-                "--scale {fraction}: must be a number in (0, 10] (1.0 is the paper's data sizes)"
-            ))
+            Err(ScaleError::OutOfRange(fraction))
         }
     }
 
@@ -60,9 +58,18 @@ impl Scale {
     }
 }
 
+/// A `--scale` that is not a fraction of the paper's data sizes.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScaleError {
+    #[error("--scale {0}: must be a number in (0, 10] (1.0 is the paper's data sizes)")]
+    OutOfRange(f64),
+    #[error("--scale '{0}': not a number")]
+    NotANumber(String),
+}
+
 impl TryFrom<f64> for Scale {
-    type Error = String;
-    fn try_from(fraction: f64) -> Result<Self, String> {
+    type Error = ScaleError;
+    fn try_from(fraction: f64) -> Result<Self, ScaleError> {
         Self::new(fraction)
     }
 }
@@ -74,12 +81,12 @@ impl From<Scale> for f64 {
 }
 
 impl FromStr for Scale {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = ScaleError;
+    fn from_str(s: &str) -> Result<Self, ScaleError> {
         let fraction: f64 = s
             .trim()
             .parse()
-            .map_err(|_| format!("--scale '{s}': not a number"))?;
+            .map_err(|_| ScaleError::NotANumber(s.to_string()))?;
         Self::new(fraction)
     }
 }
@@ -121,7 +128,11 @@ mod tests {
     #[test]
     fn out_of_range_scales_are_rejected_with_the_flag_named() {
         for bad in ["0", "-1", "nan", "inf", "11", "x"] {
-            let err = bad.parse::<Scale>().err().unwrap_or_default();
+            let err = bad
+                .parse::<Scale>()
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
             assert!(err.contains("--scale"), "{bad}: {err}");
         }
         assert_eq!("0.25".parse::<Scale>().map(Scale::fraction), Ok(0.25));

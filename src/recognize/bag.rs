@@ -10,7 +10,6 @@ use crate::recognize::decision::Decision;
 use crate::recognize::features::check_feature;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::pca::Pca;
-use crate::recognize::posterior::OnlinePosterior;
 use crate::recognize::{FeatureMatrix, RecognizeError};
 
 /// A trained PCA, codebook and object models whose dimensions agree (checked on construction).
@@ -104,11 +103,6 @@ impl BagOfFeatures {
         let mut histogram = ClusterHistogram::new(self.codebook.clusters());
         self.add_features(features, &mut histogram, "the unknown object's features")?;
         Ok(self.models.decide(&histogram))
-    }
-
-    /// A posterior over the objects that takes readings one at a time.
-    pub fn posterior(&self) -> OnlinePosterior<'_> {
-        OnlinePosterior::new(self)
     }
 }
 

@@ -99,19 +99,22 @@ impl ReadingRange {
 }
 
 impl FromStr for ReadingRange {
-    type Err = String;
+    type Err = RecognizeError;
     /// `A..B` (both included) or `N` (meaning `1..N`).
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, RecognizeError> {
         let number = |t: &str| {
             t.trim()
                 .parse::<usize>()
-                .map_err(|_| format!("'{t}' is not a reading count"))
+                .map_err(|_| RecognizeError::InvalidParameter {
+                    name: "readings",
+                    what: format!("'{t}' is not a reading count"),
+                })
         };
         let (first, last) = match s.split_once("..") {
             Some((a, b)) => (number(a)?, number(b.strip_prefix('=').unwrap_or(b))?),
             None => (1, number(s)?),
         };
-        Self::new(first, last).map_err(|e| e.to_string())
+        Self::new(first, last)
     }
 }
 

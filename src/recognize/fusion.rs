@@ -26,6 +26,26 @@ use crate::recognize::model::{
 use crate::recognize::posterior::{Belief, OnlinePosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
 
+/// A descriptor name that names no descriptor, or a fusion that names one twice or none.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DescriptorChoiceError {
+    #[error("no descriptor named")]
+    Empty,
+    #[error("'{0}' is named twice")]
+    Repeated(&'static str),
+    #[error(
+        "unknown descriptor '{part}' in '{text}'; expected one of {} (short: mn, pf), or several \
+         joined by '+' (e.g. mnti+mn)",
+        DescriptorKind::ALL.map(DescriptorKind::name).join(", ")
+    )]
+    Unknown { part: String, text: String },
+    #[error("descriptor '{text}': {error}")]
+    In {
+        text: String,
+        error: Box<DescriptorChoiceError>,
+    },
+}
+
 /// One descriptor or several fused: the parsed form of a descriptor name such as `mnti` or
 /// `mnti+mn`.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -40,32 +60,31 @@ impl DescriptorChoice {
     }
 
     /// Several descriptors fused; at least one, no repeats.
-    pub fn fused(kinds: Vec<DescriptorKind>) -> Result<Self, String> {
+    pub fn fused(kinds: Vec<DescriptorKind>) -> Result<Self, DescriptorChoiceError> {
         if kinds.is_empty() {
-            return Err("no descriptor named".into());
+            return Err(DescriptorChoiceError::Empty);
         }
         if let Some(i) = (0..kinds.len()).find(|&i| kinds[..i].contains(&kinds[i])) {
-            return Err(format!("'{}' is named twice", kinds[i].name()));
+            return Err(DescriptorChoiceError::Repeated(kinds[i].name()));
         }
         Ok(Self { kinds })
     }
 
     /// Parses `name` or `name+name+...` (each a [`DescriptorKind::from_name`] name).
-    pub fn parse(text: &str) -> Result<Self, String> {
+    pub fn parse(text: &str) -> Result<Self, DescriptorChoiceError> {
         let kinds = text
             .split('+')
             .map(|part| {
-                DescriptorKind::from_name(part.trim()).ok_or_else(|| {
-                    let known: Vec<&str> = DescriptorKind::ALL.iter().map(|k| k.name()).collect();
-                    format!(
-                        "unknown descriptor '{part}' in '{text}'; expected one of {} (short: mn, pf), \
-                         or several joined by '+' (e.g. mnti+mn)",
-                        known.join(", ")
-                    )
+                DescriptorKind::from_name(part.trim()).ok_or_else(|| DescriptorChoiceError::Unknown {
+                    part: part.to_string(),
+                    text: text.to_string(),
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Self::fused(kinds).map_err(|e| format!("descriptor '{text}': {e}"))
+        Self::fused(kinds).map_err(|e| DescriptorChoiceError::In {
+            text: text.to_string(),
+            error: Box::new(e),
+        })
     }
 
     pub fn kinds(&self) -> &[DescriptorKind] {
@@ -110,7 +129,8 @@ impl FusedModel {
         if models.len() < 2 {
             return Err(invalid("fusion needs at least two models".into()));
         }
-        DescriptorChoice::fused(models.iter().map(|m| m.descriptor.kind()).collect()).map_err(invalid)?;
+        DescriptorChoice::fused(models.iter().map(|m| m.descriptor.kind()).collect())
+            .map_err(|e| invalid(e.to_string()))?;
         for m in &models[1..] {
             if m.bag.objects() != first.bag.objects() {
                 return Err(invalid(format!(

@@ -14,21 +14,21 @@
 //! recorded data from a real sensor can be fed in. A [`TrainedModel`] adds the descriptor, the
 //! sensor configuration and persistence.
 
-pub mod bag;
-pub mod codebook;
-pub mod confusion;
-pub mod decision;
-pub mod error;
+pub(crate) mod bag;
+pub(crate) mod codebook;
+pub(crate) mod confusion;
+pub(crate) mod decision;
+pub(crate) mod error;
 pub mod evaluate;
-pub mod features;
-pub mod fusion;
-pub mod gmm;
-pub mod kmeans;
-pub mod labelled;
+pub(crate) mod features;
+pub(crate) mod fusion;
+pub(crate) mod gmm;
+pub(crate) mod kmeans;
+pub(crate) mod labelled;
 pub mod model;
-pub mod object_model;
-pub mod pca;
-pub mod posterior;
+pub(crate) mod object_model;
+pub(crate) mod pca;
+pub(crate) mod posterior;
 pub mod selection;
 
 pub use bag::BagOfFeatures;
@@ -40,12 +40,12 @@ pub use evaluate::{
     AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
 };
 pub use features::FeatureMatrix;
-pub use fusion::{DescriptorChoice, FusedModel, FusedPosterior, Recognizer};
+pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, FusedPosterior, Recognizer};
 pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
 pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
 pub use labelled::LabelledFeatures;
 pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
-pub use object_model::{ClusterHistogram, ObjectModels, PseudoCount};
+pub use object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels, PseudoCount};
 pub use pca::{Pca, VarianceFraction};
 pub use posterior::{Belief, OnlinePosterior};
 pub use selection::{

@@ -7,6 +7,14 @@ use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::Decision;
 use crate::recognize::object_model::ClusterHistogram;
 
+impl BagOfFeatures {
+    /// A posterior over the objects that takes readings one at a time. (Defined here, beside the
+    /// posterior, so that the bag's file need not know it.)
+    pub fn posterior(&self) -> OnlinePosterior<'_> {
+        OnlinePosterior::new(self)
+    }
+}
+
 /// The state after some readings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Belief {

@@ -2,18 +2,18 @@
 //! the object under exploration, free to be perturbed between readings (Sec. V-B4).
 
 pub mod arm;
-pub mod collision_shell;
-pub mod ik;
+pub(crate) mod collision_shell;
+pub(crate) mod ik;
 pub mod mjcf;
-pub mod object;
-pub mod perturb;
-pub mod scene;
+pub(crate) mod object;
+pub(crate) mod perturb;
+pub(crate) mod scene;
 
 pub use arm::{Arm, Collision, MoveOptions, MoveOutcome};
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 pub use object::{ObjectMount, ObjectSpec};
 pub use perturb::{Perturbation, PerturbationBounds};
-pub use scene::{Scene, SceneBuilder};
+pub use scene::{Scene, SceneBuilder, SceneObject};
 
 /// Errors of the simulated world; each says which part and what is wrong.
 #[derive(Debug, thiserror::Error)]

@@ -6,10 +6,12 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+use crate::valid::Check;
+
 /// Everything that determines how the covering sensor forms an image. Lengths in metres.
 ///
-/// A value of this type says nothing about validity by itself; [`SensorConfig::validate`] (called by
-/// every parser and by the plugin) checks each field against [`ConfigKey::allowed`].
+/// A value of this type says nothing about validity by itself; its [`Check`] (called by every parser
+/// and by the plugin) checks each field against [`ConfigKey::allowed`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SensorConfig {
     /// Taxel rows (image height).
@@ -172,6 +174,51 @@ pub fn rays_per_side(rays_per_taxel: usize) -> Option<usize> {
     (k >= 1 && k * k == rays_per_taxel).then_some(k)
 }
 
+impl Check for SensorConfig {
+    type Error = ConfigError;
+
+    /// Every field against its allowed range ([`ConfigKey::allowed`]); the error names the first
+    /// offending key.
+    fn check(&self) -> Result<(), ConfigError> {
+        let Self {
+            rows,
+            cols,
+            pad_width_m,
+            pad_height_m,
+            thickness_m,
+            psf_sigma_m,
+            rays_per_taxel,
+            noise_fraction,
+            noise_seed: _,
+        } = *self;
+        let bad = |key: ConfigKey, value: String| Err(ConfigError { key, value });
+        for (key, n) in [(ConfigKey::Rows, rows), (ConfigKey::Cols, cols)] {
+            if !(1..=MAX_TAXELS_PER_SIDE).contains(&n) {
+                return bad(key, n.to_string());
+            }
+        }
+        for (key, v) in [
+            (ConfigKey::PadWidth, pad_width_m),
+            (ConfigKey::PadHeight, pad_height_m),
+            (ConfigKey::Thickness, thickness_m),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= MAX_LENGTH_M) {
+                return bad(key, v.to_string());
+            }
+        }
+        if !(psf_sigma_m.is_finite() && (0.0..=MAX_LENGTH_M).contains(&psf_sigma_m)) {
+            return bad(ConfigKey::PsfSigma, psf_sigma_m.to_string());
+        }
+        if rays_per_taxel > MAX_RAYS_PER_TAXEL || rays_per_side(rays_per_taxel).is_none() {
+            return bad(ConfigKey::RaysPerTaxel, rays_per_taxel.to_string());
+        }
+        if !(noise_fraction.is_finite() && (0.0..=MAX_NOISE_FRACTION).contains(&noise_fraction)) {
+            return bad(ConfigKey::NoiseFraction, noise_fraction.to_string());
+        }
+        Ok(())
+    }
+}
+
 impl SensorConfig {
     /// A config with `rows x cols` taxels on a square pad of side `pad_m`, covering `thickness_m`,
     /// the PSF law, 4 rays per taxel and no noise.
@@ -185,35 +232,6 @@ impl SensorConfig {
             psf_sigma_m: psf_sigma_for_thickness(thickness_m),
             ..Self::default()
         }
-    }
-
-    /// Checks every field against its allowed range; the error names the first offending key.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let bad = |key: ConfigKey, value: String| Err(ConfigError { key, value });
-        for (key, n) in [(ConfigKey::Rows, self.rows), (ConfigKey::Cols, self.cols)] {
-            if !(1..=MAX_TAXELS_PER_SIDE).contains(&n) {
-                return bad(key, n.to_string());
-            }
-        }
-        for (key, v) in [
-            (ConfigKey::PadWidth, self.pad_width_m),
-            (ConfigKey::PadHeight, self.pad_height_m),
-            (ConfigKey::Thickness, self.thickness_m),
-        ] {
-            if !(v.is_finite() && v > 0.0 && v <= MAX_LENGTH_M) {
-                return bad(key, v.to_string());
-            }
-        }
-        if !(self.psf_sigma_m.is_finite() && (0.0..=MAX_LENGTH_M).contains(&self.psf_sigma_m)) {
-            return bad(ConfigKey::PsfSigma, self.psf_sigma_m.to_string());
-        }
-        if self.rays_per_taxel > MAX_RAYS_PER_TAXEL || rays_per_side(self.rays_per_taxel).is_none() {
-            return bad(ConfigKey::RaysPerTaxel, self.rays_per_taxel.to_string());
-        }
-        if !(self.noise_fraction.is_finite() && (0.0..=MAX_NOISE_FRACTION).contains(&self.noise_fraction)) {
-            return bad(ConfigKey::NoiseFraction, self.noise_fraction.to_string());
-        }
-        Ok(())
     }
 
     /// The `k` of the `k x k` rays per taxel (valid configs only; 1 otherwise).
@@ -259,7 +277,7 @@ impl SensorConfig {
             None => config.noise_seed,
             Some(s) => s.parse().map_err(|_| bad(ConfigKey::NoiseSeed, s))?,
         };
-        config.validate()?;
+        config.check()?;
         Ok(config)
     }
 
@@ -306,7 +324,7 @@ mod tests {
 
     #[test]
     fn defaults_are_valid_and_empty_config_gives_them() {
-        SensorConfig::default().validate().unwrap();
+        SensorConfig::default().check().unwrap();
         assert_eq!(parse(&[]).unwrap(), SensorConfig::default());
         assert_eq!(
             parse(&[("rows", " "), ("noise_seed", "")]).unwrap(),

@@ -31,6 +31,7 @@ use crate::tactile::mesh_bvh::{MeshBvh, MeshBvhError, OrientedBox};
 use crate::tactile::model_view::{ModelView, PoseView};
 use crate::tactile::primitive::Solid;
 use crate::tactile::raster::{Behind, rasterise_triangle};
+use crate::valid::Check;
 
 /// Why a plugin instance cannot be set up; each names the offending part of the model, briefly
 /// (MuJoCo keeps about 80 characters of a plugin's compile error).
@@ -135,7 +136,7 @@ impl Covering {
     /// each is on a site with the right dimension, chooses the sensed geoms, and builds one BVH per
     /// mesh they use.
     pub fn new(model: &ModelView, config: SensorConfig, sensor_ids: &[usize]) -> Result<Self, CoveringError> {
-        config.validate()?;
+        config.check()?;
         let grid = SampleGrid::new(&config);
         let formation = ImageFormation::new(&config, &grid);
         let mut meshes: Vec<MeshBvh> = Vec::new();

@@ -16,23 +16,24 @@
 //! image       TactileImage and PadPose
 //! ```
 
-pub mod back_contact;
-pub mod config;
-pub mod covering;
+pub(crate) mod back_contact;
+pub(crate) mod config;
+pub(crate) mod covering;
 pub mod formation;
 pub mod free_floating;
 pub mod grid;
 pub mod image;
 pub mod mesh_bvh;
-pub mod model_view;
+pub(crate) mod model_view;
 pub mod plugin;
-pub mod primitive;
+pub(crate) mod primitive;
 pub mod raster;
 pub mod sensor;
 
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
-pub use covering::{CoveringError, CoveringStats};
+pub use covering::{Covering, CoveringError, CoveringStats};
 pub use free_floating::{FreeFloatingSensor, free_floating_builder};
 pub use image::{ImageError, PadPose, TactileImage};
+pub use model_view::{ModelView, PoseView};
 pub use plugin::{PLUGIN_NAME, ensure_registered, register};
 pub use sensor::{CoveringSensor, TactileError, add_sensor, extension_xml, sensor_xml};

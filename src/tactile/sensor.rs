@@ -15,6 +15,7 @@ use crate::tactile::model_view::ModelView;
 use crate::tactile::plugin::{
     PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state, is_covering_instance,
 };
+use crate::valid::Check;
 
 /// Errors of the tactile module; each names the sensor, site or key concerned.
 #[derive(Debug, thiserror::Error)]
@@ -155,7 +156,7 @@ pub fn extension_xml() -> String {
 
 /// The `<sensor>` content of a covering sensor named `name` on site `site` with every config key.
 pub fn sensor_xml(config: &SensorConfig, name: &str, site: &str) -> Result<String, ConfigError> {
-    config.validate()?;
+    config.check()?;
     let mut xml = format!(
         "<plugin name=\"{}\" plugin=\"{PLUGIN_NAME}\" objtype=\"site\" objname=\"{}\">\n",
         escape_attr(name),

@@ -1,0 +1,22 @@
+//! The names a user of the library reaches for first, in the order of the data flow: the sensor,
+//! the controllers, exploration into a dataset, descriptors, and recognition.
+//!
+//! ```
+//! use taction::prelude::*;
+//! ```
+//!
+//! Everything else stays at its module's root (`taction::recognize::GaussianMixture`, ...); the
+//! modules' own files are not part of the interface.
+
+pub use crate::control::{ContactOutcome, ControlConfig, settle};
+pub use crate::dataset::{ContactStatus, Dataset, DatasetHeader, Reading};
+pub use crate::describe::{Descriptor, DescriptorKind};
+pub use crate::explore::collect::{CollectMode, CollectPlan};
+pub use crate::explore::{PlannerConfig, SamplerConfig};
+pub use crate::mesh::{ObjectSet, TriMesh};
+pub use crate::recognize::{
+    DescriptorChoice, OnlinePosterior, ReadingRange, Recognizer, TrainConfig, TrainedModel, evaluate, train,
+};
+pub use crate::sim::{ObjectSpec, PerturbationBounds};
+pub use crate::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, TactileImage};
+pub use crate::valid::{Check, Valid};
