@@ -107,7 +107,7 @@ const LINE_CONTACT_TILT_RAD: f64 = 0.35;
 /// A contact along a single line of taxels (the first touch of a steeply tilted surface, or an edge)
 /// fits no unique plane. If that line passes near the pad centre it is an edge under the pad, and the
 /// pad stays as it is; if it lies off-centre, the surface is closer on that side, so the stand-in normal
-/// leans toward the contact by [`LINE_CONTACT_TILT_RAD`], bringing the rest of the pad down onto it.
+/// leans toward the contact by `LINE_CONTACT_TILT_RAD`, bringing the rest of the pad down onto it.
 pub fn surface_normal(
     image: &TactileImage,
     sensor: &SensorConfig,

@@ -9,7 +9,7 @@
 //! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
 //! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
 //! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
-//! alike. The file format is in [`format`]; the counts `dataset show` prints in [`summary`].
+//! alike. The file format is in [`format`]; the counts `dataset show` prints in `summary.rs`.
 
 mod format;
 mod reading;

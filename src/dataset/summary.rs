@@ -55,7 +55,7 @@ pub struct DatasetSummary {
 /// What ended a failed attempt, as `collect` and `dataset show` count them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum FailureCause {
-    /// A recorded [`AttemptCause`], by kind.
+    /// A recorded [`AttemptCause`](crate::dataset::AttemptCause), by kind.
     Cause(CauseKind),
     /// `no_contact` after the controllers had pressed (Orient or Press lifted the pad off a narrow
     /// feature), as opposed to an Approach that met nothing.

@@ -107,7 +107,7 @@ impl Figure {
     }
 
     /// The figure as an 8-bit RGB PNG: the SVG of [`to_svg`](Self::to_svg) rendered by `resvg`
-    /// with the font of [`plot_fonts`], so the PNG shows exactly what the SVG does.
+    /// with the font of `plot_fonts`, so the PNG shows exactly what the SVG does.
     pub fn to_png(&self) -> Result<Vec<u8>, String> {
         let fontdb = plot_fonts().map_err(|e| e.to_string())?;
         let svg = self.to_svg()?;

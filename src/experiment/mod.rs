@@ -6,9 +6,9 @@
 //! the units of one [`Shard`] on a thread pool, writing each unit's rows atomically to
 //! `<out>/<experiment>/units/<key>.csv`, so a killed run resumes where it stopped and never
 //! duplicates a row; once every unit is present it assembles `<experiment>.csv`, draws the
-//! experiment's plots and rewrites the index `<out>/README.md`. [`merge`] combines the outputs of
+//! experiment's plots and rewrites the index `<out>/README.md`. [`merge()`] combines the outputs of
 //! separate shards into exactly the files of one unsharded run. The on-disk layout is in
-//! [`layout`].
+//! `layout.rs`.
 //!
 //! The framework knows nothing of MuJoCo, the paper or recognition beyond the accuracy row it
 //! plots: the experiments themselves (`crate::paper`) build the units.

@@ -17,7 +17,7 @@ pub struct NameError {
     pub what: &'static str,
 }
 
-/// A non-empty name of at most [`MAX_NAME_BYTES`] ASCII letters, digits and `_ - . = +`, not
+/// A non-empty name of at most `MAX_NAME_BYTES` ASCII letters, digits and `_ - . = +`, not
 /// starting with `.`: the same file name on every operating system, never hidden, never a path.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]

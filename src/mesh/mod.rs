@@ -1,6 +1,6 @@
 //! Objects as triangle meshes: the shapes the arm explores.
 //!
-//! - loading OBJ, OFF and STL with validation ([`load`], [`ValidationReport`]), writing OBJ;
+//! - loading OBJ, OFF and STL with validation ([`load()`], [`ValidationReport`]), writing OBJ;
 //! - geometry: bounds, area, signed volume, normalisation to a common size ([`normalise_to_diagonal`]),
 //!   and the edge topology behind watertightness and orientation checks ([`EdgeTopology`]);
 //! - the objects: ten real meshes fetched from Debian ([`cgal`]), chess pieces as surfaces of

@@ -30,7 +30,7 @@ pub struct ValidationReport {
 }
 
 impl ValidationReport {
-    /// Validates `mesh`, whose indices must be in range (as any mesh from [`super::load`] is).
+    /// Validates `mesh`, whose indices must be in range (as any mesh from [`load()`](super::load()) is).
     pub fn of(mesh: &TriMesh) -> Self {
         let diagonal = mesh.bounding_diagonal_m().unwrap_or(0.0);
         let min_area = ZERO_AREA_RELATIVE * diagonal * diagonal;

@@ -4,7 +4,7 @@
 //!
 //! | name | figure | varies |
 //! |---|---|---|
-//! | `exploration` | 1 | - (one planner run on the chess piece, drawn; [`figure1`]) |
+//! | `exploration` | 1 | - (one planner run on the chess piece, drawn; `figure1.rs`) |
 //! | `descriptors` | 7 | the six descriptors |
 //! | `strategy` | 8 | L, the probability of local exploration |
 //! | `validation` | 9 | validation (sampler) vs exploration (planner) test data |
@@ -17,7 +17,7 @@
 //! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //! | `training-size` | beyond | training readings per object (100, 300, 1000) |
-//! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence ([`active`]) |
+//! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` ([`data`]).

@@ -242,7 +242,7 @@ impl FusedModel {
         Ok(zip_trials(per_model))
     }
 
-    /// Recognition touch by touch over `trials` (as [`evaluate`](crate::recognize::evaluate)).
+    /// Recognition touch by touch over `trials` (as [`evaluate`](crate::recognize::evaluate())).
     pub fn evaluate(
         &self,
         trials: &[Trial<Vec<Vec<Feature>>>],

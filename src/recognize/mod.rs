@@ -8,7 +8,7 @@
 //! Testing: the features of the unknown object's readings go through the same PCA and codebook
 //! into a histogram `p(c_i | U)`; the guess minimises the cross-entropy of Eq. 4, and the
 //! distribution over objects is the softmax of `n_U` times the average log-likelihood (Eq. 16).
-//! [`OnlinePosterior`] does this after every reading; [`evaluate`] over a whole test set.
+//! [`OnlinePosterior`] does this after every reading; [`evaluate()`] over a whole test set.
 //!
 //! Everything here works on features (`Vec<Feature>` per reading), so it knows nothing of MuJoCo:
 //! recorded data from a real sensor can be fed in. A [`TrainedModel`] adds the descriptor, the

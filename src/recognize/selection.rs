@@ -106,7 +106,7 @@ const CODEBOOK_STEPS: usize = 4;
 /// `training_features` training features; validation accuracy, ties broken by reliability, then
 /// picks one. The paper names no `k`; a fixed small grid starves large problems (on the 52 letters
 /// validation accuracy kept rising from k = 10 to 400), so the grid starts at about one cluster per
-/// object (the ladder value at or below `objects`, at least 10) and climbs [`CODEBOOK_STEPS`]
+/// object (the ladder value at or below `objects`, at least 10) and climbs `CODEBOOK_STEPS`
 /// ladder steps: {10, 20, 50, 100} for 12 objects, {50, 100, 200, 400} for 52. Counts the
 /// features cannot support are dropped ([`supported_codebook_sizes`]). `train`, `demo` and the
 /// experiments all take their grid from here.

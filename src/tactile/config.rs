@@ -54,7 +54,7 @@ pub const DEFAULT_PAD_M: f64 = 0.012;
 pub const DEFAULT_THICKNESS_M: f64 = 0.1 * DEFAULT_PAD_M;
 
 /// The Gaussian point-spread sigma of a covering of thickness `thickness_m` (see
-/// [`PSF_SIGMA_PER_THICKNESS`]).
+/// `PSF_SIGMA_PER_THICKNESS`).
 pub fn psf_sigma_for_thickness(thickness_m: f64) -> f64 {
     PSF_SIGMA_PER_THICKNESS * thickness_m
 }

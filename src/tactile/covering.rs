@@ -95,9 +95,9 @@ pub struct CoveringStats {
     /// averaged over taxels, may show well below 1 (a sliver of an edge, a thin blade).
     pub last_full_samples: usize,
     /// Whether, in the last reading, a mesh triangle lay in the pad's rigid back (the pad's
-    /// rectangle swept [`RIGID_BACK_DEPTH_M`] behind the pad plane): the object at the back even
+    /// rectangle swept `RIGID_BACK_DEPTH_M` behind the pad plane): the object at the back even
     /// between the samples, or a blade that one turn of the pad swept past the covering
-    /// ([`triangle_overlaps_box`]).
+    /// (`triangle_overlaps_box`).
     pub last_back_touched: bool,
 }
 
