@@ -3,6 +3,14 @@
 //!
 //! ```
 //! use taction::prelude::*;
+//!
+//! // The paper's letters sensor, and controllers whose every field is checked once, here.
+//! let sensor = SensorConfig::default();
+//! assert_eq!(sensor.check(), Ok(()));
+//! let control = Valid::new(ControlConfig::default())?;
+//! let too_far = ControlConfig { orient_step: 1.5, ..*control };
+//! assert_eq!(Valid::new(too_far).unwrap_err().field, "orient_step");
+//! # Ok::<(), taction::valid::RangeError>(())
 //! ```
 //!
 //! Everything else stays at its module's root (`taction::recognize::GaussianMixture`, ...); the
