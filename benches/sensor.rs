@@ -45,7 +45,7 @@ use taction::tactile::formation::ImageFormation;
 use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml, pad_rotation};
 use taction::tactile::grid::SampleGrid;
 use taction::tactile::mesh_bvh::{MeshBvh, OrientedBox};
-use taction::tactile::raster::{Behind, rasterise_triangle};
+use taction::tactile::raster::DepthBuffer;
 use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
 
 const RADIUS_M: f64 = 0.05;
@@ -110,28 +110,24 @@ fn stages(
         axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
         half: DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * (t - z_lo)),
     };
-    let (mut stack, mut faces) = (Vec::new(), Vec::new());
-    bvh.faces_near(&region, &mut stack, &mut faces);
+    let (mut stack, mut leaves) = (Vec::new(), Vec::new());
+    bvh.leaves_near(&region, &mut stack, &mut leaves);
     group.bench_function(BenchmarkId::new("stage", "bvh_query"), |b| {
         b.iter(|| {
-            faces.clear();
-            bvh.faces_near(black_box(&region), &mut stack, &mut faces);
-            black_box(faces.len())
+            leaves.clear();
+            bvh.leaves_near(black_box(&region), &mut stack, &mut leaves);
+            black_box(leaves.len())
         })
     });
-    let mut nearest_m = vec![f64::INFINITY; grid.len()];
-    let mut behind = Behind::new(grid.len());
+    let mut depth = DepthBuffer::new(&grid);
     group.bench_function(BenchmarkId::new("stage", "rasterise"), |b| {
         b.iter(|| {
-            nearest_m.fill(f64::INFINITY);
-            for &face in &faces {
-                let corners = bvh.corners(face, &to_pad, o);
-                rasterise_triangle(&grid, corners, t, &mut nearest_m, &mut behind);
-            }
-            behind.resolve_into(&grid, &mut nearest_m);
-            black_box(nearest_m[0])
+            depth.nearest_m.fill(f64::INFINITY);
+            depth.draw_mesh(&grid, &bvh, &leaves, (&to_pad, o), t, |_| {});
+            black_box(depth.nearest_m[0])
         })
     });
+    let nearest_m = &depth.nearest_m;
     let penetration_m: Vec<f64> = nearest_m.iter().map(|z| (t - z).clamp(0.0, t)).collect();
     let mut formation = ImageFormation::new(config, &grid);
     let mut image = vec![0.0; config.taxel_count()];

@@ -15,7 +15,7 @@
 //!
 //! Sensed: every geom except those of the kinematic tree the pad is mounted on (same
 //! `body_rootid` as the pad site's body; when that root is the world body, only the geoms of the
-//! site's own body are skipped). Meshes are rasterised from their BVH's candidate faces;
+//! site's own body are skipped). Meshes are rasterised from the faces of their BVH leaves near the pad;
 //! primitives are cut analytically ([`crate::tactile::primitive`]).
 
 use glam::{DMat3, DVec3};
@@ -27,10 +27,10 @@ use crate::tactile::back_contact::triangle_overlaps_box;
 use crate::tactile::config::ConfigError;
 use crate::tactile::formation::ImageFormation;
 use crate::tactile::grid::SampleGrid;
-use crate::tactile::mesh_bvh::{MeshBvh, MeshBvhError, OrientedBox};
+use crate::tactile::mesh_bvh::{Leaf, MeshBvh, MeshBvhError, OrientedBox};
 use crate::tactile::model_view::{ModelView, PoseView};
 use crate::tactile::primitive::Solid;
-use crate::tactile::raster::{Behind, rasterise_triangle};
+use crate::tactile::raster::DepthBuffer;
 use crate::valid::Check;
 
 /// Why a plugin instance cannot be set up; each names the offending part of the model, briefly
@@ -88,7 +88,7 @@ pub struct CoveringStats {
     pub bvh_triangles: usize,
     /// Readings computed since init.
     pub readings: u64,
-    /// Mesh faces rasterised in the last reading (the BVH's candidates near the pad).
+    /// Mesh faces rasterised in the last reading (those of the BVH leaves near the pad).
     pub last_faces: usize,
     /// Samples of the last reading at full penetration: there the object reached the pad's rigid
     /// back (the covering is fully compressed), which the image, blurred by the point-spread and
@@ -114,9 +114,8 @@ pub struct Covering {
     sensors: Vec<PadSensor>,
     meshes: Vec<MeshBvh>,
     // Scratch space, reused by every reading.
-    nearest_m: Vec<f64>,
-    behind: Behind,
-    candidates: Vec<u32>,
+    depth: DepthBuffer,
+    leaves: Vec<Leaf>,
     stack: Vec<usize>,
     stats: CoveringStats,
 }
@@ -260,16 +259,15 @@ impl Covering {
                 sensed,
             });
         }
-        let samples = grid.len();
+        let depth = DepthBuffer::new(&grid);
         Ok(Self {
             config,
             grid,
             formation,
             sensors,
             meshes,
-            nearest_m: vec![f64::INFINITY; samples],
-            behind: Behind::new(samples),
-            candidates: Vec::new(),
+            depth,
+            leaves: Vec::new(),
             stack: Vec::new(),
             stats,
         })
@@ -292,12 +290,12 @@ impl Covering {
         for k in 0..self.sensors.len() {
             self.penetration(k, poses);
             let t = self.config.thickness_m;
-            self.stats.last_full_samples += self.nearest_m.iter().filter(|&&p| p >= t).count();
+            self.stats.last_full_samples += self.depth.nearest_m.iter().filter(|&&p| p >= t).count();
             let sensor = &self.sensors[k];
             let n = self.config.taxel_count();
             let out = &mut sensordata[sensor.adr..sensor.adr + n];
             self.formation
-                .form(&self.nearest_m, sensor.noise_seed, reading, out);
+                .form(&self.depth.nearest_m, sensor.noise_seed, reading, out);
         }
         self.stats.readings += 1;
     }
@@ -310,7 +308,7 @@ impl Covering {
         let pad_rotation = rotation(&poses.site_xmat[9 * sensor.site..9 * sensor.site + 9]);
         let to_pad = pad_rotation.transpose();
         let (hw, hh) = (self.grid.half_width_m, self.grid.half_height_m);
-        self.nearest_m.fill(f64::INFINITY);
+        self.depth.nearest_m.fill(f64::INFINITY);
         for g in &sensor.sensed {
             let geom_origin = DVec3::from_slice(&poses.geom_xpos[3 * g.geom..3 * g.geom + 3]);
             let geom_rotation = rotation(&poses.geom_xmat[9 * g.geom..9 * g.geom + 9]);
@@ -333,23 +331,22 @@ impl Covering {
                         half: DVec3::new(hw, hh, 0.5 * (t - z_lo)) + margin,
                     };
                     let mesh = &self.meshes[slot];
-                    self.candidates.clear();
-                    mesh.faces_near(&region, &mut self.stack, &mut self.candidates);
-                    self.stats.last_faces += self.candidates.len();
+                    self.leaves.clear();
+                    mesh.leaves_near(&region, &mut self.stack, &mut self.leaves);
+                    self.stats.last_faces += self.leaves.iter().map(Leaf::face_count).sum::<usize>();
                     let back_center = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
                     let back_half = DVec3::new(hw, hh, 0.5 * RIGID_BACK_DEPTH_M);
-                    for &face in &self.candidates {
-                        let corners = mesh.corners(face, &m, o);
-                        rasterise_triangle(&self.grid, corners, t, &mut self.nearest_m, &mut self.behind);
-                        // A face wholly in front of the pad plane cannot reach the back.
-                        if !self.stats.last_back_touched
-                            && corners.iter().any(|p| p.z <= 0.0)
-                            && triangle_overlaps_box(corners, back_center, back_half)
-                        {
-                            self.stats.last_back_touched = true;
-                        }
-                    }
-                    self.behind.resolve_into(&self.grid, &mut self.nearest_m);
+                    let back_touched = &mut self.stats.last_back_touched;
+                    self.depth
+                        .draw_mesh(&self.grid, mesh, &self.leaves, (&m, o), t, |corners| {
+                            // A face wholly in front of the pad plane cannot reach the back.
+                            if !*back_touched
+                                && corners.iter().any(|p| p.z <= 0.0)
+                                && triangle_overlaps_box(corners, back_center, back_half)
+                            {
+                                *back_touched = true;
+                            }
+                        });
                 }
                 Shape::Solid(solid) => {
                     let to_geom = m.transpose();
@@ -372,8 +369,8 @@ impl Covering {
                             {
                                 let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
                                 let s = i * self.grid.cols + j;
-                                if z < self.nearest_m[s] {
-                                    self.nearest_m[s] = z;
+                                if z < self.depth.nearest_m[s] {
+                                    self.depth.nearest_m[s] = z;
                                 }
                             }
                         }
@@ -381,7 +378,7 @@ impl Covering {
                 }
             }
         }
-        for row in self.nearest_m.chunks_exact_mut(self.grid.cols) {
+        for row in self.depth.nearest_m.chunks_exact_mut(self.grid.cols) {
             row.reverse();
             for z in row {
                 *z = (t - *z).clamp(0.0, t);

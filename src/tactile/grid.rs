@@ -84,36 +84,128 @@ impl SampleGrid {
     /// The sample columns whose x lies in `[lo, hi]` (with a hair of slack).
     #[inline]
     pub fn col_range(&self, lo: f64, hi: f64) -> Range<usize> {
-        index_range(lo, hi, self.half_width_m, self.inv_dx, self.cols)
+        self.cols_in(CellBounds::from_to(self.col_bounds(lo), self.col_bounds(hi)))
     }
 
     /// The sample rows whose y lies in `[lo, hi]` (rows count downward from `+up`).
     #[inline]
     pub fn row_range(&self, lo: f64, hi: f64) -> Range<usize> {
-        index_range(-hi, -lo, self.half_height_m, self.inv_dy, self.rows)
+        self.rows_in(CellBounds::from_to(self.row_bounds(hi), self.row_bounds(lo)))
+    }
+
+    /// The column bounds of one x, for [`Self::cols_in`].
+    #[inline]
+    pub fn col_bounds(&self, x: f64) -> CellBounds {
+        CellBounds::new(x, self.half_width_m, self.inv_dx)
+    }
+
+    /// The row bounds of one y, for [`Self::rows_in`] (rows count downward, so the bounds are
+    /// those of `-y`).
+    #[inline]
+    pub fn row_bounds(&self, y: f64) -> CellBounds {
+        CellBounds::new(-y, self.half_height_m, self.inv_dy)
+    }
+
+    /// The sample columns within `bounds`.
+    #[inline]
+    pub fn cols_in(&self, bounds: CellBounds) -> Range<usize> {
+        bounds.clip(self.cols)
+    }
+
+    /// The sample rows within `bounds`.
+    #[inline]
+    pub fn rows_in(&self, bounds: CellBounds) -> Range<usize> {
+        bounds.clip(self.rows)
     }
 }
 
-/// Indices `j` of `n` cells of width `1 / inv_d` starting at `-half` whose centres lie in
-/// `[lo, hi]`, widened by a relative 1e-9 of a cell so that rounding never drops a centre on the
-/// boundary.
-#[inline]
-fn index_range(lo: f64, hi: f64, half: f64, inv_d: f64, n: usize) -> Range<usize> {
-    const SLACK: f64 = 1e-9;
-    let u = (lo + half) * inv_d - 0.5 - SLACK;
-    let v = (hi + half) * inv_d - 0.5 + SLACK;
-    // NaN fails the comparisons and yields an empty range.
-    if !(v >= 0.0 && u <= v && u < n as f64) {
-        return 0..0;
-    }
-    // u < n and v >= 0 here, so the casts below are in range (v is clamped first).
-    let first = if u <= 0.0 {
-        0
-    } else {
-        (u as i64 + ((u as i64 as f64) < u) as i64) as usize
+/// Where one coordinate falls among cells of width `1 / inv_d` starting at `-half`, with cell
+/// centres at whole numbers of `w(x) = (x + half) inv_d - 1/2`: `first` is the first centre at
+/// or above it and `last` the last at or below it, each widened by a relative 1e-9 of a cell so
+/// that rounding never drops a centre on the boundary.
+///
+/// Both are monotone in `x` (rounding keeps the order of `+` and `*`), so for a set of points the
+/// bounds of their lowest coordinate are the least `first` and those of the highest the greatest
+/// `last`: a face's sample rectangle is a min and a max over its corners' bounds, which a mesh
+/// vertex shared by six faces computes once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CellBounds {
+    first: i32,
+    last: i32,
+}
+
+impl CellBounds {
+    /// A NaN coordinate's bounds: alone it covers no cell, and `hull` passes over it as
+    /// `f64::min` and `f64::max` pass over NaN.
+    pub const NONE: Self = Self {
+        first: i32::MAX / 4,
+        last: i32::MIN / 4,
     };
-    let last = (v.min(n as f64) as i64 + 1).min(n as i64) as usize;
-    first..last.max(first)
+
+    #[inline]
+    fn new(x: f64, half: f64, inv_d: f64) -> Self {
+        const SLACK: f64 = 1e-9;
+        // Beyond 1e8 cells a coordinate is as far off the grid as infinity.
+        const FAR: f64 = 1e8;
+        let w = (x + half) * inv_d - 0.5;
+        if w.is_nan() {
+            return Self::NONE;
+        }
+        let w = w.clamp(-FAR, FAR);
+        // With n = floor(w): n - 1 < w - SLACK < n + 1 and n <= w + SLACK < n + 2, also as
+        // rounded, so ceil(w - SLACK) = n + [w - SLACK > n] and floor(w + SLACK) =
+        // n + [w + SLACK >= n + 1]: one floor for both bounds.
+        let n = floor(w);
+        let whole = small_int(n);
+        Self {
+            first: whole + i32::from(w - SLACK > n),
+            last: whole + i32::from(w + SLACK >= n + 1.0),
+        }
+    }
+
+    /// The bounds of a set: the least `first` and the greatest `last`.
+    #[inline]
+    pub fn hull(self, other: Self) -> Self {
+        Self {
+            first: self.first.min(other.first),
+            last: self.last.max(other.last),
+        }
+    }
+
+    /// The cells from the lowest coordinate's bounds `lo` to the highest's `hi`.
+    #[inline]
+    fn from_to(lo: Self, hi: Self) -> Self {
+        Self {
+            first: lo.first,
+            last: hi.last,
+        }
+    }
+
+    /// Cells `first..=last` clipped to `0..n`, empty when they miss it.
+    #[inline]
+    fn clip(self, n: usize) -> Range<usize> {
+        let first = self.first.max(0) as usize;
+        let end = ((self.last.max(-1) + 1) as usize).min(n);
+        if first < end { first..end } else { 0..0 }
+    }
+}
+
+/// 1.5 * 2^52: adding it to an `|x| < 2^51` rounds `x` to an integer in the low bits of the sum.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
+/// `x.floor()` for `|x| < 2^51`, exactly, in a few instructions without branches (without SSE4.1,
+/// `f64::floor` is a library call, and a saturating `as` cast costs a handful of checks; a face's
+/// cell range needs four).
+#[inline]
+fn floor(x: f64) -> f64 {
+    let nearest = (x + ROUND) - ROUND;
+    nearest - f64::from(u8::from(nearest > x))
+}
+
+/// The integer `x` (a whole number, `|x| < 2^31`) as `i32`: the low bits of `x + ROUND`.
+#[inline]
+fn small_int(x: f64) -> i32 {
+    (x + ROUND).to_bits() as u32 as i32
 }
 
 #[cfg(test)]
@@ -175,5 +267,51 @@ mod tests {
         }
         assert!(g.col_range(0.02, 0.03).is_empty());
         assert!(g.col_range(f64::NAN, 0.0).is_empty());
+    }
+
+    /// The ranges with `f64::ceil` and `f64::floor` of the widened cell coordinates, the textbook
+    /// form of what [`CellBounds`] computes without them.
+    fn reference_range(lo: f64, hi: f64, half: f64, inv_d: f64, n: usize) -> Range<usize> {
+        const SLACK: f64 = 1e-9;
+        let first = ((lo + half) * inv_d - 0.5 - SLACK).ceil().max(0.0);
+        let end = (((hi + half) * inv_d - 0.5 + SLACK).floor() + 1.0).min(n as f64);
+        if first.is_nan() || end.is_nan() || first >= end {
+            return 0..0;
+        }
+        first as usize..end as usize
+    }
+
+    #[test]
+    fn ranges_equal_the_textbook_ceil_and_floor() {
+        use rand::RngExt;
+        let g = grid(6, 6, 4);
+        let mut rng = crate::rng::rng(5);
+        let half = g.half_width_m;
+        // Random bounds, and bounds on and a hair off the sample centres and cell edges.
+        let mut points: Vec<f64> = (0..2000).map(|_| rng.random_range(-0.01..0.01)).collect();
+        for j in 0..g.cols {
+            for offset in [0.0, 1e-12, -1e-12, 1e-9 * g.dx_m(), g.dx_m() / 2.0] {
+                points.push(g.x(j) + offset);
+            }
+        }
+        points.extend([-half, half, 0.0, -1.0, 1.0, 1e30, -1e30]);
+        for (k, &lo) in points.iter().enumerate() {
+            for &hi in points.iter().skip(k % 7).step_by(37) {
+                let inv_d = g.cols as f64 / (2.0 * half);
+                let want = reference_range(lo, hi, half, inv_d, g.cols);
+                let got = g.col_range(lo, hi);
+                assert_eq!(got.is_empty(), want.is_empty(), "[{lo}, {hi}]");
+                if !want.is_empty() {
+                    assert_eq!(got, want, "[{lo}, {hi}]");
+                }
+                let want = reference_range(-hi, -lo, half, inv_d, g.rows);
+                let got = g.row_range(lo, hi);
+                if !want.is_empty() {
+                    assert_eq!(got, want, "rows [{lo}, {hi}]");
+                } else {
+                    assert!(got.is_empty(), "rows [{lo}, {hi}]");
+                }
+            }
+        }
     }
 }

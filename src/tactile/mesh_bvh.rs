@@ -3,8 +3,10 @@
 //! The pad's rays are parallel and only depths in a thin range matter, so instead of traversing
 //! the BVH once per ray, the BVH is traversed once per image with the oriented box that contains
 //! every ray segment of interest (the pad rectangle swept along the normal over `[z_lo, t]`).
-//! The few triangles whose leaves overlap that box are then rasterised onto the sample grid
-//! ([`crate::tactile::raster`]), which gives exactly the ray-casting depths.
+//! The few leaves that overlap that box are then rasterised onto the sample grid
+//! ([`crate::tactile::raster`]), which gives exactly the ray-casting depths. Each leaf lists its
+//! distinct vertices at build time, so a reading moves each vertex near the pad into the pad frame
+//! once, not once for each of the (about six) faces that share it.
 //!
 //! Vertices are read from the compiled model's `mesh_vert` (MuJoCo re-centres and re-orients them
 //! into the mesh's inertial frame, which is the geom frame), so together with `geom_xpos` and
@@ -33,20 +35,52 @@ impl OrientedBox {
     /// skipped, so rare non-overlapping pairs pass, never the reverse).
     #[inline]
     pub fn may_overlap(&self, lo: DVec3, hi: DVec3) -> bool {
+        OverlapTest::new(self).may_overlap(lo, hi)
+    }
+}
+
+/// [`OrientedBox::may_overlap`] with the parts that depend on the oriented box alone computed
+/// once, for the many boxes of one BVH query.
+#[derive(Debug, Clone, Copy)]
+struct OverlapTest {
+    centre: DVec3,
+    axes: [DVec3; 3],
+    abs_axes: [DVec3; 3],
+    half: DVec3,
+    /// The box's half-extent along each coordinate axis.
+    reach: DVec3,
+}
+
+impl OverlapTest {
+    fn new(region: &OrientedBox) -> Self {
+        let [a0, a1, a2] = region.axes;
+        let h = region.half;
+        let reach = DVec3::from_array(std::array::from_fn(|k| {
+            h.x * a0[k].abs() + h.y * a1[k].abs() + h.z * a2[k].abs()
+        }));
+        Self {
+            centre: region.centre,
+            axes: region.axes,
+            abs_axes: region.axes.map(DVec3::abs),
+            half: h,
+            reach,
+        }
+    }
+
+    #[inline]
+    fn may_overlap(&self, lo: DVec3, hi: DVec3) -> bool {
         let c = (lo + hi) * 0.5;
         let e = (hi - lo) * 0.5;
         let t = self.centre - c;
-        let [a0, a1, a2] = self.axes;
-        let h = self.half;
         for k in 0..3 {
-            let r = h.x * a0[k].abs() + h.y * a1[k].abs() + h.z * a2[k].abs();
-            if t[k].abs() > r + e[k] {
+            if t[k].abs() > self.reach[k] + e[k] {
                 return false;
             }
         }
-        for (i, a) in self.axes.iter().enumerate() {
-            let r = e.x * a.x.abs() + e.y * a.y.abs() + e.z * a.z.abs();
-            if t.dot(*a).abs() > h[i] + r {
+        for i in 0..3 {
+            let a = self.abs_axes[i];
+            let r = e.x * a.x + e.y * a.y + e.z * a.z;
+            if t.dot(self.axes[i]).abs() > self.half[i] + r {
                 return false;
             }
         }
@@ -54,13 +88,41 @@ impl OrientedBox {
     }
 }
 
+/// A leaf of a mesh's BVH: its faces are `primitive_indices[first..first + count]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Leaf {
+    first: u32,
+    count: u32,
+}
+
+impl Leaf {
+    pub fn face_count(&self) -> usize {
+        self.count as usize
+    }
+
+    fn slots(&self) -> std::ops::Range<usize> {
+        self.first as usize..(self.first + self.count) as usize
+    }
+}
+
 /// A mesh of the model with its BVH.
+///
+/// Each leaf also lists its distinct vertices, and its faces' corners as positions in that list:
+/// a reading places the vertices of a leaf near the pad once, although neighbouring faces share
+/// them (a leaf of 8 faces has about 10 distinct vertices, not 24).
 #[derive(Clone)]
 pub struct MeshBvh {
     /// Vertices in the mesh (geom) frame, metres.
     vertices: Vec<DVec3>,
     faces: Vec<[u32; 3]>,
     bvh: Bvh2,
+    /// For the first slot of each leaf in `bvh.primitive_indices`: the range of the leaf's
+    /// distinct vertices in `leaf_vertices` (unused at other slots).
+    leaf_vertex_range: Vec<(u32, u32)>,
+    leaf_vertices: Vec<u32>,
+    /// For each slot of `bvh.primitive_indices`: the face's corners as positions in its leaf's
+    /// vertex range.
+    slot_corners: Vec<[u16; 3]>,
 }
 
 impl std::fmt::Debug for MeshBvh {
@@ -123,7 +185,50 @@ impl MeshBvh {
         } else {
             build_bvh2_from_tris(&triangles, BvhBuildParams::fast_build(), &mut Duration::default())
         };
-        Ok(Self { vertices, faces, bvh })
+        let mut mesh = Self {
+            vertices,
+            faces,
+            bvh,
+            leaf_vertex_range: Vec::new(),
+            leaf_vertices: Vec::new(),
+            slot_corners: Vec::new(),
+        };
+        mesh.index_leaf_vertices();
+        Ok(mesh)
+    }
+
+    /// Lists each leaf's distinct vertices and its faces' corners within them.
+    fn index_leaf_vertices(&mut self) {
+        let slots = self.bvh.primitive_indices.len();
+        self.leaf_vertex_range = vec![(0, 0); slots];
+        self.slot_corners = vec![[0; 3]; slots];
+        self.leaf_vertices.clear();
+        for node in &self.bvh.nodes {
+            if node.prim_count == 0 {
+                continue;
+            }
+            let leaf = Leaf {
+                first: node.first_index,
+                count: node.prim_count,
+            };
+            let start = self.leaf_vertices.len();
+            for slot in leaf.slots() {
+                let face = self.faces[self.bvh.primitive_indices[slot] as usize];
+                for (corner, vertex) in self.slot_corners[slot].iter_mut().zip(face) {
+                    let position = match self.leaf_vertices[start..].iter().position(|&v| v == vertex) {
+                        Some(position) => position,
+                        None => {
+                            self.leaf_vertices.push(vertex);
+                            self.leaf_vertices.len() - 1 - start
+                        }
+                    };
+                    // A leaf holds at most 255 faces (obvhs), so at most 765 vertices.
+                    *corner = position as u16;
+                }
+            }
+            self.leaf_vertex_range[leaf.first as usize] =
+                (start as u32, (self.leaf_vertices.len() - start) as u32);
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -143,19 +248,55 @@ impl MeshBvh {
             + bytes(&self.bvh.primitive_indices_freelist)
             + bytes(&self.bvh.primitives_to_nodes)
             + bytes(&self.bvh.parents)
+            + bytes(&self.leaf_vertex_range)
+            + bytes(&self.leaf_vertices)
+            + bytes(&self.slot_corners)
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// The vertex indices of face `f`.
+    #[inline]
+    pub fn face(&self, f: u32) -> [u32; 3] {
+        self.faces[f as usize]
+    }
+
+    /// Vertex `i` mapped by `x -> rotation x + offset`.
+    #[inline]
+    pub fn vertex(&self, i: u32, rotation: &DMat3, offset: DVec3) -> DVec3 {
+        *rotation * self.vertices[i as usize] + offset
     }
 
     /// The corners of face `f` mapped by `x -> rotation x + offset`.
     #[inline]
     pub fn corners(&self, f: u32, rotation: &DMat3, offset: DVec3) -> [DVec3; 3] {
-        let [a, b, c] = self.faces[f as usize];
-        let map = |i: u32| *rotation * self.vertices[i as usize] + offset;
+        let [a, b, c] = self.face(f);
+        let map = |i: u32| self.vertex(i, rotation, offset);
         [map(a), map(b), map(c)]
     }
 
-    /// Appends to `out` every face whose BVH leaf may overlap `region` (a superset of the faces
-    /// that intersect it). `stack` is scratch space, reused across calls.
-    pub fn faces_near(&self, region: &OrientedBox, stack: &mut Vec<usize>, out: &mut Vec<u32>) {
+    /// The mesh vertices of `leaf`, each once.
+    #[inline]
+    pub fn leaf_vertices(&self, leaf: Leaf) -> &[u32] {
+        let (start, count) = self.leaf_vertex_range[leaf.first as usize];
+        &self.leaf_vertices[start as usize..(start + count) as usize]
+    }
+
+    /// The faces of `leaf`, each with its corners as positions in [`Self::leaf_vertices`].
+    #[inline]
+    pub fn leaf_faces(&self, leaf: Leaf) -> impl Iterator<Item = (u32, [u16; 3])> + '_ {
+        let slots = leaf.slots();
+        self.bvh.primitive_indices[slots.clone()]
+            .iter()
+            .copied()
+            .zip(self.slot_corners[slots].iter().copied())
+    }
+
+    /// Appends to `out` every leaf that may overlap `region` (their faces are a superset of the
+    /// faces that intersect it). `stack` is scratch space, reused across calls.
+    pub fn leaves_near(&self, region: &OrientedBox, stack: &mut Vec<usize>, out: &mut Vec<Leaf>) {
         let nodes = &self.bvh.nodes;
         if nodes.is_empty() {
             return;
@@ -167,17 +308,20 @@ impl MeshBvh {
                 DVec3::from(aabb.max.to_array().map(f64::from)),
             )
         };
+        let test = OverlapTest::new(region);
         stack.clear();
         stack.push(0);
         while let Some(i) = stack.pop() {
             let (lo, hi) = bounds(i);
-            if !region.may_overlap(lo, hi) {
+            if !test.may_overlap(lo, hi) {
                 continue;
             }
             let node = &nodes[i];
             if node.prim_count > 0 {
-                let first = node.first_index as usize;
-                out.extend_from_slice(&self.bvh.primitive_indices[first..first + node.prim_count as usize]);
+                out.push(Leaf {
+                    first: node.first_index,
+                    count: node.prim_count,
+                });
             } else {
                 let child = node.first_index as usize;
                 stack.push(child + 1);
@@ -226,8 +370,12 @@ mod tests {
             axes,
             half: DVec3::new(0.1, 0.05, 0.01),
         };
-        let mut near = Vec::new();
-        mesh.faces_near(&region, &mut Vec::new(), &mut near);
+        let mut leaves = Vec::new();
+        mesh.leaves_near(&region, &mut Vec::new(), &mut leaves);
+        let near: Vec<u32> = leaves
+            .iter()
+            .flat_map(|&leaf| mesh.leaf_faces(leaf).map(|(face, _)| face))
+            .collect();
         // Every face with a corner strictly inside the box must be found.
         let inside = |p: DVec3| {
             let d = p - region.centre;
@@ -243,6 +391,40 @@ mod tests {
             }
         }
         assert!(near.len() < 400, "{} candidates", near.len());
+    }
+
+    #[test]
+    fn each_leaf_lists_its_faces_vertices_once() {
+        let (v, f) = square_grid(30);
+        let mesh = MeshBvh::new(&v, &f).unwrap();
+        let everywhere = OrientedBox {
+            centre: DVec3::ZERO,
+            axes: [DVec3::X, DVec3::Y, DVec3::Z],
+            half: DVec3::splat(10.0),
+        };
+        let mut leaves = Vec::new();
+        mesh.leaves_near(&everywhere, &mut Vec::new(), &mut leaves);
+        let mut seen = vec![0; mesh.triangle_count()];
+        let (mut corners, mut distinct) = (0, 0);
+        for &leaf in &leaves {
+            let vertices = mesh.leaf_vertices(leaf);
+            let mut sorted = vertices.to_vec();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(sorted.len(), vertices.len(), "a vertex listed twice");
+            for (face, local) in mesh.leaf_faces(leaf) {
+                seen[face as usize] += 1;
+                assert_eq!(local.map(|i| vertices[i as usize]), mesh.face(face));
+                corners += 3;
+            }
+            distinct += vertices.len();
+        }
+        assert!(seen.iter().all(|&n| n == 1), "every face in exactly one leaf");
+        // Neighbouring faces share vertices: a leaf places far fewer than three per face.
+        assert!(
+            distinct * 2 < corners,
+            "{distinct} vertices for {corners} corners"
+        );
     }
 
     #[test]

@@ -18,14 +18,20 @@
 //! `A` is twice the signed projected area: with the pad frame right-handed, the triangle's normal
 //! has z-component `A`, so `A < 0` marks a face the ray *enters* (outward normal against the ray).
 //!
+//! **Cost.** Near a 6x6 pad a face is about one sample wide, so what a face costs before its
+//! samples dominates: each BVH leaf's vertices are placed once, with the sample cells their
+//! coordinates bound ([`PadVertex`]); a face's sample rectangle is then integer min/max over its
+//! corners; and a face over at most 2 x 2 samples is written without loops.
+//!
 //! **Inside test.** A sample whose pad point lies inside a solid reads full penetration (the
 //! object pushed through the covering). For a closed, outward-oriented mesh the pad point is
 //! inside iff the nearest surface crossing *behind* it (largest z < 0) is an entering face; the
 //! rasteriser records that crossing per sample in [`Behind`].
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
-use crate::tactile::grid::SampleGrid;
+use crate::tactile::grid::{CellBounds, SampleGrid};
+use crate::tactile::mesh_bvh::{Leaf, MeshBvh};
 
 /// Relative tolerance of the edge test: samples on a shared edge belong to both triangles (both
 /// give the same depth there), so rounding never opens a crack between neighbours.
@@ -109,110 +115,296 @@ impl Behind {
 #[inline]
 pub fn rasterise_triangle(
     grid: &SampleGrid,
-    [a, b, c]: [DVec3; 3],
+    corners: [DVec3; 3],
     far_m: f64,
     nearest_m: &mut [f64],
     behind: &mut Behind,
 ) {
-    // The cheap rejections first: most faces near the pad lie beyond the covering or cover no
-    // sample (at 6x6 taxels the samples are 1 mm apart, about a face's size).
-    let zmin = a.z.min(b.z).min(c.z);
-    if zmin > far_m {
-        return;
+    let [a, b, c] = corners;
+    let at = |p: DVec3| PadVertex::new(grid, p);
+    rasterise_face(grid, [at(a), at(b), at(c)], far_m, nearest_m, behind);
+}
+
+/// [`rasterise_triangle`] with the corners' cell bounds known.
+#[inline(always)]
+pub fn rasterise_face(
+    grid: &SampleGrid,
+    corners: [PadVertex; 3],
+    far_m: f64,
+    nearest_m: &mut [f64],
+    behind: &mut Behind,
+) {
+    if let Some(face) = FaceSetup::new(grid, corners, far_m) {
+        face.draw(grid, far_m, nearest_m, behind);
     }
-    let cols = grid.col_range(a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
-    let rows = grid.row_range(a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
-    if cols.is_empty() || rows.is_empty() {
-        return;
+}
+
+/// A mesh vertex in the pad frame with the sample columns and rows its coordinates bound
+/// ([`CellBounds`]): the part of a face's set-up that belongs to its corners, computed once per
+/// vertex of a BVH leaf near the pad, although neighbouring faces share it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PadVertex {
+    /// Pad-frame position, metres.
+    pub p: DVec3,
+    cols: CellBounds,
+    rows: CellBounds,
+}
+
+impl PadVertex {
+    #[inline]
+    pub fn new(grid: &SampleGrid, p: DVec3) -> Self {
+        Self {
+            p,
+            cols: grid.col_bounds(p.x),
+            rows: grid.row_bounds(p.y),
+        }
     }
-    let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    let scale = (b - a)
-        .truncate()
-        .length_squared()
-        .max((c - a).truncate().length_squared());
-    if !area.is_finite() || area.abs() <= 1e-9 * scale {
-        // Edge-on to the rays (or degenerate): a ray grazes it at most along a line.
-        return;
+}
+
+/// The per-sample depths of one reading: the nearest surface at or in front of the pad plane, and
+/// the crossings behind it for the inside test, with the scratch space for a leaf's vertices.
+#[derive(Debug, Clone)]
+pub struct DepthBuffer {
+    /// Pad-frame depth of the nearest surface in `[0, far]` per sample (+inf: none; -inf: the pad
+    /// point is inside a solid).
+    pub nearest_m: Vec<f64>,
+    pub behind: Behind,
+    leaf_vertices: Vec<PadVertex>,
+}
+
+impl DepthBuffer {
+    pub fn new(grid: &SampleGrid) -> Self {
+        Self {
+            nearest_m: vec![f64::INFINITY; grid.len()],
+            behind: Behind::new(grid.len()),
+            leaf_vertices: Vec::new(),
+        }
     }
-    let behind_possible = zmin < 0.0;
-    if behind_possible {
-        behind.touch(&rows, &cols);
+
+    /// Draws the faces of `leaves` of `mesh` placed in the pad frame by
+    /// `x -> placement.0 x + placement.1`, then marks the samples inside the mesh; `on_face` sees
+    /// each face's pad-frame corners. Each leaf's vertices are placed once.
+    pub fn draw_mesh(
+        &mut self,
+        grid: &SampleGrid,
+        mesh: &MeshBvh,
+        leaves: &[Leaf],
+        placement: (&DMat3, DVec3),
+        far_m: f64,
+        mut on_face: impl FnMut([DVec3; 3]),
+    ) {
+        let (rotation, offset) = placement;
+        for &leaf in leaves {
+            self.leaf_vertices.clear();
+            self.leaf_vertices.extend(
+                mesh.leaf_vertices(leaf)
+                    .iter()
+                    .map(|&v| PadVertex::new(grid, mesh.vertex(v, rotation, offset))),
+            );
+            for (_, [i, j, k]) in mesh.leaf_faces(leaf) {
+                let v = &self.leaf_vertices;
+                let corners = [v[i as usize], v[j as usize], v[k as usize]];
+                rasterise_face(grid, corners, far_m, &mut self.nearest_m, &mut self.behind);
+                on_face([corners[0].p, corners[1].p, corners[2].p]);
+            }
+        }
+        self.behind.resolve_into(grid, &mut self.nearest_m);
     }
-    // Barycentric weights and depth as affine functions of the sample position:
-    // w_a = ax x + ay y + a0,  w_b = bx x + by y + b0,  w_c = 1 - w_a - w_b,
-    // z = w_a z_a + w_b z_b + w_c z_c = zx x + zy y + z0.
-    let inv = 1.0 / area;
-    let (ax, ay) = (-(c.y - b.y) * inv, (c.x - b.x) * inv);
-    let a0 = -(ax * b.x + ay * b.y);
-    let (bx, by) = (-(a.y - c.y) * inv, (a.x - c.x) * inv);
-    let b0 = -(bx * c.x + by * c.y);
-    let (dza, dzb) = (a.z - c.z, b.z - c.z);
-    let (zx, zy, z0) = (
-        ax * dza + bx * dzb,
-        ay * dza + by * dzb,
-        c.z + a0 * dza + b0 * dzb,
-    );
-    let tol = -EDGE_EPS;
-    let entering = area < 0.0;
-    // w_c = 1 - w_a - w_b = cx x + (1 - w_a,row - w_b,row).
-    let cx = -(ax + bx);
-    // Narrow faces are scanned over their bounding columns; wider ones over each row's span.
-    let spans = (cols.len() > SPAN_MIN_COLUMNS).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
-    let widen_m = grid.dx_m();
-    for i in rows {
-        let y = grid.y(i);
-        let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
-        let mut scan = cols.clone();
-        if let Some(slopes) = &spans {
-            // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is a
-            // half-line. Widened by a sample on each side, the span only skips samples the exact
-            // test below rejects, whatever the rounding of its bounds.
-            let mut span = (f64::NEG_INFINITY, f64::INFINITY);
-            let at_zero = [wa_row, wb_row, 1.0 - wa_row - wb_row];
-            for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
-                let bound = (tol - w0) * inv_slope;
-                if *slope > 0.0 {
-                    span.0 = span.0.max(bound);
-                } else if *slope < 0.0 {
-                    span.1 = span.1.min(bound);
-                } else if w0 < tol {
-                    span = (f64::INFINITY, f64::NEG_INFINITY);
+}
+
+/// What the sample loops need of one face: its sample rectangle and the barycentric weights and
+/// depth as affine functions of the sample position,
+///
+/// ```text
+/// w_a = ax x + ay y + a0,   w_b = bx x + by y + b0,   w_c = 1 - w_a - w_b,
+/// z = w_a z_a + w_b z_b + w_c z_c = zx x + zy y + z0.
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FaceSetup {
+    rows: (u32, u32),
+    cols: (u32, u32),
+    ax: f64,
+    ay: f64,
+    a0: f64,
+    bx: f64,
+    by: f64,
+    b0: f64,
+    zx: f64,
+    zy: f64,
+    z0: f64,
+    /// The ray enters the solid through the face (`A < 0`).
+    entering: bool,
+    /// Part of the face lies behind the pad plane.
+    behind_possible: bool,
+}
+
+/// The lesser of two numbers, one instruction (no care for NaN: a face with a NaN coordinate has
+/// a NaN area and is rejected).
+#[inline(always)]
+fn lesser(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+#[inline(always)]
+fn greater(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+impl FaceSetup {
+    /// The set-up of the triangle with these corners, or `None` when it can write no sample: all
+    /// of it beyond `far_m`, its bounding box over no sample, or edge-on to the rays (or
+    /// degenerate: a ray grazes such a face at most along a line).
+    #[inline(always)]
+    fn new(grid: &SampleGrid, [va, vb, vc]: [PadVertex; 3], far_m: f64) -> Option<Self> {
+        let (a, b, c) = (va.p, vb.p, vc.p);
+        // The cheap rejections first: most faces near the pad lie beyond the covering or cover no
+        // sample (at 6x6 taxels the samples are 1 mm apart, about a face's size).
+        let zmin = lesser(lesser(a.z, b.z), c.z);
+        if zmin > far_m {
+            return None;
+        }
+        let cols = grid.cols_in(va.cols.hull(vb.cols).hull(vc.cols));
+        let rows = grid.rows_in(va.rows.hull(vb.rows).hull(vc.rows));
+        if cols.is_empty() || rows.is_empty() {
+            return None;
+        }
+        let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+        let scale = greater(
+            (b - a).truncate().length_squared(),
+            (c - a).truncate().length_squared(),
+        );
+        if !(area.is_finite() && area.abs() > 1e-9 * scale) {
+            return None;
+        }
+        let inv = 1.0 / area;
+        let (ax, ay) = (-(c.y - b.y) * inv, (c.x - b.x) * inv);
+        let a0 = -(ax * b.x + ay * b.y);
+        let (bx, by) = (-(a.y - c.y) * inv, (a.x - c.x) * inv);
+        let b0 = -(bx * c.x + by * c.y);
+        let (dza, dzb) = (a.z - c.z, b.z - c.z);
+        Some(Self {
+            rows: (rows.start as u32, rows.end as u32),
+            cols: (cols.start as u32, cols.end as u32),
+            ax,
+            ay,
+            a0,
+            bx,
+            by,
+            b0,
+            zx: ax * dza + bx * dzb,
+            zy: ay * dza + by * dzb,
+            z0: c.z + a0 * dza + b0 * dzb,
+            entering: area < 0.0,
+            behind_possible: zmin < 0.0,
+        })
+    }
+
+    /// Writes the face into the samples it covers.
+    #[inline]
+    fn draw(&self, grid: &SampleGrid, far_m: f64, nearest_m: &mut [f64], behind: &mut Behind) {
+        let &Self {
+            rows,
+            cols,
+            ax,
+            ay,
+            a0,
+            bx,
+            by,
+            b0,
+            zx,
+            zy,
+            z0,
+            entering,
+            behind_possible,
+        } = self;
+        let tol = -EDGE_EPS;
+        if !behind_possible && rows.1 - rows.0 <= 2 && cols.1 - cols.0 <= 2 {
+            // Most faces near a coarse pad: at most 2 x 2 samples, all four tested without a
+            // loop, those outside the face's rectangle masked off.
+            let (i0, j0) = (rows.0 as usize, cols.0 as usize);
+            let (i1, j1) = ((i0 + 1).min(grid.rows - 1), (j0 + 1).min(grid.cols - 1));
+            let (two_rows, two_cols) = (rows.1 - rows.0 == 2, cols.1 - cols.0 == 2);
+            let (x0, x1) = (grid.x(j0), grid.x(j1));
+            for (i, row_on) in [(i0, true), (i1, two_rows)] {
+                let y = grid.y(i);
+                let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+                for (j, x, on) in [(j0, x0, row_on), (j1, x1, row_on & two_cols)] {
+                    let wa = ax * x + wa_row;
+                    let wb = bx * x + wb_row;
+                    let z = zx * x + z_row;
+                    let nearest = &mut nearest_m[i * grid.cols + j];
+                    let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
+                    let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
+                    *nearest = if on & covers & nearer { z } else { *nearest };
                 }
             }
-            let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
-            let first = in_span.start.max(cols.start);
-            scan = first..in_span.end.min(cols.end).max(first);
+            return;
         }
-        let row = i * grid.cols;
-        if !behind_possible {
-            // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
-            let (first, last) = (scan.start, scan.end);
-            for (j, nearest) in (first..last).zip(&mut nearest_m[row + first..row + last]) {
+        let rows = rows.0 as usize..rows.1 as usize;
+        let cols = cols.0 as usize..cols.1 as usize;
+        if behind_possible {
+            behind.touch(&rows, &cols);
+        }
+        // w_c = 1 - w_a - w_b = cx x + (1 - w_a,row - w_b,row).
+        let cx = -(ax + bx);
+        // Narrow faces are scanned over their bounding columns; wider ones over each row's span.
+        let spans = (cols.len() > SPAN_MIN_COLUMNS).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
+        let widen_m = grid.dx_m();
+        for i in rows {
+            let y = grid.y(i);
+            let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+            let mut scan = cols.clone();
+            if let Some(slopes) = &spans {
+                // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is
+                // a half-line. Widened by a sample on each side, the span only skips samples the
+                // exact test below rejects, whatever the rounding of its bounds.
+                let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+                let at_zero = [wa_row, wb_row, 1.0 - wa_row - wb_row];
+                for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
+                    let bound = (tol - w0) * inv_slope;
+                    if *slope > 0.0 {
+                        span.0 = span.0.max(bound);
+                    } else if *slope < 0.0 {
+                        span.1 = span.1.min(bound);
+                    } else if w0 < tol {
+                        span = (f64::INFINITY, f64::NEG_INFINITY);
+                    }
+                }
+                let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
+                let first = in_span.start.max(cols.start);
+                scan = first..in_span.end.min(cols.end).max(first);
+            }
+            let row = i * grid.cols;
+            if !behind_possible {
+                // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
+                let (first, last) = (scan.start, scan.end);
+                for (j, nearest) in (first..last).zip(&mut nearest_m[row + first..row + last]) {
+                    let x = grid.x(j);
+                    let wa = ax * x + wa_row;
+                    let wb = bx * x + wb_row;
+                    let z = zx * x + z_row;
+                    let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
+                    let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
+                    *nearest = if covers & nearer { z } else { *nearest };
+                }
+                continue;
+            }
+            for j in scan {
                 let x = grid.x(j);
                 let wa = ax * x + wa_row;
                 let wb = bx * x + wb_row;
-                let z = zx * x + z_row;
-                let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
-                let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
-                *nearest = if covers & nearer { z } else { *nearest };
-            }
-            continue;
-        }
-        for j in scan {
-            let x = grid.x(j);
-            let wa = ax * x + wa_row;
-            let wb = bx * x + wb_row;
-            if wa < tol || wb < tol || 1.0 - wa - wb < tol {
-                continue;
-            }
-            let z = zx * x + z_row;
-            let s = row + j;
-            if z >= 0.0 {
-                if z <= far_m && z < nearest_m[s] {
-                    nearest_m[s] = z;
+                if wa < tol || wb < tol || 1.0 - wa - wb < tol {
+                    continue;
                 }
-            } else if z > behind.crossings[s].z_m {
-                behind.crossings[s] = Crossing { z_m: z, entering };
+                let z = zx * x + z_row;
+                let s = row + j;
+                if z >= 0.0 {
+                    if z <= far_m && z < nearest_m[s] {
+                        nearest_m[s] = z;
+                    }
+                } else if z > behind.crossings[s].z_m {
+                    behind.crossings[s] = Crossing { z_m: z, entering };
+                }
             }
         }
     }
@@ -221,7 +413,93 @@ pub fn rasterise_triangle(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::TriMesh;
     use crate::tactile::SensorConfig;
+    use crate::tactile::mesh_bvh::OrientedBox;
+
+    /// A closed, bumpy box: `TriMesh::cuboid` split three times into four (shared edge midpoints,
+    /// so it stays watertight and outward), its vertices pushed out by a ripple.
+    fn bumpy_box(half_m: f64) -> MeshBvh {
+        let mut mesh = TriMesh::cuboid(DVec3::splat(half_m));
+        for _ in 0..3 {
+            let mut midpoints = std::collections::HashMap::new();
+            let mut triangles = Vec::new();
+            for [a, b, c] in mesh.triangles.clone() {
+                let mut mid = |p: u32, q: u32| {
+                    *midpoints.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                        mesh.vertices
+                            .push(0.5 * (mesh.vertices[p as usize] + mesh.vertices[q as usize]));
+                        mesh.vertices.len() as u32 - 1
+                    })
+                };
+                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+            }
+            mesh.triangles = triangles;
+        }
+        for v in &mut mesh.vertices {
+            *v *= 1.0 + 0.05 * (900.0 * v.x).sin() * (700.0 * v.y).cos();
+        }
+        let xyz: Vec<f32> = mesh
+            .vertices
+            .iter()
+            .flat_map(|v| v.as_vec3().to_array())
+            .collect();
+        let faces: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+        MeshBvh::new(&xyz, &faces).unwrap()
+    }
+
+    #[test]
+    fn drawing_leaves_equals_drawing_each_face() {
+        use rand::RngExt;
+        // Placing each leaf's vertices once must give, bit for bit, the image of placing every
+        // face's corners: across the covering, pushed through the pad (inside test), and off it.
+        let g = SampleGrid::new(&SensorConfig::default());
+        let mesh = bumpy_box(0.006);
+        let far_m = 0.002;
+        let everywhere = OrientedBox {
+            centre: DVec3::ZERO,
+            axes: [DVec3::X, DVec3::Y, DVec3::Z],
+            half: DVec3::splat(1.0),
+        };
+        let mut leaves = Vec::new();
+        mesh.leaves_near(&everywhere, &mut Vec::new(), &mut leaves);
+        assert!(leaves.len() > 20, "{} leaves", leaves.len());
+        let mut rng = crate::rng::rng(3);
+        let (mut covered, mut inside) = (0, 0);
+        for _ in 0..60 {
+            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            // The box's near side from 2 mm in front of the pad to 3 mm through it.
+            let offset = DVec3::new(
+                rng.random_range(-0.008..0.008),
+                rng.random_range(-0.008..0.008),
+                0.006 + rng.random_range(-0.003..0.002),
+            );
+            let mut each = DepthBuffer::new(&g);
+            for &leaf in &leaves {
+                for (face, _) in mesh.leaf_faces(leaf) {
+                    let corners = mesh.corners(face, &rotation, offset);
+                    rasterise_triangle(&g, corners, far_m, &mut each.nearest_m, &mut each.behind);
+                }
+            }
+            each.behind.resolve_into(&g, &mut each.nearest_m);
+            let mut by_leaf = DepthBuffer::new(&g);
+            let mut faces = 0;
+            by_leaf.draw_mesh(&g, &mesh, &leaves, (&rotation, offset), far_m, |_| faces += 1);
+            assert_eq!(faces, mesh.triangle_count());
+            for (s, (a, b)) in each.nearest_m.iter().zip(&by_leaf.nearest_m).enumerate() {
+                assert_eq!(a.to_bits(), b.to_bits(), "sample {s}: {a} vs {b}");
+            }
+            covered += each.nearest_m.iter().filter(|z| z.is_finite()).count();
+            inside += each.nearest_m.iter().filter(|&&z| z == f64::NEG_INFINITY).count();
+        }
+        // Not vacuous: both the surface in the covering and the inside test were exercised.
+        assert!(
+            covered > 1000 && inside > 1000,
+            "{covered} covered, {inside} inside"
+        );
+    }
 
     fn grid() -> SampleGrid {
         SampleGrid::new(&SensorConfig {
