@@ -339,11 +339,7 @@ impl Covering {
                     let back_touched = &mut self.stats.last_back_touched;
                     self.depth
                         .draw_mesh(&self.grid, mesh, &self.leaves, (&m, o), t, |corners| {
-                            // A face wholly in front of the pad plane cannot reach the back.
-                            if !*back_touched
-                                && corners.iter().any(|p| p.z <= 0.0)
-                                && triangle_overlaps_box(corners, back_center, back_half)
-                            {
+                            if !*back_touched && triangle_overlaps_box(corners, back_center, back_half) {
                                 *back_touched = true;
                             }
                         });

@@ -182,8 +182,9 @@ impl DepthBuffer {
     }
 
     /// Draws the faces of `leaves` of `mesh` placed in the pad frame by
-    /// `x -> placement.0 x + placement.1`, then marks the samples inside the mesh; `on_face` sees
-    /// each face's pad-frame corners. Each leaf's vertices are placed once.
+    /// `x -> placement.0 x + placement.1`, then marks the samples inside the mesh. `at_plane` sees
+    /// the pad-frame corners of each face with a corner at or behind the pad plane (the only faces
+    /// that can reach the pad's rigid back). Each leaf's vertices are placed once.
     pub fn draw_mesh(
         &mut self,
         grid: &SampleGrid,
@@ -191,7 +192,7 @@ impl DepthBuffer {
         leaves: &[Leaf],
         placement: (&DMat3, DVec3),
         far_m: f64,
-        mut on_face: impl FnMut([DVec3; 3]),
+        mut at_plane: impl FnMut([DVec3; 3]),
     ) {
         let (rotation, offset) = placement;
         for &leaf in leaves {
@@ -205,7 +206,10 @@ impl DepthBuffer {
                 let v = &self.leaf_vertices;
                 let corners = [v[i as usize], v[j as usize], v[k as usize]];
                 rasterise_face(grid, corners, far_m, &mut self.nearest_m, &mut self.behind);
-                on_face([corners[0].p, corners[1].p, corners[2].p]);
+                let [a, b, c] = [corners[0].p, corners[1].p, corners[2].p];
+                if lesser(lesser(a.z, b.z), c.z) <= 0.0 {
+                    at_plane([a, b, c]);
+                }
             }
         }
         self.behind.resolve_into(grid, &mut self.nearest_m);
@@ -485,9 +489,16 @@ mod tests {
             }
             each.behind.resolve_into(&g, &mut each.nearest_m);
             let mut by_leaf = DepthBuffer::new(&g);
-            let mut faces = 0;
-            by_leaf.draw_mesh(&g, &mesh, &leaves, (&rotation, offset), far_m, |_| faces += 1);
-            assert_eq!(faces, mesh.triangle_count());
+            let mut at_plane = 0;
+            by_leaf.draw_mesh(&g, &mesh, &leaves, (&rotation, offset), far_m, |corners| {
+                assert!(corners.iter().any(|p| p.z <= 0.0));
+                at_plane += 1;
+            });
+            let reaching = (leaves.iter())
+                .flat_map(|&leaf| mesh.leaf_faces(leaf))
+                .filter(|&(face, _)| mesh.corners(face, &rotation, offset).iter().any(|p| p.z <= 0.0))
+                .count();
+            assert_eq!(at_plane, reaching);
             for (s, (a, b)) in each.nearest_m.iter().zip(&by_leaf.nearest_m).enumerate() {
                 assert_eq!(a.to_bits(), b.to_bits(), "sample {s}: {a} vs {b}");
             }
