@@ -30,6 +30,17 @@ pub struct OrientedBox {
 }
 
 impl OrientedBox {
+    /// The axis-aligned cube of half-side `half_m` about the origin (for tests: a box that holds
+    /// a whole small mesh).
+    #[cfg(test)]
+    pub(crate) fn cube(half_m: f64) -> Self {
+        Self {
+            centre: DVec3::ZERO,
+            axes: [DVec3::X, DVec3::Y, DVec3::Z],
+            half: DVec3::splat(half_m),
+        }
+    }
+
     /// Whether the box may overlap the axis-aligned box `[lo, hi]`: the separating-axis test on
     /// the three coordinate axes and the three box axes (conservative: the nine edge-cross axes are
     /// skipped, so rare non-overlapping pairs pass, never the reverse).
@@ -253,10 +264,6 @@ impl MeshBvh {
             + bytes(&self.slot_corners)
     }
 
-    pub fn vertex_count(&self) -> usize {
-        self.vertices.len()
-    }
-
     /// The vertex indices of face `f`.
     #[inline]
     pub fn face(&self, f: u32) -> [u32; 3] {
@@ -397,13 +404,8 @@ mod tests {
     fn each_leaf_lists_its_faces_vertices_once() {
         let (v, f) = square_grid(30);
         let mesh = MeshBvh::new(&v, &f).unwrap();
-        let everywhere = OrientedBox {
-            centre: DVec3::ZERO,
-            axes: [DVec3::X, DVec3::Y, DVec3::Z],
-            half: DVec3::splat(10.0),
-        };
         let mut leaves = Vec::new();
-        mesh.leaves_near(&everywhere, &mut Vec::new(), &mut leaves);
+        mesh.leaves_near(&OrientedBox::cube(10.0), &mut Vec::new(), &mut leaves);
         let mut seen = vec![0; mesh.triangle_count()];
         let (mut corners, mut distinct) = (0, 0);
         for &leaf in &leaves {

@@ -239,8 +239,8 @@ struct FaceSetup {
     behind_possible: bool,
 }
 
-/// The lesser of two numbers, one instruction (no care for NaN: a face with a NaN coordinate has
-/// a NaN area and is rejected).
+/// The lesser of two numbers, one instruction (no care for NaN: a face with a NaN coordinate
+/// writes no sample, as its area is NaN or its depths are and fail every comparison).
 #[inline(always)]
 fn lesser(a: f64, b: f64) -> f64 {
     if a < b { a } else { b }
@@ -300,6 +300,37 @@ impl FaceSetup {
         })
     }
 
+    /// `(w_a, w_b, z)` at `x = 0` on the sample row at `y`.
+    #[inline(always)]
+    fn at_row(&self, y: f64) -> (f64, f64, f64) {
+        (
+            self.ay * y + self.a0,
+            self.by * y + self.b0,
+            self.zy * y + self.z0,
+        )
+    }
+
+    /// For a face wholly in front of the pad plane: its depth at `x` on a row (`row` from
+    /// [`Self::at_row`]) replaces `nearest` where the face covers the sample, within the covering
+    /// and nearer, and `on`; without branches.
+    #[inline(always)]
+    fn write_in_front(
+        &self,
+        x: f64,
+        (wa_row, wb_row, z_row): (f64, f64, f64),
+        far_m: f64,
+        on: bool,
+        nearest: &mut f64,
+    ) {
+        let tol = -EDGE_EPS;
+        let wa = self.ax * x + wa_row;
+        let wb = self.bx * x + wb_row;
+        let z = self.zx * x + z_row;
+        let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
+        let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
+        *nearest = if on & covers & nearer { z } else { *nearest };
+    }
+
     /// Writes the face into the samples it covers.
     #[inline]
     fn draw(&self, grid: &SampleGrid, far_m: f64, nearest_m: &mut [f64], behind: &mut Behind) {
@@ -316,28 +347,14 @@ impl FaceSetup {
     /// (SSE2 on x86-64), those outside the face's rectangle masked off.
     #[inline]
     fn draw_small(&self, grid: &SampleGrid, far_m: f64, nearest_m: &mut [f64]) {
-        let &Self {
-            rows,
-            cols,
-            ax,
-            ay,
-            a0,
-            bx,
-            by,
-            b0,
-            zx,
-            zy,
-            z0,
-            ..
-        } = self;
+        let (rows, cols) = (self.rows, self.cols);
         let tol = -EDGE_EPS;
         let (i0, j0) = (rows.0 as usize, cols.0 as usize);
         let (i1, j1) = ((i0 + 1).min(grid.rows - 1), (j0 + 1).min(grid.cols - 1));
         let (two_rows, two_cols) = (rows.1 - rows.0 == 2, cols.1 - cols.0 == 2);
         let (x0, x1) = (grid.x(j0), grid.x(j1));
         for i in [i0, i1].into_iter().take(1 + usize::from(two_rows)) {
-            let y = grid.y(i);
-            let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+            let (wa_row, wb_row, z_row) = self.at_row(grid.y(i));
             let (s0, s1) = (i * grid.cols + j0, i * grid.cols + j1);
             #[cfg(target_arch = "x86_64")]
             {
@@ -353,7 +370,11 @@ impl FaceSetup {
                     let along = |slope: f64, at_zero: f64| {
                         _mm_add_pd(_mm_mul_pd(_mm_set1_pd(slope), x), _mm_set1_pd(at_zero))
                     };
-                    let (wa, wb, z) = (along(ax, wa_row), along(bx, wb_row), along(zx, z_row));
+                    let (wa, wb, z) = (
+                        along(self.ax, wa_row),
+                        along(self.bx, wb_row),
+                        along(self.zx, z_row),
+                    );
                     let wc = _mm_sub_pd(_mm_sub_pd(_mm_set1_pd(1.0), wa), wb);
                     let nearest = _mm_set_pd(nearest_m[s1], nearest_m[s0]);
                     let tol = _mm_set1_pd(tol);
@@ -379,13 +400,7 @@ impl FaceSetup {
             }
             #[cfg(not(target_arch = "x86_64"))]
             for (s, x, on) in [(s1, x1, two_cols), (s0, x0, true)] {
-                let wa = ax * x + wa_row;
-                let wb = bx * x + wb_row;
-                let z = zx * x + z_row;
-                let nearest = &mut nearest_m[s];
-                let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
-                let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
-                *nearest = if on & covers & nearer { z } else { *nearest };
+                self.write_in_front(x, (wa_row, wb_row, z_row), far_m, on, &mut nearest_m[s]);
             }
         }
     }
@@ -396,16 +411,11 @@ impl FaceSetup {
             rows,
             cols,
             ax,
-            ay,
-            a0,
             bx,
-            by,
-            b0,
             zx,
-            zy,
-            z0,
             entering,
             behind_possible,
+            ..
         } = self;
         let tol = -EDGE_EPS;
         let rows = rows.0 as usize..rows.1 as usize;
@@ -419,8 +429,7 @@ impl FaceSetup {
         let spans = (cols.len() > SPAN_MIN_COLUMNS).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
         let widen_m = grid.dx_m();
         for i in rows {
-            let y = grid.y(i);
-            let (wa_row, wb_row, z_row) = (ay * y + a0, by * y + b0, zy * y + z0);
+            let (wa_row, wb_row, z_row) = self.at_row(grid.y(i));
             let mut scan = cols.clone();
             if let Some(slopes) = &spans {
                 // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is
@@ -447,13 +456,7 @@ impl FaceSetup {
                 // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
                 let (first, last) = (scan.start, scan.end);
                 for (j, nearest) in (first..last).zip(&mut nearest_m[row + first..row + last]) {
-                    let x = grid.x(j);
-                    let wa = ax * x + wa_row;
-                    let wb = bx * x + wb_row;
-                    let z = zx * x + z_row;
-                    let covers = (wa >= tol) & (wb >= tol) & (1.0 - wa - wb >= tol);
-                    let nearer = (z >= 0.0) & (z <= far_m) & (z < *nearest);
-                    *nearest = if covers & nearer { z } else { *nearest };
+                    self.write_in_front(grid.x(j), (wa_row, wb_row, z_row), far_m, true, nearest);
                 }
                 continue;
             }
@@ -580,13 +583,8 @@ mod tests {
         let g = SampleGrid::new(&SensorConfig::default());
         let mesh = bumpy_box(0.006);
         let far_m = 0.002;
-        let everywhere = OrientedBox {
-            centre: DVec3::ZERO,
-            axes: [DVec3::X, DVec3::Y, DVec3::Z],
-            half: DVec3::splat(1.0),
-        };
         let mut leaves = Vec::new();
-        mesh.leaves_near(&everywhere, &mut Vec::new(), &mut leaves);
+        mesh.leaves_near(&OrientedBox::cube(1.0), &mut Vec::new(), &mut leaves);
         assert!(leaves.len() > 20, "{} leaves", leaves.len());
         let mut rng = crate::rng::rng(3);
         let (mut covered, mut inside) = (0, 0);
