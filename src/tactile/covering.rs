@@ -288,9 +288,7 @@ impl Covering {
         self.stats.last_full_samples = 0;
         self.stats.last_back_touched = false;
         for k in 0..self.sensors.len() {
-            self.penetration(k, poses);
-            let t = self.config.thickness_m;
-            self.stats.last_full_samples += self.depth.nearest_m.iter().filter(|&&p| p >= t).count();
+            self.stats.last_full_samples += self.penetration(k, poses);
             let sensor = &self.sensors[k];
             let n = self.config.taxel_count();
             let out = &mut sensordata[sensor.adr..sensor.adr + n];
@@ -300,8 +298,9 @@ impl Covering {
         self.stats.readings += 1;
     }
 
-    /// Fills `nearest_m` with the per-sample penetration (metres) seen by sensor `k`.
-    fn penetration(&mut self, k: usize, poses: &PoseView) {
+    /// Fills `nearest_m` with the per-sample penetration (metres) seen by sensor `k`; returns how
+    /// many samples are fully penetrated.
+    fn penetration(&mut self, k: usize, poses: &PoseView) -> usize {
         let sensor = &self.sensors[k];
         let t = self.config.thickness_m;
         let pad_origin = DVec3::from_slice(&poses.site_xpos[3 * sensor.site..3 * sensor.site + 3]);
@@ -374,11 +373,14 @@ impl Covering {
                 }
             }
         }
+        let mut full = 0;
         for row in self.depth.nearest_m.chunks_exact_mut(self.grid.cols) {
             row.reverse();
             for z in row {
                 *z = (t - *z).clamp(0.0, t);
+                full += usize::from(*z >= t);
             }
         }
+        full
     }
 }

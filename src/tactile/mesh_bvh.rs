@@ -14,7 +14,7 @@
 
 use std::time::Duration;
 
-use glam::{DMat3, DVec3, Vec3A};
+use glam::{DMat3, DVec3, Mat3A, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
@@ -43,59 +43,69 @@ impl OrientedBox {
 
     /// Whether the box may overlap the axis-aligned box `[lo, hi]`: the separating-axis test on
     /// the three coordinate axes and the three box axes (conservative: the nine edge-cross axes are
-    /// skipped, so rare non-overlapping pairs pass, never the reverse).
+    /// skipped, and the test runs in `f32` widened by more than its rounding, so rare
+    /// non-overlapping pairs pass, never the reverse).
     #[inline]
     pub fn may_overlap(&self, lo: DVec3, hi: DVec3) -> bool {
-        OverlapTest::new(self).may_overlap(lo, hi)
+        let scale = lo.abs().max(hi.abs()).max_element() as f32;
+        OverlapTest::new(self, scale).may_overlap(lo.as_vec3a(), hi.as_vec3a())
     }
 }
 
 /// [`OrientedBox::may_overlap`] with the parts that depend on the oriented box alone computed
-/// once, for the many boxes of one BVH query.
+/// once, for the many boxes of one BVH query, in `f32` (the BVH's own precision: four lanes per
+/// vector, half the bytes).
+///
+/// For a node with centre `c` and half-extent `e`, and `t = centre - c`, the axes separate the
+/// boxes where `|t_k| > reach_k + e_k` (coordinate axis `k`, `reach` the box's half-extent along
+/// it) or `|a_i . t| > half_i + |a_i| . e` (box axis `a_i`). `f32` rounding moves each side by at
+/// most a few ulps of the largest coordinate involved; both right-hand sides are widened by
+/// [`Self::SLACK`] times that magnitude, far more than the rounding, so an overlapping pair always
+/// passes.
 #[derive(Debug, Clone, Copy)]
 struct OverlapTest {
-    centre: DVec3,
-    axes: [DVec3; 3],
-    abs_axes: [DVec3; 3],
-    half: DVec3,
+    centre: Vec3A,
+    /// Rows are the box axes: `to_box * t` is `t` along each.
+    to_box: Mat3A,
+    abs_to_box: Mat3A,
+    half: Vec3A,
     /// The box's half-extent along each coordinate axis.
-    reach: DVec3,
+    reach: Vec3A,
 }
 
 impl OverlapTest {
-    fn new(region: &OrientedBox) -> Self {
+    /// Relative widening of the test's bounds, against `f32` rounding (about 1e-7 per operation).
+    const SLACK: f32 = 1e-5;
+
+    /// The test for `region` against boxes whose coordinates are at most `scale` in magnitude.
+    fn new(region: &OrientedBox, scale: f32) -> Self {
         let [a0, a1, a2] = region.axes;
         let h = region.half;
         let reach = DVec3::from_array(std::array::from_fn(|k| {
             h.x * a0[k].abs() + h.y * a1[k].abs() + h.z * a2[k].abs()
         }));
+        let magnitude = scale.max((region.centre.abs().max_element() + reach.max_element()) as f32);
+        let slack = Vec3A::splat(Self::SLACK * magnitude);
+        let to_box = Mat3A::from_cols(a0.as_vec3a(), a1.as_vec3a(), a2.as_vec3a()).transpose();
         Self {
-            centre: region.centre,
-            axes: region.axes,
-            abs_axes: region.axes.map(DVec3::abs),
-            half: h,
-            reach,
+            centre: region.centre.as_vec3a(),
+            to_box,
+            abs_to_box: Mat3A::from_cols(to_box.x_axis.abs(), to_box.y_axis.abs(), to_box.z_axis.abs()),
+            half: h.as_vec3a() + slack,
+            reach: reach.as_vec3a() + slack,
         }
     }
 
     #[inline]
-    fn may_overlap(&self, lo: DVec3, hi: DVec3) -> bool {
+    fn may_overlap(&self, lo: Vec3A, hi: Vec3A) -> bool {
         let c = (lo + hi) * 0.5;
         let e = (hi - lo) * 0.5;
         let t = self.centre - c;
-        for k in 0..3 {
-            if t[k].abs() > self.reach[k] + e[k] {
-                return false;
-            }
+        if t.abs().cmpgt(self.reach + e).any() {
+            return false;
         }
-        for i in 0..3 {
-            let a = self.abs_axes[i];
-            let r = e.x * a.x + e.y * a.y + e.z * a.z;
-            if t.dot(self.axes[i]).abs() > self.half[i] + r {
-                return false;
-            }
-        }
-        true
+        let along = self.to_box * t;
+        !along.abs().cmpgt(self.half + self.abs_to_box * e).any()
     }
 }
 
@@ -311,11 +321,12 @@ impl MeshBvh {
         let bounds = |i: usize| {
             let aabb = nodes[i].aabb;
             (
-                DVec3::from(aabb.min.to_array().map(f64::from)),
-                DVec3::from(aabb.max.to_array().map(f64::from)),
+                Vec3A::from_array(aabb.min.to_array()),
+                Vec3A::from_array(aabb.max.to_array()),
             )
         };
-        let test = OverlapTest::new(region);
+        let (lo, hi) = bounds(0);
+        let test = OverlapTest::new(region, lo.abs().max(hi.abs()).max_element());
         stack.clear();
         stack.push(0);
         while let Some(i) = stack.pop() {
@@ -398,6 +409,89 @@ mod tests {
             }
         }
         assert!(near.len() < 400, "{} candidates", near.len());
+    }
+
+    /// The separating-axis test of [`OverlapTest`] in `f64` without widening: the reference the
+    /// `f32` test must never be stricter than.
+    fn exact_may_overlap(region: &OrientedBox, lo: DVec3, hi: DVec3) -> bool {
+        let (c, e) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let t = region.centre - c;
+        let [a0, a1, a2] = region.axes;
+        let h = region.half;
+        let separated_on_coordinates =
+            (0..3).any(|k| t[k].abs() > h.x * a0[k].abs() + h.y * a1[k].abs() + h.z * a2[k].abs() + e[k]);
+        let separated_on_box_axes = (0..3).any(|i| {
+            let a = region.axes[i];
+            t.dot(a).abs() > h[i] + e.dot(a.abs())
+        });
+        !(separated_on_coordinates || separated_on_box_axes)
+    }
+
+    #[test]
+    fn the_f32_overlap_test_keeps_every_box_the_exact_test_keeps_and_little_else() {
+        use rand::RngExt;
+        let mut rng = crate::rng::rng(11);
+        let (mut kept, mut extra, mut separated) = (0, 0, 0);
+        for _ in 0..200_000 {
+            let rotation = DMat3::from_quat(glam::DQuat::from_scaled_axis(DVec3::new(
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+            )));
+            let scale = 10f64.powi(rng.random_range(-3..2));
+            let random = |rng: &mut rand_chacha::ChaCha8Rng, k: f64| {
+                DVec3::new(
+                    rng.random_range(-k..k),
+                    rng.random_range(-k..k),
+                    rng.random_range(-k..k),
+                )
+            };
+            let region = OrientedBox {
+                centre: random(&mut rng, scale),
+                axes: [rotation.x_axis, rotation.y_axis, rotation.z_axis],
+                half: random(&mut rng, 0.3 * scale).abs(),
+            };
+            // Node boxes as the BVH stores them (f32 corners), many of them touching or nearly
+            // touching the region on one axis: the cases rounding could get wrong.
+            let centre = region.centre + random(&mut rng, 0.6 * scale);
+            let half = random(&mut rng, 0.3 * scale).abs();
+            let mut lo = (centre - half).as_vec3().as_dvec3();
+            let mut hi = (centre + half).as_vec3().as_dvec3();
+            let touching = rng.random_range(0..2) == 0;
+            if touching {
+                let k = rng.random_range(0..3);
+                let reach: f64 = (0..3).map(|i| region.half[i] * region.axes[i][k].abs()).sum();
+                let gap = (hi[k] - lo[k])
+                    + if rng.random_range(0..2) == 0 {
+                        0.0
+                    } else {
+                        1e-9 * scale
+                    };
+                lo[k] = region.centre[k] + reach + rng.random_range(-1e-7..1e-7) * scale;
+                hi[k] = lo[k] + gap;
+                (lo, hi) = (lo.as_vec3().as_dvec3(), hi.as_vec3().as_dvec3());
+            }
+            let exact = exact_may_overlap(&region, lo, hi);
+            let fast = region.may_overlap(lo, hi);
+            assert!(
+                fast || !exact,
+                "{region:?} rejected [{lo}, {hi}], which it overlaps"
+            );
+            kept += usize::from(exact);
+            if !touching {
+                // Away from the boundary, the widening keeps almost nothing the exact test rejects.
+                separated += usize::from(!exact);
+                extra += usize::from(fast && !exact);
+            }
+        }
+        assert!(
+            kept > 10_000 && separated > 10_000,
+            "{kept} kept, {separated} separated"
+        );
+        assert!(
+            extra * 1000 < separated,
+            "{extra} of {separated} separated boxes kept"
+        );
     }
 
     #[test]
