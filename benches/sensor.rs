@@ -44,9 +44,9 @@ use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::tactile::formation::ImageFormation;
 use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml, pad_rotation};
 use taction::tactile::grid::SampleGrid;
-use taction::tactile::mesh_bvh::{MeshBvh, OrientedBox};
+use taction::tactile::mesh_bvh::MeshBvh;
 use taction::tactile::raster::DepthBuffer;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, query_region};
 
 const RADIUS_M: f64 = 0.05;
 const RESOLUTIONS: [usize; 3] = [6, 14, 26];
@@ -87,8 +87,7 @@ fn mesh_arrays(mesh: &TriMesh) -> (Vec<f32>, Vec<i32>) {
 }
 
 /// The reading's stages outside MuJoCo, on the sphere mesh placed at the world origin: the BVH
-/// query for the faces that can meet the pad's rays (the box over the pad from the sphere's far
-/// side to the covering's outer surface), the orthographic rasterisation of those faces with the
+/// query for the faces that can meet the pad's rays (the sensor's own [`query_region`]), the orthographic rasterisation of those faces with the
 /// inside test, and image formation (folded point-spread and area average, clamp).
 fn stages(
     group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
@@ -103,13 +102,7 @@ fn stages(
     // Pad (site) frame: x = up x normal, y = up, z = normal; the mesh sits at the world origin.
     let to_pad = DMat3::from_cols(pose.up.cross(pose.normal), pose.up, pose.normal).transpose();
     let o = to_pad * -pose.center_m;
-    let z_lo = (o.z - RADIUS_M).min(0.0);
-    let to_geom = to_pad.transpose();
-    let region = OrientedBox {
-        centre: to_geom * (DVec3::new(0.0, 0.0, 0.5 * (z_lo + t)) - o),
-        axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
-        half: DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * (t - z_lo)),
-    };
+    let region = query_region(&grid, (&to_pad, o), RADIUS_M, t);
     let (mut stack, mut leaves) = (Vec::new(), Vec::new());
     bvh.leaves_near(&region, &mut stack, &mut leaves);
     group.bench_function(BenchmarkId::new("stage", "bvh_query"), |b| {
@@ -123,7 +116,7 @@ fn stages(
     group.bench_function(BenchmarkId::new("stage", "rasterise"), |b| {
         b.iter(|| {
             depth.nearest_m.fill(f64::INFINITY);
-            depth.draw_mesh(&grid, &bvh, &leaves, (&to_pad, o), t, |_| {});
+            depth.draw_mesh(&grid, &bvh, &leaves, (&to_pad, o), t);
             black_box(depth.nearest_m[0])
         })
     });

@@ -15,8 +15,10 @@
 //!
 //! Sensed: every geom except those of the kinematic tree the pad is mounted on (same
 //! `body_rootid` as the pad site's body; when that root is the world body, only the geoms of the
-//! site's own body are skipped). Meshes are rasterised from the faces of their BVH leaves near the pad;
-//! primitives are cut analytically ([`crate::tactile::primitive`]).
+//! site's own body are skipped). Meshes are rasterised from the faces of their BVH leaves over the
+//! sample rays ([`query_region`]), and a second, small query checks the pad's rigid back; each
+//! mesh's own bounding radius skips meshes out of reach and keeps both queries off empty space.
+//! Primitives are cut analytically ([`crate::tactile::primitive`]).
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
@@ -88,7 +90,7 @@ pub struct CoveringStats {
     pub bvh_triangles: usize,
     /// Readings computed since init.
     pub readings: u64,
-    /// Mesh faces rasterised in the last reading (those of the BVH leaves near the pad).
+    /// Mesh faces rasterised in the last reading (those of the BVH leaves over the sample rays).
     pub last_faces: usize,
     /// Samples of the last reading at full penetration: there the object reached the pad's rigid
     /// back (the covering is fully compressed), which the image, blurred by the point-spread and
@@ -128,6 +130,72 @@ fn rotation(xmat: &[f64]) -> DMat3 {
         DVec3::new(xmat[1], xmat[4], xmat[7]),
         DVec3::new(xmat[2], xmat[5], xmat[8]),
     )
+}
+
+/// The box, in a mesh's geom frame, that holds every face that can change a reading's depths:
+/// the mesh placed in the pad frame by `x -> placement.0 x + placement.1`, within `rbound_m` of
+/// `placement.1` (0: no bound known), under a covering `thickness_m` thick.
+///
+/// Across the pad it spans the sample rays (which pierce the pad plane half a sample inside its
+/// edges: a face elsewhere covers no sample); along the normal `[z_lo, t]` with
+/// `z_lo = min(o_z - r, 0)`: beyond `t` nothing is sensed, and behind the pad plane every crossing
+/// down to the mesh's far side counts for the inside test. A relative 1e-6 of margin keeps
+/// rounding from dropping a face on its boundary.
+pub fn query_region(
+    grid: &SampleGrid,
+    placement: (&DMat3, DVec3),
+    rbound_m: f64,
+    thickness_m: f64,
+) -> OrientedBox {
+    let (o, t) = (placement.1, thickness_m);
+    let z_lo = (o.z - rbound_m).min(0.0);
+    let (hx, hy) = grid.ray_half_extent_m();
+    pad_box(
+        placement,
+        DVec3::new(0.0, 0.0, 0.5 * (z_lo + t)),
+        DVec3::new(hx, hy, 0.5 * (t - z_lo)),
+    )
+}
+
+/// The pad-frame box of centre `centre_pad` and half-sizes `half_pad`, widened by a relative
+/// 1e-6, in the geom frame of a mesh placed by `x -> placement.0 x + placement.1`.
+fn pad_box(placement: (&DMat3, DVec3), centre_pad: DVec3, half_pad: DVec3) -> OrientedBox {
+    let (m, o) = placement;
+    let to_geom = m.transpose();
+    OrientedBox {
+        centre: to_geom * (centre_pad - o),
+        axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
+        half: half_pad + 1e-6 * half_pad.element_sum(),
+    }
+}
+
+/// Whether a face of `mesh` (placed as in [`query_region`]) lies in the pad's rigid back: the
+/// whole pad rectangle swept [`RIGID_BACK_DEPTH_M`] behind the pad plane, where the object is
+/// felt even between the samples (`triangle_overlaps_box`, touching counts). Its own BVH query,
+/// since the depths need only the faces over the sample rays; none when the mesh lies wholly in
+/// front of the pad plane.
+fn rigid_back_touched(
+    grid: &SampleGrid,
+    mesh: &MeshBvh,
+    placement: (&DMat3, DVec3),
+    rbound_m: f64,
+    (stack, leaves): (&mut Vec<usize>, &mut Vec<Leaf>),
+) -> bool {
+    let (m, o) = placement;
+    if rbound_m > 0.0 && o.z - rbound_m > 0.0 {
+        return false;
+    }
+    let centre = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
+    let half = DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * RIGID_BACK_DEPTH_M);
+    leaves.clear();
+    mesh.leaves_near(&pad_box(placement, centre, half), stack, leaves);
+    leaves
+        .iter()
+        .flat_map(|&leaf| mesh.leaf_faces(leaf))
+        .any(|(face, _)| {
+            let corners = mesh.corners(face, m, o);
+            corners.iter().any(|p| p.z <= 0.0) && triangle_overlaps_box(corners, centre, half)
+        })
 }
 
 impl Covering {
@@ -236,10 +304,12 @@ impl Covering {
                 } else {
                     return Err(unsupported("signed distance field"));
                 };
-                let rbound_m = if t == mjtGeom::mjGEOM_PLANE as i32 {
-                    0.0
-                } else {
-                    model.geom_rbound[geom]
+                // A mesh's own bound is tight (MuJoCo's `geom_rbound` of a mesh is looser): it
+                // skips more geoms out of reach and keeps the queries off empty space.
+                let rbound_m = match shape {
+                    _ if t == mjtGeom::mjGEOM_PLANE as i32 => 0.0,
+                    Shape::Mesh(slot) => meshes[slot].bounding_radius_m(),
+                    Shape::Solid(_) => model.geom_rbound[geom],
                 };
                 sensed.push(SensedGeom {
                     geom,
@@ -320,28 +390,17 @@ impl Covering {
             }
             match g.shape {
                 Shape::Mesh(slot) => {
-                    let z_lo = (o.z - r).min(0.0);
-                    let centre_pad = DVec3::new(0.0, 0.0, 0.5 * (z_lo + t));
-                    let margin = 1e-6 * (hw + hh + t - z_lo);
-                    let to_geom = m.transpose();
-                    let region = OrientedBox {
-                        centre: to_geom * (centre_pad - o),
-                        axes: [to_geom.x_axis, to_geom.y_axis, to_geom.z_axis],
-                        half: DVec3::new(hw, hh, 0.5 * (t - z_lo)) + margin,
-                    };
+                    let region = query_region(&self.grid, (&m, o), r, t);
                     let mesh = &self.meshes[slot];
                     self.leaves.clear();
                     mesh.leaves_near(&region, &mut self.stack, &mut self.leaves);
                     self.stats.last_faces += self.leaves.iter().map(Leaf::face_count).sum::<usize>();
-                    let back_center = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
-                    let back_half = DVec3::new(hw, hh, 0.5 * RIGID_BACK_DEPTH_M);
-                    let back_touched = &mut self.stats.last_back_touched;
-                    self.depth
-                        .draw_mesh(&self.grid, mesh, &self.leaves, (&m, o), t, |corners| {
-                            if !*back_touched && triangle_overlaps_box(corners, back_center, back_half) {
-                                *back_touched = true;
-                            }
-                        });
+                    self.depth.draw_mesh(&self.grid, mesh, &self.leaves, (&m, o), t);
+                    if !self.stats.last_back_touched {
+                        let scratch = (&mut self.stack, &mut self.leaves);
+                        self.stats.last_back_touched =
+                            rigid_back_touched(&self.grid, mesh, (&m, o), r, scratch);
+                    }
                 }
                 Shape::Solid(solid) => {
                     let to_geom = m.transpose();
@@ -382,5 +441,73 @@ impl Covering {
             }
         }
         full
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tactile::mesh_bvh::bumpy_ball;
+
+    #[test]
+    fn the_query_regions_keep_every_face_that_changes_a_reading() {
+        use rand::RngExt;
+        // Whether the ball lies wholly in front of the pad, touches the covering, or is pushed
+        // through the pad plane: the leaves over the sample rays give the same depths, bit for bit,
+        // as every leaf of the mesh, and the rigid-back query finds a face in the back exactly when
+        // one of all the mesh's faces is there.
+        let g = SampleGrid::new(&SensorConfig::default());
+        let t = SensorConfig::default().thickness_m;
+        let mesh = bumpy_ball(0.008);
+        let rbound_m = (0..mesh.triangle_count() as u32)
+            .flat_map(|f| mesh.corners(f, &DMat3::IDENTITY, DVec3::ZERO))
+            .map(DVec3::length)
+            .fold(0.0, f64::max);
+        let (mut every, mut stack, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+        mesh.leaves_near(&OrientedBox::cube(1.0), &mut stack, &mut every);
+        let back_centre = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
+        let back_half = DVec3::new(g.half_width_m, g.half_height_m, 0.5 * RIGID_BACK_DEPTH_M);
+        let depths = |leaves: &[Leaf], placement: (&DMat3, DVec3)| {
+            let mut depth = DepthBuffer::new(&g);
+            depth.draw_mesh(&g, &mesh, leaves, placement, t);
+            depth.nearest_m
+        };
+        let mut rng = crate::rng::rng(23);
+        let (mut fewer, mut read, mut inside, mut backs) = (0, 0, 0, 0);
+        for _ in 0..300 {
+            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            // The bounding sphere from 4 mm through the pad plane to 1 mm in front of it, the
+            // ball's rim often across the pad's border.
+            let offset = DVec3::new(
+                rng.random_range(-0.012..0.012),
+                rng.random_range(-0.012..0.012),
+                rbound_m + rng.random_range(-0.004..0.001),
+            );
+            let placement = (&rotation, offset);
+            let mut near = Vec::new();
+            mesh.leaves_near(&query_region(&g, placement, rbound_m, t), &mut stack, &mut near);
+            let (all, over_rays) = (depths(&every, placement), depths(&near, placement));
+            for (s, (a, b)) in all.iter().zip(&over_rays).enumerate() {
+                assert_eq!(a.to_bits(), b.to_bits(), "sample {s}: {a} vs {b}");
+            }
+            let in_back = (0..mesh.triangle_count() as u32).any(|f| {
+                let corners = mesh.corners(f, &rotation, offset);
+                corners.iter().any(|p| p.z <= 0.0) && triangle_overlaps_box(corners, back_centre, back_half)
+            });
+            let found = rigid_back_touched(&g, &mesh, placement, rbound_m, (&mut stack, &mut scratch));
+            assert_eq!(found, in_back, "offset {offset}");
+            let faces = |leaves: &[Leaf]| leaves.iter().map(Leaf::face_count).sum::<usize>();
+            fewer += usize::from(faces(&near) < faces(&every));
+            read += usize::from(all.iter().any(|z| z.is_finite()));
+            inside += usize::from(all.contains(&f64::NEG_INFINITY));
+            backs += usize::from(in_back);
+        }
+        // Not vacuous: fewer faces drawn, surfaces read in the covering, samples inside the
+        // ball, and faces in the rigid back (and poses without).
+        assert!(
+            fewer > 250 && read > 50 && inside > 20 && backs > 20 && backs < 280,
+            "{fewer} with fewer faces, {read} read, {inside} inside, {backs} in the back"
+        );
     }
 }

@@ -64,6 +64,12 @@ impl SampleGrid {
         }
     }
 
+    /// The largest `|x|` and `|y|` of the sample rays: they pierce the pad plane within this
+    /// rectangle, half a sample inside the pad's edges.
+    pub fn ray_half_extent_m(&self) -> (f64, f64) {
+        (self.xs_m[self.cols - 1], self.ys_m[0])
+    }
+
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.rows * self.cols

@@ -144,6 +144,8 @@ pub struct MeshBvh {
     /// For each slot of `bvh.primitive_indices`: the face's corners as positions in its leaf's
     /// vertex range.
     slot_corners: Vec<[u16; 3]>,
+    /// The largest vertex distance from the frame's origin, widened by a relative 1e-9.
+    bounding_radius_m: f64,
 }
 
 impl std::fmt::Debug for MeshBvh {
@@ -206,7 +208,10 @@ impl MeshBvh {
         } else {
             build_bvh2_from_tris(&triangles, BvhBuildParams::fast_build(), &mut Duration::default())
         };
+        // Widened so that the rounding of a placed vertex never puts it beyond the bound.
+        let bounding_radius_m = vertices.iter().map(|v| v.length()).fold(0.0, f64::max) * (1.0 + 1e-9);
         let mut mesh = Self {
+            bounding_radius_m,
             vertices,
             faces,
             bvh,
@@ -250,6 +255,12 @@ impl MeshBvh {
             self.leaf_vertex_range[leaf.first as usize] =
                 (start as u32, (self.leaf_vertices.len() - start) as u32);
         }
+    }
+
+    /// A radius about the frame's origin that holds every vertex, even once placed by a rigid
+    /// motion with rounding (the largest vertex distance, widened by a relative 1e-9).
+    pub fn bounding_radius_m(&self) -> f64 {
+        self.bounding_radius_m
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -347,6 +358,54 @@ impl MeshBvh {
             }
         }
     }
+}
+
+/// A closed, bumpy box: `TriMesh::cuboid` split three times into four (shared edge midpoints,
+/// so it stays watertight and outward), its vertices pushed out by a ripple.
+#[cfg(test)]
+pub(crate) fn bumpy_box(half_m: f64) -> MeshBvh {
+    bumpy(half_m, false)
+}
+
+/// [`bumpy_box`] split once more (faces about 1 mm at 8 mm radius), its vertices moved onto the
+/// sphere of radius `radius_m` before the ripple: a bumpy ball, whose bounding sphere is tight.
+#[cfg(test)]
+pub(crate) fn bumpy_ball(radius_m: f64) -> MeshBvh {
+    bumpy(radius_m, true)
+}
+
+#[cfg(test)]
+fn bumpy(size_m: f64, ball: bool) -> MeshBvh {
+    let mut mesh = crate::mesh::TriMesh::cuboid(DVec3::splat(size_m));
+    for _ in 0..if ball { 4 } else { 3 } {
+        let mut midpoints = std::collections::HashMap::new();
+        let mut triangles = Vec::new();
+        for [a, b, c] in mesh.triangles.clone() {
+            let mut mid = |p: u32, q: u32| {
+                *midpoints.entry((p.min(q), p.max(q))).or_insert_with(|| {
+                    mesh.vertices
+                        .push(0.5 * (mesh.vertices[p as usize] + mesh.vertices[q as usize]));
+                    mesh.vertices.len() as u32 - 1
+                })
+            };
+            let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+            triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        mesh.triangles = triangles;
+    }
+    for v in &mut mesh.vertices {
+        if ball {
+            *v = v.normalize() * size_m;
+        }
+        *v *= 1.0 + 0.05 * (900.0 * v.x).sin() * (700.0 * v.y).cos();
+    }
+    let xyz: Vec<f32> = mesh
+        .vertices
+        .iter()
+        .flat_map(|v| v.as_vec3().to_array())
+        .collect();
+    let faces: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
+    MeshBvh::new(&xyz, &faces).unwrap()
 }
 
 #[cfg(test)]
@@ -492,6 +551,33 @@ mod tests {
             extra * 1000 < separated,
             "{extra} of {separated} separated boxes kept"
         );
+    }
+
+    #[test]
+    fn the_bounding_radius_holds_every_placed_vertex_and_little_more() {
+        use rand::RngExt;
+        let mesh = bumpy_ball(0.008);
+        let r = mesh.bounding_radius_m();
+        let farthest = (0..mesh.triangle_count() as u32)
+            .flat_map(|f| mesh.corners(f, &DMat3::IDENTITY, DVec3::ZERO))
+            .map(DVec3::length)
+            .fold(0.0, f64::max);
+        assert!(
+            r >= farthest && r <= farthest * (1.0 + 2e-9),
+            "{r} for {farthest}"
+        );
+        let mut rng = crate::rng::rng(4);
+        for _ in 0..50 {
+            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            let offset = DVec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 0.3);
+            for f in 0..mesh.triangle_count() as u32 {
+                // The covering's use: every placed vertex within `r` of the offset, per coordinate.
+                for p in mesh.corners(f, &rotation, offset) {
+                    assert!((0..3).all(|k| p[k] >= offset[k] - r && p[k] <= offset[k] + r));
+                }
+            }
+        }
     }
 
     #[test]

@@ -31,7 +31,7 @@ pub mod raster;
 pub mod sensor;
 
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
-pub use covering::{Covering, CoveringError, CoveringStats};
+pub use covering::{Covering, CoveringError, CoveringStats, query_region};
 pub use free_floating::{FreeFloatingSensor, free_floating_builder};
 pub use image::{ImageError, PadPose, TactileImage};
 pub use model_view::{ModelView, PoseView};

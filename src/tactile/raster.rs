@@ -179,9 +179,8 @@ impl DepthBuffer {
     }
 
     /// Draws the faces of `leaves` of `mesh` placed in the pad frame by
-    /// `x -> placement.0 x + placement.1`, then marks the samples inside the mesh. `at_plane` sees
-    /// the pad-frame corners of each face with a corner at or behind the pad plane (the only faces
-    /// that can reach the pad's rigid back). Each leaf's vertices are placed once.
+    /// `x -> placement.0 x + placement.1`, then marks the samples inside the mesh. Each leaf's
+    /// vertices are placed once.
     pub fn draw_mesh(
         &mut self,
         grid: &SampleGrid,
@@ -189,7 +188,6 @@ impl DepthBuffer {
         leaves: &[Leaf],
         placement: (&DMat3, DVec3),
         far_m: f64,
-        mut at_plane: impl FnMut([DVec3; 3]),
     ) {
         let (rotation, offset) = placement;
         for &leaf in leaves {
@@ -203,10 +201,6 @@ impl DepthBuffer {
                 let v = &self.leaf_vertices;
                 let corners = [v[i as usize], v[j as usize], v[k as usize]];
                 rasterise_face(grid, corners, far_m, &mut self.nearest_m, &mut self.behind);
-                let [a, b, c] = [corners[0].p, corners[1].p, corners[2].p];
-                if lesser(lesser(a.z, b.z), c.z) <= 0.0 {
-                    at_plane([a, b, c]);
-                }
             }
         }
         self.behind.resolve_into(grid, &mut self.nearest_m);
@@ -483,41 +477,8 @@ impl FaceSetup {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::TriMesh;
     use crate::tactile::SensorConfig;
     use crate::tactile::mesh_bvh::OrientedBox;
-
-    /// A closed, bumpy box: `TriMesh::cuboid` split three times into four (shared edge midpoints,
-    /// so it stays watertight and outward), its vertices pushed out by a ripple.
-    fn bumpy_box(half_m: f64) -> MeshBvh {
-        let mut mesh = TriMesh::cuboid(DVec3::splat(half_m));
-        for _ in 0..3 {
-            let mut midpoints = std::collections::HashMap::new();
-            let mut triangles = Vec::new();
-            for [a, b, c] in mesh.triangles.clone() {
-                let mut mid = |p: u32, q: u32| {
-                    *midpoints.entry((p.min(q), p.max(q))).or_insert_with(|| {
-                        mesh.vertices
-                            .push(0.5 * (mesh.vertices[p as usize] + mesh.vertices[q as usize]));
-                        mesh.vertices.len() as u32 - 1
-                    })
-                };
-                let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-                triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-            }
-            mesh.triangles = triangles;
-        }
-        for v in &mut mesh.vertices {
-            *v *= 1.0 + 0.05 * (900.0 * v.x).sin() * (700.0 * v.y).cos();
-        }
-        let xyz: Vec<f32> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| v.as_vec3().to_array())
-            .collect();
-        let faces: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
-        MeshBvh::new(&xyz, &faces).unwrap()
-    }
 
     #[test]
     fn narrow_faces_drawn_without_column_loops_equal_the_row_loops() {
@@ -583,7 +544,7 @@ mod tests {
         // Placing each leaf's vertices once must give, bit for bit, the image of placing every
         // face's corners: across the covering, pushed through the pad (inside test), and off it.
         let g = SampleGrid::new(&SensorConfig::default());
-        let mesh = bumpy_box(0.006);
+        let mesh = crate::tactile::mesh_bvh::bumpy_box(0.006);
         let far_m = 0.002;
         let mut leaves = Vec::new();
         mesh.leaves_near(&OrientedBox::cube(1.0), &mut Vec::new(), &mut leaves);
@@ -608,16 +569,7 @@ mod tests {
             }
             each.behind.resolve_into(&g, &mut each.nearest_m);
             let mut by_leaf = DepthBuffer::new(&g);
-            let mut at_plane = 0;
-            by_leaf.draw_mesh(&g, &mesh, &leaves, (&rotation, offset), far_m, |corners| {
-                assert!(corners.iter().any(|p| p.z <= 0.0));
-                at_plane += 1;
-            });
-            let reaching = (leaves.iter())
-                .flat_map(|&leaf| mesh.leaf_faces(leaf))
-                .filter(|&(face, _)| mesh.corners(face, &rotation, offset).iter().any(|p| p.z <= 0.0))
-                .count();
-            assert_eq!(at_plane, reaching);
+            by_leaf.draw_mesh(&g, &mesh, &leaves, (&rotation, offset), far_m);
             for (s, (a, b)) in each.nearest_m.iter().zip(&by_leaf.nearest_m).enumerate() {
                 assert_eq!(a.to_bits(), b.to_bits(), "sample {s}: {a} vs {b}");
             }
