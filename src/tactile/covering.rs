@@ -169,9 +169,17 @@ fn pad_box(placement: (&DMat3, DVec3), centre_pad: DVec3, half_pad: DVec3) -> Or
     }
 }
 
-/// Whether a face of `mesh` (placed as in [`query_region`]) lies in the pad's rigid back: the
-/// whole pad rectangle swept [`RIGID_BACK_DEPTH_M`] behind the pad plane, where the object is
-/// felt even between the samples (`triangle_overlaps_box`, touching counts). Its own BVH query,
+/// The pad's rigid back in the pad frame, as a box's centre and half-sizes: the whole pad
+/// rectangle swept [`RIGID_BACK_DEPTH_M`] behind the pad plane.
+fn rigid_back(grid: &SampleGrid) -> (DVec3, DVec3) {
+    (
+        DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M),
+        DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * RIGID_BACK_DEPTH_M),
+    )
+}
+
+/// Whether a face of `mesh` (placed as in [`query_region`]) lies in the pad's [`rigid_back`],
+/// where the object is felt even between the samples (`triangle_overlaps_box`, touching counts). Its own BVH query,
 /// since the depths need only the faces over the sample rays; none when the mesh lies wholly in
 /// front of the pad plane.
 fn rigid_back_touched(
@@ -185,8 +193,7 @@ fn rigid_back_touched(
     if rbound_m > 0.0 && o.z - rbound_m > 0.0 {
         return false;
     }
-    let centre = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
-    let half = DVec3::new(grid.half_width_m, grid.half_height_m, 0.5 * RIGID_BACK_DEPTH_M);
+    let (centre, half) = rigid_back(grid);
     leaves.clear();
     mesh.leaves_near(&pad_box(placement, centre, half), stack, leaves);
     leaves
@@ -447,7 +454,7 @@ impl Covering {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tactile::mesh_bvh::bumpy_ball;
+    use crate::tactile::mesh_bvh::{bumpy_ball, random_rotation};
 
     #[test]
     fn the_query_regions_keep_every_face_that_changes_a_reading() {
@@ -459,14 +466,11 @@ mod tests {
         let g = SampleGrid::new(&SensorConfig::default());
         let t = SensorConfig::default().thickness_m;
         let mesh = bumpy_ball(0.008);
-        let rbound_m = (0..mesh.triangle_count() as u32)
-            .flat_map(|f| mesh.corners(f, &DMat3::IDENTITY, DVec3::ZERO))
-            .map(DVec3::length)
-            .fold(0.0, f64::max);
+        // The bound the covering uses for a mesh.
+        let rbound_m = mesh.bounding_radius_m();
         let (mut every, mut stack, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
         mesh.leaves_near(&OrientedBox::cube(1.0), &mut stack, &mut every);
-        let back_centre = DVec3::new(0.0, 0.0, -0.5 * RIGID_BACK_DEPTH_M);
-        let back_half = DVec3::new(g.half_width_m, g.half_height_m, 0.5 * RIGID_BACK_DEPTH_M);
+        let (back_centre, back_half) = rigid_back(&g);
         let depths = |leaves: &[Leaf], placement: (&DMat3, DVec3)| {
             let mut depth = DepthBuffer::new(&g);
             depth.draw_mesh(&g, &mesh, leaves, placement, t);
@@ -475,8 +479,7 @@ mod tests {
         let mut rng = crate::rng::rng(23);
         let (mut fewer, mut read, mut inside, mut backs) = (0, 0, 0, 0);
         for _ in 0..300 {
-            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
-            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            let rotation = random_rotation(&mut rng);
             // The bounding sphere from 4 mm through the pad plane to 1 mm in front of it, the
             // ball's rim often across the pad's border.
             let offset = DVec3::new(

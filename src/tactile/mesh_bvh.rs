@@ -374,6 +374,15 @@ pub(crate) fn bumpy_ball(radius_m: f64) -> MeshBvh {
     bumpy(radius_m, true)
 }
 
+/// A random rotation for the tests' poses: about the axis `(u, v, 1)` normalised, `u` and `v`
+/// drawn in `[-1, 1)`, by an angle drawn in `[0, 6.3)` rad.
+#[cfg(test)]
+pub(crate) fn random_rotation(rng: &mut crate::rng::Rng) -> DMat3 {
+    use rand::RngExt;
+    let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+    DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3))
+}
+
 #[cfg(test)]
 fn bumpy(size_m: f64, ball: bool) -> MeshBvh {
     let mut mesh = crate::mesh::TriMesh::cuboid(DVec3::splat(size_m));
@@ -568,8 +577,7 @@ mod tests {
         );
         let mut rng = crate::rng::rng(4);
         for _ in 0..50 {
-            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
-            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            let rotation = random_rotation(&mut rng);
             let offset = DVec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 0.3);
             for f in 0..mesh.triangle_count() as u32 {
                 // The covering's use: every placed vertex within `r` of the offset, per coordinate.

@@ -341,7 +341,6 @@ impl FaceSetup {
     #[inline]
     fn draw_narrow(&self, grid: &SampleGrid, far_m: f64, nearest_m: &mut [f64]) {
         let (rows, cols) = (self.rows, self.cols);
-        let tol = -EDGE_EPS;
         let j0 = cols.0 as usize;
         let j1 = (j0 + 1).min(grid.cols - 1);
         let two_cols = cols.1 - cols.0 == 2;
@@ -370,7 +369,7 @@ impl FaceSetup {
                     );
                     let wc = _mm_sub_pd(_mm_sub_pd(_mm_set1_pd(1.0), wa), wb);
                     let nearest = _mm_set_pd(nearest_m[s1], nearest_m[s0]);
-                    let tol = _mm_set1_pd(tol);
+                    let tol = _mm_set1_pd(-EDGE_EPS);
                     let covers = _mm_and_pd(
                         _mm_and_pd(_mm_cmpge_pd(wa, tol), _mm_cmpge_pd(wb, tol)),
                         _mm_cmpge_pd(wc, tol),
@@ -478,7 +477,7 @@ impl FaceSetup {
 mod tests {
     use super::*;
     use crate::tactile::SensorConfig;
-    use crate::tactile::mesh_bvh::OrientedBox;
+    use crate::tactile::mesh_bvh::{OrientedBox, random_rotation};
 
     #[test]
     fn narrow_faces_drawn_without_column_loops_equal_the_row_loops() {
@@ -552,8 +551,7 @@ mod tests {
         let mut rng = crate::rng::rng(3);
         let (mut covered, mut inside) = (0, 0);
         for _ in 0..60 {
-            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
-            let rotation = DMat3::from_axis_angle(axis, rng.random_range(0.0..6.3));
+            let rotation = random_rotation(&mut rng);
             // The box's near side from 2 mm in front of the pad to 3 mm through it.
             let offset = DVec3::new(
                 rng.random_range(-0.008..0.008),
