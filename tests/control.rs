@@ -8,6 +8,7 @@ use taction::control::free_pad::FreePad;
 use taction::control::{ControlConfig, settle};
 use taction::dataset::ContactStatus;
 use taction::explore::collect::sensor_reader;
+use taction::mesh::TriMesh;
 use taction::pose::Pose;
 use taction::rng;
 use taction::sim::ObjectSpec;
@@ -46,7 +47,57 @@ fn tilted_plane(tilt: DQuat) -> ObjectSpec {
 
 #[test]
 fn tilted_planes_converge_normal_and_pressure() {
-    let config = ControlConfig::default();
+    tilted_planes_converge(&ControlConfig::default());
+}
+
+#[test]
+fn tilted_planes_converge_with_the_edge_guard_too() {
+    tilted_planes_converge(&ControlConfig {
+        orient_edge_guard: true,
+        ..ControlConfig::default()
+    });
+}
+
+/// A 2 mm plate with an 8 mm wide bar along y raised 3 mm on it, centred at x = 0 (a letter's
+/// stroke, Sec. V-D).
+fn raised_bar() -> ObjectSpec {
+    let mut mesh = TriMesh::cuboid(DVec3::new(0.03, 0.03, 0.001)).translated(DVec3::new(0.0, 0.0, 0.001));
+    mesh.append(&TriMesh::cuboid(DVec3::new(0.004, 0.03, 0.0015)).translated(DVec3::new(0.0, 0.0, 0.0035)));
+    ObjectSpec::new("bar", mesh)
+}
+
+/// Tilt of the settled pad from level, degrees, started level 7 mm above the plate, centred at `x`.
+fn settled_tilt_deg(x_m: f64, config: &ControlConfig) -> f64 {
+    let mut free = free_sensor(raised_bar());
+    let start = PadPose::new(DVec3::new(x_m, 0.0, 0.012), DVec3::NEG_Z, DVec3::Y).unwrap();
+    let outcome = settle_from(&mut free, &start, config);
+    assert_eq!(outcome.status, ContactStatus::Converged, "x = {x_m}");
+    outcome.pose.normal.angle_between(DVec3::NEG_Z).to_degrees()
+}
+
+#[test]
+fn the_edge_guard_keeps_a_level_pad_level_beside_a_stroke_edge() {
+    let guarded = ControlConfig {
+        orient_edge_guard: true,
+        ..ControlConfig::default()
+    };
+    // The bar's edge is at x = 4 mm. On the bar 1-4 mm in from its edge, and off it 1-2.5 mm (the
+    // bar under one side of the pad) or 4.5-5.5 mm (under its border column).
+    for offset_mm in [-4.0, -3.0, -2.0, -1.0, 1.0, 1.5, 2.0, 2.5, 4.5, 5.0, 5.5] {
+        let x = 0.004 + offset_mm * 1e-3;
+        let tilt = settled_tilt_deg(x, &guarded);
+        assert!(
+            tilt < 5.0,
+            "{offset_mm} mm off the edge: settled {tilt:.1} deg from level"
+        );
+    }
+    // Without the guard a partly covered column reads as a slope and the pad tips onto the plate.
+    let unguarded = settled_tilt_deg(0.0055, &ControlConfig::default());
+    assert!(unguarded > 10.0, "{unguarded}");
+}
+
+/// Runs the controllers on eight seeded tilted planes from 30 degrees off their normal.
+fn tilted_planes_converge(config: &ControlConfig) {
     let mut r = rng::rng(404);
     for trial in 0..8 {
         let tilt_axis = DVec3::new(r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), 0.0).normalize();
@@ -57,7 +108,7 @@ fn tilted_planes_converge_normal_and_pressure() {
         let off_axis = surface_n.any_orthonormal_vector();
         let normal = DQuat::from_axis_angle(off_axis, 30f64.to_radians()) * -surface_n;
         let start = PadPose::new(surface_n * 0.003, normal, normal.any_orthonormal_vector()).unwrap();
-        let outcome = settle_from(&mut free, &start, &config);
+        let outcome = settle_from(&mut free, &start, config);
         assert_eq!(
             outcome.status,
             ContactStatus::Converged,

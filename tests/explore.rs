@@ -402,3 +402,82 @@ fn collect_writes_contact_sheets_beside_the_dataset() {
     assert!(dir.path().join("none.csv").exists());
     assert!(!dir.path().join("none.block.png").exists());
 }
+
+/// `taction collect --control FILE.json` runs the sampler with those controllers: on a raised bar
+/// touched from above, the edge guard keeps the readings level where the default Orient tips the
+/// pad over the bar's edges; a file naming an unknown field is refused, naming the file and the
+/// field.
+#[test]
+fn collect_takes_the_controllers_from_a_control_file() {
+    use taction::dataset::{ContactStatus, Dataset};
+    use taction::mesh::TriMesh;
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("bar.obj");
+    let mut bar = TriMesh::cuboid(DVec3::new(0.02, 0.02, 0.001)).translated(DVec3::new(0.0, 0.0, 0.001));
+    bar.append(&TriMesh::cuboid(DVec3::new(0.004, 0.02, 0.0015)).translated(DVec3::new(0.0, 0.0, 0.0035)));
+    taction::mesh::write_obj(&bar, &mesh, "bar").unwrap();
+    let run = |control: Option<&str>, out: &str| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_taction"));
+        command
+            .args([
+                "collect",
+                "--from-above",
+                "--readings",
+                "100",
+                "--contact-sheet",
+                "0",
+            ])
+            .arg("--objects")
+            .arg(&mesh)
+            .arg("--out")
+            .arg(dir.path().join(out));
+        if let Some(json) = control {
+            let file = dir.path().join(format!("{out}.json"));
+            std::fs::write(&file, json).unwrap();
+            command.arg("--control").arg(file);
+        }
+        command.output().unwrap()
+    };
+    let tipped = |out: &str| {
+        let dataset = Dataset::read(&dir.path().join(out)).unwrap();
+        let converged: Vec<_> = dataset
+            .readings()
+            .iter()
+            .filter(|r| r.status == ContactStatus::Converged)
+            .collect();
+        assert_eq!(converged.len(), 100);
+        converged
+            .iter()
+            .filter(|r| {
+                r.image
+                    .pose()
+                    .unwrap()
+                    .normal
+                    .angle_between(DVec3::NEG_Z)
+                    .to_degrees()
+                    > 12.0
+            })
+            .count()
+    };
+    assert!(run(None, "plain.csv").status.success());
+    assert!(
+        run(Some("{\"orient_edge_guard\": true}"), "guarded.csv")
+            .status
+            .success()
+    );
+    let (plain, guarded) = (tipped("plain.csv"), tipped("guarded.csv"));
+    assert!(
+        plain >= 10 && guarded * 3 < plain,
+        "tipped over 12 deg: {plain} plain, {guarded} guarded"
+    );
+
+    let refused = run(Some("{\"orient_edge_gard\": true}"), "refused.csv");
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        stderr.contains("--control")
+            && stderr.contains("refused.csv.json")
+            && stderr.contains("orient_edge_gard"),
+        "{stderr}"
+    );
+}

@@ -385,3 +385,49 @@ fn the_active_experiment_is_the_same_on_one_and_two_threads() {
     }
     assert!(active_rows > 0, "no active rows:\n{text}");
 }
+
+/// `--codebook knn` trains every model of a run with the neighbour codebook: `config.json` says
+/// so (with the PCA keeping 99%), the cached models are neighbour codebooks, and the same folder
+/// refuses a run with the paper's GMM instead of mixing the two.
+#[test]
+fn an_experiment_runs_with_the_neighbour_codebook_and_keeps_it_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    let letters = two_letters(dir.path());
+    let out = dir.path().join("knn");
+    let args = |codebook: &'static str| -> Vec<String> {
+        [
+            "experiment",
+            "letters",
+            "--scale",
+            "0.02",
+            "--letters",
+            letters.to_str().unwrap(),
+            "--codebook",
+            codebook,
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let knn = args("knn");
+    taction(&knn.iter().map(String::as_str).collect::<Vec<_>>());
+    let config = std::fs::read_to_string(out.join("letters/config.json")).unwrap();
+    let config: serde_json::Value = serde_json::from_str(&config).unwrap();
+    assert_eq!(config["training"]["codebook"], "knn", "{config}");
+    assert_eq!(config["training"]["variance_kept"], 0.99, "{config}");
+    assert!(!rows(&out.join("letters/letters.csv")).is_empty());
+    let models: Vec<_> = std::fs::read_dir(out.join("models")).unwrap().collect();
+    assert_eq!(models.len(), 3, "one model per descriptor");
+    for model in models {
+        let text = std::fs::read_to_string(model.unwrap().path()).unwrap();
+        assert!(text.contains("\"kind\":\"knn\""));
+    }
+    let gmm = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args("gmm"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&gmm.stderr);
+    assert!(!gmm.status.success(), "a GMM run reused the kNN folder");
+    assert!(stderr.contains("config.json"), "{stderr}");
+}

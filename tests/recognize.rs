@@ -8,9 +8,9 @@ use rand::RngExt;
 use recognize_toy::{OBJECTS, normal};
 use taction::describe::{DescriptorKind, Feature};
 use taction::recognize::{
-    ClusterHistogram, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, KMeans, KMeansConfig,
-    LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, TrainProgress, cross_entropy,
-    evaluate, kmeans_plus_plus, make_trials, train,
+    ClusterHistogram, CodebookKind, CodebookModel, FeatureMatrix, GaussianMixture, GmmConfig, KMeans,
+    KMeansConfig, LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, TrainProgress,
+    cross_entropy, evaluate, kmeans_plus_plus, make_trials, train,
 };
 use taction::rng::stream;
 
@@ -291,11 +291,13 @@ fn toy_objects_are_recognised_at_100_percent_with_10_readings() {
     let training = toy_features(60, 1);
     let validation = toy_features(20, 2);
     let test = toy_features(30, 3);
-    for kind in [CodebookKind::Gmm, CodebookKind::Kmeans] {
+    for kind in CodebookKind::ALL {
         let trained = train(&training, Some(&validation), &toy_config(kind), &mut |_| {}).unwrap();
         let chosen = trained.selection.chosen().unwrap();
         assert!([3, 6].contains(&trained.selection.chosen_k));
-        assert_eq!(trained.selection.candidates.len(), 4);
+        // The neighbour codebook draws nothing at random: one candidate per k, not per restart.
+        let restarts = if kind.is_random() { 2 } else { 1 };
+        assert_eq!(trained.selection.candidates.len(), 2 * restarts);
         assert!(
             trained
                 .selection
@@ -379,6 +381,40 @@ fn training_is_seeded_and_deterministic() {
     assert_eq!(a, b);
     let json = |t: &taction::recognize::Trained| serde_json::to_string(&t.bag).unwrap();
     assert_eq!(json(&a), json(&b));
+}
+
+/// The neighbour codebook is a function of the data (the same model from 1 and 3 threads), holds
+/// every training feature with one cluster per object, and (its training memberships taken with
+/// each reading left out, unit-tested in `recognize::neighbours`) gives each toy object's own bin
+/// more than chance and less than all.
+#[test]
+fn the_neighbour_codebook_is_deterministic_and_holds_the_training_features() {
+    let training = toy_features(30, 4);
+    let config = TrainConfig {
+        ks: vec![5],
+        ..toy_config(CodebookKind::Knn)
+    };
+    let train_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| train(&training, None, &config, &mut |_| {}).unwrap())
+    };
+    let one = train_on(1);
+    assert_eq!(one, train_on(3));
+    let CodebookModel::Knn(nn) = one.bag.codebook() else {
+        panic!("not a neighbour codebook")
+    };
+    assert_eq!((nn.neighbours(), nn.clusters()), (5, OBJECTS.len()));
+    // The training part of the data (hold-out taken off) went in whole.
+    assert_eq!(nn.len(), one.selection.training_features);
+    let models = one.bag.models();
+    let own: Vec<f64> = (0..OBJECTS.len()).map(|j| models.probabilities(j)[j]).collect();
+    assert!(
+        own.iter().all(|&p| p > 1.0 / OBJECTS.len() as f64 && p < 1.0),
+        "{own:?}"
+    );
 }
 
 #[test]

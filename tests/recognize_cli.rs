@@ -17,6 +17,21 @@ fn taction(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `taction recognize` of `model` on `test`, readings 1 to 30, into `out`.
+fn recognise_30(model: &str, test: &str, out: &str) -> (bool, String, String) {
+    taction(&[
+        "recognize",
+        "--model",
+        model,
+        "--dataset",
+        test,
+        "--readings",
+        "1..30",
+        "--out",
+        out,
+    ])
+}
+
 #[test]
 fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     let dir = tempfile::tempdir().unwrap();
@@ -58,17 +73,7 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     assert!(ok, "{stderr}");
     assert!(stdout.contains("chosen k = "), "{stdout}");
 
-    let (ok, stdout, stderr) = taction(&[
-        "recognize",
-        "--model",
-        &p("model.json"),
-        "--dataset",
-        &p("test.csv"),
-        "--readings",
-        "1..30",
-        "--out",
-        &p("out"),
-    ]);
+    let (ok, stdout, stderr) = recognise_30(&p("model.json"), &p("test.csv"), &p("out"));
     assert!(ok, "{stderr}");
     assert!(
         stdout.contains("accuracy at   1 readings") && stdout.contains("accuracy at  30 readings: 1.000"),
@@ -158,4 +163,53 @@ fn bad_inputs_fail_with_a_message_naming_the_problem() {
         &p("o"),
     ]);
     assert!(!ok && stderr.contains("5..2"), "{stderr}");
+}
+
+/// `train --codebook knn`: the neighbour codebook with its own defaults (PCA keeping 99% of the
+/// variance, 10 and 20 neighbours tried), recognising the toy objects; an unknown codebook is
+/// refused with the names that exist.
+#[test]
+fn the_neighbour_codebook_trains_with_its_own_defaults_and_recognises() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    recognize_toy::dataset(60, 1)
+        .write(dir.path().join("train.csv").as_path())
+        .unwrap();
+    recognize_toy::dataset(30, 3)
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+    let train = |codebook: &str| {
+        taction(&[
+            "train",
+            "--dataset",
+            &p("train.csv"),
+            "--descriptor",
+            "polar-fourier",
+            "--codebook",
+            codebook,
+            "--out",
+            &p("model.json"),
+        ])
+    };
+    let (ok, stdout, stderr) = train("knn");
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("explain 99.") || stdout.contains("explain 100.0%"),
+        "{stdout}"
+    );
+    // 60 readings of each of 3 objects: half an object's share is 30 neighbours.
+    assert!(
+        stdout.contains("k=10 ") && stdout.contains("k=20 ") && !stdout.contains("k=50 "),
+        "{stdout}"
+    );
+    let (ok, stdout, stderr) = recognise_30(&p("model.json"), &p("test.csv"), &p("out"));
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("accuracy at  30 readings: 1.000"), "{stdout}");
+
+    let (ok, _, stderr) = train("knnn");
+    assert!(!ok);
+    assert!(
+        stderr.contains("unknown codebook 'knnn'; expected gmm, kmeans, knn"),
+        "{stderr}"
+    );
 }

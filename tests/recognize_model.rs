@@ -39,7 +39,7 @@ fn model(kind: CodebookKind) -> TrainedModel {
 fn save_then_load_gives_identical_predictions() {
     let dir = tempfile::tempdir().unwrap();
     let test = recognize_toy::dataset(10, 77);
-    for kind in [CodebookKind::Gmm, CodebookKind::Kmeans] {
+    for kind in CodebookKind::ALL {
         let original = model(kind);
         let path = dir.path().join(format!("{}.json", kind.name()));
         original.save(&path).unwrap();
@@ -69,6 +69,14 @@ fn saved() -> (tempfile::TempDir, std::path::PathBuf, String) {
     model(CodebookKind::Gmm).save(&path).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     (dir, path, text)
+}
+
+/// The JSON text of a saved `kind` model.
+fn dir_model_text(kind: CodebookKind) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.json");
+    model(kind).save(&path).unwrap();
+    std::fs::read_to_string(&path).unwrap()
 }
 
 fn load_text(path: &std::path::Path, text: &str) -> RecognizeError {
@@ -167,6 +175,15 @@ fn inconsistent_or_foreign_content() {
     let e = load_text(&path, &broken.to_string());
     assert!(
         matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("positive definite"),
+        "{e}"
+    );
+    // A neighbour codebook naming an object the model does not have.
+    let knn = dir_model_text(CodebookKind::Knn);
+    let mut broken: serde_json::Value = serde_json::from_str(&knn).unwrap();
+    broken["bag"]["codebook"]["labels"][0] = serde_json::json!(99);
+    let e = load_text(&path, &broken.to_string());
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("object 99"),
         "{e}"
     );
     let e = TrainedModel::load(&path.with_file_name("missing.json")).unwrap_err();

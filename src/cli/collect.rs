@@ -14,7 +14,7 @@ use taction::sim::PerturbationBounds;
 use taction::tactile::image::write_contact_sheet;
 use taction::valid::Valid;
 
-use crate::cli::common::{SeedArg, ThreadsArg, flag_error};
+use crate::cli::common::{ControlArg, SeedArg, ThreadsArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
 
@@ -64,6 +64,8 @@ pub struct CollectArgs {
     pub threads: ThreadsArg,
     #[command(flatten)]
     pub sensor: SensorArgs,
+    #[command(flatten)]
+    pub control: ControlArg,
     /// Dataset file to write.
     #[arg(long)]
     pub out: PathBuf,
@@ -143,7 +145,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let plan = CollectPlan {
         mode,
         sensor,
-        control: Valid::default(),
+        control: args.control.valid(sensor.noise_fraction)?,
         perturbation,
         readings_per_object: args.readings,
         seed: args.seed.seed,

@@ -8,6 +8,9 @@ use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use taction::control::ControlConfig;
+use taction::recognize::CodebookKind;
+use taction::valid::Valid;
 
 /// The seed a command uses when `--seed` is not given.
 pub const DEFAULT_SEED: u64 = 1;
@@ -58,6 +61,66 @@ impl ThreadsArg {
     pub fn count(&self) -> NonZeroUsize {
         NonZeroUsize::new(self.threads)
             .unwrap_or_else(|| NonZeroUsize::new(cores()).unwrap_or(NonZeroUsize::MIN))
+    }
+}
+
+/// Parses a `--codebook` value, naming the kinds there are when it is none of them.
+pub fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
+    CodebookKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = CodebookKind::ALL.iter().map(|k| k.name()).collect();
+        format!("unknown codebook '{name}'; expected {}", names.join(", "))
+    })
+}
+
+/// `--control`, the surface contact controllers' configuration, shared by the commands that settle
+/// the pad (`touch`, `collect`).
+#[derive(Debug, Clone, Args)]
+pub struct ControlArg {
+    /// Controller configuration as JSON: any subset of the controllers' fields, units in their
+    /// names (e.g. `{"target_mean_pressure": 0.4}` or `{"orient_edge_guard": true}`); an unknown
+    /// field is an error naming it. `expected_noise_fraction` is always taken from `--noise`.
+    #[arg(long, value_name = "FILE.json")]
+    pub control: Option<PathBuf>,
+}
+
+/// A `--control` file that cannot be read, parsed or accepted.
+#[derive(Debug, thiserror::Error)]
+#[error("--control: {path}: {what}")]
+pub struct ControlFileError {
+    /// The file, or `(defaults)` without one.
+    pub path: String,
+    pub what: String,
+}
+
+impl ControlArg {
+    /// The file's fields over the defaults, the controllers told to expect the sensor's noise
+    /// (`noise_fraction`, as the sensor's), not yet checked.
+    pub fn config(&self, noise_fraction: f64) -> Result<ControlConfig, ControlFileError> {
+        let mut config = match &self.control {
+            None => ControlConfig::default(),
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|e| self.error(e))?;
+                serde_json::from_str(&text).map_err(|e| self.error(e))?
+            }
+        };
+        config.expected_noise_fraction = noise_fraction;
+        Ok(config)
+    }
+
+    /// [`config`](Self::config), checked.
+    pub fn valid(&self, noise_fraction: f64) -> Result<Valid<ControlConfig>, ControlFileError> {
+        Valid::new(self.config(noise_fraction)?).map_err(|e| self.error(e))
+    }
+
+    /// An error naming the file (or the defaults) and `what` is wrong.
+    pub fn error(&self, what: impl std::fmt::Display) -> ControlFileError {
+        ControlFileError {
+            path: self
+                .control
+                .as_ref()
+                .map_or_else(|| "(defaults)".into(), |p| p.display().to_string()),
+            what: what.to_string(),
+        }
     }
 }
 

@@ -153,7 +153,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                 .filter(|r| r.status == ContactStatus::Converged)
                 .count();
             let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
-            config.ks = codebook_sizes(dataset.header().objects.len(), training_features);
+            config.ks = codebook_sizes(config.codebook, dataset.header().objects.len(), training_features);
             println!(
                 "training: {training_features} training features; trying k = {:?}",
                 config.ks

@@ -14,7 +14,8 @@ use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIAL
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 use taction::valid::Check;
 
-use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError};
+use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError, parse_codebook};
+use taction::recognize::CodebookKind;
 
 /// What every paper experiment takes.
 #[derive(Debug, Args)]
@@ -63,6 +64,11 @@ pub struct PaperArgs {
     /// then exits 1.
     #[arg(long)]
     pub allow_short: bool,
+    /// The codebook of every model: gmm (the paper's) | kmeans | knn (beyond the paper: the
+    /// objects' shares of a feature's nearest training features, PCA keeping 99%). A run with
+    /// another codebook needs its own `--out`.
+    #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
+    pub codebook: CodebookKind,
     /// real-frames (Fig. 16b): Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
     #[arg(
         long,
@@ -97,7 +103,8 @@ impl PaperArgs {
         };
         Ok(
             PaperContext::new(self.scale, self.seed.seed, run, shapes, letters, real)
-                .with_real_frames(real_frames),
+                .with_real_frames(real_frames)
+                .with_codebook(self.codebook),
         )
     }
 }

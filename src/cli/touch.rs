@@ -11,8 +11,6 @@
 //! The output's `pad_center` is metres in the world, `pad_normal` a unit vector, `mean_pressure` and
 //! the `image` values fractions of the sensing range (row 0 the pad's up edge, as in `sense`).
 
-use std::path::PathBuf;
-
 use clap::Args;
 use taction::control::arm_pad::ArmPad;
 use taction::control::carrier::covering_back_check;
@@ -25,7 +23,7 @@ use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuild
 use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::SeedArg;
+use crate::cli::common::{ControlArg, ControlFileError, SeedArg};
 use crate::cli::plausible::Carrier;
 use crate::cli::sensor_args::{PadArgs, PadFrameError, SensorArgs, SensorFlagError};
 
@@ -46,11 +44,8 @@ pub struct TouchArgs {
     /// [default: the controller config's, 0.3].
     #[arg(long, allow_hyphen_values = true)]
     pub target_pressure: Option<f64>,
-    /// Controller configuration as JSON: any subset of the controllers' fields, units in their
-    /// names (e.g. `{"target_mean_pressure": 0.4}`); an unknown field is an error naming it.
-    /// `expected_noise_fraction` is always taken from `--noise`.
-    #[arg(long, value_name = "FILE.json")]
-    pub control: Option<PathBuf>,
+    #[command(flatten)]
+    pub control: ControlArg,
 }
 
 /// What can go wrong; each names the flag or file at fault.
@@ -62,8 +57,8 @@ pub enum TouchError {
     PadFrame(#[from] PadFrameError),
     #[error("--target-pressure: {0} is out of range: want a fraction of the range in (0, 1)")]
     TargetPressure(f64),
-    #[error("--control: {path}: {what}")]
-    ControlFile { path: String, what: String },
+    #[error(transparent)]
+    ControlFile(#[from] ControlFileError),
     #[error(
         "--pad-center / --pad-normal: the arm cannot reach the start pose ({0}); with --arm the object stands on the table at the world origin, the arm's base at x = -0.35 m"
     )]
@@ -90,33 +85,16 @@ impl TouchArgs {
     /// The controller configuration the flags describe, validated. The controllers expect the
     /// sensor's own noise: their contact threshold and tolerances widen with it.
     pub fn control_config(&self, sensor: &SensorConfig) -> Result<Valid<ControlConfig>, TouchError> {
-        let mut config = match &self.control {
-            None => ControlConfig::default(),
-            Some(path) => {
-                let file_error = |what: String| TouchError::ControlFile {
-                    path: path.display().to_string(),
-                    what,
-                };
-                let text = std::fs::read_to_string(path).map_err(|e| file_error(e.to_string()))?;
-                serde_json::from_str(&text).map_err(|e| file_error(e.to_string()))?
-            }
-        };
+        let mut config = self.control.config(sensor.noise_fraction)?;
         if let Some(target) = self.target_pressure {
             if !(target > 0.0 && target < 1.0) {
                 return Err(TouchError::TargetPressure(target));
             }
             config.target_mean_pressure = target;
         }
-        config.expected_noise_fraction = sensor.noise_fraction;
         Valid::new(config).map_err(|e| match (e.field, self.target_pressure) {
             ("target_mean_pressure", Some(t)) => TouchError::TargetPressure(t),
-            _ => TouchError::ControlFile {
-                path: self
-                    .control
-                    .as_ref()
-                    .map_or_else(|| "(defaults)".into(), |p| p.display().to_string()),
-                what: e.to_string(),
-            },
+            _ => self.control.error(e).into(),
         })
     }
 }

@@ -14,7 +14,7 @@ use taction::recognize::{
     TrainedModel, VarianceFraction, codebook_sizes,
 };
 
-use crate::cli::common::SeedArg;
+use crate::cli::common::{SeedArg, parse_codebook};
 
 #[derive(Debug, Args)]
 pub struct TrainArgs {
@@ -31,12 +31,14 @@ pub struct TrainArgs {
     /// data, written as one fused model whose posterior multiplies their likelihoods.
     #[arg(long, value_name = "NAME[+NAME]", value_parser = DescriptorChoice::parse)]
     pub descriptor: DescriptorChoice,
-    /// gmm (soft membership) | kmeans (hard membership)
+    /// gmm (soft membership) | kmeans (hard membership) | knn (beyond the paper: the objects'
+    /// shares of a feature's k nearest training features; the model keeps every training feature)
     #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
     pub codebook: CodebookKind,
-    /// Cluster counts to try, comma-separated. Default: four steps of 10, 20, 50, 100, 200, 400, ...
-    /// starting near one cluster per object ({50, 100, 200, 400} for 52 objects), without counts
-    /// that leave fewer than 5 training readings per cluster.
+    /// Cluster counts to try, comma-separated (neighbour counts with `--codebook knn`). Default:
+    /// four steps of 10, 20, 50, 100, 200, 400, ... starting near one cluster per object ({50,
+    /// 100, 200, 400} for 52 objects), without counts that leave fewer than 5 training readings per
+    /// cluster; for knn 10, 20, 50, 100 neighbours, below half an object's training readings.
     #[arg(long = "k", value_name = "K,...", value_delimiter = ',')]
     pub ks: Option<Vec<usize>>,
     /// Seeded restarts per cluster count.
@@ -44,14 +46,10 @@ pub struct TrainArgs {
     pub restarts: usize,
     #[command(flatten)]
     pub seed: SeedArg,
-    /// Fraction of the training variance the kept principal components explain.
-    #[arg(
-        long,
-        default_value_t = 0.9,
-        value_name = "FRACTION",
-        allow_hyphen_values = true
-    )]
-    pub variance_kept: f64,
+    /// Fraction of the training variance the kept principal components explain [default: 0.9,
+    /// the paper's; 0.99 with `--codebook knn`].
+    #[arg(long, value_name = "FRACTION", allow_hyphen_values = true)]
+    pub variance_kept: Option<f64>,
     /// Pseudo-count added to every cluster bin of every object histogram.
     #[arg(long, default_value_t = 1.0, value_name = "ALPHA", allow_hyphen_values = true)]
     pub pseudo_count: f64,
@@ -61,10 +59,6 @@ pub struct TrainArgs {
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-}
-
-fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
-    CodebookKind::from_name(name).ok_or_else(|| format!("unknown codebook '{name}'; expected gmm or kmeans"))
 }
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -79,7 +73,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
                 .filter(|r| r.status == ContactStatus::Converged)
                 .collect();
             let objects: BTreeSet<&str> = converged.iter().map(|r| r.object.as_str()).collect();
-            codebook_sizes(objects.len(), converged.len())
+            codebook_sizes(args.codebook, objects.len(), converged.len())
         }
     };
     let config = TrainConfig {
@@ -87,7 +81,10 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         ks,
         restarts: args.restarts,
         seed: args.seed.seed,
-        variance_kept: VarianceFraction::new(args.variance_kept)?,
+        variance_kept: match args.variance_kept {
+            Some(fraction) => VarianceFraction::new(fraction)?,
+            None => args.codebook.default_variance_kept(),
+        },
         pseudo_count: PseudoCount::new(args.pseudo_count)?,
         trial_readings: args.trial_readings,
         ..TrainConfig::default()

@@ -46,6 +46,15 @@ pub struct ControlConfig {
     pub orient_max_step_rad: f64,
     /// Press/Orient alternations before `MaxIterations`.
     pub max_iterations: usize,
+    /// Keep Orient from tilting over an edge ([`surface_normal`](crate::control::orient::surface_normal)):
+    /// fit the plane to the taxels inside the contact patch, whose coverage is whole, and issue no
+    /// tilt when the fitted plane says the surface comes well into the covering where a taxel reads
+    /// no contact. Off by default, because it costs recognition: on the 52 raised letters (sampler
+    /// from above, 6x6, 1000 training readings per letter, MNTI, k = 200) the readings tilted more
+    /// than 10 degrees fell from 44% to 12%, and accuracy at 10 / 20 / 60 readings from 51.5 / 76.9
+    /// / 94.2% to 33.1 / 54.2 / 87.3%: a pad tipped over a stroke's edge onto the plate shows the
+    /// stroke's edge and the plate, which tells letters apart better than a level stroke top.
+    pub orient_edge_guard: bool,
 }
 
 impl Default for ControlConfig {
@@ -66,6 +75,7 @@ impl Default for ControlConfig {
             orient_tolerance_rad: 1.0_f64.to_radians(),
             orient_max_step_rad: 15.0_f64.to_radians(),
             max_iterations: 40,
+            orient_edge_guard: false,
         }
     }
 }
@@ -91,6 +101,7 @@ impl Check for ControlConfig {
             orient_tolerance_rad,
             orient_max_step_rad,
             max_iterations,
+            orient_edge_guard: _,
         } = *self;
         FieldChecks::of("control config")
             .real(
@@ -260,8 +271,9 @@ mod tests {
         // Each field in turn set out of range (negative, or zero for the counts) must be the one named.
         let defaults = serde_json::to_value(ControlConfig::default()).unwrap();
         let fields = defaults.as_object().unwrap();
-        assert_eq!(fields.len(), 15);
-        for (name, value) in fields {
+        assert_eq!(fields.len(), 16);
+        // The one switch has no range to leave; serde refuses a non-boolean for it.
+        for (name, value) in fields.iter().filter(|(_, v)| !v.is_boolean()) {
             let mut bad = fields.clone();
             let out_of_range = if value.is_u64() {
                 serde_json::json!(0)
@@ -273,6 +285,11 @@ mod tests {
             let error = config.check().expect_err(name);
             assert_eq!(error.field, name.as_str());
         }
+        let mut not_a_switch = fields.clone();
+        not_a_switch.insert("orient_edge_guard".into(), serde_json::json!(1.0));
+        let error =
+            serde_json::from_value::<ControlConfig>(serde_json::Value::Object(not_a_switch)).unwrap_err();
+        assert!(error.to_string().contains("boolean"), "{error}");
         let nan = ControlConfig {
             orient_max_step_rad: f64::NAN,
             ..ControlConfig::default()

@@ -76,6 +76,34 @@ pub fn contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f6
     points
 }
 
+/// The surface points of the taxels inside the contact patch: those in contact whose four neighbours
+/// on the pad are in contact too (a neighbour off the pad counts as in contact, since the pad's edge is
+/// not the patch's edge).
+///
+/// A taxel on the patch's boundary may be only partly covered: over the edge of a raised stroke its
+/// value is the covered fraction of the penetration, which [`contact_points`] reads as a deeper
+/// surface, a slope that is not there. An interior taxel is covered whole, so its depth is the
+/// surface's.
+pub fn interior_contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f64) -> Vec<DVec3> {
+    let (rows, cols) = (image.rows(), image.cols());
+    let touching = |row: usize, col: usize| image.get(row, col) > threshold;
+    let mut points = Vec::new();
+    for row in 0..rows {
+        for col in 0..cols {
+            let inside = touching(row, col)
+                && (row == 0 || touching(row - 1, col))
+                && (row + 1 == rows || touching(row + 1, col))
+                && (col == 0 || touching(row, col - 1))
+                && (col + 1 == cols || touching(row, col + 1));
+            if inside {
+                let (x, y) = taxel_position_m(sensor, row, col);
+                points.push(DVec3::new(x, y, sensor.thickness_m * (1.0 - image.get(row, col))));
+            }
+        }
+    }
+    points
+}
+
 /// A rotation of the pad about a pivot.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OrientCommand {
@@ -108,16 +136,32 @@ const LINE_CONTACT_TILT_RAD: f64 = 0.35;
 /// fits no unique plane. If that line passes near the pad centre it is an edge under the pad, and the
 /// pad stays as it is; if it lies off-centre, the surface is closer on that side, so the stand-in normal
 /// leans toward the contact by `LINE_CONTACT_TILT_RAD`, bringing the rest of the pad down onto it.
+///
+/// With [`ControlConfig::orient_edge_guard`] the plane is fitted to the patch's interior
+/// ([`interior_contact_points`]) when it spans a plane, else to every contact taxel, and a plane that
+/// a taxel reading no contact refutes gives the pad's own normal (no tilt). On a raised bar 3 mm high
+/// the guarded pad, started level, stays level wherever the bar crosses the pad but one case: a bar
+/// covering the pad's border column and part of the next. That image is also the first touch of a
+/// plane tilted some 15 degrees, and one image cannot tell the two apart.
 pub fn surface_normal(
     image: &TactileImage,
     sensor: &SensorConfig,
     config: &ControlConfig,
 ) -> Option<(DVec3, DVec3)> {
-    let points = contact_points(image, sensor, config.effective_contact_threshold());
-    if let PlaneFit::Plane { normal, centroid } = fit_plane(&points)
-        && !is_line_like(&points, sensor)
-    {
-        return Some((normal, centroid));
+    let threshold = config.effective_contact_threshold();
+    let points = contact_points(image, sensor, threshold);
+    if config.orient_edge_guard {
+        let interior = interior_contact_points(image, sensor, threshold);
+        for fitted in [&interior, &points] {
+            if let Some((normal, centroid)) = plane_through(fitted, sensor) {
+                if refuted_by_a_drop(image, sensor, threshold, normal, centroid) {
+                    return Some((DVec3::Z, centroid));
+                }
+                return Some((normal, centroid));
+            }
+        }
+    } else if let Some(plane) = plane_through(&points, sensor) {
+        return Some(plane);
     }
     if points.is_empty() {
         return None;
@@ -130,6 +174,35 @@ pub fn surface_normal(
     }
     let lean = offset.normalize() * LINE_CONTACT_TILT_RAD.tan();
     Some(((lean + DVec3::Z).normalize(), centroid))
+}
+
+/// The least-squares plane through `points` (normal, centroid), unless they fit none or lie along a
+/// line.
+fn plane_through(points: &[DVec3], sensor: &SensorConfig) -> Option<(DVec3, DVec3)> {
+    match fit_plane(points) {
+        PlaneFit::Plane { normal, centroid } if !is_line_like(points, sensor) => Some((normal, centroid)),
+        _ => None,
+    }
+}
+
+/// Whether the fitted plane says the surface comes well into the covering at a taxel that reads no
+/// contact: the surface ends before it (a stroke's or a step's edge), so the fitted slope is the
+/// edge's partial coverage, not a slope of the surface.
+fn refuted_by_a_drop(
+    image: &TactileImage,
+    sensor: &SensorConfig,
+    threshold: f64,
+    normal: DVec3,
+    centroid: DVec3,
+) -> bool {
+    (0..image.rows()).any(|row| {
+        (0..image.cols()).any(|col| {
+            let (x, y) = taxel_position_m(sensor, row, col);
+            let depth = centroid.z - (normal.x * (x - centroid.x) + normal.y * (y - centroid.y)) / normal.z;
+            let predicted = 1.0 - depth / sensor.thickness_m;
+            predicted > threshold + 0.5 && image.get(row, col) <= threshold
+        })
+    })
 }
 
 /// Whether the points' pad-plane positions lie along one line (spread across it below half a taxel).
@@ -208,5 +281,43 @@ mod tests {
             .map(|i| DVec3::new(i as f64, 2.0 * i as f64, 0.5))
             .collect();
         assert_eq!(fit_plane(&line), PlaneFit::Degenerate);
+    }
+    /// A 6x6 image whose every row is `row`.
+    fn striped(row: [f64; 6]) -> TactileImage {
+        TactileImage::new(6, 6, (0..6).flat_map(|_| row).collect()).unwrap()
+    }
+
+    fn tilt_deg(image: &TactileImage, guard: bool) -> f64 {
+        let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
+        let config = ControlConfig {
+            orient_edge_guard: guard,
+            ..ControlConfig::default()
+        };
+        let (normal, _) = surface_normal(image, &sensor, &config).unwrap();
+        normal.angle_between(DVec3::Z).to_degrees()
+    }
+
+    #[test]
+    fn the_edge_guard_sees_a_partly_covered_column_as_an_edge_not_a_slope() {
+        // A raised stroke under the left of a level pad (a press on upper_I, 2 mm off its stem):
+        // column 0 is 70% covered, column 1 whole, column 2 holds the blur's tail.
+        let stroke = striped([0.51, 0.92, 0.08, 0.0, 0.0, 0.0]);
+        assert!(tilt_deg(&stroke, false) > 5.0, "{}", tilt_deg(&stroke, false));
+        assert_eq!(tilt_deg(&stroke, true), 0.0);
+        // The interior alone decides when it spans a plane: column 1, beside a column out of
+        // contact, is partly covered.
+        let wide = striped([0.0, 0.25, 0.5, 0.5, 0.5, 0.5]);
+        assert!(tilt_deg(&wide, true) < 1e-9, "{}", tilt_deg(&wide, true));
+        assert!(tilt_deg(&wide, false) > 1.0);
+    }
+
+    #[test]
+    fn the_edge_guard_leaves_a_plane_that_fills_the_pad_alone() {
+        // Depth falling by 0.1 t a column: the surface rises toward column 0, where the pad touches.
+        let ramp = striped([0.8, 0.7, 0.6, 0.5, 0.4, 0.3]);
+        let (guarded, plain) = (tilt_deg(&ramp, true), tilt_deg(&ramp, false));
+        let expected = (0.1 * 0.0012 / 0.002f64).atan().to_degrees();
+        assert!((plain - expected).abs() < 1e-9, "{plain} vs {expected}");
+        assert!((guarded - plain).abs() < 1e-9, "{guarded} vs {plain}");
     }
 }

@@ -135,7 +135,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     let sweep = sweep();
     let objects = context.objects(Family::Shapes)?;
     let counts = context.scale.counts();
-    let training = training_config(context.seed, counts, objects.specs.len());
+    let training = training_config(context, counts, objects.specs.len());
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let key = SafeName::builder(DESCRIPTOR.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);

@@ -15,6 +15,7 @@ use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
 use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
 use crate::paper::real_data::{Calibration, RealData, RealImport, parse_real_csv};
+use crate::recognize::CodebookKind;
 
 /// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):
 /// the sim-to-real experiment's default input, so that its whole path runs without a recording.
@@ -73,6 +74,8 @@ pub struct PaperContext {
     pub real: RealRecording,
     /// Fig. 16b's settings ([`super::real_frames`]).
     pub real_frames: RealFramesOptions,
+    /// The codebook every model is trained with: the paper's GMM unless `--codebook` says otherwise.
+    pub codebook: CodebookKind,
     pub(crate) store: DataStore,
     built: Mutex<HashMap<String, Arc<Objects>>>,
 }
@@ -96,6 +99,7 @@ impl PaperContext {
             letters,
             real,
             real_frames: RealFramesOptions::default(),
+            codebook: CodebookKind::Gmm,
             built: Mutex::new(HashMap::new()),
         }
     }
@@ -123,6 +127,12 @@ impl PaperContext {
     /// The context with Fig. 16b's settings.
     pub fn with_real_frames(mut self, options: RealFramesOptions) -> Self {
         self.real_frames = options;
+        self
+    }
+
+    /// Trains every model with `codebook` instead of the paper's GMM.
+    pub fn with_codebook(mut self, codebook: CodebookKind) -> Self {
+        self.codebook = codebook;
         self
     }
 

@@ -178,6 +178,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         )
     })?;
     let training = selection_config(
+        context.codebook,
         rng::substream(context.seed, MODEL_STREAM),
         sizes.train,
         sizes.validation,

@@ -30,7 +30,8 @@ use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::paper::real_data::RealData;
 use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
-    LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate, make_trials,
+    CodebookKind, LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate,
+    make_trials,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -149,7 +150,7 @@ impl RecognitionSweep {
     pub fn run(&self, context: &PaperContext) -> Result<RunReport, BoxError> {
         let objects = context.objects(self.family)?;
         let counts = context.scale.counts();
-        let training = training_config(context.seed, counts, objects.specs.len());
+        let training = training_config(context, counts, objects.specs.len());
         let plans = self.unit_plans()?;
         let setting_counts = |setting: usize| self.setting_counts(setting, counts);
 
@@ -176,7 +177,7 @@ impl RecognitionSweep {
             .map(|plan| {
                 let objects = Arc::clone(&objects);
                 let counts = setting_counts(plan.setting);
-                let training = training_config(context.seed, counts, objects.specs.len());
+                let training = training_config(context, counts, objects.specs.len());
                 let real = real.clone();
                 let setting = plan.setting;
                 let descriptor = plan.descriptor;
@@ -463,28 +464,33 @@ impl RecognitionSweep {
 }
 
 /// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
-/// problem ([`codebook_sizes`], counting one feature per training reading).
-pub(super) fn training_config(seed: u64, counts: DataCounts, objects: usize) -> TrainConfig {
+/// problem ([`codebook_sizes`], counting one feature per training reading), with the run's codebook.
+pub(super) fn training_config(context: &PaperContext, counts: DataCounts, objects: usize) -> TrainConfig {
     selection_config(
-        rng::substream(seed, MODEL_STREAM),
+        context.codebook,
+        rng::substream(context.seed, MODEL_STREAM),
         counts.training_per_object,
         counts.validation_per_object,
         objects,
     )
 }
 
-/// The model-selection settings for `training_per_object` training and `validation_per_object`
-/// validation readings of each of `objects` objects, seeded with `model_seed`.
+/// The model-selection settings for a `codebook` on `training_per_object` training and
+/// `validation_per_object` validation readings of each of `objects` objects, seeded with
+/// `model_seed`; the PCA keeps the codebook's default share of the variance.
 pub(super) fn selection_config(
+    codebook: CodebookKind,
     model_seed: u64,
     training_per_object: usize,
     validation_per_object: usize,
     objects: usize,
 ) -> TrainConfig {
     TrainConfig {
-        ks: codebook_sizes(objects, training_per_object * objects),
+        codebook,
+        ks: codebook_sizes(codebook, objects, training_per_object * objects),
         restarts: 3,
         seed: model_seed,
+        variance_kept: codebook.default_variance_kept(),
         trial_readings: validation_per_object.min(10),
         ..TrainConfig::default()
     }

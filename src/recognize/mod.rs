@@ -1,7 +1,8 @@
 //! Bag-of-features recognition (Sec. IV-A, V-B1; Fig. 4).
 //!
 //! Training: descriptor features of every training image -> [`Pca`] keeping 90% of the variance ->
-//! a [`Codebook`] (k-means, hard membership, or a Gaussian mixture, soft membership) -> per object
+//! a [`Codebook`] (k-means, hard membership, or a Gaussian mixture, soft membership; beyond the
+//! paper, [`NearestNeighbours`], the objects' shares of a feature's nearest training features) -> per object
 //! the smoothed histogram `p(c_i | O_j)` ([`ObjectModels`]); [`train`] repeats the codebook step
 //! over a grid of `k` and seeded restarts and keeps the best on validation data.
 //!
@@ -26,13 +27,14 @@ pub(crate) mod gmm;
 pub(crate) mod kmeans;
 pub(crate) mod labelled;
 pub mod model;
+pub(crate) mod neighbours;
 pub(crate) mod object_model;
 pub(crate) mod pca;
 pub(crate) mod posterior;
 pub mod selection;
 
 pub use bag::BagOfFeatures;
-pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
+pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel, TrainingFeatures};
 pub use confusion::ConfusionMatrix;
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use error::RecognizeError;
@@ -45,6 +47,7 @@ pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
 pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
 pub use labelled::LabelledFeatures;
 pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
+pub use neighbours::NearestNeighbours;
 pub use object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels, PseudoCount};
 pub use pca::{Pca, VarianceFraction};
 pub use posterior::{Belief, OnlinePosterior};

@@ -14,6 +14,8 @@ pub struct VarianceFraction(f64);
 impl VarianceFraction {
     /// The paper's choice: keep 90% of the variance.
     pub const PAPER: Self = Self(0.9);
+    /// The neighbour codebook's default (`CodebookKind::default_variance_kept`): 99%.
+    pub const NEIGHBOURS: Self = Self(0.99);
 
     pub fn new(fraction: f64) -> Result<Self, RecognizeError> {
         if fraction > 0.0 && fraction <= 1.0 {

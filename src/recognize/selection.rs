@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
-use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
+use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel, TrainingFeatures};
 use crate::recognize::evaluate::{Trial, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
@@ -99,6 +99,9 @@ pub fn supported_codebook_sizes(grid: &[usize], training_features: usize) -> Vec
 /// The ladder the candidate cluster counts come from (roughly doubling).
 const CODEBOOK_LADDER: [usize; 9] = [10, 20, 50, 100, 200, 400, 800, 1600, 3200];
 
+/// The neighbour counts the neighbour codebook tries.
+const NEIGHBOUR_COUNTS: [usize; 4] = [10, 20, 50, 100];
+
 /// Candidate cluster counts per problem: [`CODEBOOK_LADDER`] steps tried.
 const CODEBOOK_STEPS: usize = 4;
 
@@ -110,7 +113,20 @@ const CODEBOOK_STEPS: usize = 4;
 /// ladder steps: {10, 20, 50, 100} for 12 objects, {50, 100, 200, 400} for 52. Counts the
 /// features cannot support are dropped ([`supported_codebook_sizes`]). `train`, `demo` and the
 /// experiments all take their grid from here.
-pub fn codebook_sizes(objects: usize, training_features: usize) -> Vec<usize> {
+///
+/// For the neighbour codebook ([`CodebookKind::Knn`]) the candidates are neighbour counts, {10, 20,
+/// 50, 100}, kept below half an object's share of the training features (so an object's own
+/// neighbourhood can outvote the rest); when none is, that half (at least 1).
+pub fn codebook_sizes(kind: CodebookKind, objects: usize, training_features: usize) -> Vec<usize> {
+    if kind == CodebookKind::Knn {
+        let most = (training_features / objects.max(1) / 2).max(1);
+        let supported: Vec<usize> = NEIGHBOUR_COUNTS.into_iter().filter(|&k| k <= most).collect();
+        return if supported.is_empty() {
+            vec![most]
+        } else {
+            supported
+        };
+    }
     let first = CODEBOOK_LADDER.iter().rposition(|&k| k <= objects).unwrap_or(0);
     let last = (first + CODEBOOK_STEPS).min(CODEBOOK_LADDER.len());
     supported_codebook_sizes(&CODEBOOK_LADDER[first..last], training_features)
@@ -271,8 +287,14 @@ pub fn train(
     drop(raw);
     // Rows of `reduced` are object by object; each object's block gives its histogram.
     let mut blocks = Vec::with_capacity(objects.len());
+    let (mut row_objects, mut row_readings) = (Vec::new(), Vec::new());
     let mut start = 0;
     for j in 0..objects.len() {
+        for reading in training.readings(j) {
+            let id = row_readings.last().map_or(0, |&last: &u32| last + 1);
+            row_objects.extend(std::iter::repeat_n(j as u32, reading.len()));
+            row_readings.extend(std::iter::repeat_n(id, reading.len()));
+        }
         let n: usize = training.readings(j).iter().map(Vec::len).sum();
         blocks.push(FeatureMatrix::from_trusted(
             n,
@@ -283,7 +305,18 @@ pub fn train(
     }
     let trials = make_trials(validation, &objects, config.trial_readings)?;
     let trials = reduce_trials(&pca, &trials)?;
-    let total = config.ks.len() * config.restarts;
+    let features = TrainingFeatures {
+        data: &reduced,
+        objects: &row_objects,
+        object_count: objects.len(),
+        readings: &row_readings,
+    };
+    let restarts = if config.codebook.is_random() {
+        config.restarts
+    } else {
+        1
+    };
+    let total = config.ks.len() * restarts;
     progress(TrainProgress::PcaFitted {
         components: pca.output_dim(),
         variance_ratio: pca.kept_variance_ratio(),
@@ -295,7 +328,7 @@ pub fn train(
     let jobs: Vec<(usize, usize)> = config
         .ks
         .iter()
-        .flat_map(|&k| (0..config.restarts).map(move |restart| (k, restart)))
+        .flat_map(|&k| (0..restarts).map(move |restart| (k, restart)))
         .collect();
     let progress = Mutex::new(progress);
     let report = |event: TrainProgress| {
@@ -312,7 +345,7 @@ pub fn train(
                 k,
                 restart,
             });
-            let candidate = fit_candidate(config, &reduced, &blocks, &objects, &trials, k, restart);
+            let candidate = fit_candidate(config, features, &blocks, &objects, &trials, k, restart);
             report(TrainProgress::Scored(candidate.score.clone()));
             candidate
         })
@@ -369,7 +402,7 @@ struct Candidate {
 /// over it, and scores the pair on the validation trials.
 fn fit_candidate(
     config: &TrainConfig,
-    reduced: &FeatureMatrix,
+    features: TrainingFeatures,
     blocks: &[FeatureMatrix],
     objects: &[String],
     trials: &[ReducedTrial],
@@ -377,8 +410,12 @@ fn fit_candidate(
     restart: usize,
 ) -> Candidate {
     let mut rng = stream(substream(config.seed, k as u64), restart as u64);
-    let fitted = CodebookModel::fit(config.codebook, reduced, k, &config.fitting, &mut rng).and_then(|cb| {
-        let histograms: Vec<ClusterHistogram> = blocks.iter().map(|b| reduced_histogram(&cb, b)).collect();
+    let fitted = CodebookModel::fit(config.codebook, features, k, &config.fitting, &mut rng).and_then(|cb| {
+        let histograms: Vec<ClusterHistogram> = match &cb {
+            // A training feature must not count itself, nor its reading's other features.
+            CodebookModel::Knn(nn) => nn.leave_one_reading_out_histograms(features.readings),
+            _ => blocks.iter().map(|b| reduced_histogram(&cb, b)).collect(),
+        };
         let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?;
         Ok((cb, models))
     });
@@ -474,15 +511,29 @@ mod tests {
     #[test]
     fn codebook_sizes_grow_with_the_objects_and_fit_the_features() {
         // Paper scale: 1000 training readings per object.
-        assert_eq!(codebook_sizes(52, 52_000), vec![50, 100, 200, 400]);
-        assert_eq!(codebook_sizes(12, 12_000), vec![10, 20, 50, 100]);
-        assert_eq!(codebook_sizes(2, 2_000), vec![10, 20, 50, 100]);
-        assert_eq!(codebook_sizes(5000, 10_000_000), vec![3200]);
+        assert_eq!(
+            codebook_sizes(CodebookKind::Gmm, 52, 52_000),
+            vec![50, 100, 200, 400]
+        );
+        assert_eq!(
+            codebook_sizes(CodebookKind::Gmm, 12, 12_000),
+            vec![10, 20, 50, 100]
+        );
+        assert_eq!(codebook_sizes(CodebookKind::Gmm, 2, 2_000), vec![10, 20, 50, 100]);
+        assert_eq!(codebook_sizes(CodebookKind::Gmm, 5000, 10_000_000), vec![3200]);
         // 52 letters at a small scale: 30 readings each support k <= 312.
-        assert_eq!(codebook_sizes(52, 52 * 30), vec![50, 100, 200]);
+        assert_eq!(codebook_sizes(CodebookKind::Gmm, 52, 52 * 30), vec![50, 100, 200]);
         // Too few features for any: the largest count they support.
-        assert_eq!(codebook_sizes(52, 100), vec![20]);
-        assert_eq!(codebook_sizes(3, 0), vec![1]);
+        assert_eq!(codebook_sizes(CodebookKind::Gmm, 52, 100), vec![20]);
+        assert_eq!(codebook_sizes(CodebookKind::Gmm, 3, 0), vec![1]);
+        // Neighbour counts: below half an object's share of the features.
+        assert_eq!(
+            codebook_sizes(CodebookKind::Knn, 52, 52_000),
+            vec![10, 20, 50, 100]
+        );
+        assert_eq!(codebook_sizes(CodebookKind::Knn, 12, 12 * 60), vec![10, 20]);
+        assert_eq!(codebook_sizes(CodebookKind::Knn, 12, 12 * 10), vec![5]);
+        assert_eq!(codebook_sizes(CodebookKind::Knn, 3, 0), vec![1]);
     }
 
     fn score(correct: usize, reliability: f64, failure: bool) -> CandidateScore {
