@@ -152,8 +152,9 @@ fn gmm_fit(c: &mut Criterion) {
 }
 
 fn per_touch(c: &mut Criterion) {
-    // A model at the paper's scale: 10 objects, GMM with k = 50 on the PCA'd features; a touch is
-    // one 38-value feature (Polar-Fourier at 6x6) through PCA, the codebook and Eq. 16.
+    // A model at the paper's scale: 10 objects, GMM with k = 50 (or 20 nearest of the 10 000
+    // training features) on the PCA'd features; a touch is one 38-value feature (Polar-Fourier at
+    // 6x6) through PCA, the codebook and Eq. 16.
     let raw_dim = 38;
     let lift: Vec<Vec<f64>> = {
         let mut rng = stream(7, 0);
@@ -173,7 +174,7 @@ fn per_touch(c: &mut Criterion) {
         .collect();
     let names = (0..OBJECTS).map(|o| format!("object{o}")).collect();
     let training = LabelledFeatures::new(names, readings).expect("distinct names");
-    let config = TrainConfig {
+    let gmm = TrainConfig {
         codebook: CodebookKind::Gmm,
         ks: vec![50],
         restarts: 1,
@@ -186,16 +187,26 @@ fn per_touch(c: &mut Criterion) {
         },
         ..TrainConfig::default()
     };
-    let trained = train(&training, None, &config, &mut |_| {}).expect("train");
+    // The neighbour codebook scans every training feature per touch (README, "A neighbour
+    // codebook"); beside the GMM it shows what that costs.
+    let knn = TrainConfig {
+        codebook: CodebookKind::Knn,
+        ks: vec![20],
+        variance_kept: CodebookKind::Knn.default_variance_kept(),
+        ..gmm.clone()
+    };
     let touch = training.readings(3)[17].clone();
     let mut group = c.benchmark_group("per_touch");
-    group.bench_function(
-        format!("gmm_k50_{}objects_pca{}", OBJECTS, trained.bag.pca().output_dim()),
-        |b| {
-            let mut posterior = trained.bag.posterior();
-            b.iter(|| black_box(posterior.observe(black_box(&touch)).expect("valid touch")))
-        },
-    );
+    for (name, config) in [("gmm_k50", gmm), ("knn_k20", knn)] {
+        let trained = train(&training, None, &config, &mut |_| {}).expect("train");
+        group.bench_function(
+            format!("{name}_{}objects_pca{}", OBJECTS, trained.bag.pca().output_dim()),
+            |b| {
+                let mut posterior = trained.bag.posterior();
+                b.iter(|| black_box(posterior.observe(black_box(&touch)).expect("valid touch")))
+            },
+        );
+    }
     group.finish();
 }
 

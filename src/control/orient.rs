@@ -282,6 +282,7 @@ mod tests {
             .collect();
         assert_eq!(fit_plane(&line), PlaneFit::Degenerate);
     }
+
     /// A 6x6 image whose every row is `row`.
     fn striped(row: [f64; 6]) -> TactileImage {
         TactileImage::new(6, 6, (0..6).flat_map(|_| row).collect()).unwrap()

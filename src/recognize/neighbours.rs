@@ -118,25 +118,38 @@ impl NearestNeighbours {
 
     /// The membership over the training features `skip` does not exclude. Ties in distance go to
     /// the lower row, so the neighbours are a function of the data alone.
+    ///
+    /// One pass keeps the `k` nearest so far, sorted by (distance, row); a row's squared distance
+    /// stops accumulating once it exceeds the `k`-th nearest's, since it can no longer enter.
     fn membership_skipping(&self, f: &[f64], out: &mut [f64], skip: impl Fn(usize) -> bool) {
-        let mut nearest: Vec<(f64, usize)> = self
-            .points
-            .chunks_exact(self.dim)
-            .enumerate()
-            .filter(|&(row, _)| !skip(row))
-            .map(|(row, g)| (f.iter().zip(g).map(|(a, b)| (a - b) * (a - b)).sum(), row))
-            .collect();
-        let k = self.neighbours.min(nearest.len());
+        let k = self.neighbours;
+        let mut nearest: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
+        for (row, g) in self.points.chunks_exact(self.dim).enumerate() {
+            if skip(row) {
+                continue;
+            }
+            let bound = if nearest.len() == k {
+                nearest[k - 1].0
+            } else {
+                f64::INFINITY
+            };
+            let mut d = 0.0;
+            for (a, b) in f.iter().zip(g) {
+                d += (a - b) * (a - b);
+                if d > bound {
+                    break;
+                }
+            }
+            // Rows come in increasing order, so an equal distance never displaces an earlier row.
+            if d < bound {
+                let at = nearest.partition_point(|&(e, _)| e <= d);
+                nearest.insert(at, (d, row));
+                nearest.truncate(k);
+            }
+        }
         out.fill(0.0);
-        if k == 0 {
-            return;
-        }
-        let order = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        if k < nearest.len() {
-            nearest.select_nth_unstable_by(k - 1, order);
-        }
-        for &(_, row) in &nearest[..k] {
-            out[self.labels[row] as usize] += 1.0 / k as f64;
+        for &(_, row) in &nearest {
+            out[self.labels[row] as usize] += 1.0 / nearest.len() as f64;
         }
     }
 
@@ -192,6 +205,35 @@ mod tests {
         assert_eq!(out, [2.0 / 3.0, 1.0 / 3.0]);
         nn.membership(&[10.4, 0.0], &mut out);
         assert_eq!(out, [1.0 / 3.0, 2.0 / 3.0]);
+    }
+
+    #[test]
+    fn the_one_pass_scan_keeps_the_k_nearest_of_a_full_sort() {
+        use rand::RngExt;
+        let mut rng = crate::rng::rng(5);
+        // Coordinates on a coarse grid, so that many distances tie.
+        let mut coordinate = || f64::from(rng.random_range(0..6u8));
+        let rows: Vec<[f64; 2]> = (0..300).map(|_| [coordinate(), coordinate()]).collect();
+        let labels: Vec<u32> = (0..300).map(|i| (i * 7 % 5) as u32).collect();
+        for k in [1, 7, 40] {
+            let nn = NearestNeighbours::new(&matrix(&rows), labels.clone(), 5, k).unwrap();
+            for q in 0..30 {
+                let f = [coordinate() + 0.5 * f64::from(q % 2), coordinate()];
+                let mut all: Vec<(f64, usize)> = rows
+                    .iter()
+                    .enumerate()
+                    .map(|(r, g)| ((f[0] - g[0]).powi(2) + (f[1] - g[1]).powi(2), r))
+                    .collect();
+                all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                let mut expected = [0.0; 5];
+                for &(_, r) in &all[..k] {
+                    expected[labels[r] as usize] += 1.0 / k as f64;
+                }
+                let mut out = [0.0; 5];
+                nn.membership(&f, &mut out);
+                assert_eq!(out, expected, "k = {k}, query {f:?}");
+            }
+        }
     }
 
     #[test]
