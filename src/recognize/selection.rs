@@ -20,9 +20,11 @@ use crate::rng::{stream, substream};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfig {
     pub codebook: CodebookKind,
-    /// The cluster counts to try ([`codebook_sizes`] chooses them for a problem).
+    /// The cluster counts to try, neighbour counts for [`CodebookKind::Knn`] ([`codebook_sizes`]
+    /// chooses them for a problem).
     pub ks: Vec<usize>,
-    /// Seeded restarts per `k`.
+    /// Seeded restarts per `k` (one for a codebook that draws nothing at random,
+    /// [`CodebookKind::is_random`]).
     pub restarts: usize,
     /// Restart `r` of `k` draws from `rng::stream(substream(seed, k), r)`, so adding values of
     /// `k` or restarts leaves the other candidates unchanged.
