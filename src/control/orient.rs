@@ -63,13 +63,21 @@ pub fn taxel_position_m(sensor: &SensorConfig, row: usize, col: usize) -> (f64, 
 
 /// The surface points of Algorithm 1, lines 1-7, in the pad frame (metres).
 pub fn contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f64) -> Vec<DVec3> {
+    surface_points(image, sensor, |row, col| image.get(row, col) > threshold)
+}
+
+/// The surface point `(x_i, y_i, t (1 - v_i))` of every taxel `keep` accepts, in the pad frame.
+fn surface_points(
+    image: &TactileImage,
+    sensor: &SensorConfig,
+    keep: impl Fn(usize, usize) -> bool,
+) -> Vec<DVec3> {
     let mut points = Vec::new();
     for row in 0..image.rows() {
         for col in 0..image.cols() {
-            let v = image.get(row, col);
-            if v > threshold {
+            if keep(row, col) {
                 let (x, y) = taxel_position_m(sensor, row, col);
-                points.push(DVec3::new(x, y, sensor.thickness_m * (1.0 - v)));
+                points.push(DVec3::new(x, y, sensor.thickness_m * (1.0 - image.get(row, col))));
             }
         }
     }
@@ -87,21 +95,13 @@ pub fn contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f6
 pub fn interior_contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f64) -> Vec<DVec3> {
     let (rows, cols) = (image.rows(), image.cols());
     let touching = |row: usize, col: usize| image.get(row, col) > threshold;
-    let mut points = Vec::new();
-    for row in 0..rows {
-        for col in 0..cols {
-            let inside = touching(row, col)
-                && (row == 0 || touching(row - 1, col))
-                && (row + 1 == rows || touching(row + 1, col))
-                && (col == 0 || touching(row, col - 1))
-                && (col + 1 == cols || touching(row, col + 1));
-            if inside {
-                let (x, y) = taxel_position_m(sensor, row, col);
-                points.push(DVec3::new(x, y, sensor.thickness_m * (1.0 - image.get(row, col))));
-            }
-        }
-    }
-    points
+    surface_points(image, sensor, |row, col| {
+        touching(row, col)
+            && (row == 0 || touching(row - 1, col))
+            && (row + 1 == rows || touching(row + 1, col))
+            && (col == 0 || touching(row, col - 1))
+            && (col + 1 == cols || touching(row, col + 1))
+    })
 }
 
 /// A rotation of the pad about a pivot.

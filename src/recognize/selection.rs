@@ -89,13 +89,14 @@ pub const MIN_FEATURES_PER_CLUSTER: usize = 5;
 /// [`MIN_FEATURES_PER_CLUSTER`] per cluster); when none does, the largest count that is supported
 /// (at least 1). Small runs (the demo, experiments at small `--scale`) train on what they have.
 pub fn supported_codebook_sizes(grid: &[usize], training_features: usize) -> Vec<usize> {
-    let most = (training_features / MIN_FEATURES_PER_CLUSTER).max(1);
-    let supported: Vec<usize> = grid.iter().copied().filter(|&k| k <= most).collect();
-    if supported.is_empty() {
-        vec![most]
-    } else {
-        supported
-    }
+    sizes_up_to(grid, training_features / MIN_FEATURES_PER_CLUSTER)
+}
+
+/// The counts of `grid` up to `most`; when none is, `most` itself (at least 1).
+fn sizes_up_to(grid: &[usize], most: usize) -> Vec<usize> {
+    let most = most.max(1);
+    let kept: Vec<usize> = grid.iter().copied().filter(|&k| k <= most).collect();
+    if kept.is_empty() { vec![most] } else { kept }
 }
 
 /// The ladder the candidate cluster counts come from (roughly doubling).
@@ -121,13 +122,7 @@ const CODEBOOK_STEPS: usize = 4;
 /// neighbourhood can outvote the rest); when none is, that half (at least 1).
 pub fn codebook_sizes(kind: CodebookKind, objects: usize, training_features: usize) -> Vec<usize> {
     if kind == CodebookKind::Knn {
-        let most = (training_features / objects.max(1) / 2).max(1);
-        let supported: Vec<usize> = NEIGHBOUR_COUNTS.into_iter().filter(|&k| k <= most).collect();
-        return if supported.is_empty() {
-            vec![most]
-        } else {
-            supported
-        };
+        return sizes_up_to(&NEIGHBOUR_COUNTS, training_features / objects.max(1) / 2);
     }
     let first = CODEBOOK_LADDER.iter().rposition(|&k| k <= objects).unwrap_or(0);
     let last = (first + CODEBOOK_STEPS).min(CODEBOOK_LADDER.len());
@@ -290,12 +285,13 @@ pub fn train(
     // Rows of `reduced` are object by object; each object's block gives its histogram.
     let mut blocks = Vec::with_capacity(objects.len());
     let (mut row_objects, mut row_readings) = (Vec::new(), Vec::new());
+    let mut reading_id = 0u32;
     let mut start = 0;
     for j in 0..objects.len() {
         for reading in training.readings(j) {
-            let id = row_readings.last().map_or(0, |&last: &u32| last + 1);
             row_objects.extend(std::iter::repeat_n(j as u32, reading.len()));
-            row_readings.extend(std::iter::repeat_n(id, reading.len()));
+            row_readings.extend(std::iter::repeat_n(reading_id, reading.len()));
+            reading_id += 1;
         }
         let n: usize = training.readings(j).iter().map(Vec::len).sum();
         blocks.push(FeatureMatrix::from_trusted(
