@@ -45,7 +45,7 @@ from sklearn.mixture import GaussianMixture
 from threadpoolctl import threadpool_limits
 
 GROUPS = {"gmm_fit_10x1000x20": 0.0, "gmm_fit_10x1000x20_tol1e-3": 1e-3}
-KS = (10, 20, 50)
+KS = (10, 20, 50, 100)
 MAX_ITER = 100
 
 

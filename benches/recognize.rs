@@ -1,10 +1,11 @@
 //! Recognition speed (issue 7): the GMM codebook fit at the paper's training-set size (10 objects x
-//! 1000 readings of ~20-dimensional PCA'd features, Sec. V-B) and the per-touch cost of the online
-//! posterior.
+//! 1000 readings of ~20-dimensional PCA'd features, Sec. V-B), the per-touch cost of the online
+//! posterior, and the neighbour codebook's training histograms.
 //!
 //! Two GMM groups: `gmm_fit_10x1000x20` runs exactly 100 EM iterations (tolerance 0, the same work
 //! for every implementation) and `gmm_fit_10x1000x20_tol1e-3` runs with the default settings (stop
-//! when the mean log-likelihood changes by < 1e-3, at most 100 iterations), each for k = 10, 20, 50.
+//! when the mean log-likelihood changes by < 1e-3, at most 100 iterations), each for k = 10, 20, 50,
+//! 100 (the grid model selection tries for 10 objects, [`codebook_sizes`](taction::recognize::codebook_sizes)).
 //! The features are written to `target/bench-data/gmm_features.csv` and each fit's iterations and
 //! final mean log-likelihood to `target/bench-data/gmm_taction.json`, so that
 //! `benches/gmm_sklearn.py` times scikit-learn's `GaussianMixture` on exactly the same data with the
@@ -24,7 +25,7 @@ use taction::dataset::format_f64;
 use taction::describe::Feature;
 use taction::recognize::{
     CodebookConfig, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LabelledFeatures,
-    TrainConfig, train,
+    LeaveOneReadingOut, TrainConfig, TrainingFeatures, train,
 };
 use taction::rng::{Rng, stream};
 
@@ -130,7 +131,7 @@ fn gmm_fit(c: &mut Criterion) {
         let mut group = c.benchmark_group(name);
         group.sample_size(10);
         let mut fits = Vec::new();
-        for k in [10, 20, 50] {
+        for k in [10, 20, 50, 100] {
             let mut last = None;
             group.bench_with_input(BenchmarkId::new("k", k), &k, |b, &k| {
                 b.iter(|| {
@@ -210,5 +211,35 @@ fn per_touch(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, gmm_fit, per_touch);
+/// The neighbour codebook's training histograms for model selection's four candidates (10, 20, 50,
+/// 100 neighbours) on 10 objects x 1000 single-feature readings: a scan per candidate (the
+/// baseline) against one scan at the largest k whose prefixes serve the rest (what `train` does;
+/// the histograms are the same bit for bit, `neighbours.rs` tests it).
+fn knn_training(c: &mut Criterion) {
+    let features: Vec<Feature> = object_features(2011).into_iter().flatten().collect();
+    let data = FeatureMatrix::from_features(&features, "benchmark").expect("finite features");
+    let objects: Vec<u32> = (0..OBJECTS * READINGS).map(|r| (r / READINGS) as u32).collect();
+    let readings: Vec<u32> = (0..(OBJECTS * READINGS) as u32).collect();
+    let training = TrainingFeatures {
+        data: &data,
+        objects: &objects,
+        object_count: OBJECTS,
+        readings: &readings,
+    };
+    let ks = [10, 20, 50, 100];
+    let mut group = c.benchmark_group("knn_training_histograms_10x1000x20");
+    group.sample_size(10);
+    group.bench_function("scan_per_k", |b| {
+        b.iter(|| ks.map(|k| black_box(LeaveOneReadingOut::scan(training, k).histograms(k))))
+    });
+    group.bench_function("one_scan", |b| {
+        b.iter(|| {
+            let shared = LeaveOneReadingOut::scan(training, 100);
+            ks.map(|k| black_box(shared.histograms(k)))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, gmm_fit, per_touch, knn_training);
 criterion_main!(benches);

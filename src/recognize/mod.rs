@@ -47,7 +47,7 @@ pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
 pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
 pub use labelled::LabelledFeatures;
 pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
-pub use neighbours::NearestNeighbours;
+pub use neighbours::{LeaveOneReadingOut, NearestNeighbours};
 pub use object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels, PseudoCount};
 pub use pca::{Pca, VarianceFraction};
 pub use posterior::{Belief, OnlinePosterior};

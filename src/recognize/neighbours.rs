@@ -20,11 +20,14 @@
 //! chosen from 50-400) to 77.3 / 90.4 / 98.8% (PCA keeping 99%).
 //!
 //! Cost: the model keeps every training feature, and a membership scans them all (at most `n d`
-//! flops; `cargo bench --bench recognize`, `per_touch`, times it against the GMM).
+//! flops; `cargo bench --bench recognize`, `per_touch`, times it against the GMM). Training scans
+//! every training feature's neighbourhood once for all candidate `k` ([`LeaveOneReadingOut`]),
+//! `n^2 d` flops; the bench's `knn_training` group times it against a scan per candidate.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::recognize::codebook::TrainingFeatures;
 use crate::recognize::object_model::ClusterHistogram;
 use crate::recognize::{FeatureMatrix, RecognizeError};
 
@@ -117,60 +120,101 @@ impl NearestNeighbours {
         self.membership_skipping(f, out, |_| false);
     }
 
-    /// The membership over the training features `skip` does not exclude. Ties in distance go to
-    /// the lower row, so the neighbours are a function of the data alone.
-    ///
-    /// One pass keeps the `k` nearest so far, sorted by (distance, row); a row's squared distance
-    /// stops accumulating once it exceeds the `k`-th nearest's, since it can no longer enter.
+    /// The membership over the training features `skip` does not exclude.
     fn membership_skipping(&self, f: &[f64], out: &mut [f64], skip: impl Fn(usize) -> bool) {
-        let k = self.neighbours;
-        let mut nearest: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
-        for (row, g) in self.points.chunks_exact(self.dim).enumerate() {
-            if skip(row) {
-                continue;
-            }
-            let bound = if nearest.len() == k {
-                nearest[k - 1].0
-            } else {
-                f64::INFINITY
-            };
-            let mut d = 0.0;
-            for (a, b) in f.iter().zip(g) {
-                d += (a - b) * (a - b);
-                if d > bound {
-                    break;
-                }
-            }
-            // Rows come in increasing order, so an equal distance never displaces an earlier row.
-            if d < bound {
-                let at = nearest.partition_point(|&(e, _)| e <= d);
-                nearest.insert(at, (d, row));
-                nearest.truncate(k);
-            }
-        }
+        let nearest = nearest_rows(&self.points, self.dim, f, self.neighbours, skip);
         out.fill(0.0);
-        for &(_, row) in &nearest {
+        for &row in &nearest {
             out[self.labels[row] as usize] += 1.0 / nearest.len() as f64;
         }
     }
+}
 
-    /// Every object's histogram of its own training features, each feature's membership taken
-    /// with the features of its reading (`readings[r]`, one id per row) left out. Computed in
-    /// parallel and summed in row order, so the result does not depend on the thread count.
-    pub fn leave_one_reading_out_histograms(&self, readings: &[u32]) -> Vec<ClusterHistogram> {
-        debug_assert_eq!(readings.len(), self.len());
-        let memberships: Vec<Vec<f64>> = (0..self.len())
+/// The rows of `points` (row-major, `dim` values each) nearest to `f`, at most `k` of those `skip`
+/// does not exclude, nearest first. Ties in distance go to the lower row, so the neighbours are a
+/// function of the data alone.
+///
+/// One pass keeps the `k` nearest so far, sorted by (distance, row); a row's squared distance
+/// stops accumulating once it exceeds the `k`-th nearest's, since it can no longer enter.
+fn nearest_rows(points: &[f64], dim: usize, f: &[f64], k: usize, skip: impl Fn(usize) -> bool) -> Vec<usize> {
+    let mut nearest: Vec<(f64, usize)> = Vec::with_capacity(k + 1);
+    for (row, g) in points.chunks_exact(dim).enumerate() {
+        if skip(row) {
+            continue;
+        }
+        let bound = if nearest.len() == k {
+            nearest[k - 1].0
+        } else {
+            f64::INFINITY
+        };
+        let mut d = 0.0;
+        for (a, b) in f.iter().zip(g) {
+            d += (a - b) * (a - b);
+            if d > bound {
+                break;
+            }
+        }
+        // Rows come in increasing order, so an equal distance never displaces an earlier row.
+        if d < bound {
+            let at = nearest.partition_point(|&(e, _)| e <= d);
+            nearest.insert(at, (d, row));
+            nearest.truncate(k);
+        }
+    }
+    nearest.into_iter().map(|(_, row)| row).collect()
+}
+
+/// Every training feature's nearest other training features, its own reading's left out: what
+/// the objects' histograms of a neighbour codebook are made of. A feature's membership with its
+/// reading in its own neighbourhood would make every object look perfectly distinct.
+///
+/// The `k` nearest in (distance, row) order are the first `k` of the `k_max` nearest, so one scan
+/// at the largest candidate `k` serves every candidate of model selection, with the histograms
+/// each would have computed itself, bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeaveOneReadingOut {
+    objects: usize,
+    /// Per training row, the objects of its nearest rows, nearest first.
+    nearest_objects: Vec<Vec<u32>>,
+    row_objects: Vec<u32>,
+}
+
+impl LeaveOneReadingOut {
+    /// The `k_max` nearest of every row of `training` (fewer when fewer rows lie outside its
+    /// reading), found in parallel.
+    pub fn scan(training: TrainingFeatures, k_max: usize) -> Self {
+        let (data, dim) = (training.data.as_slice(), training.data.dim());
+        let readings = training.readings;
+        debug_assert_eq!(readings.len(), training.data.rows());
+        let nearest_objects = (0..training.data.rows())
             .into_par_iter()
             .map(|row| {
-                let mut out = vec![0.0; self.objects];
-                let f = &self.points[row * self.dim..(row + 1) * self.dim];
-                self.membership_skipping(f, &mut out, |other| readings[other] == readings[row]);
-                out
+                let f = &data[row * dim..(row + 1) * dim];
+                nearest_rows(data, dim, f, k_max, |other| readings[other] == readings[row])
+                    .into_iter()
+                    .map(|other| training.objects[other])
+                    .collect()
             })
             .collect();
+        Self {
+            objects: training.object_count,
+            nearest_objects,
+            row_objects: training.objects.to_vec(),
+        }
+    }
+
+    /// Every object's histogram of its own training features under the `k`-nearest codebook
+    /// (`k` at most the scan's `k_max`), summed in row order.
+    pub fn histograms(&self, k: usize) -> Vec<ClusterHistogram> {
         let mut histograms = vec![ClusterHistogram::new(self.objects); self.objects];
-        for (row, m) in memberships.iter().enumerate() {
-            histograms[self.labels[row] as usize].add(m);
+        let mut membership = vec![0.0; self.objects];
+        for (nearest, &object) in self.nearest_objects.iter().zip(&self.row_objects) {
+            let nearest = &nearest[..k.min(nearest.len())];
+            membership.fill(0.0);
+            for &o in nearest {
+                membership[o as usize] += 1.0 / nearest.len() as f64;
+            }
+            histograms[object as usize].add(&membership);
         }
         histograms
     }
@@ -195,6 +239,19 @@ mod tests {
             [0.5, 0.5],
         ]);
         NearestNeighbours::new(&data, vec![0, 0, 0, 1, 1, 1], 2, 3).unwrap()
+    }
+
+    /// The codebook's training histograms with the features of each reading (`readings[r]` per
+    /// row) left out.
+    fn leave_one_reading_out(nn: &NearestNeighbours, readings: &[u32]) -> Vec<ClusterHistogram> {
+        let data = FeatureMatrix::from_trusted(nn.len(), nn.dim, nn.points.clone());
+        let training = TrainingFeatures {
+            data: &data,
+            objects: &nn.labels,
+            object_count: nn.objects,
+            readings,
+        };
+        LeaveOneReadingOut::scan(training, nn.neighbours).histograms(nn.neighbours)
     }
 
     #[test]
@@ -241,7 +298,7 @@ mod tests {
     fn training_memberships_leave_the_reading_out() {
         let nn = two_clouds();
         // Every feature its own reading: (0, 0) sees (0.5, 0.5), (1, 0), (0, 1) -> 2/3 object 0.
-        let alone = nn.leave_one_reading_out_histograms(&[0, 1, 2, 3, 4, 5]);
+        let alone = leave_one_reading_out(&nn, &[0, 1, 2, 3, 4, 5]);
         assert_eq!(alone[0].features(), 3);
         assert_eq!(alone[1].features(), 3);
         // Object 1's two far features see each other, (1, 0) and (0.5, 0.5): 2/3 object 1 each;
@@ -249,8 +306,46 @@ mod tests {
         let far = alone[1].sums()[1];
         assert!((far - 4.0 / 3.0).abs() < 1e-12, "{far}");
         // Features 3 and 4 one reading: neither sees the other any more.
-        let grouped = nn.leave_one_reading_out_histograms(&[0, 1, 2, 3, 3, 5]);
+        let grouped = leave_one_reading_out(&nn, &[0, 1, 2, 3, 3, 5]);
         assert!(grouped[1].sums()[1] < far);
+    }
+
+    #[test]
+    fn one_scan_at_the_largest_k_gives_every_smaller_k_its_own_histograms() {
+        use rand::RngExt;
+        let mut rng = crate::rng::rng(11);
+        // A coarse grid (many tied distances) and readings of 1-3 features.
+        let rows: Vec<[f64; 2]> = (0..200)
+            .map(|_| {
+                [
+                    f64::from(rng.random_range(0..5u8)),
+                    f64::from(rng.random_range(0..5u8)),
+                ]
+            })
+            .collect();
+        let labels: Vec<u32> = (0..200).map(|i| (i / 50) as u32).collect();
+        let readings: Vec<u32> = (0..200).map(|i| (i / 3) as u32).collect();
+        let data = matrix(&rows);
+        let training = TrainingFeatures {
+            data: &data,
+            objects: &labels,
+            object_count: 4,
+            readings: &readings,
+        };
+        let shared = LeaveOneReadingOut::scan(training, 40);
+        for k in [1, 5, 17, 40] {
+            let own = LeaveOneReadingOut::scan(training, k).histograms(k);
+            assert_eq!(shared.histograms(k), own, "k = {k}");
+            // And each row's share is what the codebook's own membership says with its reading out.
+            let nn = NearestNeighbours::new(&data, labels.clone(), 4, k).unwrap();
+            let mut expected = vec![ClusterHistogram::new(4); 4];
+            let mut m = [0.0; 4];
+            for (row, f) in rows.iter().enumerate() {
+                nn.membership_skipping(f, &mut m, |other| readings[other] == readings[row]);
+                expected[labels[row] as usize].add(&m);
+            }
+            assert_eq!(own, expected, "k = {k}");
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@ use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
 use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel, TrainingFeatures};
 use crate::recognize::evaluate::{Trial, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::neighbours::LeaveOneReadingOut;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 use crate::recognize::pca::{Pca, VarianceFraction};
 use crate::recognize::{FeatureMatrix, RecognizeError};
@@ -328,6 +329,9 @@ pub fn train(
         .iter()
         .flat_map(|&k| (0..restarts).map(move |restart| (k, restart)))
         .collect();
+    // The neighbour codebook's training histograms, for every candidate k, from one scan.
+    let neighbours = (config.codebook == CodebookKind::Knn)
+        .then(|| LeaveOneReadingOut::scan(features, config.ks.iter().copied().max().unwrap_or(1)));
     let progress = Mutex::new(progress);
     let report = |event: TrainProgress| {
         let mut progress = progress.lock().unwrap_or_else(PoisonError::into_inner);
@@ -343,7 +347,12 @@ pub fn train(
                 k,
                 restart,
             });
-            let candidate = fit_candidate(config, features, &blocks, &objects, &trials, k, restart);
+            let training = CandidateTraining {
+                features,
+                blocks: &blocks,
+                neighbours: neighbours.as_ref(),
+            };
+            let candidate = fit_candidate(config, &training, &objects, &trials, k, restart);
             report(TrainProgress::Scored(candidate.score.clone()));
             candidate
         })
@@ -396,27 +405,40 @@ struct Candidate {
     fitted: Result<(CodebookModel, ObjectModels), RecognizeError>,
 }
 
+/// What every candidate is fitted on: the reduced training features, the same rows object by
+/// object, and for the neighbour codebook every feature's nearest other-reading features.
+struct CandidateTraining<'a> {
+    features: TrainingFeatures<'a>,
+    blocks: &'a [FeatureMatrix],
+    neighbours: Option<&'a LeaveOneReadingOut>,
+}
+
 /// Fits the codebook of `k` clusters on restart `restart`'s random stream, the objects' histograms
 /// over it, and scores the pair on the validation trials.
 fn fit_candidate(
     config: &TrainConfig,
-    features: TrainingFeatures,
-    blocks: &[FeatureMatrix],
+    training: &CandidateTraining,
     objects: &[String],
     trials: &[ReducedTrial],
     k: usize,
     restart: usize,
 ) -> Candidate {
     let mut rng = stream(substream(config.seed, k as u64), restart as u64);
-    let fitted = CodebookModel::fit(config.codebook, features, k, &config.fitting, &mut rng).and_then(|cb| {
-        let histograms: Vec<ClusterHistogram> = match &cb {
-            // A training feature must not count itself, nor its reading's other features.
-            CodebookModel::Knn(nn) => nn.leave_one_reading_out_histograms(features.readings),
-            _ => blocks.iter().map(|b| reduced_histogram(&cb, b)).collect(),
-        };
-        let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?;
-        Ok((cb, models))
-    });
+    let fitted = CodebookModel::fit(config.codebook, training.features, k, &config.fitting, &mut rng)
+        .and_then(|cb| {
+            let histograms: Vec<ClusterHistogram> = match (&cb, training.neighbours) {
+                // A training feature must not count itself, nor its reading's other features.
+                (CodebookModel::Knn(_), Some(neighbours)) => neighbours.histograms(k),
+                (CodebookModel::Knn(_), None) => LeaveOneReadingOut::scan(training.features, k).histograms(k),
+                _ => training
+                    .blocks
+                    .iter()
+                    .map(|b| reduced_histogram(&cb, b))
+                    .collect(),
+            };
+            let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?;
+            Ok((cb, models))
+        });
     let score = match &fitted {
         Ok((cb, models)) => score_candidate(cb, models, trials, k, restart),
         Err(e) => CandidateScore {
