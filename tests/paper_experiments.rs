@@ -177,7 +177,13 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     assert_eq!(values("noise").len(), 4);
     assert_eq!(
         values("training-size"),
-        BTreeSet::from(["100".into(), "300".into(), "1000".into()])
+        BTreeSet::from([
+            "100".into(),
+            "300".into(),
+            "1000".into(),
+            "3000".into(),
+            "10000".into()
+        ])
     );
     assert_eq!(
         values("active"),

@@ -16,7 +16,7 @@
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
 //! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
-//! | `training-size` | beyond | training readings per object (100, 300, 1000) |
+//! | `training-size` | beyond | training readings per object (100, 300, 1000, 3000, 10,000) |
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and

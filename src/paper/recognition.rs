@@ -82,7 +82,7 @@ pub struct Setting {
     pub label: String,
     pub sensor: SensorConfig,
     pub sampler: SamplerConfig,
-    /// Share of the scale's training readings per object this setting trains on (1 in the paper's
+    /// Multiple of the scale's training readings per object this setting trains on (1 in the paper's
     /// figures; the training-size experiment varies it).
     pub training_fraction: f64,
     pub curves: Vec<Curve>,
