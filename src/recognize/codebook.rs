@@ -3,11 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::recognize::RecognizeError;
+use crate::recognize::features::TrainingFeatures;
 use crate::recognize::gmm::{GaussianMixture, GmmConfig};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
 use crate::recognize::neighbours::NearestNeighbours;
 use crate::recognize::pca::VarianceFraction;
-use crate::recognize::{FeatureMatrix, RecognizeError};
 use crate::rng::Rng;
 
 /// A clustering function with a membership usable on new features.
@@ -135,16 +136,6 @@ pub enum CodebookModel {
     Kmeans(KMeans),
     Gmm(GaussianMixture),
     Knn(NearestNeighbours),
-}
-
-/// The training features a codebook is fitted on: PCA-reduced, row `r` from object `objects[r]`'s
-/// reading `readings[r]` (the neighbour codebook needs both; the clusterings ignore them).
-#[derive(Debug, Clone, Copy)]
-pub struct TrainingFeatures<'a> {
-    pub data: &'a FeatureMatrix,
-    pub objects: &'a [u32],
-    pub object_count: usize,
-    pub readings: &'a [u32],
 }
 
 impl CodebookModel {

@@ -93,3 +93,13 @@ pub fn check_feature(f: &[f64], expected: usize, origin: &str, index: usize) -> 
     }
     Ok(())
 }
+
+/// The training features a codebook is fitted on: PCA-reduced, row `r` from object `objects[r]`'s
+/// reading `readings[r]` (the neighbour codebook needs both; the clusterings ignore them).
+#[derive(Debug, Clone, Copy)]
+pub struct TrainingFeatures<'a> {
+    pub data: &'a FeatureMatrix,
+    pub objects: &'a [u32],
+    pub object_count: usize,
+    pub readings: &'a [u32],
+}

@@ -34,14 +34,14 @@ pub(crate) mod posterior;
 pub mod selection;
 
 pub use bag::BagOfFeatures;
-pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel, TrainingFeatures};
+pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 pub use confusion::ConfusionMatrix;
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use error::RecognizeError;
 pub use evaluate::{
     AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
 };
-pub use features::FeatureMatrix;
+pub use features::{FeatureMatrix, TrainingFeatures};
 pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, FusedPosterior, Recognizer};
 pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
 pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};

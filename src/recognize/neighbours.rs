@@ -27,7 +27,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::recognize::codebook::TrainingFeatures;
+use crate::recognize::features::TrainingFeatures;
 use crate::recognize::object_model::ClusterHistogram;
 use crate::recognize::{FeatureMatrix, RecognizeError};
 

@@ -8,8 +8,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
-use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel, TrainingFeatures};
+use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 use crate::recognize::evaluate::{Trial, make_trials};
+use crate::recognize::features::TrainingFeatures;
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::neighbours::LeaveOneReadingOut;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
