@@ -41,7 +41,7 @@ fn fused_names_parse_and_bad_ones_are_named() {
     assert!(!single.is_fused());
     assert_eq!(single.kinds(), [DescriptorKind::PolarFourier]);
     let e = DescriptorChoice::parse("mnti+hog").unwrap_err().to_string();
-    assert!(e.contains("'hog'") && e.contains("mnti+mn"), "{e}");
+    assert!(e.contains("'hog'") && e.contains("mnti+sift"), "{e}");
     let e = DescriptorChoice::parse("mn+moment-normalized")
         .unwrap_err()
         .to_string();

@@ -27,8 +27,8 @@ pub struct TrainArgs {
     #[arg(long, value_name = "FILE")]
     pub validation: Option<PathBuf>,
     /// vectorize | sift | mr8 | moment-normalized (mn) | polar-fourier (pf) | mnti (default
-    /// parameters); several joined by '+' (e.g. mnti+mn) train one model per descriptor on the same
-    /// data, written as one fused model whose posterior multiplies their likelihoods.
+    /// parameters); several joined by '+' (e.g. mnti+sift) train one model per descriptor on the
+    /// same data, written as one fused model whose posterior multiplies their likelihoods.
     #[arg(long, value_name = "NAME[+NAME]", value_parser = DescriptorChoice::parse)]
     pub descriptor: DescriptorChoice,
     /// gmm (soft membership) | kmeans (hard membership) | knn (beyond the paper: the objects'

@@ -7,8 +7,12 @@
 //! model scores a reading on its own; the fused log-likelihood of object `O_j` is the sum of the
 //! models' `ln p(U | O_j)` (Eq. 15-16), i.e. the product of their likelihoods, as if the descriptors
 //! were independent given the object, and the posterior is its softmax under a uniform prior. Two
-//! descriptors that err on different objects then correct each other: MNTI drops the translation
-//! that Moment-Normalized keeps (Sec. IV-B4, IV-B6).
+//! descriptors that err on different objects then correct each other, and the more differently
+//! they describe a patch the more they do: SIFT's gradient orientations (Sec. IV-B2) with MNTI's
+//! normalised moments (Sec. IV-B6) gained 3.0 / 1.1 points over MNTI alone at 10 / 20 readings on
+//! the 12 shapes (6x6, neighbour codebook, 1000 training readings per object) and 3.3 / 2.0 at
+//! 26x26, where MNTI with Moment-Normalized, both moments, gained 1.1 / -1.0 and -0.5 / -0.5
+//! (README, "What resolution and a second descriptor buy").
 
 use std::path::Path;
 
@@ -35,7 +39,7 @@ pub enum DescriptorChoiceError {
     Repeated(&'static str),
     #[error(
         "unknown descriptor '{part}' in '{text}'; expected one of {} (short: mn, pf), or several \
-         joined by '+' (e.g. mnti+mn)",
+         joined by '+' (e.g. mnti+sift)",
         DescriptorKind::ALL.map(DescriptorKind::name).join(", ")
     )]
     Unknown { part: String, text: String },
