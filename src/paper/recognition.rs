@@ -236,8 +236,7 @@ impl RecognitionSweep {
         Ok(plans)
     }
 
-    /// The sensor of a setting with the run's noise stream.
-    /// The scale's data counts with `setting`'s share of the training readings (at least one).
+    /// The scale's data counts with `setting`'s multiple of the training readings (at least one).
     pub(crate) fn setting_counts(&self, setting: usize, counts: DataCounts) -> DataCounts {
         let fraction = self.settings[setting].training_fraction;
         DataCounts {
@@ -246,6 +245,7 @@ impl RecognitionSweep {
         }
     }
 
+    /// The sensor of a setting with the run's noise stream.
     pub(super) fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
         SensorConfig {
             noise_seed: rng::substream(context.seed, NOISE_STREAM),

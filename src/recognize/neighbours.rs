@@ -123,10 +123,18 @@ impl NearestNeighbours {
     /// The membership over the training features `skip` does not exclude.
     fn membership_skipping(&self, f: &[f64], out: &mut [f64], skip: impl Fn(usize) -> bool) {
         let nearest = nearest_rows(&self.points, self.dim, f, self.neighbours, skip);
-        out.fill(0.0);
-        for &row in &nearest {
-            out[self.labels[row] as usize] += 1.0 / nearest.len() as f64;
-        }
+        shares_of_objects(nearest.iter().map(|&row| self.labels[row]), out);
+    }
+}
+
+/// `p(c_i | f)` from the objects of `f`'s nearest training features: each object's share of them.
+/// The one definition, so that a training histogram ([`LeaveOneReadingOut`]) and a touch's
+/// membership are the same arithmetic, bit for bit.
+fn shares_of_objects(nearest_objects: impl ExactSizeIterator<Item = u32>, out: &mut [f64]) {
+    let share = 1.0 / nearest_objects.len() as f64;
+    out.fill(0.0);
+    for object in nearest_objects {
+        out[object as usize] += share;
     }
 }
 
@@ -210,10 +218,7 @@ impl LeaveOneReadingOut {
         let mut membership = vec![0.0; self.objects];
         for (nearest, &object) in self.nearest_objects.iter().zip(&self.row_objects) {
             let nearest = &nearest[..k.min(nearest.len())];
-            membership.fill(0.0);
-            for &o in nearest {
-                membership[o as usize] += 1.0 / nearest.len() as f64;
-            }
+            shares_of_objects(nearest.iter().copied(), &mut membership);
             histograms[object as usize].add(&membership);
         }
         histograms

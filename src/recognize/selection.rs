@@ -333,6 +333,11 @@ pub fn train(
     // The neighbour codebook's training histograms, for every candidate k, from one scan.
     let neighbours = (config.codebook == CodebookKind::Knn)
         .then(|| LeaveOneReadingOut::scan(features, config.ks.iter().copied().max().unwrap_or(1)));
+    let candidate_training = CandidateTraining {
+        features,
+        blocks: &blocks,
+        neighbours: neighbours.as_ref(),
+    };
     let progress = Mutex::new(progress);
     let report = |event: TrainProgress| {
         let mut progress = progress.lock().unwrap_or_else(PoisonError::into_inner);
@@ -348,12 +353,7 @@ pub fn train(
                 k,
                 restart,
             });
-            let training = CandidateTraining {
-                features,
-                blocks: &blocks,
-                neighbours: neighbours.as_ref(),
-            };
-            let candidate = fit_candidate(config, &training, &objects, &trials, k, restart);
+            let candidate = fit_candidate(config, &candidate_training, &objects, &trials, k, restart);
             report(TrainProgress::Scored(candidate.score.clone()));
             candidate
         })
@@ -411,6 +411,7 @@ struct Candidate {
 struct CandidateTraining<'a> {
     features: TrainingFeatures<'a>,
     blocks: &'a [FeatureMatrix],
+    /// Present exactly when the codebook is [`CodebookKind::Knn`] (`train` scans for it).
     neighbours: Option<&'a LeaveOneReadingOut>,
 }
 
@@ -427,11 +428,11 @@ fn fit_candidate(
     let mut rng = stream(substream(config.seed, k as u64), restart as u64);
     let fitted = CodebookModel::fit(config.codebook, training.features, k, &config.fitting, &mut rng)
         .and_then(|cb| {
-            let histograms: Vec<ClusterHistogram> = match (&cb, training.neighbours) {
+            debug_assert_eq!(matches!(cb, CodebookModel::Knn(_)), training.neighbours.is_some());
+            let histograms: Vec<ClusterHistogram> = match training.neighbours {
                 // A training feature must not count itself, nor its reading's other features.
-                (CodebookModel::Knn(_), Some(neighbours)) => neighbours.histograms(k),
-                (CodebookModel::Knn(_), None) => LeaveOneReadingOut::scan(training.features, k).histograms(k),
-                _ => training
+                Some(neighbours) => neighbours.histograms(k),
+                None => training
                     .blocks
                     .iter()
                     .map(|b| reduced_histogram(&cb, b))
