@@ -46,12 +46,17 @@ pub struct CollectArgs {
     /// Planner: probability L of the local strategy.
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub local_prob: f64,
-    /// Planner: iterations allowed per object before it gives up short of `--readings`.
-    #[arg(long, default_value_t = PlannerConfig::default().max_iterations, allow_hyphen_values = true)]
-    pub max_iterations: usize,
+    /// Planner: iterations allowed per object before it gives up short of `--readings`
+    /// [default: 200 per reading asked for, at least 20000]
+    #[arg(long, allow_hyphen_values = true)]
+    pub max_iterations: Option<usize>,
     /// Sampler: approach only from above (raised letters, Sec. V-D).
     #[arg(long)]
     pub from_above: bool,
+    /// Sampler: only starts the exploring arm can reach (no underside on the table, no patch facing
+    /// away from the arm), with the arm's roll: training data that matches what the arm feels
+    #[arg(long)]
+    pub reachable: bool,
     /// Perturb the object after every reading: largest rotation, degrees, in [0, 180].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_deg: f64,
@@ -88,7 +93,10 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         )
         .into());
     }
-    if args.max_iterations == 0 {
+    let max_iterations = args
+        .max_iterations
+        .unwrap_or_else(|| PlannerConfig::iterations_for(args.readings));
+    if max_iterations == 0 {
         return Err(flag_error("max-iterations", 0, "want 1 or more").into());
     }
     if !(0.0..=1.0).contains(&args.local_prob) {
@@ -125,14 +133,19 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         Mode::Sampler => {
             let config = SamplerConfig {
                 from_above_only: args.from_above,
+                reachable_by_arm: args.reachable,
                 ..SamplerConfig::default()
             };
-            (CollectMode::Sampler(Valid::new(config)?), "sampler".to_string())
+            let generator = match args.reachable {
+                true => "sampler reachable by the arm",
+                false => "sampler",
+            };
+            (CollectMode::Sampler(Valid::new(config)?), generator.to_string())
         }
         Mode::Planner => {
             let config = PlannerConfig {
                 local_probability: args.local_prob,
-                max_iterations: args.max_iterations,
+                max_iterations,
                 ..PlannerConfig::default()
             }
             .fitted_to(&objects);

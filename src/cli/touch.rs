@@ -13,7 +13,6 @@
 
 use clap::Args;
 use taction::control::arm_pad::ArmPad;
-use taction::control::carrier::covering_back_check;
 use taction::control::free_pad::FreePad;
 use taction::control::{ContactOutcome, ContactReport, ControlConfig, settle};
 use taction::explore::collect::sensor_reader;
@@ -124,8 +123,7 @@ fn touch_arm(
     let builder = SceneBuilder::with_arm_and_table().object(object);
     let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)?.build()?;
     let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
-    let covering = CoveringSensor::on_site(scene.model(), PAD_SITE)?;
-    let reader = sensor_reader(covering.clone());
+    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
     let (ik_options, motion) = precise_motion();
     let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
     let home = arm.q(scene.data());
@@ -145,8 +143,7 @@ fn touch_arm(
             b: c.body_b,
         });
     }
-    let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?
-        .with_back_check(covering_back_check(covering));
+    let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?;
     Ok(settle(&mut pad, control)?)
 }
 

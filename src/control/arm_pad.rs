@@ -4,9 +4,9 @@
 //! `sim::arm`), Sec. III-B on the arm of Sec. V-A1. The sensor is read only when a command is done.
 //!
 //! The pad's rigid back is as wide as the covering, so it reaches the surface exactly when a taxel
-//! would read full compression: MuJoCo's contacts see it reach the table, the covering sensor (an
-//! optional check, [`ArmPad::with_back_check`]) sees it reach the object's exact surface, which the
-//! object's convex collision pieces only approximate. A Press command that would press it onto the
+//! would read full compression: MuJoCo's contacts see it reach the table, the covering sensor on
+//! the pad site (`control::carrier::pad_back_check`, as on the free-floating pad) sees it reach
+//! the object's exact surface, which the object's convex collision pieces only approximate. A Press command that would press it onto the
 //! surface is refused
 //! (the carrier stays at its previous pose and reports [`PadMotion::RigidContact`], Press's
 //! saturation termination). An Orient command that would do so, because tilting the pad about the
@@ -19,7 +19,7 @@
 
 use glam::DVec3;
 
-use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off};
+use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off, pad_back_check};
 use crate::pose::Pose;
 use crate::sim::arm::Execution;
 use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
@@ -44,8 +44,9 @@ pub struct ArmPad<'s, R> {
     motion: MoveOptions,
     /// The configuration at which a Press command was last refused outright by a rigid contact.
     refused_at: Option<Vec<f64>>,
-    /// The back's contact with the object, when MuJoCo's contacts do not see it (see
-    /// [`with_back_check`](Self::with_back_check)).
+    /// The back's contact with the object, which MuJoCo's contacts do not see: the object's
+    /// collision shell does not collide with the back (`mjcf/arm.xml`), so that the back can come
+    /// as close to the exact surface as the covering allows. `None` without a covering sensor.
     back_check: Option<BackCheck<'s>>,
 }
 
@@ -62,6 +63,7 @@ where
         motion: MoveOptions,
     ) -> Result<Self, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
+        let back_check = pad_back_check(scene.model());
         Ok(Self {
             scene,
             arm,
@@ -70,18 +72,8 @@ where
             reader,
             motion,
             refused_at: None,
-            back_check: None,
+            back_check,
         })
-    }
-
-    /// Treats the object reaching the pad's rigid back, as `check` tells after every command, as the
-    /// rigid contact MuJoCo would report: the object's collision shell does not collide with the
-    /// back (`mjcf/arm.xml`), so that the back can come as close to the exact surface as the
-    /// covering allows, and the covering sensor, which sees the exact triangles, says when it
-    /// arrives (`CoveringSensor::back_reached`).
-    pub fn with_back_check(mut self, check: BackCheck<'s>) -> Self {
-        self.back_check = Some(check);
-        self
     }
 
     pub fn scene(&mut self) -> &mut Scene {
@@ -178,11 +170,12 @@ where
         target: &PadPose,
         start: &[f64],
     ) -> Result<(PadMotion, Option<Collision>), ControlError> {
-        let q = match self.ik.solve(
+        let q = match self.ik.solve_with_up(
             &PadTarget {
                 center_m: target.center_m,
                 normal: target.normal,
             },
+            target.up,
             start,
         ) {
             Ok(q) => q,

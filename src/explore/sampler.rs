@@ -17,11 +17,13 @@ use serde::{Deserialize, Serialize};
 use crate::control::free_pad::FreePad;
 use crate::control::{ControlConfig, ControlError, settle};
 use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
+use crate::explore::reach::{ArmReach, carried};
 use crate::explore::report::ExplorationReport;
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
+use crate::pose::Pose;
 use crate::rng::Rng;
-use crate::sim::{PerturbationBounds, Scene, SimError};
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SimError};
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
@@ -38,6 +40,11 @@ pub struct SamplerConfig {
     pub from_above_only: bool,
     /// Draws allowed per requested converged reading before giving up.
     pub max_attempts_per_reading: usize,
+    /// Only starts the exploring arm could take (`explore::reach`), the object resting as it is
+    /// but turned to a random heading about the vertical: the draws the arm cannot reach (the
+    /// underside on the table, patches the links cannot get to) are skipped, and the pad starts
+    /// with the arm's roll. Off by default: the paper's sampler approaches from every direction.
+    pub reachable_by_arm: bool,
 }
 
 impl Default for SamplerConfig {
@@ -47,6 +54,7 @@ impl Default for SamplerConfig {
             orientation_noise_deg: 10.0,
             from_above_only: false,
             max_attempts_per_reading: 20,
+            reachable_by_arm: false,
         }
     }
 }
@@ -61,6 +69,7 @@ impl Check for SamplerConfig {
             orientation_noise_deg,
             from_above_only: _,
             max_attempts_per_reading,
+            reachable_by_arm: _,
         } = *self;
         FieldChecks::of("sampler config")
             .real("back_off_m", back_off_m, back_off_m > 0.0, "(0, inf)")
@@ -116,6 +125,10 @@ where
                 message: "no surface area to sample".into(),
             }
         })?;
+    let mut reach = match config.reachable_by_arm {
+        true => Some(ArmReach::new(ObjectSpec::new(object, mesh.clone()))?),
+        false => None,
+    };
     let mut pad = FreePad::new(scene, sensor, reader)?;
     let mut report = ExplorationReport::default();
     let max_attempts = converged_target
@@ -136,11 +149,24 @@ where
         let tilt = DQuat::from_axis_angle(tilt_axis, rng.random_range(0.0..=1.0) * tilt_max);
         let normal = (tilt * -outward).normalize();
         let up = random_perpendicular(normal, rng);
-        let start = PadPose {
+        let mut start = PadPose {
             center_m: point + outward * config.back_off_m,
             normal,
             up,
         };
+        if let Some(reach) = &mut reach {
+            // The arm knows neither the object nor its heading on the table (Sec. III-A): the
+            // start is tested with the object turned about the vertical by a random angle.
+            let heading = DQuat::from_rotation_z(rng.random_range(0.0..std::f64::consts::TAU));
+            let to_arm = reach
+                .object_pose()
+                .compose(&Pose::new(DVec3::ZERO, heading))
+                .compose(&object_pose.inverse());
+            match reach.start_pose(&carried(&start, &to_arm)) {
+                Some(arm_start) => start = carried(&arm_start, &to_arm.inverse()),
+                None => continue,
+            }
+        }
         pad.place(&start);
         let outcome = settle(&mut pad, control)?;
         report.readings.push(Reading {

@@ -257,6 +257,67 @@ pub fn letters() -> RecognitionSweep {
     }
 }
 
+/// Training readings per object of "ours" in the end-to-end experiment, in multiples of the paper's
+/// 1000 (scaled by `--scale` like every count).
+pub const END_TO_END_TRAINING_FRACTION: f64 = 3.0;
+
+/// Beyond the paper: the product's job, end to end. The arm explores each object blind (L = 0.5
+/// and 1, the object fixed or perturbed after every reading, Sec. V-B3-4) and is recognised by a
+/// model trained the paper's way (1000 sampler readings per object from every direction) or ours:
+/// three times as many readings of the sampler restricted to the starts the arm can take from any
+/// heading of the object (`SamplerConfig::reachable_by_arm`), pressed by the same rigid-backed pad.
+pub fn end_to_end() -> RecognitionSweep {
+    let perturbed = PerturbationBounds::new(10.0, 0.1).unwrap_or(PerturbationBounds::NONE);
+    let curves = |training: &str| {
+        [
+            (0.5, "fixed"),
+            (1.0, "fixed"),
+            (0.5, "perturbed"),
+            (1.0, "perturbed"),
+        ]
+        .into_iter()
+        .map(|(l, object)| Curve {
+            value: format!("{training} L={l} {object}"),
+            test: TestData::Planner {
+                local_probability: l,
+                perturbation: if object == "perturbed" {
+                    perturbed
+                } else {
+                    PerturbationBounds::NONE
+                },
+            },
+        })
+        .collect()
+    };
+    RecognitionSweep {
+        name: "end-to-end",
+        description: "Beyond the paper: blind arm exploration (L = 0.5, 1; fixed, perturbed) recognised by the paper's sampler training and by ours (3x readings, starts the arm can reach)",
+        title: "End to end: the arm's own touches",
+        parameter: "training",
+        family: Family::Shapes,
+        descriptors: vec![DescriptorKind::Mnti, DescriptorKind::PolarFourier],
+        settings: vec![
+            Setting {
+                label: "paper".into(),
+                sensor: default_sensor(),
+                sampler: SamplerConfig::default(),
+                training_fraction: 1.0,
+                curves: curves("paper"),
+            },
+            Setting {
+                label: "reachable".into(),
+                sensor: default_sensor(),
+                sampler: SamplerConfig {
+                    reachable_by_arm: true,
+                    ..SamplerConfig::default()
+                },
+                training_fraction: END_TO_END_TRAINING_FRACTION,
+                curves: curves("reachable"),
+            },
+        ],
+    }
+}
+
 /// Training readings per object in the training-size experiment, at scale 1 (`--scale` scales them).
 pub const TRAINING_SIZES: [usize; 5] = [100, 300, 1000, 3000, 10_000];
 

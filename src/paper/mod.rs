@@ -18,6 +18,7 @@
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //! | `training-size` | beyond | training readings per object (100, 300, 1000, 3000, 10,000) |
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
+//! | `end-to-end` | beyond | the arm's blind touches recognised by the paper's training and ours (L, fixed/perturbed) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` ([`data`]).
@@ -69,12 +70,13 @@ pub enum PaperExperiment {
     SimToReal,
     TrainingSize,
     Active,
+    EndToEnd,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
     /// experiments beyond the paper).
-    pub const ALL: [PaperExperiment; 14] = [
+    pub const ALL: [PaperExperiment; 15] = [
         Self::Exploration,
         Self::Descriptors,
         Self::Strategy,
@@ -89,6 +91,7 @@ impl PaperExperiment {
         Self::SimToReal,
         Self::TrainingSize,
         Self::Active,
+        Self::EndToEnd,
     ];
 
     /// The recognition figure's sweep; `None` for Fig. 1, a picture, Fig. 14, which is not a
@@ -107,6 +110,7 @@ impl PaperExperiment {
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
             Self::TrainingSize => figures::training_size(),
+            Self::EndToEnd => figures::end_to_end(),
         })
     }
 

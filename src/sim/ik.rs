@@ -16,7 +16,7 @@
 
 use std::sync::Arc;
 
-use glam::DVec3;
+use glam::{DMat3, DQuat, DVec3};
 use mujoco_rs::prelude::*;
 use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
 use rand::RngExt;
@@ -135,7 +135,7 @@ impl InverseKinematics {
                     .collect()
             };
             self.arm.clamp(&mut q);
-            match self.descend(&mut q, target.center_m, normal) {
+            match self.descend(&mut q, target.center_m, normal, None) {
                 Ok(()) => return Ok(q),
                 Err((dp, da)) => {
                     if dp + da * self.options.orientation_weight_m
@@ -152,8 +152,43 @@ impl InverseKinematics {
         })
     }
 
+    /// As [`solve`](Self::solve), also turning the pad about its normal so that its image "up" is
+    /// `up` (the 6-D task, the projector `P` dropped), tried from `start` alone; where that fails,
+    /// the 5-D solve with the roll free. The controllers command the pad's whole frame (Orient turns
+    /// it the short way, Press keeps it, `control::orient`): holding the roll through them makes the
+    /// arm settle as the free-floating pad does from the same start. With the roll left to the
+    /// redundancy the taxel grid turned by up to 40 degrees over a settle on the dragon, and with it
+    /// the image that Orient fitted its plane to.
+    pub fn solve_with_up(
+        &mut self,
+        target: &PadTarget,
+        up: DVec3,
+        start: &[f64],
+    ) -> Result<Vec<f64>, IkError> {
+        let normal = target.normal.try_normalize().ok_or(IkError::BadTarget)?;
+        if let Some(up) = (up - normal * up.dot(normal)).try_normalize()
+            && target.center_m.is_finite()
+        {
+            let mut q = start.to_vec();
+            self.arm.clamp(&mut q);
+            if self.descend(&mut q, target.center_m, normal, Some(up)).is_ok() {
+                return Ok(q);
+            }
+        }
+        self.solve(target, start)
+    }
+
     /// Damped least-squares descent from `q`; `Err` carries the final (position, angle) error.
-    fn descend(&mut self, q: &mut [f64], target_p: DVec3, target_n: DVec3) -> Result<(), (f64, f64)> {
+    /// With `target_up` the angle is that of the whole rotation to the frame (normal, up).
+    fn descend(
+        &mut self,
+        q: &mut [f64],
+        target_p: DVec3,
+        target_n: DVec3,
+        target_up: Option<DVec3>,
+    ) -> Result<(), (f64, f64)> {
+        let target_rotation = target_up
+            .map(|up| DQuat::from_mat3(&DMat3::from_cols(up.cross(target_n), up, target_n)).normalize());
         let w = self.options.orientation_weight_m;
         let lambda2 = self.options.damping * self.options.damping;
         let n_dof = self.arm.dof();
@@ -166,14 +201,22 @@ impl InverseKinematics {
             let pose = self.arm.pad_pose(&self.data);
             let n = pose.transform_vector(DVec3::Z);
             let dp = target_p - pose.position_m;
-            let (axis, angle) = rotation_between(n, target_n);
+            let (axis, angle) = match target_rotation {
+                Some(r) => shortest_axis_angle(r * pose.rotation.inverse()),
+                None => rotation_between(n, target_n),
+            };
             error = (dp.length(), angle);
             if error.0 <= self.options.position_tolerance_m && error.1 <= self.options.angle_tolerance_rad {
                 return Ok(());
             }
             let (jacp, jacr) = self.data.jac_site(true, true, self.arm.site());
-            let proj = nalgebra::Matrix3::identity()
-                - nalgebra::Vector3::new(n.x, n.y, n.z) * nalgebra::RowVector3::new(n.x, n.y, n.z);
+            let proj = match target_rotation {
+                Some(_) => nalgebra::Matrix3::identity(),
+                None => {
+                    nalgebra::Matrix3::identity()
+                        - nalgebra::Vector3::new(n.x, n.y, n.z) * nalgebra::RowVector3::new(n.x, n.y, n.z)
+                }
+            };
             let mut jac = DMatrix::<f64>::zeros(6, n_dof);
             for (c, joint) in self.arm.joints().iter().enumerate() {
                 let d = joint.dof_adr;
@@ -200,6 +243,13 @@ impl InverseKinematics {
         }
         Err(error)
     }
+}
+
+/// Unit axis and angle (radians, in [0, π]) of rotation `r`, the short way round.
+fn shortest_axis_angle(r: DQuat) -> (DVec3, f64) {
+    let r = if r.w < 0.0 { -r } else { r };
+    let (axis, angle) = r.to_axis_angle();
+    (axis.try_normalize().unwrap_or(DVec3::Z), angle)
 }
 
 /// Unit axis and angle (radians, in [0, π]) of the shortest rotation taking unit `from` to unit `to`.
