@@ -45,11 +45,11 @@ use crate::dataset::Reading;
 use crate::describe::Descriptor;
 use crate::explore::Planner;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
-use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, OnlinePosterior};
+use crate::recognize::{FusedModel, FusedPosterior, RecognizeError};
 use crate::sim::Scene;
 use crate::tactile::TactileImage;
 
@@ -165,37 +165,73 @@ impl TouchScorer for InformationGain<'_> {
 }
 
 /// A recogniser that also scores where to touch next: the online posterior (Eq. 16) and the
-/// [`InformationGain`] state fed with the same readings.
+/// [`InformationGain`] state fed with the same readings. A fused model (several descriptors, their
+/// likelihoods multiplied, `recognize::fusion`) gives the belief; its first model's clusters give
+/// the gain's predictions.
 pub struct ActiveRecognition<'a> {
     bag: &'a BagOfFeatures,
-    descriptor: &'a dyn Descriptor,
-    posterior: OnlinePosterior<'a>,
+    descriptors: Vec<&'a dyn Descriptor>,
+    posterior: Posterior<'a>,
     gain: InformationGain<'a>,
+}
+
+/// The belief of one model or of a fused one.
+enum Posterior<'a> {
+    Single(OnlinePosterior<'a>),
+    Fused(FusedPosterior<'a>),
 }
 
 impl<'a> ActiveRecognition<'a> {
     pub fn new(bag: &'a BagOfFeatures, descriptor: &'a dyn Descriptor, neighbourhood_m: f64) -> Self {
         Self {
             bag,
-            descriptor,
-            posterior: bag.posterior(),
+            descriptors: vec![descriptor],
+            posterior: Posterior::Single(bag.posterior()),
             gain: InformationGain::new(bag.models(), neighbourhood_m),
         }
     }
 
+    /// The recogniser of a fused model; `descriptors[m]` describes readings for `model.fused[m]`.
+    pub fn fused(
+        model: &'a FusedModel,
+        descriptors: Vec<&'a dyn Descriptor>,
+        neighbourhood_m: f64,
+    ) -> Result<Self, RecognizeError> {
+        let kinds: Vec<_> = model.fused.iter().map(|m| m.descriptor.kind()).collect();
+        if descriptors.iter().map(|d| d.kind()).ne(kinds.iter().copied()) {
+            return Err(RecognizeError::InvalidParameter {
+                name: "fused recogniser",
+                what: format!("descriptors do not match the fused model's {kinds:?}"),
+            });
+        }
+        let bag = &model.fused[0].bag;
+        Ok(Self {
+            bag,
+            descriptors,
+            posterior: Posterior::Fused(model.posterior()),
+            gain: InformationGain::new(bag.models(), neighbourhood_m),
+        })
+    }
+
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
-        let features = self.descriptor.describe(image);
-        let belief = self.posterior.observe(&features)?;
+        let features: Vec<_> = self.descriptors.iter().map(|d| d.describe(image)).collect();
+        let belief = match &mut self.posterior {
+            Posterior::Single(p) => p.observe(&features[0])?,
+            Posterior::Fused(p) => p.observe(&features)?,
+        };
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
-        self.bag.add_features(&features, &mut reading, "the reading")?;
+        self.bag.add_features(&features[0], &mut reading, "the reading")?;
         self.gain
             .record(image.pose().map(|p| p.center_m), &reading, belief.probabilities());
         Ok(belief)
     }
 
     pub fn belief(&self) -> Belief {
-        self.posterior.belief()
+        match &self.posterior {
+            Posterior::Single(p) => p.belief(),
+            Posterior::Fused(p) => p.belief(),
+        }
     }
 
     pub fn scorer(&self) -> &InformationGain<'a> {

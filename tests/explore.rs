@@ -185,6 +185,36 @@ fn sampler_readings_cover_every_face_of_a_box() {
     );
 }
 
+/// The sampler restricted to starts the arm can reach (`SamplerConfig::reachable_by_arm`) reads
+/// the box's four sides and its top, never the bottom resting on the table, which the free sampler
+/// reads as often as its area says; every start it keeps is one the arm's IK and collision check
+/// accept.
+#[test]
+fn reachable_sampler_reads_every_face_but_the_one_on_the_table() {
+    use taction::explore::SamplerConfig;
+    let reachable = Valid::new(SamplerConfig {
+        reachable_by_arm: true,
+        ..SamplerConfig::default()
+    })
+    .unwrap();
+    let plan = plan(CollectMode::Sampler(reachable), 60, PerturbationBounds::NONE);
+    let report = plan.collect_object(&box_object(), 0).unwrap();
+    assert_eq!(report.converged(), 60);
+    let mut faces = std::collections::BTreeSet::new();
+    for r in report
+        .readings
+        .iter()
+        .filter(|r| r.status == ContactStatus::Converged)
+    {
+        let n = r.image.pose().unwrap().normal;
+        let axis = (0..3).max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs())).unwrap();
+        faces.insert((axis, n[axis] > 0.0));
+    }
+    // The bottom face is read by a pad looking up (+z).
+    assert!(!faces.contains(&(2, true)), "the bottom face was read: {faces:?}");
+    assert_eq!(faces.len(), 5, "faces read: {faces:?}");
+}
+
 /// The dataset a collection writes depends on the seed only: 1 and 2 worker threads write
 /// byte-identical files, for the sampler and for the planner; another seed writes another file.
 #[test]

@@ -1,6 +1,9 @@
-//! `taction demo`: the product in one run. Trains a recogniser on the 3D object set from sampler
-//! readings (or reuses the model it cached), then lets the arm explore one object whose identity and
-//! pose it does not know, printing after every converged touch the best guess, its probability and
+//! `taction demo`: the product in one run. Trains a recogniser on the 3D object set (or reuses the
+//! model it cached) the way that matches what the arm feels: readings of the training sampler
+//! restricted to the starts the arm can take from any heading of the object, the pad pressed by the
+//! same rigid-backed controllers, MNTI and SIFT fused over the neighbour codebook (the end-to-end
+//! experiment's recipe, `taction experiment end-to-end`). Then the arm explores one object whose
+//! identity it does not know, standing on the table at a heading, tilt and place it is not told, printing after every converged touch the best guess, its probability and
 //! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
 //! the posterior over touches, a contact sheet of the tactile images and the paper's Fig. 1: the object
 //! with a patch at every converged touch, the images beside it. `--strategy active` chooses
@@ -13,22 +16,22 @@ use std::path::PathBuf;
 use clap::Args;
 use rand::RngExt;
 use taction::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
-use taction::dataset::ContactStatus;
 use taction::dataset::describe_shortfalls;
 use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::progress::CollectionProgress;
 use taction::explore::Probability;
+use taction::explore::SamplerConfig;
 use taction::explore::active::DEFAULT_CANDIDATES;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::exploration::{Placement, write_exploration_png};
-use taction::recognize::model::TrainedModel;
 use taction::recognize::selection::{TrainConfig, codebook_sizes};
+use taction::recognize::{CodebookKind, DescriptorChoice, FusedModel, Recognizer};
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
-use taction::sim::{PerturbationBounds, SceneBuilder};
+use taction::sim::{Perturbation, PerturbationBounds, SceneBuilder};
 use taction::tactile::image::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
@@ -41,6 +44,15 @@ use crate::cli::plausible::{Carrier, build_objects};
 const UNKNOWN_OBJECT_STREAM: u64 = 0xDE30;
 const PLANNER_STREAM: u64 = 0xE7;
 
+/// The seed of the training data and the model: the model is the product's, trained once and
+/// cached, whatever `--seed` draws (the unknown object, its pose, the exploration).
+const TRAINING_SEED: u64 = 1;
+
+/// The demo's descriptors, fused: on the arm's own touches of the 12 shapes (6x6, 3000 reachable
+/// sampler readings per object, neighbour codebook) MNTI and SIFT together named 90% of 120 blind
+/// explorations right after 30 touches, MNTI alone 82%.
+const DEMO_DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
+
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// The object set to learn (a built-in set, a folder of meshes, or mesh files).
@@ -49,11 +61,11 @@ pub struct DemoArgs {
     /// The object to explore [default: one drawn with the seed].
     #[arg(long)]
     pub object: Option<String>,
-    /// Sampler readings per object for training.
-    #[arg(long, default_value_t = 150)]
+    /// Sampler readings per object for training (starts the arm can reach).
+    #[arg(long, default_value_t = 3000)]
     pub training_readings: usize,
     /// Converged touches of the unknown object.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 30)]
     pub touches: usize,
     #[command(flatten)]
     pub seed: SeedArg,
@@ -99,24 +111,25 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         Carrier::Arm,
         "rescale the meshes to metres (or collect them with `taction collect --object-size-m`)",
     )?;
-    let descriptor_kind = DescriptorKind::PolarFourier;
-    let descriptor = descriptor_kind.build();
+    let choice = DescriptorChoice::fused(DEMO_DESCRIPTORS.to_vec())?;
+    let descriptors: Vec<_> = choice.kinds().iter().map(|k| k.build()).collect();
 
-    // 1. The model: cached per (object set, readings, seed), else trained now.
+    // 1. The model: cached per (object set, readings, training seed, descriptors), else trained now.
     let model_path = args.out.join(format!(
-        "model-{}-{}-{}.json",
+        "model-{}-{}-{}-{}-reachable-knn.json",
         set.id(),
         args.training_readings,
-        args.seed.seed
+        TRAINING_SEED,
+        choice.name()
     ));
-    let model = match TrainedModel::load(&model_path) {
-        Ok(model) if model.check_sensor(&sensor).is_ok() => {
+    let model = match Recognizer::load(&model_path) {
+        Ok(Recognizer::Fused(model)) if model.fused.iter().all(|m| m.check_sensor(&sensor).is_ok()) => {
             println!("using the model trained before: {}", model_path.display());
             model
         }
         _ => {
             println!(
-                "training: {} sampler readings of each of {} objects ({})",
+                "training: {} sampler readings of each of {} objects from starts the arm can reach ({})",
                 args.training_readings,
                 objects.len(),
                 objects
@@ -126,12 +139,15 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
                     .join(", ")
             );
             let plan = CollectPlan {
-                mode: CollectMode::Sampler(Valid::default()),
+                mode: CollectMode::Sampler(Valid::new(SamplerConfig {
+                    reachable_by_arm: true,
+                    ..SamplerConfig::default()
+                })?),
                 sensor,
                 control: Valid::default(),
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: args.training_readings,
-                seed: args.seed.seed,
+                seed: TRAINING_SEED,
             };
             let progress = CollectionProgress::new("training data", objects.len(), args.training_readings);
             let dataset = plan.collect_dataset(&set.id(), &objects, 0, &|| progress.converged())?;
@@ -140,30 +156,30 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             if !short.is_empty() {
                 eprintln!("warning: training: {}", describe_shortfalls(&short));
             }
+            let codebook = CodebookKind::Knn;
             let mut config = TrainConfig {
+                codebook,
                 restarts: 1,
-                seed: args.seed.seed,
+                seed: TRAINING_SEED,
+                variance_kept: codebook.default_variance_kept(),
                 ..TrainConfig::default()
             };
             // The hold-out keeps about `holdout` of each object's readings for validation; one
-            // Polar-Fourier feature per converged reading.
-            let converged = dataset
-                .readings()
-                .iter()
-                .filter(|r| r.status == ContactStatus::Converged)
-                .count();
+            // feature per converged reading under the descriptor that gives the fewest.
+            let converged = dataset.converged_only().len();
             let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
             config.ks = codebook_sizes(config.codebook, dataset.header().objects.len(), training_features);
             println!(
-                "training: {training_features} training features; trying k = {:?}",
+                "training {}: {training_features} training readings; trying k = {:?}",
+                choice.name(),
                 config.ks
             );
-            let model = TrainedModel::fit(&dataset, None, descriptor.as_ref(), config, &mut |_| {})?;
+            let model = FusedModel::fit(&dataset, None, &choice, config, &mut |_| {})?;
             model.save(&model_path)?;
             model
         }
     };
-    let names = model.bag.objects().to_vec();
+    let names = model.objects().to_vec();
 
     // 2. The unknown object, at a pose the planner is not told.
     let mut r = rng::stream(args.seed.seed, UNKNOWN_OBJECT_STREAM);
@@ -182,8 +198,17 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         PAD_SITE,
     )?
     .build()?;
+    // Any heading about the vertical, then the perturbation of Sec. V-B4 (a tilt of up to 10
+    // degrees about a random axis, a shift of up to 10% of the width): the object stands on the
+    // table as objects do, in a pose the planner is not told.
     let width = scene.object_width_m().unwrap_or(0.1);
-    let shuffle = PerturbationBounds::new(180.0, 0.1)?.draw(width, &mut r);
+    let heading = Perturbation {
+        axis: glam::DVec3::Z,
+        angle_rad: r.random_range(0.0..std::f64::consts::TAU),
+        translation_m: glam::DVec3::ZERO,
+    };
+    scene.perturb_object(&heading)?;
+    let shuffle = PerturbationBounds::new(10.0, 0.1)?.draw(width, &mut r);
     scene.perturb_object(&shuffle)?;
     println!(
         "exploring an unknown object with the arm (it is '{}'; the planner is not told)",
@@ -211,7 +236,11 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         rng::stream(args.seed.seed, PLANNER_STREAM),
         reader,
     )?;
-    let mut recognition = ActiveRecognition::new(&model.bag, descriptor.as_ref(), planner_config.grid_cell_m);
+    let mut recognition = ActiveRecognition::fused(
+        &model,
+        descriptors.iter().map(|d| d.as_ref()).collect(),
+        planner_config.grid_cell_m,
+    )?;
     let mut csv = String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n");
     let mut p_true_series = Vec::new();
     println!(

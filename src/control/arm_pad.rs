@@ -3,23 +3,26 @@
 //! [`MoveOptions`]: position servos while MuJoCo steps, or MuJoCo-checked kinematic motion (see
 //! `sim::arm`), Sec. III-B on the arm of Sec. V-A1. The sensor is read only when a command is done.
 //!
-//! The pad's rigid back is as wide as the covering, so it reaches the surface exactly when a taxel
-//! would read full compression: MuJoCo's contacts see it reach the table, the covering sensor on
-//! the pad site (`control::carrier::pad_back_check`, as on the free-floating pad) sees it reach
-//! the object's exact surface, which the object's convex collision pieces only approximate. A Press command that would press it onto the
-//! surface is refused
-//! (the carrier stays at its previous pose and reports [`PadMotion::RigidContact`], Press's
-//! saturation termination). An Orient command that would do so, because tilting the pad about the
-//! contact centroid lowers its far edge, is executed backed off along the new pad normal by the
-//! least of t/4, t/2 or t that keeps the back clear, as a compliant wrist would; Press then closes the
-//! gap. Refusing the rotation instead (the carrier returning to its previous pose) left Orient
-//! repeating the same refused command until the iteration budget ran out, the arm's most common
-//! failure (`MaxIterations`) while the free-floating pad, whose back passes through the surface,
-//! converged at the same place.
+//! On the object the pad is stopped by Press's own terminations alone (Sec. III-B: the mean
+//! pressure reached, or a taxel close to saturation), as the free-floating pad of the training
+//! sampler is: the pad's rigid back collides with the table but not with the object
+//! (`mjcf/arm.xml`), whose contact with the pad is what the covering measures. The two carriers
+//! therefore settle to the same image from the same start (`tests/carrier_parity.rs`). An exact
+//! stop at the object's triangles, which this carrier had and the free pad had not, ended Press
+//! at a sharp feature's tip: the arm's readings of the dragon pressed to a mean of 0.13 where the
+//! free pad's reached 0.27, 44% of the arm's readings were cut short so, and the model learned
+//! images the arm never felt; given to both carriers it cut Fig. 14's convergence on the dragon
+//! from 100% to 63%.
+//!
+//! A Press command that would press the back onto the table is refused (the carrier stays at its
+//! previous pose and reports [`PadMotion::RigidContact`]). An Orient command that would do so is
+//! executed backed off along the new pad normal by the least of t/4, t/2 or t that keeps the back
+//! clear, as a compliant wrist would; Press then closes the gap. The IK holds the pad's roll
+//! through both (`InverseKinematics::solve_with_up`).
 
 use glam::DVec3;
 
-use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off, pad_back_check};
+use crate::control::carrier::{ControlError, PadCarrier, PadMotion, backed_off};
 use crate::pose::Pose;
 use crate::sim::arm::Execution;
 use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
@@ -44,10 +47,6 @@ pub struct ArmPad<'s, R> {
     motion: MoveOptions,
     /// The configuration at which a Press command was last refused outright by a rigid contact.
     refused_at: Option<Vec<f64>>,
-    /// The back's contact with the object, which MuJoCo's contacts do not see: the object's
-    /// collision shell does not collide with the back (`mjcf/arm.xml`), so that the back can come
-    /// as close to the exact surface as the covering allows. `None` without a covering sensor.
-    back_check: Option<BackCheck<'s>>,
 }
 
 impl<'s, R> ArmPad<'s, R>
@@ -63,7 +62,6 @@ where
         motion: MoveOptions,
     ) -> Result<Self, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
-        let back_check = pad_back_check(scene.model());
         Ok(Self {
             scene,
             arm,
@@ -72,7 +70,6 @@ where
             reader,
             motion,
             refused_at: None,
-            back_check,
         })
     }
 
@@ -184,20 +181,7 @@ where
             }
         };
         Ok(match self.arm.move_to(self.scene, &q, &self.motion, |_| false)? {
-            MoveOutcome::Reached | MoveOutcome::Stopped => {
-                let back_reached = match &mut self.back_check {
-                    Some(check) => check(self.scene)?,
-                    None => false,
-                };
-                if back_reached {
-                    // The exact check sees only where the motion ended: back to where it began,
-                    // which was clear (the servo's retreat).
-                    self.arm.place(self.scene, start);
-                    (PadMotion::RigidContact, Some(Collision::back_on_object()))
-                } else {
-                    (PadMotion::Moved, None)
-                }
-            }
+            MoveOutcome::Reached | MoveOutcome::Stopped => (PadMotion::Moved, None),
             MoveOutcome::Collided(c) if self.is_pad_contact(&c) => {
                 if self.motion.execution == Execution::Servo {
                     self.arm.place(self.scene, start);

@@ -1,14 +1,15 @@
 //! The free-floating pad as a [`PadCarrier`]: the pad site on a mocap body with no arm, moved by
 //! writing the mocap pose (the training sampler of Sec. V-A3, and `taction touch`).
 //!
-//! Its rigid back is the arm pad's (`control::arm_pad`): a command that would put the object into
-//! the back is refused (Press) or backed off along the new normal (Orient), so that both carriers,
-//! started over the same patch from the same direction, settle to the same image.
+//! Nothing but Press's own terminations stops it (Sec. III-B: the mean pressure reached, or a
+//! taxel close to saturation), as nothing else stops the arm's pad on the object
+//! (`control::arm_pad`): started over the same patch from the same direction, both settle to the
+//! same image (`tests/carrier_parity.rs`).
 
 use mujoco_rs::prelude::*;
 
 use crate::control::arm_pad::pad_pose_of_site;
-use crate::control::carrier::{BackCheck, ControlError, PadCarrier, PadMotion, backed_off, pad_back_check};
+use crate::control::carrier::{ControlError, PadCarrier, PadMotion};
 use crate::pose::Pose;
 use crate::sim::arm::{PAD_SITE, site_pose};
 use crate::sim::{Scene, SimError};
@@ -24,8 +25,6 @@ pub struct FreePad<'s, R> {
     site_in_body: Pose,
     sensor: SensorConfig,
     reader: R,
-    /// The pad's rigid back; `None` in a scene without a covering sensor on the pad.
-    back_check: Option<BackCheck<'s>>,
 }
 
 impl<'s, R> FreePad<'s, R>
@@ -48,7 +47,6 @@ where
             return Err(missing("the body carrying site 'pad' is not a mocap body").into());
         }
         let site_in_body = Pose::from_mujoco(model.site_pos()[site], model.site_quat()[site]);
-        let back_check = pad_back_check(model);
         Ok(Self {
             scene,
             site,
@@ -56,7 +54,6 @@ where
             site_in_body,
             sensor,
             reader,
-            back_check,
         })
     }
 
@@ -72,15 +69,6 @@ where
         data.mocap_pos_mut()[self.mocap] = body.position_m.to_array();
         data.mocap_quat_mut()[self.mocap] = body.mujoco_quat();
         data.kinematics();
-    }
-}
-
-impl<R> FreePad<'_, R> {
-    fn back_reached(&mut self) -> Result<bool, ControlError> {
-        match &mut self.back_check {
-            Some(check) => check(self.scene),
-            None => Ok(false),
-        }
     }
 }
 
@@ -105,20 +93,7 @@ where
         if !(target.center_m.is_finite() && target.normal.is_finite() && target.up.is_finite()) {
             return Ok(PadMotion::Unreachable);
         }
-        let current = self.pad_pose();
         self.place(target);
-        if !self.back_reached()? {
-            return Ok(PadMotion::Moved);
-        }
-        if current.normal.angle_between(target.normal) > 1e-6 {
-            for retreated in backed_off(target, self.sensor.thickness_m) {
-                self.place(&retreated);
-                if !self.back_reached()? {
-                    return Ok(PadMotion::Moved);
-                }
-            }
-        }
-        self.place(&current);
-        Ok(PadMotion::RigidContact)
+        Ok(PadMotion::Moved)
     }
 }

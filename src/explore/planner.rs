@@ -669,6 +669,15 @@ pub fn turn_toward(from: DVec3, to: DVec3, max_rad: f64) -> DVec3 {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn the_iteration_budget_grows_with_the_readings_asked_for() {
+        assert_eq!(PlannerConfig::iterations_for(10), 20_000);
+        assert_eq!(PlannerConfig::iterations_for(100), 20_000);
+        assert_eq!(PlannerConfig::iterations_for(1000), 200_000);
+        assert_eq!(PlannerConfig::iterations_for(usize::MAX), usize::MAX);
+    }
+
     use super::*;
 
     #[test]
