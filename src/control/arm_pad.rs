@@ -12,7 +12,10 @@
 //! at a sharp feature's tip: the arm's readings of the dragon pressed to a mean of 0.13 where the
 //! free pad's reached 0.27, 44% of the arm's readings were cut short so, and the model learned
 //! images the arm never felt; given to both carriers it cut Fig. 14's convergence on the dragon
-//! from 100% to 63%.
+//! from 100% to 63%. The price: where a feature narrower than a taxel (an ear, a horn) pokes into
+//! the covering, no taxel saturates and the pad plane can pass the surface there (by up to 2.2 mm
+//! on the shapes, `tests/explore_shapes.rs` counts it), as the paper's simulated sensor, a depth
+//! camera through the covering, allows.
 //!
 //! A Press command that would press the back onto the table is refused (the carrier stays at its
 //! previous pose and reports [`PadMotion::RigidContact`]). An Orient command that would do so is

@@ -2,7 +2,7 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scales 0.2 and 1.0 (the paper's, the default; together 61 minutes); at any other
+//! scales 0.2 and 1.0 (the paper's, the default; together 61 minutes, and 10 more estimated for `end-to-end`); at any other
 //! scale it is the power law through the 1.0 timing, `t(s) = t_1 s^p`, with the exponent the two
 //! timings give, `p = ln(t_1 / t_0.2) / ln 5`, held in [1, 3]: data collection grows linearly with
 //! the scale and codebook fitting faster, so a smaller `p` only says that the 0.2 timing was
@@ -41,7 +41,10 @@ const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
     // Re-measured alone (collecting all its data) when it grew to 10,000 readings per object.
     ("training-size", 54.5, 298.7),
     ("active", 126.7, 417.6),
-    ("end-to-end", 120.0, 900.0),
+    // Not a timed run: its datasets' collection and models' training timed alone in the session
+    // that added it (test explorations 4 x 3 x 12 x 100 planner readings, about 60 s per 3600 on
+    // 2 cores; 36,000 reachable sampler readings 58 s; four neighbour models).
+    ("end-to-end", 120.0, 600.0),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
@@ -175,7 +178,7 @@ mod tests {
             .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
             .sum();
         assert!(
-            (60.0 * 60.0..62.0 * 60.0).contains(&whole_run),
+            (70.0 * 60.0..72.0 * 60.0).contains(&whole_run),
             "{whole_run} s at scale 1.0"
         );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);
