@@ -139,21 +139,29 @@ fn planner_collects_converged_readings_on_a_box() {
     }
 }
 
-#[test]
-fn sampler_readings_cover_every_face_of_a_box() {
-    let plan = plan(
-        CollectMode::Sampler(Valid::default()),
-        60,
-        PerturbationBounds::NONE,
-    );
+/// 60 converged readings of the box by the sampler `mode`, with the plan that took them.
+fn sampled_box(mode: CollectMode) -> (CollectPlan, taction::explore::ExplorationReport) {
+    let plan = plan(mode, 60, PerturbationBounds::NONE);
     let report = plan.collect_object(&box_object(), 0).unwrap();
     assert_eq!(report.converged(), 60);
-    let mut faces = std::collections::BTreeSet::new();
-    for r in report
+    (plan, report)
+}
+
+/// The converged readings of `report`.
+fn converged(
+    report: &taction::explore::ExplorationReport,
+) -> impl Iterator<Item = &taction::dataset::Reading> {
+    report
         .readings
         .iter()
         .filter(|r| r.status == ContactStatus::Converged)
-    {
+}
+
+#[test]
+fn sampler_readings_cover_every_face_of_a_box() {
+    let (plan, report) = sampled_box(CollectMode::Sampler(Valid::default()));
+    let mut faces = std::collections::BTreeSet::new();
+    for r in converged(&report) {
         let n = r.image.pose().unwrap().normal;
         let axis = if n.x.abs() > 0.7 {
             0
@@ -201,15 +209,9 @@ fn reachable_sampler_reads_every_face_but_the_one_on_the_table() {
         ..SamplerConfig::default()
     })
     .unwrap();
-    let plan = plan(CollectMode::Sampler(reachable), 60, PerturbationBounds::NONE);
-    let report = plan.collect_object(&box_object(), 0).unwrap();
-    assert_eq!(report.converged(), 60);
+    let (_, report) = sampled_box(CollectMode::Sampler(reachable));
     let mut faces = std::collections::BTreeSet::new();
-    for r in report
-        .readings
-        .iter()
-        .filter(|r| r.status == ContactStatus::Converged)
-    {
+    for r in converged(&report) {
         let n = r.image.pose().unwrap().normal;
         let axis = (0..3).max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs())).unwrap();
         faces.insert((axis, n[axis] > 0.0));
