@@ -13,13 +13,13 @@ use taction::control::arm_pad::{ArmPad, pad_pose_of_site};
 use taction::control::free_pad::FreePad;
 use taction::control::{ContactOutcome, ControlConfig, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::SurfaceSampler;
 use taction::explore::collect::sensor_reader;
 use taction::explore::planner::precise_kinematic_motion;
+use taction::explore::{SurfaceSampler, carried};
 use taction::mesh::ObjectSet;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{InverseKinematics, ObjectSpec, PadTarget, Scene, SceneBuilder};
-use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, TactileImage, add_sensor};
+use taction::tactile::{CoveringSensor, FreeFloatingSensor, SensorConfig, TactileImage, add_sensor};
 use taction::valid::Valid;
 
 /// Surface points per object at which the arm's start pose is reachable and free of collision.
@@ -94,11 +94,7 @@ fn touch_both(object: &ObjectSpec, sensor: SensorConfig, seed: u64) -> (Vec<Pair
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).expect("covering"));
         let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion).expect("arm pad");
         let arm_outcome = settle(&mut pad, &control).expect("arm settles");
-        let free_start = PadPose {
-            center_m: to_free.transform_point(start.center_m),
-            normal: to_free.transform_vector(start.normal),
-            up: to_free.transform_vector(start.up),
-        };
+        let free_start = carried(&start, &to_free);
         let reader = sensor_reader(free.sensor().clone());
         let mut pad = FreePad::new(free.scene_mut(), sensor, reader).expect("free pad");
         pad.place(&free_start);

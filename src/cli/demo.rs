@@ -1,9 +1,10 @@
 //! `taction demo`: the product in one run. Trains a recogniser on the 3D object set (or reuses the
 //! model it cached) the way that matches what the arm feels: readings of the training sampler
-//! restricted to the starts the arm can take from any heading of the object, the pad pressed by the
-//! same rigid-backed controllers, MNTI and SIFT fused over the neighbour codebook (the end-to-end
-//! experiment's recipe, `taction experiment end-to-end`). Then the arm explores one object whose
-//! identity it does not know, standing on the table at a heading, tilt and place it is not told, printing after every converged touch the best guess, its probability and
+//! restricted to the starts the arm can take from any heading of the object, pressed by the same
+//! controllers as the arm's pad, MNTI and SIFT fused over the neighbour codebook (the README's
+//! "Training that matches the arm"). Then the arm explores one object whose identity it does not
+//! know, standing on the table at a heading, tilt and place it is not told, printing after every
+//! converged touch the best guess, its probability and
 //! the entropy of the posterior (Sec. IV-A, Appendix Eq. 16), and writes the per-touch CSV, a plot of
 //! the posterior over touches, a contact sheet of the tactile images and the paper's Fig. 1: the object
 //! with a patch at every converged touch, the images beside it. `--strategy active` chooses
@@ -48,9 +49,9 @@ const PLANNER_STREAM: u64 = 0xE7;
 /// cached, whatever `--seed` draws (the unknown object, its pose, the exploration).
 const TRAINING_SEED: u64 = 1;
 
-/// The demo's descriptors, fused: on the arm's own touches of the 12 shapes (6x6, 3000 reachable
-/// sampler readings per object, neighbour codebook) MNTI and SIFT together named 90% of 120 blind
-/// explorations right after 30 touches, MNTI alone 82%.
+/// The demo's descriptors, fused: fusing SIFT's gradient orientations with MNTI's moments gained
+/// on the arm's own touches as on sampler data (the README's "Training that matches the arm" has
+/// the measurements).
 const DEMO_DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
 
 #[derive(Debug, Args)]
@@ -73,8 +74,8 @@ pub struct DemoArgs {
     #[arg(long, default_value = "results/demo")]
     pub out: PathBuf,
     /// How the arm chooses where to touch: `blind`, the paper's planner (local strategy with
-    /// probability 0.5, else global: the setting the recipe was measured at), or `active`, the candidate touch with the largest expected
-    /// information gain about the object's identity.
+    /// probability 0.5, else global: the setting the recipe was measured at), or `active`, the
+    /// candidate touch with the largest expected information gain about the object's identity.
     #[arg(long, value_enum, default_value_t = DemoStrategy::Blind)]
     pub strategy: DemoStrategy,
     /// Stop exploring once the best guess's probability reaches P, a probability in (0, 1]

@@ -669,6 +669,7 @@ pub fn turn_toward(from: DVec3, to: DVec3, max_rad: f64) -> DVec3 {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn the_iteration_budget_grows_with_the_readings_asked_for() {
@@ -677,8 +678,6 @@ mod tests {
         assert_eq!(PlannerConfig::iterations_for(1000), 200_000);
         assert_eq!(PlannerConfig::iterations_for(usize::MAX), usize::MAX);
     }
-
-    use super::*;
 
     #[test]
     fn every_numeric_field_is_checked_and_named() {

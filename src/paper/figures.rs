@@ -265,7 +265,8 @@ pub const END_TO_END_TRAINING_FRACTION: f64 = 3.0;
 /// and 1, the object fixed or perturbed after every reading, Sec. V-B3-4) and is recognised by a
 /// model trained the paper's way (1000 sampler readings per object from every direction) or ours:
 /// three times as many readings of the sampler restricted to the starts the arm can take from any
-/// heading of the object (`SamplerConfig::reachable_by_arm`), pressed by the same rigid-backed pad.
+/// heading of the object (`SamplerConfig::reachable_by_arm`). Both carriers press alike
+/// (`tests/carrier_parity.rs`).
 pub fn end_to_end() -> RecognitionSweep {
     let perturbed = PerturbationBounds::new(10.0, 0.1).unwrap_or(PerturbationBounds::NONE);
     let curves = |training: &str| {
