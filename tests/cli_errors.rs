@@ -159,10 +159,118 @@ fn coordinates_that_are_not_metres_are_refused_with_the_fix() {
         1,
     );
     assert!(
-        line.contains("huge.obj") && line.contains("use --object-size-m"),
+        line.contains("huge.obj") && line.contains("--object-size-m"),
         "{line}"
     );
     assert!(!Path::new(&ds).exists());
+}
+
+/// Every command that builds objects refuses a mesh in millimetres before it simulates or writes
+/// anything, and takes the one rescale flag, `--object-size-m`.
+#[test]
+fn every_command_refuses_millimetres_and_takes_object_size_m() {
+    let dir = tempfile::tempdir().unwrap();
+    let meshes = dir.path().join("mm");
+    std::fs::create_dir(&meshes).unwrap();
+    // A 50 mm tetrahedron written in millimetres: an 86.6 m diagonal when read as metres.
+    let mesh = write(&meshes, "box_mm.obj", &TETRA.replace("0.05", "50"));
+    let folder = meshes.display().to_string();
+    let out = dir.path().join("out").display().to_string();
+    let commands: [&[&str]; 5] = [
+        &[
+            "experiment",
+            "descriptors",
+            "--objects",
+            &folder,
+            "--scale",
+            "0.02",
+            "--out",
+            &out,
+        ],
+        &[
+            "reproduce",
+            "--only",
+            "noise",
+            "--objects",
+            &folder,
+            "--scale",
+            "0.02",
+            "--out",
+            &out,
+        ],
+        &["demo", "--objects", &folder, "--out", &out],
+        &["scene", "export", "--object", &mesh, "--out", &out],
+        &["objects", "export", &folder, "--out", &out],
+    ];
+    for args in commands {
+        let line = fails_with(&taction(args), 1);
+        assert!(
+            line.contains("box_mm") && line.contains("86.6 m") && line.contains("--object-size-m"),
+            "{args:?}: {line}"
+        );
+        assert!(!Path::new(&out).join("scene.xml").exists(), "{args:?}");
+    }
+    // A metre-sized object is a table-top object for the free pad but out of the arm's reach.
+    let metre = write(dir.path(), "metre.obj", &TETRA.replace("0.05", "1"));
+    let line = fails_with(
+        &taction(&["scene", "export", "--object", &metre, "--out", &out]),
+        1,
+    );
+    assert!(line.contains("the arm's workspace"), "{line}");
+    // Rescaled, the same file exports, at the size asked for.
+    let scene = dir.path().join("scene");
+    let done = taction(&[
+        "scene",
+        "export",
+        "--object",
+        &mesh,
+        "--object-size-m",
+        "0.1",
+        "--out",
+        &scene.display().to_string(),
+    ]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    let exported = taction::mesh::load(&scene.join("box_mm.obj")).unwrap().mesh;
+    let diagonal_m = exported.bounding_diagonal_m().unwrap();
+    assert!((diagonal_m - 0.1).abs() < 1e-9, "{diagonal_m}");
+    let line = fails_with(
+        &taction(&[
+            "objects",
+            "export",
+            &folder,
+            "--object-size-m",
+            "0",
+            "--out",
+            &out,
+        ]),
+        2,
+    );
+    assert!(line.contains("not a positive number of metres"), "{line}");
+}
+
+/// A quick look into the folder of an earlier run of another scale stops at once, naming the
+/// folder and what differs, before any estimate or data collection.
+#[test]
+fn an_experiment_refuses_a_folder_of_another_scale_before_it_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let earlier = dir.path().join("strategy");
+    std::fs::create_dir(&earlier).unwrap();
+    std::fs::write(
+        earlier.join("config.json"),
+        r#"{"scale": 1.0, "seed": 1, "training": {"codebook": "gmm"}}"#,
+    )
+    .unwrap();
+    let out = dir.path().display().to_string();
+    let run = taction(&["experiment", "strategy", "--scale", "0.1", "--out", &out]);
+    let line = fails_with(&run, 1);
+    assert!(
+        line.contains("scale 1, seed 1, codebook gmm")
+            && line.contains("scale 0.1")
+            && line.contains("--out"),
+        "{line}"
+    );
+    assert!(!stderr(&run).contains("estimated duration"), "{}", stderr(&run));
+    assert!(!earlier.join("units").exists());
 }
 
 #[test]

@@ -14,7 +14,7 @@ use taction::sim::PerturbationBounds;
 use taction::tactile::image::write_contact_sheet;
 use taction::valid::Valid;
 
-use crate::cli::common::{ControlArg, SeedArg, ThreadsArg, flag_error};
+use crate::cli::common::{ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
 
@@ -35,9 +35,8 @@ pub struct CollectArgs {
     /// The objects: a built-in set name, a folder of OBJ/OFF/STL files, a manifest, or mesh files.
     #[arg(long, num_args = 1.., required = true, value_name = "DIR|FILES|SET")]
     pub objects: Vec<PathBuf>,
-    /// Rescale user meshes to this bounding diagonal, metres (centred, resting on the table).
-    #[arg(long, allow_hyphen_values = true)]
-    pub object_size_m: Option<f64>,
+    #[command(flatten)]
+    pub object_size: ObjectSizeArg,
     #[arg(long, value_enum, default_value_t = Mode::Sampler)]
     pub mode: Mode,
     /// Converged readings per object (at most 1000000; the paper trains on 1000).
@@ -113,22 +112,14 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         )
         .into());
     }
-    if let Some(size) = args.object_size_m.filter(|d| !(d.is_finite() && *d > 0.0)) {
-        return Err(flag_error("object-size-m", size, "want a positive number of metres").into());
-    }
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed.seed)?;
-    let set = ObjectSet::resolve(&args.objects, None, args.object_size_m)?;
+    let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
     let carrier = match args.mode {
         Mode::Sampler => Carrier::FreePad,
         Mode::Planner => Carrier::Arm,
     };
-    let objects = build_objects(
-        &set,
-        "collect",
-        carrier,
-        "use --object-size-m to rescale the meshes to a bounding diagonal in metres",
-    )?;
+    let objects = build_objects(&set, "collect", carrier)?;
     let (mode, generator) = match args.mode {
         Mode::Sampler => {
             let config = SamplerConfig {

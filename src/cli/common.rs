@@ -24,6 +24,30 @@ pub struct SeedArg {
     pub seed: u64,
 }
 
+/// `--object-size-m`: the one rescale flag of every command that builds objects from the user's
+/// meshes (a mesh read as metres can be millimetres; `taction::mesh::check_plausible` then refuses
+/// it and points here).
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct ObjectSizeArg {
+    /// Rescale user meshes to this bounding diagonal, metres (centred, resting on the table);
+    /// built-in sets keep their own size.
+    #[arg(
+        long = "object-size-m",
+        alias = "diagonal-m",
+        value_name = "M",
+        allow_hyphen_values = true,
+        value_parser = parse_object_size_m
+    )]
+    pub m: Option<f64>,
+}
+
+fn parse_object_size_m(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
+        _ => Err(format!("'{text}' is not a positive number of metres")),
+    }
+}
+
 /// Worker threads per core at most: beyond this the threads only wait for the cores and each
 /// still reserves its stack.
 pub const THREADS_PER_CORE: usize = 4;

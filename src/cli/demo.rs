@@ -37,7 +37,7 @@ use taction::tactile::image::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{OutputLock, SeedArg, flag_error};
+use crate::cli::common::{ObjectSizeArg, OutputLock, SeedArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 
 /// The random stream that draws the unknown object and its pose, and the planner's own stream
@@ -59,6 +59,8 @@ pub struct DemoArgs {
     /// The object set to learn (a built-in set, a folder of meshes, or mesh files).
     #[arg(long, default_value = "shapes")]
     pub objects: PathBuf,
+    #[command(flatten)]
+    pub object_size: ObjectSizeArg,
     /// The object to explore [default: one drawn with the seed].
     #[arg(long)]
     pub object: Option<String>,
@@ -105,13 +107,8 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let _lock = OutputLock::acquire(&args.out, "out")?;
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
-    let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, None)?;
-    let objects = build_objects(
-        &set,
-        "demo",
-        Carrier::Arm,
-        "rescale the meshes to metres (or collect them with `taction collect --object-size-m`)",
-    )?;
+    let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, args.object_size.m)?;
+    let objects = build_objects(&set, "demo", Carrier::Arm)?;
     let choice = DescriptorChoice::fused(DEMO_DESCRIPTORS.to_vec())?;
     let descriptors: Vec<_> = choice.kinds().iter().map(|k| k.build()).collect();
 

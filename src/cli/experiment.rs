@@ -6,6 +6,7 @@ use std::time::Instant;
 use clap::Args;
 use taction::experiment::RunOptions;
 use taction::mesh::ObjectSet;
+use taction::mesh::object_set::BUILTIN_SETS;
 use taction::paper::data::{SHORTFALLS_FILE, read_shortfalls};
 use taction::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::paper::headline::headline_table;
@@ -14,7 +15,8 @@ use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIAL
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 use taction::valid::Check;
 
-use crate::cli::common::{OutputLock, SeedArg, ThreadsArg, UsageError, parse_codebook};
+use crate::cli::common::{ObjectSizeArg, OutputLock, SeedArg, ThreadsArg, UsageError, parse_codebook};
+use crate::cli::plausible::{Carrier, build_objects};
 use taction::recognize::CodebookKind;
 
 /// What every paper experiment takes.
@@ -33,6 +35,8 @@ pub struct PaperArgs {
     /// The 3D objects: a built-in set, a folder of meshes, a manifest, or mesh files.
     #[arg(long, num_args = 1.., default_value = "shapes", value_name = "SET")]
     pub objects: Vec<PathBuf>,
+    #[command(flatten)]
+    pub object_size: ObjectSizeArg,
     /// The raised letters (Fig. 16a): the built-in `letters` or another set.
     #[arg(long, num_args = 1.., default_value = "letters", value_name = "SET")]
     pub letters: Vec<PathBuf>,
@@ -81,8 +85,12 @@ pub struct PaperArgs {
 
 impl PaperArgs {
     fn context(&self) -> Result<PaperContext, Box<dyn std::error::Error>> {
-        let shapes = ObjectSet::resolve(&self.objects, None, None).map_err(|e| format!("--objects: {e}"))?;
-        let letters = ObjectSet::resolve(&self.letters, None, None).map_err(|e| format!("--letters: {e}"))?;
+        let shapes = ObjectSet::resolve(&self.objects, None, self.object_size.m)
+            .map_err(|e| format!("--objects: {e}"))?;
+        let letters = ObjectSet::resolve(&self.letters, None, self.object_size.m)
+            .map_err(|e| format!("--letters: {e}"))?;
+        check_user_set("objects", &self.objects, &shapes)?;
+        check_user_set("letters", &self.letters, &letters)?;
         let mut real = match &self.real {
             Some(path) => RealRecording::read(path).map_err(|e| format!("--real: {e}"))?,
             None => RealRecording::example(),
@@ -107,6 +115,19 @@ impl PaperArgs {
                 .with_codebook(self.codebook),
         )
     }
+}
+
+/// Builds a set of the user's meshes once before anything runs, so that a mesh the arm cannot
+/// explore (millimetres read as metres, a flat or tiny mesh) stops the run with its name here rather
+/// than as failed readings an hour later. The built-in sets are known to pass.
+fn check_user_set(flag: &str, spec: &[PathBuf], set: &ObjectSet) -> Result<(), Box<dyn std::error::Error>> {
+    if let [one] = spec
+        && BUILTIN_SETS.contains(&one.to_string_lossy().as_ref())
+    {
+        return Ok(());
+    }
+    build_objects(set, "experiment", Carrier::Arm).map_err(|e| format!("--{flag}: {e}"))?;
+    Ok(())
 }
 
 #[derive(Debug, Args)]
@@ -146,6 +167,7 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
     let experiment = parse_experiment(&args.name)?;
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
+    check_earlier_runs(&[experiment.name()], &context)?;
     announce_estimate(&[experiment.name()], &context);
     let report = experiment.run(&context).map_err(|e| e.to_string())?;
     println!("{report}");
@@ -185,6 +207,66 @@ fn check_shortfalls(
     }
 }
 
+/// Refuses, before any estimate or data collection, to resume an experiment whose folder holds a
+/// run of another scale, seed or codebook (its `config.json`): the runner would refuse it only
+/// after collecting this run's data, and the shipped `results/` (scale 1.0, seed 1, gmm) is the
+/// default output folder.
+fn check_earlier_runs(names: &[&str], context: &PaperContext) -> Result<(), Box<dyn std::error::Error>> {
+    let ours = RunSettings {
+        scale: context.scale.fraction(),
+        seed: context.seed,
+        codebook: serde_json::to_value(context.codebook)?
+            .as_str()
+            .map(str::to_owned),
+    };
+    for name in names {
+        let path = context.options.out.join(name).join("config.json");
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        let config: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let theirs = RunSettings {
+            scale: config["scale"].as_f64().unwrap_or(ours.scale),
+            seed: config["seed"].as_u64().unwrap_or(ours.seed),
+            codebook: match config["training"]["codebook"].as_str() {
+                Some(kind) => Some(kind.to_owned()),
+                None => ours.codebook.clone(),
+            },
+        };
+        if theirs != ours {
+            return Err(format!(
+                "{} holds a run at {theirs} ({}); this run is at {ours}, and resuming would mix the two: \
+                 give this run its own --out, or delete {}",
+                path.parent().unwrap_or(&path).display(),
+                path.display(),
+                path.parent().unwrap_or(&path).display()
+            )
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// What an experiment's folder must share with a run that resumes it, as `check_earlier_runs`
+/// reads it from `config.json`.
+#[derive(Debug, PartialEq)]
+struct RunSettings {
+    scale: f64,
+    seed: u64,
+    codebook: Option<String>,
+}
+
+impl std::fmt::Display for RunSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "scale {}, seed {}", self.scale, self.seed)?;
+        match &self.codebook {
+            Some(kind) => write!(f, ", codebook {kind}"),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Prints the estimated duration of running `names` (those not finished in the output folder) and
 /// returns the estimate to update as they finish.
 fn announce_estimate(names: &[&str], context: &PaperContext) -> RunEstimate {
@@ -213,8 +295,9 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
     };
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
-    let started = Instant::now();
     let names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
+    check_earlier_runs(&names, &context)?;
+    let started = Instant::now();
     let mut estimate = announce_estimate(&names, &context);
     for experiment in &experiments {
         let begun = Instant::now();

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::cli::common::ObjectSizeArg;
 use clap::{Args, Subcommand};
 use taction::mesh::cgal::{CGAL_MESHES, ObjectCache};
 use taction::mesh::glyph::Font;
@@ -62,9 +63,8 @@ pub enum ObjectsCommand {
         /// Font of the letters set [default: OpenDyslexic, capital I of DejaVu Sans Mono, built in].
         #[arg(long, value_name = "FILE.ttf")]
         font: Option<PathBuf>,
-        /// Rescale user meshes to this bounding-box diagonal, metres (centred, resting on z = 0).
-        #[arg(long, value_name = "M")]
-        diagonal_m: Option<f64>,
+        #[command(flatten)]
+        object_size: ObjectSizeArg,
         /// Fetch the CGAL meshes first if the cache lacks them.
         #[arg(long)]
         fetch: bool,
@@ -111,10 +111,10 @@ pub fn run(args: &ObjectsArgs) -> Result<(), Box<dyn std::error::Error>> {
             set,
             out,
             font,
-            diagonal_m,
+            object_size,
             fetch,
         } => {
-            let set = ObjectSet::resolve(set, font.as_deref(), *diagonal_m)?;
+            let set = ObjectSet::resolve(set, font.as_deref(), object_size.m)?;
             export(&set, &BuildOptions { cache, fetch: *fetch }, out)
         }
     }

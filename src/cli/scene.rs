@@ -14,6 +14,8 @@ use taction::sim::arm::PAD_SITE;
 use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::tactile::add_sensor;
 
+use crate::cli::common::ObjectSizeArg;
+use crate::cli::plausible::{Carrier, check_mesh};
 use crate::cli::plugin_path::PLUGIN_LIBRARY;
 use crate::cli::sensor_args::SensorArgs;
 
@@ -41,6 +43,8 @@ pub struct ExportArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]
+    pub object_size: ObjectSizeArg,
+    #[command(flatten)]
     pub sensor: SensorArgs,
     /// Noise seed of the sensor.
     #[arg(long, default_value_t = 0)]
@@ -59,14 +63,14 @@ pub enum SceneExportError {
 }
 
 /// The object `--object` names, built as `collect` builds it (resting on z = 0, centred).
-fn resolve_object(object: &str) -> Result<BuiltObject, SceneExportError> {
+fn resolve_object(object: &str, object_size_m: Option<f64>) -> Result<BuiltObject, SceneExportError> {
     let options = BuildOptions {
         fetch: true,
         ..BuildOptions::default()
     };
     let path = Path::new(object);
     if path.is_file() {
-        let set = ObjectSet::from_files("custom", &[path.to_path_buf()], None)?;
+        let set = ObjectSet::from_files("custom", &[path.to_path_buf()], object_size_m)?;
         let name = set
             .object_names()
             .first()
@@ -89,7 +93,8 @@ fn resolve_object(object: &str) -> Result<BuiltObject, SceneExportError> {
 /// Writes the scene and its mesh; returns the scene file's path.
 pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let config = args.sensor.config(args.seed)?;
-    let built = resolve_object(&args.object)?;
+    let built = resolve_object(&args.object, args.object_size.m)?;
+    check_mesh(&format!("--object: {}", args.object), &built.mesh, Carrier::Arm)?;
     if !built.warnings.is_clean() {
         eprintln!(
             "taction scene export: warning: {}: {}",

@@ -161,12 +161,7 @@ impl PadArgs {
         carrier: Carrier,
     ) -> Result<ObjectSpec, Box<dyn std::error::Error>> {
         let loaded = taction::mesh::load(&self.mesh)?;
-        check_mesh(
-            &self.mesh.display().to_string(),
-            &loaded.mesh,
-            carrier,
-            "the mesh is placed as given: write its coordinates in metres",
-        )?;
+        check_mesh(&self.mesh.display().to_string(), &loaded.mesh, carrier)?;
         if !loaded.warnings.is_clean() {
             eprintln!(
                 "taction {command}: warning: {}: {}",

@@ -49,6 +49,7 @@ use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
 use crate::explore::report::ExplorationReport;
 use crate::explore::tree::ExplorationTree;
+use crate::mesh::SizeLimit;
 use crate::rng::Rng;
 use crate::sim::arm::{Execution, PAD_SITE, Watch};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
@@ -104,6 +105,15 @@ impl PlannerConfig {
         readings
             .saturating_mul(ITERATIONS_PER_READING)
             .max(Self::default().max_iterations)
+    }
+
+    /// The largest object the arm explores: the diagonal of the workspace box (Sec. III-A), the
+    /// only region the planner's targets are drawn from.
+    pub fn object_size_limit(&self) -> SizeLimit {
+        SizeLimit {
+            max_diagonal_m: (self.workspace_max_m - self.workspace_min_m).length(),
+            reason: "the arm's workspace",
+        }
     }
 }
 

@@ -85,6 +85,11 @@ pub enum MeshError {
     },
     #[error("fetching {what} failed: {why}")]
     Fetch { what: String, why: String },
+    #[error("object '{object}': {problem}")]
+    Implausible {
+        object: String,
+        problem: super::Implausible,
+    },
     #[error("object set: {what}")]
     ObjectSet { what: String },
 }

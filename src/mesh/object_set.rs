@@ -23,6 +23,7 @@ use super::glyph::Font;
 use super::letters::{LetterStyle, alphabet, letter_name, raised_letter};
 use super::load::{MeshFormat, load};
 use super::normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
+use super::plausible::{SizeLimit, check_plausible};
 use super::validate::ValidationReport;
 
 /// The common size of the 3D objects: a 12 cm bounding-box diagonal, table-top objects an arm can
@@ -473,6 +474,10 @@ impl ObjectSet {
             Some(d) => normalise_to_diagonal(&mesh, d)?,
             None => mesh,
         };
+        check_plausible(&mesh, SizeLimit::TABLE_TOP).map_err(|problem| MeshError::Implausible {
+            object: format!("{} ({})", object.name, object.source),
+            problem,
+        })?;
         Ok(BuiltObject {
             name: object.name.clone(),
             mesh,
