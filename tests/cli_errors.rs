@@ -230,7 +230,7 @@ fn every_command_refuses_millimetres_and_takes_object_size_m() {
         &scene.display().to_string(),
     ]);
     assert!(done.status.success(), "{}", stderr(&done));
-    let exported = taction::mesh::load(&scene.join("box_mm.obj")).unwrap().mesh;
+    let exported = taction::mesh::load(scene.join("box_mm.obj")).unwrap().mesh;
     let diagonal_m = exported.bounding_diagonal_m().unwrap();
     assert!((diagonal_m - 0.1).abs() < 1e-9, "{diagonal_m}");
     let line = fails_with(
