@@ -50,7 +50,7 @@ const PLANNER_STREAM: u64 = 0xE7;
 const TRAINING_SEED: u64 = 1;
 
 /// The demo's descriptors, fused: fusing SIFT's gradient orientations with MNTI's moments gained
-/// on the arm's own touches as on sampler data (the README's "Training that matches the arm" has
+/// on the arm's own touches as on sampler data ("Training that matches the arm" in docs/measurements.md has
 /// the measurements).
 const DEMO_DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
 

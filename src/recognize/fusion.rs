@@ -12,7 +12,7 @@
 //! normalised moments (Sec. IV-B6) gained 3.0 / 1.1 points over MNTI alone at 10 / 20 readings on
 //! the 12 shapes (6x6, neighbour codebook, 1000 training readings per object) and 3.3 / 2.0 at
 //! 26x26, where MNTI with Moment-Normalized, both moments, gained 1.1 / -1.0 and -0.5 / -0.5
-//! (README, "What resolution and a second descriptor buy").
+//! (docs/measurements.md, "What resolution and a second descriptor buy").
 
 use std::path::Path;
 
