@@ -115,7 +115,10 @@ fn closed_letter_with_holes(font: &Font, ch: char, holes: usize) -> TriMesh {
 fn all_52_letters_are_closed_oriented_solids_with_their_holes() {
     let mut meshes = BTreeMap::new();
     for ch in alphabet() {
-        meshes.insert(ch, closed_letter_with_holes(&built_in_font(ch), ch, expected_holes(ch)));
+        meshes.insert(
+            ch,
+            closed_letter_with_holes(&built_in_font(ch), ch, expected_holes(ch)),
+        );
     }
     let letters: Vec<char> = meshes.keys().copied().collect();
     for (i, a) in letters.iter().enumerate() {

@@ -16,10 +16,10 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::error::MeshError;
-use super::topology::EdgeTopology;
 use super::TriMesh;
+use super::error::MeshError;
 use super::glyph::{Font, GlyphOutline};
+use super::topology::EdgeTopology;
 use super::triangulate::{ring_area2, triangulate_with_holes};
 
 /// The size and shape parameters of the raised letters.
