@@ -44,7 +44,8 @@ enum Command {
     Scene(cli::scene::SceneArgs),
     /// One raw reading of the free-floating tactile sensor on a mesh, written as CSV or PNG.
     Sense(cli::sense::SenseArgs),
-    /// Show what a dataset file holds: objects, readings per object and status, sensor configuration.
+    /// Show what a dataset file holds (objects, readings per object and status, sensor), or import
+    /// recorded sensor frames as a dataset.
     Dataset(cli::dataset::DatasetArgs),
     /// Recognise a test dataset touch by touch with a saved model; write posterior, accuracy, confusion CSVs.
     Recognize(cli::recognize::RecognizeArgs),

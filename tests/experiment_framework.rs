@@ -730,6 +730,8 @@ fn plots_are_valid_svg_and_png_and_the_index_quotes_headlines() {
             "Robustness to noise",
             "polar-fourier",
             "noise_fraction = 0.2",
+            // The shaded band says what it is.
+            "band: lowest to highest trial",
         ],
     );
     let (w, h, colours) = decode_png(&noise.join("noise.png"));
@@ -768,6 +770,9 @@ fn plots_are_valid_svg_and_png_and_the_index_quotes_headlines() {
         ],
     );
     assert_eq!(decode_png(&conv.join("convergence.png")).0, 1280);
+    // One row per noise level: no band, so no legend entry for one.
+    let convergence_svg = std::fs::read_to_string(conv.join("convergence.svg")).unwrap();
+    assert!(!convergence_svg.contains("band: lowest to highest trial"));
 
     let index = std::fs::read_to_string(dir.path().join("README.md")).unwrap();
     assert!(

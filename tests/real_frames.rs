@@ -6,6 +6,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::{Command, Output};
 
+use taction::dataset::{ContactStatus, Dataset, Strategy};
 use taction::experiment::AccuracyRow;
 use taction::paper::context::EXAMPLE_REAL_CSV;
 use taction::paper::real_data::{Calibration, RealImport, parse_real_csv};
@@ -128,6 +129,14 @@ fn the_shipped_example_runs_end_to_end_with_every_descriptor_and_trial() {
         assert!(config.contains(needle), "config.json lacks {needle}:\n{config}");
     }
     assert!(dir.path().join("real-frames/real-frames.png").exists());
+    // The shipped example is synthetic: its plot does not claim a real sensor, and its band says
+    // what it spans.
+    let svg = std::fs::read_to_string(dir.path().join("real-frames/real-frames.svg")).unwrap();
+    assert!(
+        svg.contains("Trained and tested on example frames (synthetic)") && !svg.contains("real sensor"),
+        "the title of the example's plot"
+    );
+    assert!(svg.contains("band: lowest to highest trial"));
 }
 
 #[test]
@@ -286,4 +295,188 @@ fn a_calibration_applies_gain_and_offset_per_taxel() {
     let bad = "taxel,gain,offset\nr0c0,inf,0\n";
     let err = Calibration::parse(bad, "cal.csv").unwrap_err().to_string();
     assert!(err.contains("line 2") && err.contains("gain"), "{err}");
+}
+
+#[test]
+fn a_synthetic_mark_says_the_frames_are_not_a_real_sensors() {
+    let example = parse_real_csv(EXAMPLE_REAL_CSV, "example", &RealImport::default()).unwrap();
+    assert!(example.synthetic);
+    assert_eq!(example.frames_words(), "example frames (synthetic)");
+    let frame: Vec<f64> = (0..36).map(|k| k as f64).collect();
+    let recorded =
+        parse_real_csv(&recording(&[("A", vec![frame])]), "r.csv", &RealImport::default()).unwrap();
+    assert!(!recorded.synthetic);
+    assert_eq!(recorded.frames_words(), "real sensor frames");
+}
+
+/// The largest raw value of a frames file: what import divides by.
+fn file_max(text: &str) -> f64 {
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("label"))
+        .flat_map(|l| l.split(',').skip(1))
+        .map(|v| v.trim().parse::<f64>().unwrap())
+        .fold(0.0, f64::max)
+}
+
+/// `dataset import` of the shipped example, then `train` and `recognize` on it: the recorded frames
+/// go through the ordinary pipeline, with the very images the real-frames experiment describes.
+#[test]
+fn imported_frames_train_and_recognise_with_the_experiments_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/real_letters_example.csv");
+    // The frames themselves are no dataset; the error says how to make one.
+    let output = taction(&[
+        "train",
+        "--dataset",
+        example.to_str().unwrap(),
+        "--descriptor",
+        "polar-fourier",
+        "--out",
+        &p("never.json"),
+    ]);
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success()
+            && err.contains("not a taction dataset")
+            && err.contains("taction dataset import"),
+        "{err}"
+    );
+    run_ok(&[
+        "dataset",
+        "import",
+        example.to_str().unwrap(),
+        "--out",
+        &p("example.csv"),
+    ]);
+    let imported = Dataset::read(&dir.path().join("example.csv")).unwrap();
+    assert_eq!(imported.header().objects, ["A", "E", "I", "O", "U"]);
+    assert_eq!(
+        (imported.header().sensor.rows, imported.header().sensor.cols),
+        (6, 6)
+    );
+    assert_eq!(imported.len(), 40);
+    assert!(
+        imported
+            .readings()
+            .iter()
+            .all(|r| r.status == ContactStatus::Converged && r.strategy == Strategy::Recorded)
+    );
+    // Known answers: the first frame is `A,7,12,34,38,...`, divided by the file's largest value.
+    let max = file_max(EXAMPLE_REAL_CSV);
+    assert!(max > 800.0, "{max}");
+    let first = imported.readings()[0].image.values();
+    assert_eq!(&first[..4], &[7.0 / max, 12.0 / max, 34.0 / max, 38.0 / max]);
+    // Every image is the one the experiment keeps, in file order.
+    let real = parse_real_csv(EXAMPLE_REAL_CSV, "example", &RealImport::default()).unwrap();
+    let (kept, _) = prune(&real, 0.1);
+    assert_eq!(kept.len(), imported.len());
+    for (frame, reading) in kept.iter().zip(imported.readings()) {
+        assert_eq!((&frame.label, &frame.image), (&reading.object, &reading.image));
+    }
+    // The square root of Sec. V-F, as `experiment real-frames --square-root` takes it.
+    run_ok(&[
+        "dataset",
+        "import",
+        example.to_str().unwrap(),
+        "--square-root",
+        "--out",
+        &p("rooted.csv"),
+    ]);
+    let rooted = Dataset::read(&dir.path().join("rooted.csv")).unwrap();
+    assert_eq!(rooted.readings()[0].image.values()[1], (12.0 / max).sqrt());
+
+    run_ok(&[
+        "train",
+        "--dataset",
+        &p("example.csv"),
+        "--descriptor",
+        "polar-fourier",
+        "--out",
+        &p("model.json"),
+    ]);
+    run_ok(&[
+        "recognize",
+        "--model",
+        &p("model.json"),
+        "--dataset",
+        &p("example.csv"),
+        "--readings",
+        "1..4",
+        "--out",
+        &p("out"),
+    ]);
+    let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
+    assert_eq!(accuracy.lines().count(), 1 + 4, "{accuracy}");
+    assert!(dir.path().join("out/accuracy.svg").exists());
+}
+
+/// Import keeps the frames the experiment prunes as `no_contact` readings, applies a calibration,
+/// and names the file and line of a malformed frame (writing nothing).
+#[test]
+fn import_prunes_calibrates_and_names_a_malformed_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let contact: Vec<f64> = (0..36).map(|k| if k % 5 == 0 { 800.0 } else { 10.0 }).collect();
+    let touchless = vec![30.0; 36];
+    let text = recording(&[
+        ("A", vec![contact.clone(), touchless.clone(), contact.clone()]),
+        ("B", vec![touchless, contact]),
+    ]);
+    std::fs::write(dir.path().join("frames.csv"), &text).unwrap();
+    let mut calibration = String::from("taxel,gain,offset\n");
+    for k in 0..36 {
+        let (gain, offset) = if k == 0 { (0.5, 0.0) } else { (1.0, 0.0) };
+        calibration.push_str(&format!("r{}c{},{gain},{offset}\n", k / 6, k % 6));
+    }
+    std::fs::write(dir.path().join("cal.csv"), calibration).unwrap();
+    run_ok(&[
+        "dataset",
+        "import",
+        &p("frames.csv"),
+        "--calibration",
+        &p("cal.csv"),
+        "--out",
+        &p("d.csv"),
+    ]);
+    let d = Dataset::read(&dir.path().join("d.csv")).unwrap();
+    let statuses: Vec<(&str, ContactStatus)> = d
+        .readings()
+        .iter()
+        .map(|r| (r.object.as_str(), r.status))
+        .collect();
+    use ContactStatus::{Converged, NoContact};
+    assert_eq!(
+        statuses,
+        [
+            ("A", Converged),
+            ("A", NoContact),
+            ("A", Converged),
+            ("B", NoContact),
+            ("B", Converged)
+        ]
+    );
+    // Taxel r0c0 reads 800 at half gain: 400 of the file's largest, 800 (taxel r0c5).
+    assert_eq!(&d.readings()[0].image.values()[..2], &[0.5, 10.0 / 800.0]);
+
+    let lines: Vec<&str> = text.lines().collect();
+    let short = text.replace(lines[2], "A,1,2,3");
+    std::fs::write(dir.path().join("bad.csv"), short).unwrap();
+    let output = taction(&["dataset", "import", &p("bad.csv"), "--out", &p("bad_dataset.csv")]);
+    assert_eq!(output.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(err.contains("bad.csv") && err.contains("line 3"), "{err}");
+    assert!(!dir.path().join("bad_dataset.csv").exists());
+
+    let output = taction(&[
+        "dataset",
+        "import",
+        &p("frames.csv"),
+        "--contact-threshold",
+        "2",
+        "--out",
+        &p("x.csv"),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&output.stderr).contains("--contact-threshold"));
 }

@@ -17,8 +17,8 @@ fn taction(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// `taction recognize` of `model` on `test`, readings 1 to 30, into `out`.
-fn recognise_30(model: &str, test: &str, out: &str) -> (bool, String, String) {
+/// `taction recognize` of `model` on `test`, readings `readings`, into `out`.
+fn recognise(model: &str, test: &str, readings: &str, out: &str) -> (bool, String, String) {
     taction(&[
         "recognize",
         "--model",
@@ -26,10 +26,15 @@ fn recognise_30(model: &str, test: &str, out: &str) -> (bool, String, String) {
         "--dataset",
         test,
         "--readings",
-        "1..30",
+        readings,
         "--out",
         out,
     ])
+}
+
+/// `taction recognize` of `model` on `test`, readings 1 to 30, into `out`.
+fn recognise_30(model: &str, test: &str, out: &str) -> (bool, String, String) {
+    recognise(model, test, "1..30", out)
 }
 
 #[test]
@@ -212,4 +217,130 @@ fn the_neighbour_codebook_trains_with_its_own_defaults_and_recognises() {
         stderr.contains("unknown codebook 'knnn'; expected gmm, kmeans, knn"),
         "{stderr}"
     );
+}
+
+/// Trains a polar-fourier model of the toy objects on 40 readings each into `dir/model.json`.
+fn toy_model(dir: &std::path::Path) {
+    let train = dir.join("train.csv");
+    recognize_toy::dataset(40, 1).write(&train).unwrap();
+    let (ok, _, stderr) = taction(&[
+        "train",
+        "--dataset",
+        train.to_str().unwrap(),
+        "--descriptor",
+        "polar-fourier",
+        "--k",
+        "3,5",
+        "--restarts",
+        "2",
+        "--out",
+        dir.join("model.json").to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+}
+
+/// `--readings 50` on 20 readings per object: the files say 20, the readings used, and stderr
+/// says the request went beyond the data (confusion.csv once said 50).
+#[test]
+fn readings_beyond_the_data_are_labelled_as_used_and_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    toy_model(dir.path());
+    recognize_toy::dataset(20, 3)
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), "50", &p("out"));
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("warning: --readings 1..50")
+            && stderr.contains("more than 20 converged readings")
+            && stderr.contains("accuracy.csv ends at 20"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("3 trials of up to 20 readings"), "{stdout}");
+    let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
+    assert!(
+        accuracy.lines().last().unwrap().starts_with("20,3,"),
+        "{accuracy}"
+    );
+    let confusion = std::fs::read_to_string(dir.path().join("out/confusion.csv")).unwrap();
+    let rows: Vec<&str> = confusion.lines().skip(1).collect();
+    assert_eq!(rows.len(), 9);
+    assert!(rows.iter().all(|r| r.starts_with("20,")), "{confusion}");
+
+    // 1..30 goes beyond the data too; 1..20 does not.
+    let (ok, _, stderr) = recognise_30(&p("model.json"), &p("test.csv"), &p("out2"));
+    assert!(ok && stderr.contains("warning"), "{stderr}");
+    let (ok, _, stderr) = recognise(&p("model.json"), &p("test.csv"), "1..20", &p("out3"));
+    assert!(ok && !stderr.contains("warning"), "{stderr}");
+}
+
+/// `recognize` plots accuracy against readings beside its CSVs, as the experiments do: 30 test
+/// readings per object in trials of 10 are three trials per object, plotted as three trials with
+/// their mean, the band from the lowest to the highest, and chance at 1/3. The first reading of
+/// 'ridges' is a bump, so the first trial starts lower than the others.
+#[test]
+fn recognize_plots_accuracy_with_its_band_and_chance_beside_the_csvs() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    toy_model(dir.path());
+    let test = recognize_toy::dataset(30, 3);
+    let mut readings = test.readings().to_vec();
+    assert_eq!(readings[0].object, "ridges");
+    readings[0].image = recognize_toy::image(1, &mut taction::rng::stream(9, 0));
+    taction::dataset::Dataset::new(test.header().clone(), readings)
+        .unwrap()
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), "1..10", &p("out"));
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("accuracy.svg") && stdout.contains("accuracy.png"),
+        "{stdout}"
+    );
+    let svg = std::fs::read_to_string(dir.path().join("out/accuracy.svg")).unwrap();
+    for needle in [
+        "test.csv recognised by model.json",
+        "number of readings",
+        "accuracy (fraction correct)",
+        "chance (1/3)",
+        "band: lowest to highest trial",
+    ] {
+        assert!(svg.contains(needle), "accuracy.svg lacks '{needle}'");
+    }
+    let png = std::fs::read(dir.path().join("out/accuracy.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+
+    // The plotted trials: trial k is every object's k-th trial; their mean is accuracy.csv's.
+    let rows: Vec<taction::experiment::AccuracyRow> =
+        csv::Reader::from_path(dir.path().join("out/accuracy_trials.csv"))
+            .unwrap()
+            .deserialize()
+            .collect::<Result<_, _>>()
+            .unwrap();
+    assert_eq!(rows.len(), 3 * 10);
+    let first: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.n_readings == 1)
+        .map(|r| r.accuracy)
+        .collect();
+    assert_eq!(
+        first,
+        [2.0 / 3.0, 1.0, 1.0],
+        "the bump read as ridges misleads trial 0"
+    );
+    let accuracy = std::fs::read_to_string(dir.path().join("out/accuracy.csv")).unwrap();
+    for line in accuracy.lines().skip(1) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let n: u32 = fields[0].parse().unwrap();
+        let pooled: f64 = fields[3].parse().unwrap();
+        let at_n: Vec<f64> = rows
+            .iter()
+            .filter(|r| r.n_readings == n)
+            .map(|r| r.accuracy)
+            .collect();
+        assert_eq!(at_n.len(), 3, "three trials at {n} readings");
+        let mean = at_n.iter().sum::<f64>() / 3.0;
+        assert!((mean - pooled).abs() < 1e-12, "{n}: {mean} vs {pooled}");
+    }
 }

@@ -1,9 +1,17 @@
 //! `taction dataset show DATASET`: what a dataset file holds (see `taction::dataset` for the format).
+//! `taction dataset import FRAMES --out DATASET`: recorded sensor frames as a dataset, so that
+//! `train` and `recognize` take real data.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use taction::dataset::Dataset;
+use taction::dataset::recorded::{Calibration, RealImport, import_real_csv};
+use taction::dataset::{Dataset, DatasetError};
+use taction::paper::real_frames::recorded_dataset;
+use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
+use taction::valid::Check;
+
+use crate::cli::common::UsageError;
 
 #[derive(Debug, Args)]
 pub struct DatasetArgs {
@@ -18,15 +26,114 @@ pub enum DatasetCommand {
         /// The dataset file.
         dataset: PathBuf,
     },
+    /// Recorded sensor frames as a dataset: each label an object, each frame a `recorded`
+    /// reading, `converged` when it touched and `no_contact` when the real-frames experiment would
+    /// prune it, its image as that experiment describes it.
+    Import(ImportArgs),
+}
+
+/// `dataset import`: the recording and the settings of the real-frames experiment that shape its
+/// images (the same flags as `experiment real-frames`).
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// Recorded frames. CSV: a header `label,r0c0,r0c1,...` naming every taxel of a rows x cols
+    /// grid (4x4 to 32x32), then one frame per line: its label, then one non-negative raw value
+    /// per taxel; `#` lines are comments. Values are divided by the file's largest value.
+    #[arg(value_name = "FRAMES.csv")]
+    pub frames: PathBuf,
+    /// The dataset to write.
+    #[arg(long, value_name = "DATASET.csv")]
+    pub out: PathBuf,
+    /// Per-taxel calibration of the frames, applied as gain * (raw - offset), clamped at 0. CSV:
+    /// a header `taxel,gain,offset`, then one line per taxel (`r0c0,1.02,13`), every taxel of the
+    /// grid exactly once.
+    #[arg(long, value_name = "CSV")]
+    pub calibration: Option<PathBuf>,
+    /// Frames whose largest taxel is below this fraction of the sensing range did not touch: they
+    /// are written as `no_contact` readings, which training and recognition skip.
+    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION", allow_hyphen_values = true)]
+    pub contact_threshold: f64,
+    /// Square root of every taxel (Sec. V-F), as `experiment real-frames --square-root`.
+    #[arg(long)]
+    pub square_root: bool,
+    /// Gaussian blur width in taxels (Sec. V-F); 0 is off.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "TAXELS",
+        allow_hyphen_values = true
+    )]
+    pub blur_sigma: f64,
 }
 
 pub fn run(args: &DatasetArgs) -> Result<(), Box<dyn std::error::Error>> {
     match &args.command {
         DatasetCommand::Show { dataset } => {
-            let data = Dataset::read(dataset)?;
+            let data = read_dataset(dataset)?;
             println!("{}", dataset.display());
             println!("{}", data.summary());
         }
+        DatasetCommand::Import(import) => run_import(import)?,
     }
+    Ok(())
+}
+
+/// Reads a dataset; a file of recorded frames is not one, and the error says how to make one of it.
+pub fn read_dataset(path: &Path) -> Result<Dataset, Box<dyn std::error::Error>> {
+    Dataset::read(path).map_err(|e| {
+        let frames = matches!(e, DatasetError::NotADataset { .. })
+            && import_real_csv(path, &RealImport::default()).is_ok();
+        if frames {
+            format!(
+                "{e}\n  it holds recorded sensor frames: `taction dataset import {} --out DATASET.csv` \
+                 makes a dataset of them",
+                path.display()
+            )
+            .into()
+        } else {
+            e.into()
+        }
+    })
+}
+
+fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let same_file = std::fs::canonicalize(&args.out)
+        .ok()
+        .is_some_and(|out| std::fs::canonicalize(&args.frames).is_ok_and(|frames| frames == out));
+    if same_file {
+        return Err(UsageError(format!(
+            "--out {} is the frames file itself; write the dataset to another file",
+            args.out.display()
+        ))
+        .into());
+    }
+    let options = RealFramesOptions {
+        contact_threshold: args.contact_threshold,
+        square_root: args.square_root,
+        blur_sigma_taxels: args.blur_sigma,
+        ..RealFramesOptions::default()
+    };
+    options.check().map_err(|e| UsageError(e.to_string()))?;
+    let calibration = args
+        .calibration
+        .as_deref()
+        .map(Calibration::read)
+        .transpose()
+        .map_err(|e| format!("--calibration: {e}"))?;
+    let real = import_real_csv(
+        &args.frames,
+        &RealImport {
+            calibration,
+            ..RealImport::default()
+        },
+    )?;
+    let object_set = args
+        .frames
+        .file_stem()
+        .map_or_else(|| "recorded".to_string(), |s| s.to_string_lossy().into_owned());
+    let dataset = recorded_dataset(&real, &options, &object_set).map_err(|e| e.to_string())?;
+    dataset.write(&args.out)?;
+    println!("wrote {}", args.out.display());
+    println!("{}", dataset.summary());
     Ok(())
 }

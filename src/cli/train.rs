@@ -15,6 +15,7 @@ use taction::recognize::{
 };
 
 use crate::cli::common::{SeedArg, parse_codebook};
+use crate::cli::dataset::read_dataset;
 
 #[derive(Debug, Args)]
 pub struct TrainArgs {
@@ -62,7 +63,7 @@ pub struct TrainArgs {
 }
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let training = Dataset::read(&args.dataset)?;
+    let training = read_dataset(&args.dataset)?;
     let ks = match &args.ks {
         Some(ks) => ks.clone(),
         None => {
@@ -89,7 +90,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         trial_readings: args.trial_readings,
         ..TrainConfig::default()
     };
-    let validation = args.validation.as_deref().map(Dataset::read).transpose()?;
+    let validation = args.validation.as_deref().map(read_dataset).transpose()?;
     let mut models = Vec::new();
     for &kind in args.descriptor.kinds() {
         let model = fit_one(args, kind, &training, validation.as_ref(), config.clone())?;

@@ -9,10 +9,13 @@
 //! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
 //! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
 //! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
-//! alike. The file format is in [`format`]; the counts `dataset show` prints in `summary.rs`.
+//! alike. The file format is in [`format`]; the counts `dataset show` prints in `summary.rs`; the
+//! recorded frames of a real sensor, and their import as a dataset (`dataset import`), in
+//! [`recorded`].
 
 mod format;
 mod reading;
+pub mod recorded;
 mod status;
 mod strategy;
 mod summary;

@@ -20,6 +20,9 @@ pub struct Series {
     pub band: Vec<(f64, f64, f64)>,
 }
 
+/// The legend entry of the shaded bands (see [`Series::band`]).
+pub const BAND_LABEL: &str = "band: lowest to highest trial";
+
 /// A horizontal reference line drawn dashed, e.g. chance level (1 / number of objects).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReferenceLine {
@@ -39,7 +42,7 @@ pub struct Panel {
     pub series: Vec<Series>,
     /// Draw a marker at every point (for sparse x, e.g. noise levels).
     pub markers: bool,
-    /// Draw a legend (not for a lone unnamed line).
+    /// Draw a legend (not for a lone unnamed line without a band); it explains the bands.
     pub legend: bool,
     /// Label the x axis at integers only (counts, such as the number of readings).
     pub integer_x: bool,
@@ -198,6 +201,7 @@ fn draw_panel<DB: DrawingBackend>(
         mesh.x_label_formatter(&|v| format_number(*v));
     }
     mesh.draw()?;
+    let mut band_explained = false;
     for (i, series) in panel.series.iter().enumerate() {
         if series.band.len() < 2 {
             continue;
@@ -209,7 +213,17 @@ fn draw_panel<DB: DrawingBackend>(
             .map(|&(x, _, high)| (x, high))
             .chain(series.band.iter().rev().map(|&(x, low, _)| (x, low)))
             .collect();
-        chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.1).filled())))?;
+        let drawn = chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.1).filled())))?;
+        // One legend entry says what every band is.
+        if !band_explained {
+            band_explained = true;
+            drawn.label(BAND_LABEL).legend(|(x, y)| {
+                Rectangle::new(
+                    [(x, y - 5), (x + 22, y + 5)],
+                    RGBColor(90, 90, 90).mix(0.2).filled(),
+                )
+            });
+        }
     }
     if let Some(reference) = &panel.reference {
         let style = ShapeStyle::from(RGBColor(90, 90, 90)).stroke_width(1);

@@ -362,6 +362,8 @@ fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<V
             let all = || series.iter().flat_map(|s| s.points.iter());
             let (xmin, xmax) = bounds(all().map(|p| p.0));
             let (ymin, ymax) = bounds(all().map(|p| p.1));
+            // A band needs its legend entry even beside a lone line.
+            let legend = !series_cols.is_empty() || series.iter().any(|s| !s.band.is_empty());
             Panel {
                 title: if ys.len() > 1 {
                     y.label.clone()
@@ -374,7 +376,7 @@ fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<V
                 y_range: padded(ymin.min(0.0), ymax.max(0.0), true),
                 series,
                 markers: true,
-                legend: !series_cols.is_empty(),
+                legend,
                 integer_x: false,
                 reference: None,
             }

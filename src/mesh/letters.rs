@@ -10,7 +10,8 @@
 //! walls stand on the glyph contours, and its top face is the glyph with its holes. Every contour
 //! vertex is shared by the faces that meet there, so the mesh is watertight; it is a topological
 //! sphere (Euler characteristic 2), and its top face at z = t_p + h has one boundary loop per
-//! contour: its holes are the glyph's counters ('B' two, 'o' one, 'x' none).
+//! contour: its holes are the glyph's counters ('B' two, 'o' one, 'x' none). [`raised_letter`]
+//! checks the finished mesh and names the glyph when it is not so, whatever the font.
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -18,6 +19,7 @@ use serde::{Deserialize, Serialize};
 use super::TriMesh;
 use super::error::MeshError;
 use super::glyph::{Font, GlyphOutline};
+use super::topology::EdgeTopology;
 use super::triangulate::{ring_area2, triangulate_with_holes};
 
 /// The size and shape parameters of the raised letters.
@@ -282,8 +284,45 @@ pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMe
             b.cap(&rings, &what("top"))?;
         }
     }
-    Ok(TriMesh {
+    let mesh = TriMesh {
         vertices: b.vertices,
         triangles: b.triangles,
-    })
+    };
+    closed_sphere(&mesh).map_err(|what| MeshError::Glyph {
+        font: font.path().to_path_buf(),
+        glyph: ch,
+        what,
+    })?;
+    Ok(mesh)
+}
+
+/// Whether `mesh` is what the module docs promise: one closed, consistently oriented shell of
+/// Euler characteristic 2. A glyph whose contours the construction misreads (contours that cross or
+/// touch) fails here rather than leaving an open or tangled mesh to the simulation.
+fn closed_sphere(mesh: &TriMesh) -> Result<(), String> {
+    let topology = EdgeTopology::new(mesh);
+    let open = topology.boundary_edges().count();
+    if open > 0 {
+        return Err(format!(
+            "the raised letter is not closed: {open} open boundary edge(s) in {} loop(s)",
+            topology.boundary_loop_count()
+        ));
+    }
+    let (non_manifold, misoriented) = (
+        topology.non_manifold_edge_count(),
+        topology.misoriented_edge_count(),
+    );
+    if non_manifold + misoriented > 0 {
+        return Err(format!(
+            "the raised letter is not one oriented surface: {non_manifold} non-manifold and \
+             {misoriented} misoriented edge(s)"
+        ));
+    }
+    let chi = topology.euler_characteristic(mesh);
+    if chi != 2 {
+        return Err(format!(
+            "the raised letter has Euler characteristic {chi}, not 2 (one solid without tunnels)"
+        ));
+    }
+    Ok(())
 }

@@ -4,10 +4,14 @@
 //!
 //! Ear clipping with hole bridging is done by the `earcut` crate. Earcut silently drops ring
 //! vertices that are exactly collinear with their neighbours (also ones that become collinear after
-//! a hole is bridged); each dropped vertex lies on an edge of the triangulation's boundary, so it is
-//! put back by splitting the one triangle on that edge: (a, b, c) with v on ab becomes (a, v, c) and
-//! (v, b, c). The result is checked: every vertex used, every triangle counter-clockwise, and the
-//! triangle areas summing to the polygon's area, A = |A_outer| - sum |A_hole|.
+//! a hole is bridged). A dropped vertex lies on an edge of the triangulation; so may a vertex earcut
+//! kept, when a bridge runs along collinear ring edges (DejaVu Serif's 'B' and 'D': the counters'
+//! bottom edges continue the top edge of the serif, and one triangle edge spans both, passing
+//! through the bridge's ends). Either way the edge along the ring is not the ring's own, and the
+//! wall built on the ring would meet it in a T-junction. So every triangle with a ring vertex inside
+//! one of its edges is split there: (a, b, c) with v on ab becomes (a, v, c) and (v, b, c). The
+//! result is checked: every vertex used, every triangle counter-clockwise, and the triangle areas
+//! summing to the polygon's area, A = |A_outer| - sum |A_hole|.
 
 use glam::DVec2;
 
@@ -56,38 +60,42 @@ pub fn triangulate_with_holes(rings: &[Vec<DVec2>], what: &str) -> Result<Vec<[u
         })
         .collect();
 
+    let scale = rings[0]
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
+        .max(f64::MIN_POSITIVE);
+    // Whether `v` lies strictly inside the segment from `a` to `b`.
+    let on_edge = |v: usize, a: usize, b: usize| {
+        let (p, pa, pb) = (points[v], points[a], points[b]);
+        let d = pb - pa;
+        let t = (p - pa).dot(d) / d.length_squared();
+        t > 0.0 && t < 1.0 && area2(pa, pb, p).abs() <= 1e-12 * scale * d.length()
+    };
+    for v in 0..points.len() {
+        // Split every triangle with `v` inside one of its edges: after this no edge passes through
+        // a ring vertex, so the edges along each ring are exactly the ring's own.
+        while let Some((k, (a, b, c))) = triangles.iter().enumerate().find_map(|(k, &[a, b, c])| {
+            [(a, b, c), (b, c, a), (c, a, b)]
+                .into_iter()
+                .find(|&(x, y, z)| z != v && on_edge(v, x, y))
+                .map(|e| (k, e))
+        }) {
+            triangles[k] = [a, v, c];
+            triangles.push([v, b, c]);
+        }
+    }
     let mut used = vec![false; points.len()];
     for t in &triangles {
         for &i in t {
             used[i] = true;
         }
     }
-    let scale = rings[0]
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
-        .max(f64::MIN_POSITIVE);
-    for v in (0..points.len()).filter(|&v| !used[v]) {
+    if let Some(v) = (0..points.len()).find(|&v| !used[v]) {
         let p = points[v];
-        let on_edge = |a: usize, b: usize| {
-            let (pa, pb) = (points[a], points[b]);
-            let d = pb - pa;
-            let t = (p - pa).dot(d) / d.length_squared();
-            t > 0.0 && t < 1.0 && area2(pa, pb, p).abs() <= 1e-12 * scale * d.length()
-        };
-        let found = triangles.iter().enumerate().find_map(|(k, &[a, b, c])| {
-            [(a, b, c), (b, c, a), (c, a, b)]
-                .into_iter()
-                .find(|&(x, y, _)| on_edge(x, y))
-                .map(|e| (k, e))
-        });
-        let Some((k, (a, b, c))) = found else {
-            return Err(fail(format!(
-                "point {v} at ({}, {}) is not on the triangulation",
-                p.x, p.y
-            )));
-        };
-        triangles[k] = [a, v, c];
-        triangles.push([v, b, c]);
+        return Err(fail(format!(
+            "point {v} at ({}, {}) is not on the triangulation",
+            p.x, p.y
+        )));
     }
 
     let expected = ring_area2(&rings[0]).abs() - rings[1..].iter().map(|r| ring_area2(r).abs()).sum::<f64>();
@@ -141,6 +149,42 @@ mod tests {
         assert!((area - 12.0).abs() < 1e-12);
         // A triangulation of a polygon with h holes and n vertices has n + 2h - 2 triangles.
         assert_eq!(tris.len(), 10 + 2 - 2);
+    }
+
+    #[test]
+    fn a_hole_whose_edge_continues_an_outer_edge_leaves_no_t_junction() {
+        // DejaVu Serif's 'D' in font units / 100: the serif's top edge (y = 1.77, x 1.89 to 5.07)
+        // and the counter's bottom edge (x 8.47 to 11.59) lie on one line.
+        let outer = vec![
+            v(1.89, 0.0),
+            v(11.84, 0.0),
+            v(25.52, 12.53),
+            v(11.84, 25.0),
+            v(1.89, 25.0),
+            v(1.89, 23.21),
+            v(5.07, 23.21),
+            v(5.07, 1.77),
+            v(1.89, 1.77),
+        ];
+        let hole = vec![
+            v(8.47, 1.77),
+            v(8.47, 23.21),
+            v(11.59, 23.21),
+            v(21.67, 12.53),
+            v(11.59, 1.77),
+        ];
+        let tris = triangulate_with_holes(&[outer.clone(), hole.clone()], "D").unwrap();
+        let pts: Vec<DVec2> = outer.iter().chain(&hole).copied().collect();
+        for &[a, b, c] in &tris {
+            for (x, y) in [(a, b), (b, c), (c, a)] {
+                for (k, &p) in pts.iter().enumerate() {
+                    let d = pts[y] - pts[x];
+                    let t = (p - pts[x]).dot(d) / d.length_squared();
+                    let inside = t > 0.0 && t < 1.0 && area2(pts[x], pts[y], p) == 0.0;
+                    assert!(!inside, "vertex {k} lies inside edge {x}-{y}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -361,7 +361,7 @@ pub fn sim_to_real() -> RecognitionSweep {
     RecognitionSweep {
         name: "sim-to-real",
         description: "Fig. 17: trained on simulated letters (30% noise), tested on recorded real frames (trial 0 in recorded order)",
-        title: "Simulation to real sensor",
+        title: "Trained on simulated letters, tested on",
         parameter: "",
         family: Family::RealLabels,
         descriptors: TOP_THREE.to_vec(),
@@ -377,7 +377,29 @@ pub fn sim_to_real() -> RecognitionSweep {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::paper::context::EXAMPLE_REAL_CSV;
+    use crate::paper::real_data::{RealData, RealImport, parse_real_csv};
     use crate::paper::scale::DataCounts;
+
+    #[test]
+    fn sim_to_real_on_the_synthetic_example_does_not_claim_a_real_sensor() {
+        let example = parse_real_csv(EXAMPLE_REAL_CSV, "example", &RealImport::default()).unwrap();
+        let title = sim_to_real().plot_title(Some(&example));
+        assert_eq!(
+            title,
+            "Trained on simulated letters, tested on example frames (synthetic)"
+        );
+        let recorded = RealData {
+            synthetic: false,
+            ..example
+        };
+        assert!(
+            sim_to_real()
+                .plot_title(Some(&recorded))
+                .ends_with("tested on real sensor frames")
+        );
+        assert_eq!(descriptors().plot_title(None), descriptors().title);
+    }
 
     #[test]
     fn training_size_settings_train_on_their_share_of_the_readings() {

@@ -25,6 +25,7 @@ use serde::Serialize;
 use super::context::PaperContext;
 use super::real_frames_options::RealFramesOptions;
 use super::recognition::selection_config;
+use crate::dataset::{ContactStatus, Dataset};
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
 use crate::experiment::name::SafeName;
@@ -63,11 +64,10 @@ pub fn prune(real: &RealData, contact_threshold: f64) -> (Vec<&RealReading>, BTr
     let mut counts: BTreeMap<String, PruneCount> = BTreeMap::new();
     let mut kept = Vec::new();
     for reading in &real.readings {
-        let peak = reading.image.values().iter().copied().fold(0.0, f64::max);
         let count = counts
             .entry(reading.label.clone())
             .or_insert(PruneCount { kept: 0, dropped: 0 });
-        if peak >= contact_threshold {
+        if touched(reading, contact_threshold) {
             count.kept += 1;
             kept.push(reading);
         } else {
@@ -75,6 +75,48 @@ pub fn prune(real: &RealData, contact_threshold: f64) -> (Vec<&RealReading>, BTr
         }
     }
     (kept, counts)
+}
+
+/// Whether the frame's peak (largest taxel) reaches `contact_threshold`: the letter touched the
+/// sensor.
+fn touched(reading: &RealReading, contact_threshold: f64) -> bool {
+    reading.image.values().iter().copied().fold(0.0, f64::max) >= contact_threshold
+}
+
+/// The recording as a taction dataset (`taction dataset import`), so that `train` and `recognize`
+/// take recorded frames: every frame a reading of its label, `converged` when it touched and
+/// `no_contact` when [`prune`] drops it, its image as this experiment describes it (square root and
+/// blur when `options` ask). `object_set` names the recording in the dataset's header.
+pub fn recorded_dataset(
+    real: &RealData,
+    options: &RealFramesOptions,
+    object_set: &str,
+) -> Result<Dataset, BoxError> {
+    options.check()?;
+    let blur = GaussianBlur::new(options.blur_sigma_taxels)?;
+    let generator = format!(
+        "recorded {}, pruned below {} of the range{}{}",
+        real.frames_words(),
+        options.contact_threshold,
+        if options.square_root {
+            ", square-rooted"
+        } else {
+            ""
+        },
+        if options.blur_sigma_taxels > 0.0 {
+            format!(", blurred by {} taxels", options.blur_sigma_taxels)
+        } else {
+            String::new()
+        }
+    );
+    Ok(real.to_dataset(object_set, &generator, |frame| {
+        let status = if touched(frame, options.contact_threshold) {
+            ContactStatus::Converged
+        } else {
+            ContactStatus::NoContact
+        };
+        (preprocess(&frame.image, options, &blur), status)
+    })?)
 }
 
 /// A label with fewer frames than the split's three parts.
@@ -212,7 +254,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                PlotSpec::accuracy(name, "Trained and tested on real sensor frames")
+                PlotSpec::accuracy(name, &format!("Trained and tested on {}", real.frames_words()))
                     .with_chance(labels.len()),
             ],
         },

@@ -113,6 +113,8 @@ pub struct RecognitionSweep {
     pub name: &'static str,
     #[serde(skip)]
     pub description: &'static str,
+    /// The plot's title; a sweep on recorded frames ends it with what they are
+    /// ([`RealData::frames_words`]).
     #[serde(skip)]
     pub title: &'static str,
     /// The column `parameter` of the rows: what the curves vary.
@@ -145,6 +147,15 @@ struct UnitPlan {
 }
 
 impl RecognitionSweep {
+    /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
+    /// by what they are (real sensor frames, or the synthetic example's).
+    pub(crate) fn plot_title(&self, real: Option<&RealData>) -> String {
+        match real {
+            Some(real) => format!("{} {}", self.title, real.frames_words()),
+            None => self.title.to_string(),
+        }
+    }
+
     /// Runs the sweep in `context`: prepares the datasets its pending units need, then runs the
     /// units on the experiment framework (resumable, sharded, parallel).
     pub fn run(&self, context: &PaperContext) -> Result<RunReport, BoxError> {
@@ -198,7 +209,10 @@ impl RecognitionSweep {
             spec: ExperimentSpec {
                 name: name.clone(),
                 description: self.description.to_string(),
-                plots: vec![PlotSpec::accuracy(name, self.title).with_chance(objects.specs.len())],
+                plots: vec![
+                    PlotSpec::accuracy(name, &self.plot_title(real.as_deref()))
+                        .with_chance(objects.specs.len()),
+                ],
             },
             config: SweepConfig {
                 sweep: self,

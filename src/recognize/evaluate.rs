@@ -185,7 +185,8 @@ pub struct Evaluation {
     pub touches: Vec<TouchRow>,
     /// One row per reading count in the range up to the longest trial ([`AccuracyPoint`]).
     pub accuracy: Vec<AccuracyPoint>,
-    /// Each trial's final guess (after `min(last, trial length)` readings) against the truth.
+    /// Each trial's final guess (after `min(last, trial length)` readings) against the truth,
+    /// labelled with `min(last, longest trial)`: the readings the decisions actually used.
     pub confusion: ConfusionMatrix,
 }
 
@@ -260,7 +261,9 @@ where
         });
     }
     let mut touches = Vec::new();
-    let mut confusion = ConfusionMatrix::new(objects.to_vec(), range.last);
+    // The decisions are taken after the range's end or the longest trial's last reading, whichever
+    // comes first: a range beyond the data labels no decision with readings it never had.
+    let mut confusion = ConfusionMatrix::new(objects.to_vec(), range.last.min(longest));
     for (trial, beliefs) in trials.iter().zip(per_trial) {
         let in_range: Vec<TouchRow> = beliefs
             .into_iter()

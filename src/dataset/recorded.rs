@@ -1,0 +1,614 @@
+//! Recorded readings of a real tactile sensor (Sec. V-E, V-F), imported from CSV: the counterpart
+//! of the dataset format for frames that no simulation produced. The experiments on recorded frames
+//! read them here (`paper::real_frames`, `sim-to-real`); [`RealData::to_dataset`] files them as a
+//! [`Dataset`] of [`Strategy::Recorded`] readings, which `taction dataset import` writes so that
+//! `train` and `recognize` take real data.
+//!
+//! # Format
+//!
+//! One frame per line. The first line that is not a comment is the header: `label` followed by one
+//! column per taxel, named `r<row>c<col>` (0-based) in row-major order, which fixes the frame size:
+//!
+//! ```text
+//! # comment lines start with '#'
+//! label,r0c0,r0c1,...,r0c5,r1c0,...,r5c5
+//! A,0,12,873,901,15,0,...
+//! ```
+//!
+//! - `label`: the object the frame was taken from (e.g. `A`); non-empty. When the importer is given
+//!   a set of allowed labels, any other label is an error.
+//! - taxel values: raw sensor units (any scale), finite and non-negative; row 0 is the pad's `up`
+//!   edge, column 0 its left edge, as in [`TactileImage`].
+//! - lines are frames in collection order (Fig. 17b uses that order); fields are separated by commas
+//!   and trimmed, without quoting; blank lines and lines starting with `#` are skipped.
+//! - a comment line starting with `# SYNTHETIC` says the frames are made up, not recorded (the
+//!   shipped `data/real_letters_example.csv`): [`RealData::synthetic`], so that plots of them do not
+//!   speak of a real sensor.
+//!
+//! Sensors of [`MIN_TAXELS_PER_SIDE`] to [`MAX_TAXELS_PER_SIDE`] taxels per side are accepted (the
+//! paper's PPS sensor is 6x6; Sec. V-C compares 6x6 to 26x26).
+//!
+//! When a per-taxel [`Calibration`] is given, every raw value `v` of taxel `(i, j)` first becomes
+//! `gain(i, j) * (v - offset(i, j))`, clamped at 0 (a taxel reading below its no-load offset
+//! carries no pressure), so that elements of different sensitivity read alike (Sec. V-F: the
+//! real elements differ from each other). Without one, raw values must be non-negative.
+//!
+//! Import then divides every value by one number so that frames land in [0, 1] of the sensing
+//! range ([`Normalisation`]): the largest value in the file, or a given range (`--range`), above
+//! which a value is an error. Errors name the file, the line and the column.
+//!
+//! # Calibration format
+//!
+//! ```text
+//! # comment lines start with '#'
+//! taxel,gain,offset
+//! r0c0,1.02,13
+//! r0c1,0.97,9
+//! ...
+//! ```
+//!
+//! One line per taxel of the recording's grid, each taxel exactly once (any order); `gain` finite
+//! and non-negative, `offset` finite, both in raw units of the recording.
+
+use std::collections::BTreeSet;
+use std::ops::RangeInclusive;
+use std::path::Path;
+
+use crate::dataset::{ContactStatus, Dataset, DatasetError, DatasetHeader, Reading, Strategy};
+use crate::pose::Pose;
+use crate::tactile::{SensorConfig, TactileImage};
+
+/// The comment that marks a file of made-up frames (module docs).
+pub const SYNTHETIC_MARK: &str = "# SYNTHETIC";
+
+/// How raw sensor units become fractions of the sensing range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Normalisation {
+    /// Divide by the largest value in the file (the file's strongest reading becomes 1).
+    FileMax,
+    /// Divide by this full-scale value, in raw units; it must be finite and positive.
+    Range(f64),
+}
+
+/// A `--range` that is neither `max` nor a full-scale value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("'{0}' is neither 'max' nor a finite positive full-scale value")]
+pub struct NormalisationError(pub String);
+
+impl std::str::FromStr for Normalisation {
+    type Err = NormalisationError;
+
+    /// `max` for [`Normalisation::FileMax`], or a full-scale value in raw units for
+    /// [`Normalisation::Range`] (the `--range` flag).
+    fn from_str(s: &str) -> Result<Self, NormalisationError> {
+        if s.trim() == "max" {
+            return Ok(Self::FileMax);
+        }
+        match s.trim().parse::<f64>() {
+            Ok(range) if range.is_finite() && range > 0.0 => Ok(Self::Range(range)),
+            _ => Err(NormalisationError(s.to_string())),
+        }
+    }
+}
+
+/// The smallest sensor side accepted, in taxels.
+pub const MIN_TAXELS_PER_SIDE: usize = 4;
+/// The largest sensor side accepted, in taxels.
+pub const MAX_TAXELS_PER_SIDE: usize = 32;
+/// The accepted sensor sides, in taxels.
+pub const TAXELS_PER_SIDE: RangeInclusive<usize> = MIN_TAXELS_PER_SIDE..=MAX_TAXELS_PER_SIDE;
+
+/// Import settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealImport {
+    pub normalisation: Normalisation,
+    /// When set, the only labels accepted.
+    pub allowed_labels: Option<BTreeSet<String>>,
+    /// Per-taxel gain and offset applied to raw values before normalisation.
+    pub calibration: Option<Calibration>,
+}
+
+impl Default for RealImport {
+    fn default() -> Self {
+        Self {
+            normalisation: Normalisation::FileMax,
+            allowed_labels: None,
+            calibration: None,
+        }
+    }
+}
+
+/// Per-taxel gain and offset of a recording (format in the module docs), row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibration {
+    /// Where it came from, for errors.
+    pub origin: String,
+    pub rows: usize,
+    pub cols: usize,
+    pub gain: Vec<f64>,
+    pub offset: Vec<f64>,
+}
+
+impl Calibration {
+    /// Reads a calibration file.
+    pub fn read(path: &Path) -> Result<Self, RealDataError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| RealDataError::Io {
+            origin: origin.clone(),
+            source,
+        })?;
+        Self::parse(&text, &origin)
+    }
+
+    /// Parses calibration text; `origin` names the source in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Self, RealDataError> {
+        let invalid = |line: u64, what: String| RealDataError::Invalid {
+            origin: origin.to_string(),
+            line,
+            what,
+        };
+        let mut header_seen = false;
+        let mut entries: Vec<(u64, usize, usize, f64, f64)> = Vec::new();
+        for (line, record) in records(text) {
+            if !header_seen {
+                if record != ["taxel", "gain", "offset"] {
+                    return Err(RealDataError::Header {
+                        origin: origin.to_string(),
+                        line,
+                        what: format!("expected 'taxel,gain,offset', got '{}'", record.join(",")),
+                    });
+                }
+                header_seen = true;
+                continue;
+            }
+            if record.len() != 3 {
+                return Err(invalid(
+                    line,
+                    format!("{} columns, expected 3 (taxel,gain,offset)", record.len()),
+                ));
+            }
+            let (row, col) = parse_taxel_name(record[0])
+                .ok_or_else(|| invalid(line, format!("taxel '{}' is not r<row>c<col>", record[0])))?;
+            let number = |column: &str, text: &str| -> Result<f64, RealDataError> {
+                match text.parse::<f64>() {
+                    Ok(v) if v.is_finite() => Ok(v),
+                    _ => Err(invalid(line, format!("{column} '{text}' is not a finite number"))),
+                }
+            };
+            let gain = number("gain", record[1])?;
+            if gain < 0.0 {
+                return Err(invalid(line, format!("gain {gain} is negative")));
+            }
+            let offset = number("offset", record[2])?;
+            entries.push((line, row, col, gain, offset));
+        }
+        if !header_seen {
+            return Err(RealDataError::NoHeader {
+                origin: origin.to_string(),
+            });
+        }
+        if entries.is_empty() {
+            return Err(invalid(
+                text.lines().count() as u64,
+                "no taxel lines after the header".to_string(),
+            ));
+        }
+        let rows = entries.iter().map(|e| e.1).max().unwrap_or(0) + 1;
+        let cols = entries.iter().map(|e| e.2).max().unwrap_or(0) + 1;
+        let mut gain = vec![f64::NAN; rows * cols];
+        let mut offset = vec![f64::NAN; rows * cols];
+        for &(line, row, col, g, o) in &entries {
+            let k = row * cols + col;
+            if !gain[k].is_nan() {
+                return Err(invalid(line, format!("taxel r{row}c{col} is listed twice")));
+            }
+            gain[k] = g;
+            offset[k] = o;
+        }
+        if let Some(k) = gain.iter().position(|g| g.is_nan()) {
+            return Err(RealDataError::Invalid {
+                origin: origin.to_string(),
+                line: entries.last().map_or(0, |e| e.0),
+                what: format!(
+                    "taxel r{}c{} is missing ({rows}x{cols} grid, every taxel needs a line)",
+                    k / cols,
+                    k % cols
+                ),
+            });
+        }
+        Ok(Self {
+            origin: origin.to_string(),
+            rows,
+            cols,
+            gain,
+            offset,
+        })
+    }
+
+    /// `gain * (raw - offset)` of taxel `k` (row-major), clamped at 0.
+    fn apply(&self, k: usize, raw: f64) -> f64 {
+        (self.gain[k] * (raw - self.offset[k])).max(0.0)
+    }
+}
+
+/// `r<row>c<col>` as (row, col).
+fn parse_taxel_name(name: &str) -> Option<(usize, usize)> {
+    let (r, c) = name.strip_prefix('r')?.split_once('c')?;
+    Some((r.parse().ok()?, c.parse().ok()?))
+}
+
+/// One imported frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealReading {
+    pub label: String,
+    /// The line of the file it came from (1-based).
+    pub line: u64,
+    /// Values normalised to [0, 1]; no pad pose (a recording has none).
+    pub image: TactileImage,
+}
+
+/// An imported file: frames of `rows x cols` taxels in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealData {
+    pub rows: usize,
+    pub cols: usize,
+    pub readings: Vec<RealReading>,
+    /// The file says its frames are made up ([`SYNTHETIC_MARK`]), not recorded by a sensor.
+    pub synthetic: bool,
+}
+
+/// The sensor recorded frames are filed under in a dataset: the recording's `rows x cols` at the
+/// pitch of the paper's letters sensor (2 mm), the default covering and point-spread, no simulated
+/// noise. A recording tells nothing of its pad's geometry, so these fields only describe; a 6x6
+/// recording gets exactly [`SensorConfig::default`].
+pub fn recorded_sensor(rows: usize, cols: usize) -> SensorConfig {
+    let default = SensorConfig::default();
+    SensorConfig {
+        rows,
+        cols,
+        pad_width_m: default.pad_width_m * (cols as f64 / default.cols as f64),
+        pad_height_m: default.pad_height_m * (rows as f64 / default.rows as f64),
+        ..default
+    }
+}
+
+impl RealData {
+    /// What the frames are, for titles: `real sensor frames`, or `example frames (synthetic)`.
+    pub fn frames_words(&self) -> &'static str {
+        if self.synthetic {
+            "example frames (synthetic)"
+        } else {
+            "real sensor frames"
+        }
+    }
+
+    /// The frames as a dataset, the hand-off `train` and `recognize` read: one object per label
+    /// (sorted), every frame a [`Strategy::Recorded`] reading in file order, without a pad pose,
+    /// the object at the origin (a recording has neither). `file` gives each frame's image as
+    /// filed and its status: [`ContactStatus::Converged`] for a frame that touched the object,
+    /// [`ContactStatus::NoContact`] for one that did not (the caller's pruning and preprocessing).
+    pub fn to_dataset(
+        &self,
+        object_set: &str,
+        generator: &str,
+        mut file: impl FnMut(&RealReading) -> (TactileImage, ContactStatus),
+    ) -> Result<Dataset, DatasetError> {
+        let header = DatasetHeader::new(
+            recorded_sensor(self.rows, self.cols),
+            object_set,
+            self.labels().into_iter().map(str::to_string).collect(),
+            generator,
+            0,
+        );
+        let readings = self
+            .readings
+            .iter()
+            .map(|frame| {
+                let (image, status) = file(frame);
+                Reading {
+                    image,
+                    object: frame.label.clone(),
+                    object_pose: Pose::IDENTITY,
+                    status,
+                    iterations: 0,
+                    strategy: Strategy::Recorded,
+                    cause: None,
+                }
+            })
+            .collect();
+        Dataset::new(header, readings)
+    }
+
+    /// The distinct labels, sorted.
+    pub fn labels(&self) -> BTreeSet<&str> {
+        self.readings.iter().map(|r| r.label.as_str()).collect()
+    }
+
+    /// The line of the first frame labelled `label`, for messages about the label.
+    pub fn first_line_of(&self, label: &str) -> Option<u64> {
+        self.readings.iter().find(|r| r.label == label).map(|r| r.line)
+    }
+}
+
+/// What is wrong with a real-data file; `origin` is its path, `line` 1-based.
+#[derive(Debug, thiserror::Error)]
+pub enum RealDataError {
+    #[error("{origin}: {source}")]
+    Io { origin: String, source: std::io::Error },
+    #[error("{origin}: line {line}: {what}")]
+    Invalid { origin: String, line: u64, what: String },
+    #[error("{origin}: line {line}: bad header: {what}")]
+    Header { origin: String, line: u64, what: String },
+    #[error("{origin}: no header line (label,r0c0,...)")]
+    NoHeader { origin: String },
+    #[error("{origin}: line {line}: {got} columns, expected {expected} (label + {rows}x{cols} taxels)")]
+    ColumnCount {
+        origin: String,
+        line: u64,
+        got: usize,
+        expected: usize,
+        rows: usize,
+        cols: usize,
+    },
+    #[error("{origin}: line {line}: empty label")]
+    EmptyLabel { origin: String, line: u64 },
+    #[error("{origin}: line {line}: unknown label '{label}' (allowed: {allowed})")]
+    UnknownLabel {
+        origin: String,
+        line: u64,
+        label: String,
+        allowed: String,
+    },
+    #[error("{origin}: line {line}: column {column}: '{text}' is not a number")]
+    NotANumber {
+        origin: String,
+        line: u64,
+        column: String,
+        text: String,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} is not finite")]
+    NotFinite {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} is negative")]
+    Negative {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+    },
+    #[error("{origin}: line {line}: column {column}: {value} exceeds the range {range}")]
+    AboveRange {
+        origin: String,
+        line: u64,
+        column: String,
+        value: f64,
+        range: f64,
+    },
+    #[error("{origin}: the range must be finite and positive, got {range}")]
+    BadRange { origin: String, range: f64 },
+    #[error("{origin}: no frames")]
+    NoFrames { origin: String },
+    #[error("{origin}: every value is zero; nothing to normalise by")]
+    AllZero { origin: String },
+}
+
+/// Reads and normalises a real-data file (format in the module docs).
+pub fn import_real_csv(path: &Path, options: &RealImport) -> Result<RealData, RealDataError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| RealDataError::Io {
+        origin: origin.clone(),
+        source,
+    })?;
+    parse_real_csv(&text, &origin, options)
+}
+
+/// Parses real-data CSV text; `origin` names the source in errors.
+pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<RealData, RealDataError> {
+    let origin_s = || origin.to_string();
+    if let Normalisation::Range(range) = options.normalisation
+        && !(range.is_finite() && range > 0.0)
+    {
+        return Err(RealDataError::BadRange {
+            origin: origin_s(),
+            range,
+        });
+    }
+    let mut header: Option<(usize, usize, Vec<String>)> = None;
+    let mut raw: Vec<(String, u64, Vec<f64>)> = Vec::new();
+    for (line, record) in records(text) {
+        let Some((rows, cols, names)) = &header else {
+            let parsed = parse_header(&record, line, origin)?;
+            if let Some(calibration) = &options.calibration
+                && (calibration.rows, calibration.cols) != (parsed.0, parsed.1)
+            {
+                return Err(RealDataError::Header {
+                    origin: origin_s(),
+                    line,
+                    what: format!(
+                        "the frames are {}x{} taxels but the calibration {} is {}x{}",
+                        parsed.0, parsed.1, calibration.origin, calibration.rows, calibration.cols
+                    ),
+                });
+            }
+            header = Some(parsed);
+            continue;
+        };
+        let expected = 1 + rows * cols;
+        if record.len() != expected {
+            return Err(RealDataError::ColumnCount {
+                origin: origin_s(),
+                line,
+                got: record.len(),
+                expected,
+                rows: *rows,
+                cols: *cols,
+            });
+        }
+        let label = record[0].to_string();
+        if label.is_empty() {
+            return Err(RealDataError::EmptyLabel {
+                origin: origin_s(),
+                line,
+            });
+        }
+        if let Some(allowed) = &options.allowed_labels
+            && !allowed.contains(&label)
+        {
+            let allowed = allowed.iter().cloned().collect::<Vec<_>>().join(", ");
+            return Err(RealDataError::UnknownLabel {
+                origin: origin_s(),
+                line,
+                label,
+                allowed,
+            });
+        }
+        let mut values = Vec::with_capacity(rows * cols);
+        for (k, (text, column)) in record[1..].iter().zip(names).enumerate() {
+            let column = column.clone();
+            let raw: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
+                origin: origin_s(),
+                line,
+                column: column.clone(),
+                text: text.to_string(),
+            })?;
+            if !raw.is_finite() {
+                return Err(RealDataError::NotFinite {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value: raw,
+                });
+            }
+            let value = match &options.calibration {
+                Some(calibration) => calibration.apply(k, raw),
+                None => raw,
+            };
+            if value < 0.0 {
+                return Err(RealDataError::Negative {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value,
+                });
+            }
+            if let Normalisation::Range(range) = options.normalisation
+                && value > range
+            {
+                return Err(RealDataError::AboveRange {
+                    origin: origin_s(),
+                    line,
+                    column,
+                    value,
+                    range,
+                });
+            }
+            values.push(value);
+        }
+        raw.push((label, line, values));
+    }
+    let Some((rows, cols, _)) = header else {
+        return Err(RealDataError::NoHeader { origin: origin_s() });
+    };
+    if raw.is_empty() {
+        return Err(RealDataError::NoFrames { origin: origin_s() });
+    }
+    let scale = match options.normalisation {
+        Normalisation::Range(range) => range,
+        Normalisation::FileMax => raw
+            .iter()
+            .flat_map(|(_, _, v)| v.iter().copied())
+            .fold(0.0, f64::max),
+    };
+    if scale == 0.0 {
+        return Err(RealDataError::AllZero { origin: origin_s() });
+    }
+    let readings = raw
+        .into_iter()
+        .map(|(label, line, values)| {
+            let values = values.into_iter().map(|v| v / scale).collect();
+            TactileImage::new(rows, cols, values)
+                .map(|image| RealReading { label, line, image })
+                .map_err(|e| RealDataError::Invalid {
+                    origin: origin_s(),
+                    line,
+                    what: e.to_string(),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let synthetic = text
+        .lines()
+        .any(|line| line.trim_start().starts_with(SYNTHETIC_MARK));
+    Ok(RealData {
+        rows,
+        cols,
+        readings,
+        synthetic,
+    })
+}
+
+/// Reads `label,r0c0,...`: the taxel columns must be `r<i>c<j>` in row-major order and fill a grid.
+fn parse_header(
+    record: &[&str],
+    line: u64,
+    origin: &str,
+) -> Result<(usize, usize, Vec<String>), RealDataError> {
+    let bad = |what: String| RealDataError::Header {
+        origin: origin.to_string(),
+        line,
+        what,
+    };
+    if record[0] != "label" {
+        return Err(bad(format!(
+            "the first column must be 'label', got '{}'",
+            record[0]
+        )));
+    }
+    let names: Vec<String> = record[1..].iter().map(|s| s.to_string()).collect();
+    if names.is_empty() {
+        return Err(bad("no taxel columns".to_string()));
+    }
+    let cells = names
+        .iter()
+        .map(|name| {
+            parse_taxel_name(name).ok_or_else(|| bad(format!("taxel column '{name}' is not r<row>c<col>")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let rows = cells.iter().map(|c| c.0).max().unwrap_or(0) + 1;
+    let cols = cells.iter().map(|c| c.1).max().unwrap_or(0) + 1;
+    for (k, (&cell, name)) in cells.iter().zip(&names).enumerate() {
+        if cell != (k / cols, k % cols) {
+            return Err(bad(format!(
+                "taxel column {} is '{name}', expected r{}c{} (row-major, {rows}x{cols})",
+                k + 2,
+                k / cols,
+                k % cols
+            )));
+        }
+    }
+    if cells.len() != rows * cols {
+        return Err(bad(format!(
+            "{} taxel columns do not fill a {rows}x{cols} grid",
+            cells.len()
+        )));
+    }
+    if !(TAXELS_PER_SIDE.contains(&rows) && TAXELS_PER_SIDE.contains(&cols)) {
+        return Err(bad(format!(
+            "a {rows}x{cols} sensor; accepted are {MIN_TAXELS_PER_SIDE} to {MAX_TAXELS_PER_SIDE} taxels per side"
+        )));
+    }
+    Ok((rows, cols, names))
+}
+
+/// The lines of a CSV text that carry data, as (1-based line number, trimmed comma-separated
+/// fields): blank lines and `#` comments are skipped.
+fn records(text: &str) -> impl Iterator<Item = (u64, Vec<&str>)> {
+    text.lines().enumerate().filter_map(|(i, text_line)| {
+        let trimmed = text_line.trim();
+        (!trimmed.is_empty() && !trimmed.starts_with('#'))
+            .then(|| (i as u64 + 1, trimmed.split(',').map(str::trim).collect()))
+    })
+}
