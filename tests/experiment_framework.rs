@@ -12,8 +12,8 @@ use serde::{Deserialize, Serialize};
 
 use taction::experiment::plot::build_figure;
 use taction::experiment::{
-    AccuracyCurve, AccuracyRow, Axis, Experiment, ExperimentError, ExperimentSpec, PlotSpec, RunOptions,
-    SafeName, Shard, Unit, merge, run,
+    AccuracyCurve, AccuracyRow, Axis, DetailRow, Experiment, ExperimentError, ExperimentSpec, Factor,
+    Factors, PlotSpec, RunOptions, SafeName, Shard, Unit, merge, run,
 };
 use taction::paper::real_data::parse_real_csv;
 use taction::paper::sim_to_real::square_root;
@@ -22,6 +22,7 @@ use taction::paper::{
     split_per_label,
 };
 use taction::recognize::AccuracyPoint;
+use taction::recognize::evaluate::TrialOutcome;
 use taction::tactile::TactileImage;
 
 // ---------------------------------------------------------------------------------------------
@@ -75,30 +76,15 @@ fn paced_toy<'a>(
 ) -> Experiment<'a, ToyRow, ToyConfig> {
     let units = (0..TOY_UNITS)
         .map(|i| {
-            let key = SafeName::builder("toy")
-                .param("noise", (i % 3) as f64 * 0.1)
-                .param("trial", i)
-                .build()
-                .unwrap();
-            let name = key.to_string();
-            Unit::new(key, move || {
-                std::thread::sleep(pace);
-                let call = calls.fetch_add(1, Ordering::SeqCst) + 1;
-                if Some(call) == fail_on_call {
-                    return Err("simulated crash".into());
-                }
-                let mut rng = taction::rng::stream(seed, i as u64);
-                Ok((0..3)
-                    .map(|step| ToyRow {
-                        unit: name.clone(),
-                        step,
-                        value: rng.random_range(-1.0..1.0),
-                        draw: rng.random(),
-                    })
-                    .collect())
-            })
+            let work = toy_work(seed, i, calls, fail_on_call, pace);
+            Unit::new(toy_key(i), work)
         })
         .collect();
+    toy_experiment(seed, units)
+}
+
+/// The toy experiment of `units`, made with `seed`.
+fn toy_experiment<'a, D>(seed: u64, units: Vec<Unit<'a, ToyRow, D>>) -> Experiment<'a, ToyRow, ToyConfig, D> {
     Experiment {
         spec: toy_spec(),
         config: ToyConfig {
@@ -106,6 +92,41 @@ fn paced_toy<'a>(
             units: TOY_UNITS,
         },
         units,
+    }
+}
+
+fn toy_key(i: usize) -> SafeName {
+    SafeName::builder("toy")
+        .param("noise", (i % 3) as f64 * 0.1)
+        .param("trial", i)
+        .build()
+        .unwrap()
+}
+
+/// The work of toy unit `i`: three random steps, after `pace`, failing as the `fail_on_call`-th call.
+fn toy_work<'a>(
+    seed: u64,
+    i: usize,
+    calls: &'a AtomicUsize,
+    fail_on_call: Option<usize>,
+    pace: Duration,
+) -> impl Fn() -> Result<Vec<ToyRow>, taction::experiment::BoxError> + Send + Sync + 'a {
+    let name = toy_key(i).to_string();
+    move || {
+        std::thread::sleep(pace);
+        let call = calls.fetch_add(1, Ordering::SeqCst) + 1;
+        if Some(call) == fail_on_call {
+            return Err("simulated crash".into());
+        }
+        let mut rng = taction::rng::stream(seed, i as u64);
+        Ok((0..3)
+            .map(|step| ToyRow {
+                unit: name.clone(),
+                step,
+                value: rng.random_range(-1.0..1.0),
+                draw: rng.random(),
+            })
+            .collect())
     }
 }
 
@@ -403,6 +424,124 @@ fn thread_count_does_not_change_the_output() {
     assert_same_tree(one.path(), two.path());
 }
 
+/// A second table: each toy step split into two parts (the shape of per-object rows beside
+/// averaged ones).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct ToyPart {
+    unit: String,
+    step: u32,
+    part: u32,
+    share: f64,
+}
+
+impl DetailRow for ToyPart {
+    const TABLE: Option<&'static str> = Some("per_part");
+}
+
+/// [`toy`] whose units also write [`ToyPart`] rows: each step's value in two equal shares.
+fn detailed_toy<'a>(
+    seed: u64,
+    calls: &'a AtomicUsize,
+    fail_on_call: Option<usize>,
+) -> Experiment<'a, ToyRow, ToyConfig, ToyPart> {
+    let units = (0..TOY_UNITS)
+        .map(|i| {
+            let work = toy_work(seed, i, calls, fail_on_call, Duration::ZERO);
+            Unit::with_detail(toy_key(i), move || {
+                let rows = work()?;
+                let parts = rows
+                    .iter()
+                    .flat_map(|r| {
+                        (0..2).map(|part| ToyPart {
+                            unit: r.unit.clone(),
+                            step: r.step,
+                            part,
+                            share: r.value / 2.0,
+                        })
+                    })
+                    .collect();
+                Ok((rows, parts))
+            })
+        })
+        .collect();
+    toy_experiment(seed, units)
+}
+
+#[test]
+fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
+    let reference = tempfile::tempdir().unwrap();
+    let calls = AtomicUsize::new(0);
+    let report = run(
+        &detailed_toy(7, &calls, None),
+        &options(reference.path(), 2, "1/1"),
+    )
+    .unwrap();
+    let detail = reference.path().join("toy/toy_per_part.csv");
+    assert_eq!(report.finished.unwrap().detail, Some(detail.clone()));
+    let parts: Vec<ToyPart> = csv::Reader::from_path(&detail)
+        .unwrap()
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .unwrap();
+    let rows = read_toy_csv(&reference.path().join("toy/toy.csv"));
+    assert_eq!(parts.len(), 2 * rows.len(), "two parts per row, units in order");
+    for (row, pair) in rows.iter().zip(parts.chunks(2)) {
+        assert!(pair.iter().all(|p| (&p.unit, p.step) == (&row.unit, row.step)));
+        assert_eq!(pair[0].share + pair[1].share, row.value);
+    }
+    let manifest = std::fs::read_to_string(reference.path().join("toy/manifest.json")).unwrap();
+    assert!(manifest.contains("\"detail\": \"per_part\""), "{manifest}");
+    let index = std::fs::read_to_string(reference.path().join("README.md")).unwrap();
+    assert!(
+        index.contains("Data: [toy.csv](toy/toy.csv), [toy_per_part.csv](toy/toy_per_part.csv)\n"),
+        "{index}"
+    );
+
+    // A failed run resumes to the same files, detail rows included.
+    let resumed = tempfile::tempdir().unwrap();
+    let calls = AtomicUsize::new(0);
+    run(
+        &detailed_toy(7, &calls, Some(4)),
+        &options(resumed.path(), 1, "1/1"),
+    )
+    .unwrap_err();
+    let calls = AtomicUsize::new(0);
+    let report = run(&detailed_toy(7, &calls, None), &options(resumed.path(), 2, "1/1")).unwrap();
+    assert_eq!((report.reused, report.ran), (3, TOY_UNITS - 3));
+    assert_same_tree(reference.path(), resumed.path());
+
+    // Shards merged give the same files.
+    let (a, b, merged) = (
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+        tempfile::tempdir().unwrap(),
+    );
+    run(&detailed_toy(7, &calls, None), &options(a.path(), 1, "1/2")).unwrap();
+    run(&detailed_toy(7, &calls, None), &options(b.path(), 2, "2/2")).unwrap();
+    let report = merge(&[a.path().to_path_buf(), b.path().to_path_buf()], merged.path()).unwrap();
+    assert_eq!(report.copied, 2 * TOY_UNITS, "each unit's two files");
+    assert_same_tree(reference.path(), merged.path());
+
+    // Units saved before the experiment had its second table are reused, not rerun; the main
+    // table is assembled as before and the index says why the second one is missing.
+    std::fs::remove_dir_all(resumed.path().join("toy/units/per_part")).unwrap();
+    std::fs::remove_file(resumed.path().join("toy/toy_per_part.csv")).unwrap();
+    let calls = AtomicUsize::new(0);
+    let report = run(&detailed_toy(7, &calls, None), &options(resumed.path(), 2, "1/1")).unwrap();
+    assert_eq!((report.reused, report.ran), (TOY_UNITS, 0));
+    assert_eq!(report.finished.unwrap().detail, None);
+    assert!(!resumed.path().join("toy/toy_per_part.csv").exists());
+    assert_eq!(
+        std::fs::read(resumed.path().join("toy/toy.csv")).unwrap(),
+        std::fs::read(reference.path().join("toy/toy.csv")).unwrap()
+    );
+    let index = std::fs::read_to_string(resumed.path().join("README.md")).unwrap();
+    assert!(
+        index.contains("`toy_per_part.csv` is not here: 10 of 10 units were saved before"),
+        "{index}"
+    );
+}
+
 #[test]
 fn merge_rejects_mismatched_incomplete_and_empty_inputs() {
     let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
@@ -578,14 +717,17 @@ fn the_merge_command_merges_and_reports_errors() {
 // ---------------------------------------------------------------------------------------------
 // Plots and the index.
 
-/// An evaluation's point after `n_readings` readings: `correct` of `trials` right.
+/// An evaluation's point after `n_readings` readings: `correct` of `trials` right, each trial
+/// giving `reliability` to its true object.
 fn point(n_readings: usize, correct: usize, trials: usize, reliability: f64) -> AccuracyPoint {
-    AccuracyPoint {
-        n_readings,
-        trials,
-        correct,
-        reliability,
-    }
+    let outcomes = (0..trials)
+        .map(|t| TrialOutcome {
+            object: t,
+            correct: t < correct,
+            p_true: reliability,
+        })
+        .collect();
+    AccuracyPoint::new(n_readings, outcomes)
 }
 
 fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
@@ -604,8 +746,7 @@ fn accuracy_experiment<'a>() -> Experiment<'a, AccuracyRow, u64> {
                     let curve = AccuracyCurve {
                         experiment: "noise".into(),
                         descriptor: descriptor.into(),
-                        parameter: "noise_fraction".into(),
-                        value: noise.to_string(),
+                        factors: Factors::new([(Factor::NoiseFraction, noise.to_string())]),
                         trial,
                         seed: 42,
                         stream_seed: seed,
@@ -803,15 +944,18 @@ fn accuracy_rows_out_of_range_are_named() {
     let curve = AccuracyCurve {
         experiment: "bad".into(),
         descriptor: "mnti".into(),
-        parameter: String::new(),
-        value: String::new(),
+        factors: Factors::none(),
         trial: 0,
         seed: 0,
         stream_seed: 0,
     };
     let units = vec![Unit::new(SafeName::new("u").unwrap(), move || {
         // 3 of 2 trials right: an accuracy no evaluation gives, which the runner must reject.
-        Ok(curve.rows(&[point(1, 1, 2, 0.5), point(2, 3, 2, 0.5)]))
+        let impossible = AccuracyPoint {
+            correct: 3,
+            ..point(2, 2, 2, 0.5)
+        };
+        Ok(curve.rows(&[point(1, 1, 2, 0.5), impossible]))
     })];
     let e = run(
         &Experiment {

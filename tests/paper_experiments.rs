@@ -7,14 +7,28 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use taction::experiment::AccuracyRow;
+use taction::experiment::{AccuracyRow, Factor, PerObjectRow};
 use taction::mesh::ObjectSet;
 use taction::mesh::glyph::Font;
 use taction::mesh::letters::LetterStyle;
 use taction::paper::PaperExperiment;
 
-const ACCURACY_HEADER: &str =
-    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";
+/// The factor columns of each recognition experiment: one per thing it varies besides the
+/// descriptor.
+fn factor_columns(experiment: &str) -> &'static [&'static str] {
+    match experiment {
+        "strategy" => &["local_probability"],
+        "validation" => &["data", "resolution"],
+        "perturbation" => &["object_motion"],
+        "thickness" => &["thickness_fraction"],
+        "resolution" => &["resolution"],
+        "noise" => &["noise_fraction"],
+        "training-size" => &["training_readings"],
+        "active" => &["strategy", "local_probability", "object_motion"],
+        "end-to-end" => &["training", "local_probability", "object_motion"],
+        _ => &[],
+    }
+}
 
 fn taction(args: &[&str]) -> Output {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
@@ -43,19 +57,79 @@ fn two_letters(dir: &Path) -> PathBuf {
     path
 }
 
-fn rows(csv: &Path) -> Vec<AccuracyRow> {
+/// `csv`'s rows, after checking its header is `experiment,descriptor`, one column per factor of
+/// the experiment, `trial` and `after`, and that no factor cell is empty or a packed pair.
+fn tidy_rows<R: serde::de::DeserializeOwned>(csv: &Path, after: &str) -> Vec<R> {
     let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
-    // `active` adds the confidence stop's columns after the accuracy ones.
+    let experiment = csv
+        .parent()
+        .and_then(Path::file_name)
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let factors = factor_columns(experiment);
+    let mut columns = vec!["experiment", "descriptor"];
+    columns.extend(factors);
+    columns.push("trial");
+    let expected = format!("{},{after}", columns.join(","));
     let header = text.lines().next().unwrap_or_default();
-    assert!(
-        header == ACCURACY_HEADER || header == format!("{ACCURACY_HEADER},confident,correct_at_stop"),
-        "{}: {header}",
-        csv.display()
-    );
+    assert_eq!(header, expected, "{}", csv.display());
+    for line in text.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        for (k, column) in factors.iter().enumerate() {
+            let cell = cells.get(2 + k).copied().unwrap_or_default();
+            assert!(
+                !cell.is_empty() && !cell.contains(char::is_whitespace),
+                "{}: {column} = '{cell}' is not one level: {line}",
+                csv.display()
+            );
+        }
+    }
     csv::Reader::from_reader(text.as_bytes())
         .deserialize()
-        .collect::<Result<Vec<AccuracyRow>, _>>()
+        .collect::<Result<Vec<R>, _>>()
         .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
+}
+
+fn rows(csv: &Path) -> Vec<AccuracyRow> {
+    // `active` adds the confidence stop's columns after the accuracy ones.
+    let active = csv.file_stem().is_some_and(|s| s == "active");
+    let after = "n_readings,accuracy,reliability,seed,stream_seed";
+    if active {
+        tidy_rows(csv, &format!("{after},confident,correct_at_stop"))
+    } else {
+        tidy_rows(csv, after)
+    }
+}
+
+/// Checks the per-object table beside `name`'s accuracy table: one row per test object at every
+/// point of every curve, whose mean `correct` is the point's accuracy and mean `p_true` its
+/// reliability.
+fn assert_per_object_rows_average_to(name: &str, out: &Path, rows: &[AccuracyRow]) {
+    let csv = out.join(name).join(format!("{name}_per_object.csv"));
+    let per_object: Vec<PerObjectRow> = tidy_rows(&csv, "object,n_readings,correct,p_true");
+    let mut objects = BTreeSet::new();
+    for row in rows {
+        let at: Vec<&PerObjectRow> = per_object
+            .iter()
+            .filter(|o| {
+                (&o.descriptor, &o.factors, o.trial, o.n_readings)
+                    == (&row.descriptor, &row.factors, row.trial, row.n_readings)
+            })
+            .collect();
+        assert!(!at.is_empty(), "{name}: no per-object rows for {row:?}");
+        let k = at.len() as f64;
+        let correct = at.iter().filter(|o| o.correct).count() as f64 / k;
+        let p_true = at.iter().map(|o| o.p_true).sum::<f64>() / k;
+        assert_eq!(correct, row.accuracy, "{name}: {row:?}");
+        assert!((p_true - row.reliability).abs() < 1e-12, "{name}: {row:?}");
+        objects.extend(at.iter().map(|o| o.object.clone()));
+    }
+    let points = rows.len();
+    assert_eq!(
+        per_object.len(),
+        points * objects.len(),
+        "{name}: every object at every point"
+    );
 }
 
 fn assert_svg_and_png(stem: &Path) {
@@ -130,21 +204,22 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
             assert!(r.n_readings >= 1);
             // `seed` is the run's --seed; each trial's derived stream is its own column.
             assert_eq!(r.seed, 1, "{name}: seed column");
-            curves.insert((r.descriptor.clone(), r.value.clone(), r.trial));
+            curves.insert((r.descriptor.clone(), r.factors.to_string(), r.trial));
         }
         // Every curve starts at one reading and counts up without gaps.
-        for (descriptor, value, trial) in &curves {
+        for (descriptor, levels, trial) in &curves {
             let ns: Vec<u32> = rows
                 .iter()
-                .filter(|r| (&r.descriptor, &r.value, &r.trial) == (descriptor, value, trial))
+                .filter(|r| (&r.descriptor, &r.factors.to_string(), &r.trial) == (descriptor, levels, trial))
                 .map(|r| r.n_readings)
                 .collect();
             assert_eq!(
                 ns,
                 (1..=ns.len() as u32).collect::<Vec<_>>(),
-                "{name} {descriptor} {value}"
+                "{name} {descriptor} {levels}"
             );
         }
+        assert_per_object_rows_average_to(name, &out, &rows);
         assert_svg_and_png(&root.join(name));
         let config = std::fs::read_to_string(root.join("config.json")).expect("config.json written");
         assert!(
@@ -157,7 +232,10 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     let values = |name: &str| -> BTreeSet<String> {
         rows(&out.join(name).join(format!("{name}.csv")))
             .into_iter()
-            .map(|r| r.value)
+            .map(|r| {
+                let levels: Vec<&str> = r.factors.iter().map(|(_, level)| level).collect();
+                levels.join(" ")
+            })
             .collect()
     };
     let descriptors: BTreeSet<String> = rows(&out.join("descriptors/descriptors.csv"))
@@ -188,13 +266,27 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     assert_eq!(
         values("active"),
         BTreeSet::from([
-            "L=1 fixed".into(),
-            "L=1 perturbed".into(),
-            "L=0.5 fixed".into(),
-            "L=0.5 perturbed".into(),
-            "active fixed".into(),
-            "active perturbed".into(),
+            "blind 1 fixed".into(),
+            "blind 1 perturbed".into(),
+            "blind 0.5 fixed".into(),
+            "blind 0.5 perturbed".into(),
+            "active 0.5 fixed".into(),
+            "active 0.5 perturbed".into(),
         ])
+    );
+    assert_eq!(
+        values("validation"),
+        BTreeSet::from([
+            "validation 6x6".into(),
+            "exploration 6x6".into(),
+            "validation 26x26".into(),
+            "exploration 26x26".into(),
+        ])
+    );
+    let e2e = rows(&out.join("end-to-end/end-to-end.csv"));
+    assert!(
+        e2e.iter()
+            .any(|r| r.factors.level(Factor::Training) == Some("reachable"))
     );
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
@@ -246,6 +338,10 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
     let dir = tempfile::tempdir().unwrap();
     let whole = dir.path().join("whole");
     let reference = run_experiment("descriptors", &whole, &["--threads", "2"]);
+    let per_object = |root: &Path| {
+        std::fs::read(root.join("descriptors/descriptors_per_object.csv")).expect("the per-object CSV")
+    };
+    let reference_objects = per_object(&whole);
 
     // Kill a run as soon as its first unit is on disk, then run it again.
     let killed = dir.path().join("killed");
@@ -293,6 +389,10 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
             resumed, reference,
             "the resumed run has the rows of the uninterrupted one"
         );
+        assert!(
+            per_object(&killed) == reference_objects,
+            "the resumed run has the per-object rows of the uninterrupted one"
+        );
     }
     let lines: Vec<&[u8]> = reference
         .split(|&b| b == b'\n')
@@ -329,6 +429,10 @@ fn a_killed_run_resumes_to_the_rows_of_an_uninterrupted_run_and_shards_merge_to_
     taction(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let merged_csv = std::fs::read(merged.join("descriptors/descriptors.csv")).expect("merged CSV");
     assert_eq!(merged_csv, reference, "merged shards == one run, byte for byte");
+    assert!(
+        per_object(&merged) == reference_objects,
+        "merged shards' per-object rows == one run's"
+    );
 }
 
 #[test]
@@ -367,8 +471,10 @@ fn the_active_experiment_is_the_same_on_one_and_two_threads() {
     let mut reader = csv::Reader::from_reader(text.as_bytes());
     let headers = reader.headers().expect("a header").clone();
     let column = |name: &str| headers.iter().position(|h| h == name).expect(name);
-    let (value, trial, confident, correct) = (
-        column("value"),
+    let (strategy, local, motion, trial, confident, correct) = (
+        column("strategy"),
+        column("local_probability"),
+        column("object_motion"),
         column("trial"),
         column("confident"),
         column("correct_at_stop"),
@@ -380,7 +486,10 @@ fn the_active_experiment_is_the_same_on_one_and_two_threads() {
         let c: f64 = record[confident].parse().expect("confident");
         let r: f64 = record[correct].parse().expect("correct_at_stop");
         assert!((0.0..=1.0).contains(&c) && r <= c + 1e-12, "{record:?}");
-        let curve = (record[value].to_string(), record[trial].to_string());
+        let curve = (
+            format!("{} {} {}", &record[strategy], &record[local], &record[motion]),
+            record[trial].to_string(),
+        );
         if let Some((v, t, previous)) = &last
             && (v, t) == (&curve.0, &curve.1)
         {

@@ -7,13 +7,14 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use taction::dataset::{ContactStatus, Dataset, Strategy};
-use taction::experiment::AccuracyRow;
+use taction::experiment::{AccuracyRow, PerObjectRow};
 use taction::paper::context::EXAMPLE_REAL_CSV;
 use taction::paper::real_data::{Calibration, RealImport, parse_real_csv};
 use taction::paper::real_frames::{prune, scaled_split_sizes, trial_split};
 
-const ACCURACY_HEADER: &str =
-    "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed";
+/// The figure varies only the descriptor: no factor column.
+const ACCURACY_HEADER: &str = "experiment,descriptor,trial,n_readings,accuracy,reliability,seed,stream_seed";
+const PER_OBJECT_HEADER: &str = "experiment,descriptor,trial,object,n_readings,correct,p_true";
 
 fn taction(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_taction"))
@@ -22,8 +23,9 @@ fn taction(args: &[&str]) -> Output {
         .expect("the taction binary runs")
 }
 
-/// The rows of `experiment real-frames --trials 2` on the recording `text`.
-fn two_trials_of(text: &str) -> Vec<AccuracyRow> {
+/// The rows of `experiment real-frames --trials 2` on the recording `text`, and its per-object
+/// rows.
+fn two_trials_of(text: &str) -> (Vec<AccuracyRow>, Vec<PerObjectRow>) {
     let dir = tempfile::tempdir().unwrap();
     let real = dir.path().join("recording.csv");
     std::fs::write(&real, text).unwrap();
@@ -38,7 +40,13 @@ fn two_trials_of(text: &str) -> Vec<AccuracyRow> {
         "--out",
         out.to_str().unwrap(),
     ]);
-    rows(&out)
+    (
+        rows(&out),
+        read_csv(
+            &out.join("real-frames/real-frames_per_object.csv"),
+            PER_OBJECT_HEADER,
+        ),
+    )
 }
 
 fn run_ok(args: &[&str]) {
@@ -53,12 +61,16 @@ fn run_ok(args: &[&str]) {
 }
 
 fn rows(out: &Path) -> Vec<AccuracyRow> {
-    let csv = out.join("real-frames/real-frames.csv");
-    let text = std::fs::read_to_string(&csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
-    assert_eq!(text.lines().next(), Some(ACCURACY_HEADER));
+    read_csv(&out.join("real-frames/real-frames.csv"), ACCURACY_HEADER)
+}
+
+/// The rows of `csv`, whose first line must be `header`.
+fn read_csv<R: serde::de::DeserializeOwned>(csv: &Path, header: &str) -> Vec<R> {
+    let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    assert_eq!(text.lines().next(), Some(header), "{}", csv.display());
     csv::Reader::from_reader(text.as_bytes())
         .deserialize()
-        .collect::<Result<Vec<AccuracyRow>, _>>()
+        .collect::<Result<Vec<R>, _>>()
         .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
 }
 
@@ -113,7 +125,7 @@ fn the_shipped_example_runs_end_to_end_with_every_descriptor_and_trial() {
     // 8 frames per vowel, scale 0.02 -> 7 used: 4 training, 1 validation, 2 test.
     assert!(
         rows.iter()
-            .all(|r| r.experiment == "real-frames" && r.value == "real")
+            .all(|r| r.experiment == "real-frames" && r.factors.is_empty())
     );
     assert!(rows.iter().all(|r| (1..=2).contains(&r.n_readings)));
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r.accuracy)));
@@ -149,9 +161,22 @@ fn two_labels_with_disjoint_constant_frames_are_told_apart_after_one_reading() {
     let cross: Vec<f64> = (0..36)
         .map(|k| if k / 6 == 2 || k % 6 == 2 { 500.0 } else { 0.0 })
         .collect();
-    let rows = two_trials_of(&recording(&[("A", vec![bar(0..3); 14]), ("B", vec![cross; 14])]));
+    let (rows, per_object) = two_trials_of(&recording(&[("A", vec![bar(0..3); 14]), ("B", vec![cross; 14])]));
     for r in rows.iter().filter(|r| r.n_readings == 1) {
         assert_eq!(r.accuracy, 1.0, "{} trial {}", r.descriptor, r.trial);
+        // Each label, named, right on its own.
+        let labels: Vec<(&str, bool)> = per_object
+            .iter()
+            .filter(|o| (&o.descriptor, o.trial, o.n_readings) == (&r.descriptor, r.trial, 1))
+            .map(|o| (o.object.as_str(), o.correct))
+            .collect();
+        assert_eq!(
+            labels,
+            [("A", true), ("B", true)],
+            "{} trial {}",
+            r.descriptor,
+            r.trial
+        );
     }
 }
 
@@ -160,7 +185,11 @@ fn labels_sharing_the_same_frames_stay_at_chance() {
     let frame: Vec<f64> = (0..36).map(|k| (k % 7) as f64 * 100.0).collect();
     let labels = ["A", "E", "I", "O"];
     let frames: Vec<(&str, Vec<Vec<f64>>)> = labels.iter().map(|l| (*l, vec![frame.clone(); 14])).collect();
-    let rows = two_trials_of(&recording(&frames));
+    let (rows, per_object) = two_trials_of(&recording(&frames));
+    assert!(
+        per_object.iter().all(|o| (o.p_true - 0.25).abs() < 1e-9),
+        "every label's own probability stays at 1/4"
+    );
     // Identical evidence for every label: the belief stays at the uniform prior.
     for n in 1..=4 {
         let (_, reliability) = mean_at(&rows, n);

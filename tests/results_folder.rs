@@ -116,3 +116,77 @@ fn every_figure_paper_md_discusses_links_its_csv_from_one_run() {
         );
     }
 }
+
+/// The experiment folders under `root` that hold an accuracy table (`<name>/<name>.csv` whose
+/// header starts `experiment,descriptor`), with that table.
+fn accuracy_tables(root: &Path) -> Vec<(String, PathBuf)> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(root).unwrap_or_else(|e| panic!("{}: {e}", root.display())) {
+        let dir = entry.expect("a directory entry").path();
+        let Some(name) = dir.file_name().and_then(|n| n.to_str()).map(str::to_string) else {
+            continue;
+        };
+        let csv = dir.join(format!("{name}.csv"));
+        let header = std::fs::read_to_string(&csv)
+            .ok()
+            .and_then(|t| t.lines().next().map(str::to_string));
+        if header.is_some_and(|h| h.starts_with("experiment,descriptor,")) {
+            found.push((name, csv));
+        }
+    }
+    found.sort();
+    found
+}
+
+/// Every shipped accuracy table (the run's and the neighbour codebook's) has one column per factor
+/// between `descriptor` and `trial`, each cell one level (no `parameter`/`value` pair, no packed
+/// `validation 6x6`, no empty cell); its per-object table is there, or the index says why not.
+#[test]
+fn shipped_accuracy_tables_have_one_column_per_factor_and_account_for_per_object_rows() {
+    let mut tables = accuracy_tables(&results());
+    tables.extend(accuracy_tables(&results().join("knn")));
+    assert!(tables.len() >= 15, "every recognition experiment: {tables:?}");
+    for (name, csv) in &tables {
+        let mut reader = csv::Reader::from_path(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+        let header = reader.headers().expect("a header").clone();
+        let trial = header
+            .iter()
+            .position(|c| c == "trial")
+            .unwrap_or_else(|| panic!("{}: no trial column", csv.display()));
+        let factors: Vec<&str> = header.iter().take(trial).skip(2).collect();
+        assert!(
+            !factors.iter().any(|c| *c == "parameter" || *c == "value"),
+            "{}: factor columns {factors:?}",
+            csv.display()
+        );
+        for record in reader.records() {
+            let record = record.expect("a CSV record");
+            for (k, column) in factors.iter().enumerate() {
+                let cell = &record[2 + k];
+                assert!(
+                    !cell.is_empty() && !cell.contains(char::is_whitespace),
+                    "{}: {column} = '{cell}' is not one level",
+                    csv.display()
+                );
+            }
+        }
+        let per_object = csv.with_file_name(format!("{name}_per_object.csv"));
+        let root = csv.parent().and_then(Path::parent).expect("the results root");
+        let index = std::fs::read_to_string(root.join("README.md")).expect("the index");
+        assert!(
+            per_object.is_file() || index.contains(&format!("`{name}_per_object.csv` is not here")),
+            "{name}: neither {} nor a word on its absence in {}/README.md",
+            per_object.display(),
+            root.display()
+        );
+    }
+    let validation = csv::Reader::from_path(results().join("validation/validation.csv"))
+        .expect("validation.csv")
+        .headers()
+        .expect("a header")
+        .clone();
+    assert_eq!(
+        validation.iter().take(5).collect::<Vec<_>>(),
+        ["experiment", "descriptor", "data", "resolution", "trial"]
+    );
+}

@@ -1,9 +1,21 @@
-//! The tidy accuracy table of the paper's recognition figures (Fig. 7-13, 16, 17): one row per
-//! observation, i.e. per (setting, trial, number of readings).
+//! The tidy tables of the paper's recognition figures (Fig. 7-13, 16, 17): the accuracy table, one
+//! row per (setting, trial, number of readings), and beside it the per-object table, one row per
+//! test object at each of those points.
+//!
+//! Both start with `experiment`, `descriptor` and the experiment's factor columns ([`Factor`]: one
+//! column per thing the experiment varies, none when it varies only the descriptor), then `trial`.
+//! The factor columns differ between experiments, so the rows are written and read by name rather
+//! than derived.
 
+use std::fmt;
+
+use serde::de::{self, Deserializer, MapAccess, Visitor};
+use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
 
-use crate::recognize::AccuracyPoint;
+use super::factor::{Factor, FactorError, Factors};
+use super::unit::DetailRow;
+use crate::recognize::{AccuracyPoint, Evaluation};
 
 /// One point of one recognition curve.
 ///
@@ -11,20 +23,18 @@ use crate::recognize::AccuracyPoint;
 /// |---|---|
 /// | `experiment` | the experiment's name, e.g. `noise` |
 /// | `descriptor` | the descriptor's command-line name, e.g. `polar-fourier` |
-/// | `parameter` | the setting the experiment varies, e.g. `noise_fraction`, `local_probability`, `object` (`fixed`/`perturbed`), `data` (`validation`/`exploration`); empty when nothing but the descriptor varies |
-/// | `value` | that setting's value, as text: `0.1`, `perturbed` |
+/// | one column per factor | what the experiment varies besides the descriptor, one level per cell (see [`Factor`]): `noise_fraction` = `0.1`; `data` = `validation` and `resolution` = `6x6`; none in `descriptors`, `letters`, `real-frames`, `sim-to-real` |
 /// | `trial` | the repetition (0-based); the plot averages over trials |
 /// | `n_readings` | number of readings of the unknown object used so far (1-based) |
 /// | `accuracy` | fraction of test objects whose most probable identity after `n_readings` readings is correct, in [0, 1] (the "empirical probability of correctly identifying any unknown object", Sec. V-B2) |
 /// | `reliability` | mean posterior probability given to the correct object, in [0, 1] (Sec. V-B1) |
 /// | `seed` | the run's seed, as given with `--seed` |
 /// | `stream_seed` | the seed the trial's randomness was drawn from (derived from `seed`), its 64 bits read as a signed integer so that every CSV reader takes it as an int64 (`as u64` gives it back) |
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AccuracyRow {
     pub experiment: String,
     pub descriptor: String,
-    pub parameter: String,
-    pub value: String,
+    pub factors: Factors,
     pub trial: u32,
     pub n_readings: u32,
     pub accuracy: f64,
@@ -33,18 +43,54 @@ pub struct AccuracyRow {
     pub stream_seed: i64,
 }
 
+/// One test object of one point of one recognition curve: the rows whose mean `correct` is the
+/// accuracy row's `accuracy` and whose mean `p_true` its `reliability`.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment`, `descriptor`, factor columns, `trial`, `n_readings` | as in [`AccuracyRow`] |
+/// | `object` | the test object's name (for recorded frames, its label) |
+/// | `correct` | 1 when the object's most probable identity after `n_readings` readings (or its last, when it has fewer; none for an object never read) is the object, else 0 |
+/// | `p_true` | the posterior probability given to the object itself (1 / objects for one never read) |
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerObjectRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub factors: Factors,
+    pub trial: u32,
+    pub object: String,
+    pub n_readings: u32,
+    pub correct: bool,
+    pub p_true: f64,
+}
+
+impl DetailRow for PerObjectRow {
+    const TABLE: Option<&'static str> = Some("per_object");
+}
+
 /// Everything an [`AccuracyRow`] holds but the point itself: one curve of one trial.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccuracyCurve {
     pub experiment: String,
     pub descriptor: String,
-    pub parameter: String,
-    pub value: String,
+    pub factors: Factors,
     pub trial: u32,
     /// The run's seed (`--seed`).
     pub seed: u64,
     /// The seed the trial's randomness was drawn from.
     pub stream_seed: u64,
+}
+
+/// Per-object rows need one test sequence per object and trial.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{experiment}, {descriptor}, trial {trial}: object '{object}' is tested twice; per-object rows need one test sequence per object"
+)]
+pub struct RepeatedObject {
+    pub experiment: String,
+    pub descriptor: String,
+    pub trial: u32,
+    pub object: String,
 }
 
 impl AccuracyCurve {
@@ -56,8 +102,7 @@ impl AccuracyCurve {
             .map(|point| AccuracyRow {
                 experiment: self.experiment.clone(),
                 descriptor: self.descriptor.clone(),
-                parameter: self.parameter.clone(),
-                value: self.value.clone(),
+                factors: self.factors.clone(),
                 trial: self.trial,
                 n_readings: point.n_readings as u32,
                 accuracy: point.accuracy(),
@@ -67,30 +112,237 @@ impl AccuracyCurve {
             })
             .collect()
     }
+
+    /// The per-object rows of `evaluation`: at every point, each trial's outcome (the outcomes the
+    /// point's accuracy counts) under its object's name, objects in trial order.
+    pub fn object_rows(&self, evaluation: &Evaluation) -> Result<Vec<PerObjectRow>, RepeatedObject> {
+        let mut rows = Vec::new();
+        for point in &evaluation.accuracy {
+            for (i, outcome) in point.outcomes.iter().enumerate() {
+                let object = &evaluation.objects[outcome.object];
+                if point.outcomes[..i].iter().any(|o| o.object == outcome.object) {
+                    return Err(RepeatedObject {
+                        experiment: self.experiment.clone(),
+                        descriptor: self.descriptor.clone(),
+                        trial: self.trial,
+                        object: object.clone(),
+                    });
+                }
+                rows.push(PerObjectRow {
+                    experiment: self.experiment.clone(),
+                    descriptor: self.descriptor.clone(),
+                    factors: self.factors.clone(),
+                    trial: self.trial,
+                    object: object.clone(),
+                    n_readings: point.n_readings as u32,
+                    correct: outcome.correct,
+                    p_true: outcome.p_true,
+                });
+            }
+        }
+        Ok(rows)
+    }
+}
+
+impl AccuracyRow {
+    /// The columns, in order, into a row that may add its own after them (`active` does).
+    pub(crate) fn serialize_columns<S: SerializeStruct>(&self, row: &mut S) -> Result<(), S::Error> {
+        row.serialize_field("experiment", &self.experiment)?;
+        row.serialize_field("descriptor", &self.descriptor)?;
+        self.factors.serialize_columns(row)?;
+        row.serialize_field("trial", &self.trial)?;
+        row.serialize_field("n_readings", &self.n_readings)?;
+        row.serialize_field("accuracy", &self.accuracy)?;
+        row.serialize_field("reliability", &self.reliability)?;
+        row.serialize_field("seed", &self.seed)?;
+        row.serialize_field("stream_seed", &self.stream_seed)
+    }
+
+    /// The number of columns.
+    pub(crate) fn width(&self) -> usize {
+        8 + self.factors.len()
+    }
+
+    /// The row in `record`; columns after the accuracy ones (`active`'s) are left there.
+    pub(crate) fn from_record(record: &TidyRecord) -> Result<Self, String> {
+        Ok(Self {
+            experiment: record.text("experiment")?,
+            descriptor: record.text("descriptor")?,
+            factors: record.factors()?,
+            trial: record.number("trial")?,
+            n_readings: record.number("n_readings")?,
+            accuracy: record.number("accuracy")?,
+            reliability: record.number("reliability")?,
+            seed: record.number("seed")?,
+            stream_seed: record.number("stream_seed")?,
+        })
+    }
+}
+
+impl Serialize for AccuracyRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("AccuracyRow", self.width())?;
+        self.serialize_columns(&mut row)?;
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for AccuracyRow {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        Self::from_record(&TidyRecord::deserialize(deserializer)?).map_err(de::Error::custom)
+    }
+}
+
+impl Serialize for PerObjectRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("PerObjectRow", 7 + self.factors.len())?;
+        row.serialize_field("experiment", &self.experiment)?;
+        row.serialize_field("descriptor", &self.descriptor)?;
+        self.factors.serialize_columns(&mut row)?;
+        row.serialize_field("trial", &self.trial)?;
+        row.serialize_field("object", &self.object)?;
+        row.serialize_field("n_readings", &self.n_readings)?;
+        row.serialize_field("correct", &u8::from(self.correct))?;
+        row.serialize_field("p_true", &self.p_true)?;
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for PerObjectRow {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let record = TidyRecord::deserialize(deserializer)?;
+        let row = || -> Result<Self, String> {
+            Ok(Self {
+                experiment: record.text("experiment")?,
+                descriptor: record.text("descriptor")?,
+                factors: record.factors()?,
+                trial: record.number("trial")?,
+                object: record.text("object")?,
+                n_readings: record.number("n_readings")?,
+                correct: match record.number::<u8>("correct")? {
+                    0 => false,
+                    1 => true,
+                    other => return Err(format!("column 'correct': {other} is not 0 or 1")),
+                },
+                p_true: record.number("p_true")?,
+            })
+        };
+        row().map_err(de::Error::custom)
+    }
+}
+
+/// One CSV record as (column, cell) pairs in header order: what the recognition rows are read
+/// from, since their factor columns are known only from the header.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct TidyRecord {
+    cells: Vec<(String, String)>,
+}
+
+impl TidyRecord {
+    fn cell(&self, column: &str) -> Result<&str, String> {
+        self.cells
+            .iter()
+            .find(|(c, _)| c == column)
+            .map(|(_, v)| v.as_str())
+            .ok_or_else(|| format!("no column '{column}'"))
+    }
+
+    pub(crate) fn text(&self, column: &str) -> Result<String, String> {
+        self.cell(column).map(str::to_string)
+    }
+
+    pub(crate) fn number<T: std::str::FromStr>(&self, column: &str) -> Result<T, String> {
+        let text = self.cell(column)?;
+        text.parse().map_err(|_| {
+            format!(
+                "column '{column}': '{text}' is not a {}",
+                std::any::type_name::<T>()
+            )
+        })
+    }
+
+    /// The columns between `descriptor` and `trial`, each a [`Factor`] with a valid level.
+    fn factors(&self) -> Result<Factors, String> {
+        let position = |column: &str| {
+            self.cells
+                .iter()
+                .position(|(c, _)| c == column)
+                .ok_or_else(|| format!("no column '{column}'"))
+        };
+        let (first, end) = (position("descriptor")? + 1, position("trial")?);
+        let factors = Factors::new(
+            self.cells
+                .get(first..end)
+                .unwrap_or_default()
+                .iter()
+                .map(|(column, level)| {
+                    Factor::from_column(column)
+                        .map(|f| (f, level.clone()))
+                        .ok_or_else(|| FactorError::Unknown {
+                            column: column.clone(),
+                        })
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| e.to_string())?,
+        );
+        factors.check().map_err(|e| e.to_string())?;
+        Ok(factors)
+    }
+}
+
+impl<'de> Deserialize<'de> for TidyRecord {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Cells;
+        impl<'de> Visitor<'de> for Cells {
+            type Value = TidyRecord;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a CSV record with a header")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<TidyRecord, A::Error> {
+                let mut cells = Vec::new();
+                while let Some((column, cell)) = map.next_entry::<String, String>()? {
+                    cells.push((column, cell));
+                }
+                Ok(TidyRecord { cells })
+            }
+        }
+        deserializer.deserialize_map(Cells)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::recognize::evaluate::TrialOutcome;
 
-    #[test]
-    fn curve_rows_carry_each_points_readings_accuracy_and_reliability() {
-        let curve = AccuracyCurve {
+    fn curve() -> AccuracyCurve {
+        AccuracyCurve {
             experiment: "noise".into(),
             descriptor: "mnti".into(),
-            parameter: "noise_fraction".into(),
-            value: "0.1".into(),
+            factors: Factors::new([(Factor::NoiseFraction, "0.1")]),
             trial: 2,
             seed: 9,
             stream_seed: u64::MAX - 1,
-        };
-        let point = |n_readings, correct, reliability| AccuracyPoint {
+        }
+    }
+
+    /// A point of five trials, `correct` of them right, every one with `p_true`.
+    fn point(n_readings: usize, correct: usize, p_true: f64) -> AccuracyPoint {
+        AccuracyPoint::new(
             n_readings,
-            trials: 5,
-            correct,
-            reliability,
-        };
-        let rows = curve.rows(&[point(1, 1, 0.3), point(2, 2, 0.5)]);
+            (0..5)
+                .map(|object| TrialOutcome {
+                    object,
+                    correct: object < correct,
+                    p_true,
+                })
+                .collect(),
+        )
+    }
+
+    #[test]
+    fn curve_rows_carry_each_points_readings_accuracy_and_reliability() {
+        let rows = curve().rows(&[point(1, 1, 0.3), point(2, 2, 0.5)]);
         assert_eq!(rows.len(), 2);
         assert_eq!((rows[0].n_readings, rows[0].accuracy), (1, 0.2));
         assert_eq!(
@@ -105,5 +357,82 @@ mod tests {
         // A derived seed above i64::MAX is written as a negative int64 and read back unchanged.
         assert_eq!(rows[0].stream_seed, -2);
         assert_eq!(rows[0].stream_seed as u64, u64::MAX - 1);
+    }
+
+    fn csv_of<R: Serialize>(rows: &[R]) -> String {
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        for row in rows {
+            writer.serialize(row).unwrap();
+        }
+        String::from_utf8(writer.into_inner().unwrap()).unwrap()
+    }
+
+    fn read<R: for<'de> Deserialize<'de>>(text: &str) -> Result<Vec<R>, csv::Error> {
+        csv::Reader::from_reader(text.as_bytes()).deserialize().collect()
+    }
+
+    #[test]
+    fn rows_write_one_column_per_factor_and_read_back() {
+        let mut two = curve();
+        two.factors = Factors::new([(Factor::Data, "validation"), (Factor::Resolution, "6x6")]);
+        let rows = two.rows(&[point(1, 1, 0.3)]);
+        let text = csv_of(&rows);
+        assert!(
+            text.starts_with("experiment,descriptor,data,resolution,trial,n_readings,accuracy,"),
+            "{text}"
+        );
+        assert_eq!(read::<AccuracyRow>(&text).unwrap(), rows);
+        let mut none = curve();
+        none.factors = Factors::none();
+        let text = csv_of(&none.rows(&[point(1, 1, 0.3)]));
+        assert!(text.starts_with("experiment,descriptor,trial,"), "{text}");
+        assert_eq!(read::<AccuracyRow>(&text).unwrap()[0].factors, Factors::none());
+    }
+
+    #[test]
+    fn packed_or_unknown_factor_columns_are_refused() {
+        let mut packed = curve();
+        packed.factors = Factors::new([(Factor::Data, "validation 6x6")]);
+        let mut writer = csv::Writer::from_writer(Vec::new());
+        let e = writer
+            .serialize(&packed.rows(&[point(1, 1, 0.3)])[0])
+            .unwrap_err();
+        assert!(e.to_string().contains("one level per cell"), "{e}");
+        let old = "experiment,descriptor,parameter,value,trial,n_readings,accuracy,reliability,seed,stream_seed\n\
+                   noise,mnti,noise_fraction,0.1,0,1,0.5,0.5,1,2\n";
+        let e = read::<AccuracyRow>(old).unwrap_err().to_string();
+        assert!(e.contains("'parameter'") && e.contains("no factor"), "{e}");
+    }
+
+    #[test]
+    fn per_object_rows_average_to_the_accuracy_row() {
+        let objects = ["a", "b", "c", "d", "e"].map(String::from).to_vec();
+        let points = vec![point(1, 1, 0.3), point(2, 4, 0.7)];
+        let evaluation = Evaluation {
+            objects: objects.clone(),
+            touches: Vec::new(),
+            accuracy: points.clone(),
+            confusion: crate::recognize::ConfusionMatrix::new(objects, 2),
+        };
+        let per_object = curve().object_rows(&evaluation).unwrap();
+        assert_eq!(per_object.len(), 10);
+        for row in curve().rows(&points) {
+            let at: Vec<&PerObjectRow> = per_object
+                .iter()
+                .filter(|r| r.n_readings == row.n_readings)
+                .collect();
+            let correct = at.iter().filter(|r| r.correct).count() as f64 / at.len() as f64;
+            assert_eq!(correct, row.accuracy);
+        }
+        let text = csv_of(&per_object);
+        assert!(
+            text.starts_with("experiment,descriptor,noise_fraction,trial,object,n_readings,correct,p_true\n"),
+            "{text}"
+        );
+        assert!(text.contains("\nnoise,mnti,0.1,2,a,1,1,0.3\n"), "{text}");
+        assert_eq!(read::<PerObjectRow>(&text).unwrap(), per_object);
+        let mut twice = evaluation;
+        twice.accuracy[0].outcomes[1].object = 0;
+        assert!(curve().object_rows(&twice).is_err());
     }
 }

@@ -70,17 +70,32 @@ pub fn missing_units<'m>(dir: &ExperimentDir, manifest: &'m Manifest) -> Vec<&'m
         .collect()
 }
 
+/// The units of `manifest` whose detail file is not in `dir` (none when the experiment has no
+/// detail table). Units saved before their experiment had one lack it.
+pub fn missing_detail<'m>(dir: &ExperimentDir, manifest: &'m Manifest) -> Vec<&'m UnitKey> {
+    match &manifest.detail {
+        None => Vec::new(),
+        Some(table) => manifest
+            .units
+            .iter()
+            .filter(|key| !dir.detail_unit_csv(table, key).is_file())
+            .collect(),
+    }
+}
+
 /// The files an assembled experiment has.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Finished {
     pub csv: PathBuf,
+    /// `<experiment>_<table>.csv`, when the experiment has a detail table and every unit its file.
+    pub detail: Option<PathBuf>,
     pub config: PathBuf,
     pub plots: Vec<PathBuf>,
 }
 
 /// Assembles `<experiment>.csv` from every unit file in manifest order (one header; every unit must
-/// have the same header) and draws the manifest's plots from it. Fails with
-/// [`ExperimentError::Incomplete`] when a unit file is missing.
+/// have the same header), the detail table likewise when every unit has its detail file, and draws
+/// the manifest's plots. Fails with [`ExperimentError::Incomplete`] when a unit file is missing.
 pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, ExperimentError> {
     let missing = missing_units(dir, manifest);
     if let Some(first) = missing.first() {
@@ -92,11 +107,41 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
             first_missing: (*first).clone(),
         });
     }
+    let csv = dir.csv();
+    let units: Vec<PathBuf> = manifest.units.iter().map(|key| dir.unit_csv(key)).collect();
+    write_if_changed(&csv, &concatenate(&units)?)?;
+    let detail = match &manifest.detail {
+        Some(table) if missing_detail(dir, manifest).is_empty() => {
+            let path = dir.detail_csv(table);
+            let units: Vec<PathBuf> = manifest
+                .units
+                .iter()
+                .map(|key| dir.detail_unit_csv(table, key))
+                .collect();
+            write_if_changed(&path, &concatenate(&units)?)?;
+            Some(path)
+        }
+        _ => None,
+    };
+    let mut plots = Vec::new();
+    for spec in &manifest.spec.plots {
+        plots.extend(render_plot(spec, &csv, dir)?);
+    }
+    Ok(Finished {
+        csv,
+        detail,
+        config: dir.config(),
+        plots,
+    })
+}
+
+/// The unit files `paths` as one table: the first one's header, then every file's rows in order;
+/// every file must have the same header.
+fn concatenate(paths: &[PathBuf]) -> Result<Vec<u8>, ExperimentError> {
     let mut out: Vec<u8> = Vec::new();
-    let mut first: Option<(UnitTable, PathBuf)> = None;
-    for key in &manifest.units {
-        let path = dir.unit_csv(key);
-        let table = UnitTable::read(&path)?;
+    let mut first: Option<(UnitTable, &PathBuf)> = None;
+    for path in paths {
+        let table = UnitTable::read(path)?;
         match &first {
             None => {
                 out.extend_from_slice(&table.header);
@@ -105,7 +150,7 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
             }
             Some((head, head_path)) if head.columns != table.columns => {
                 return Err(ExperimentError::CorruptUnit {
-                    path,
+                    path: path.clone(),
                     what: format!(
                         "header '{}' differs from '{}' of {}",
                         table.columns.iter().collect::<Vec<_>>().join(","),
@@ -117,15 +162,5 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
             Some(_) => out.extend_from_slice(&table.body),
         }
     }
-    let csv = dir.csv();
-    write_if_changed(&csv, &out)?;
-    let mut plots = Vec::new();
-    for spec in &manifest.spec.plots {
-        plots.extend(render_plot(spec, &csv, dir)?);
-    }
-    Ok(Finished {
-        csv,
-        config: dir.config(),
-        plots,
-    })
+    Ok(out)
 }

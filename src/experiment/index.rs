@@ -5,12 +5,13 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::assemble::missing_units;
+use super::assemble::{missing_detail, missing_units};
 use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
 use super::files::read;
 use super::layout::ExperimentDir;
 use super::layout::{experiments_in, folders_holding};
+use super::name::SafeName;
 use super::plot::{PlotKind, build_figure};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
@@ -24,7 +25,8 @@ const MAX_LINE_COLUMNS: usize = 8;
 /// (Re)writes `<out>/README.md`; returns its path.
 pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
     let mut text = String::from(
-        "# Results\n\nOne directory per experiment: `<name>.csv` (tidy, one row per observation), its plots \
+        "# Results\n\nOne directory per experiment: `<name>.csv` (tidy, one row per observation; beside a \
+         recognition experiment's, `<name>_per_object.csv` with one row per test object), its plots \
          (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
          per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
     );
@@ -51,7 +53,11 @@ fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Resul
         let _ = writeln!(text, "Incomplete: {} of {total} units done.", total - missing);
         return Ok(());
     }
-    let _ = writeln!(text, "Data: [{name}.csv]({name}/{name}.csv)");
+    let _ = write!(text, "Data: [{name}.csv]({name}/{name}.csv)");
+    match &manifest.detail {
+        Some(table) => detail_data(text, dir, manifest, table),
+        None => text.push('\n'),
+    }
     for spec in &manifest.spec.plots {
         let stem = &spec.stem;
         let _ = write!(
@@ -68,6 +74,25 @@ fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Resul
         }
     }
     Ok(())
+}
+
+/// Ends the data line with the experiment's detail table, or says after it why that table is not
+/// there: units saved before their experiment had one lack its rows, which cannot be made up from
+/// the main rows.
+fn detail_data(text: &mut String, dir: &ExperimentDir, manifest: &Manifest, table: &SafeName) {
+    let name = dir.name();
+    let missing = missing_detail(dir, manifest).len();
+    if missing == 0 && dir.detail_csv(table).is_file() {
+        let _ = writeln!(text, ", [{name}_{table}.csv]({name}/{name}_{table}.csv)");
+    } else {
+        let _ = writeln!(
+            text,
+            "\n\n`{name}_{table}.csv` is not here: {missing} of {} units were saved before their `{table}` rows \
+             were written, and those rows cannot be derived from the averaged ones; a run into a fresh \
+             folder (or after deleting `{name}/units/`) writes them.",
+            manifest.units.len()
+        );
+    }
 }
 
 /// A picture experiment (Fig. 1) is one drawing, not a run of units: its folder holds

@@ -5,7 +5,10 @@
 //! <out>/<experiment>/manifest.json     name, description, plots, the ordered unit keys
 //! <out>/<experiment>/config.json       the run's full configuration
 //! <out>/<experiment>/units/<key>.csv   one unit's rows, header first
+//! <out>/<experiment>/units/<table>/<key>.csv   one unit's detail rows (experiments with a second
+//!                                      table, e.g. `per_object`)
 //! <out>/<experiment>/<experiment>.csv  all rows, units in manifest order, one header
+//! <out>/<experiment>/<experiment>_<table>.csv  all detail rows, likewise
 //! <out>/<experiment>/<stem>.svg|.png   the plots
 //! ```
 
@@ -53,9 +56,23 @@ impl ExperimentDir {
         self.units_dir().join(format!("{key}.csv"))
     }
 
+    /// The folder of a detail table's unit files, `units/<table>`.
+    pub fn detail_units_dir(&self, table: &SafeName) -> PathBuf {
+        self.units_dir().join(table.as_str())
+    }
+
+    pub fn detail_unit_csv(&self, table: &SafeName, key: &UnitKey) -> PathBuf {
+        self.detail_units_dir(table).join(format!("{key}.csv"))
+    }
+
     /// The assembled table, `<experiment>.csv`.
     pub fn csv(&self) -> PathBuf {
         self.root.join(format!("{}.csv", self.name))
+    }
+
+    /// The assembled detail table, `<experiment>_<table>.csv`.
+    pub fn detail_csv(&self, table: &SafeName) -> PathBuf {
+        self.root.join(format!("{}_{table}.csv", self.name))
     }
 
     /// A plot file, `<stem>.<extension>`.

@@ -9,7 +9,7 @@ use super::error::ExperimentError;
 use super::files::{create_dir_all, read};
 use super::index::write_index;
 use super::layout::{ExperimentDir, experiments_in};
-use super::name::ExperimentName;
+use super::name::{ExperimentName, UnitKey};
 use super::spec::{Manifest, write_manifest, write_or_check};
 use crate::atomic::{remove_stale_temporaries, write_atomic};
 
@@ -89,53 +89,70 @@ fn merge_experiment(
     }
 
     let target = ExperimentDir::new(out, name);
-    create_dir_all(&target.units_dir())?;
-    for stale in [out, target.root(), &target.units_dir()] {
-        remove_stale_temporaries(stale)?;
+    let mut folders = vec![out.to_path_buf(), target.root().to_path_buf(), target.units_dir()];
+    folders.extend(manifest.detail.iter().map(|table| target.detail_units_dir(table)));
+    for folder in &folders {
+        create_dir_all(folder)?;
+        remove_stale_temporaries(folder)?;
     }
     write_manifest(&target.manifest(), &manifest, &manifest_bytes, target.root())?;
     write_or_check(&target.config(), &config_bytes, target.root(), "configuration")?;
     let mut copied = 0;
     for key in &manifest.units {
-        let mut chosen: Option<(Vec<u8>, PathBuf)> = None;
-        for source in sources {
-            let path = source.unit_csv(key);
-            if !path.is_file() {
-                continue;
-            }
-            let bytes = read(&path)?;
-            match &chosen {
-                Some((kept, kept_path)) if kept != &bytes => {
-                    return Err(ExperimentError::UnitConflict {
-                        key: key.clone(),
-                        first: kept_path.clone(),
-                        second: path,
-                    });
-                }
-                Some(_) => {}
-                None => {
-                    UnitTable::parse(bytes.clone(), &path)?;
-                    chosen = Some((bytes, path));
-                }
-            }
-        }
-        let Some((bytes, path)) = chosen else { continue };
-        let dest = target.unit_csv(key);
-        match std::fs::read(&dest) {
-            Ok(existing) if existing == bytes => {}
-            Ok(_) => {
-                return Err(ExperimentError::UnitConflict {
-                    key: key.clone(),
-                    first: path,
-                    second: dest,
-                });
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                write_atomic(&dest, &bytes)?;
-                copied += 1;
-            }
-            Err(source) => return Err(ExperimentError::Io { path: dest, source }),
+        let files = |dir: &ExperimentDir| match &manifest.detail {
+            Some(table) => vec![dir.unit_csv(key), dir.detail_unit_csv(table, key)],
+            None => vec![dir.unit_csv(key)],
+        };
+        let sources: Vec<Vec<PathBuf>> = sources.iter().map(files).collect();
+        for (i, dest) in files(&target).into_iter().enumerate() {
+            let paths: Vec<&PathBuf> = sources.iter().map(|s| &s[i]).collect();
+            copied += usize::from(copy_unit_file(key, &paths, &dest)?);
         }
     }
     Ok((finish(&target, &manifest)?, copied))
+}
+
+/// Copies the unit file of `key` found among `sources` (which must agree where several have it) to
+/// `dest` (which must agree if it exists); whether it wrote `dest`. A file in no source is skipped.
+fn copy_unit_file(key: &UnitKey, sources: &[&PathBuf], dest: &Path) -> Result<bool, ExperimentError> {
+    let mut chosen: Option<(Vec<u8>, PathBuf)> = None;
+    for &path in sources {
+        if !path.is_file() {
+            continue;
+        }
+        let bytes = read(path)?;
+        match &chosen {
+            Some((kept, kept_path)) if kept != &bytes => {
+                return Err(ExperimentError::UnitConflict {
+                    key: key.clone(),
+                    first: kept_path.clone(),
+                    second: path.clone(),
+                });
+            }
+            Some(_) => {}
+            None => {
+                UnitTable::parse(bytes.clone(), path)?;
+                chosen = Some((bytes, path.clone()));
+            }
+        }
+    }
+    let Some((bytes, path)) = chosen else {
+        return Ok(false);
+    };
+    match std::fs::read(dest) {
+        Ok(existing) if existing == bytes => Ok(false),
+        Ok(_) => Err(ExperimentError::UnitConflict {
+            key: key.clone(),
+            first: path,
+            second: dest.to_path_buf(),
+        }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            write_atomic(dest, &bytes)?;
+            Ok(true)
+        }
+        Err(source) => Err(ExperimentError::Io {
+            path: dest.to_path_buf(),
+            source,
+        }),
+    }
 }

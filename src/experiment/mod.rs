@@ -2,10 +2,12 @@
 //! CSV, plots and an index. The paper's experiments themselves are in `crate::paper`.
 //!
 //! An experiment is a list of [`Unit`]s, each a stable [`UnitKey`] and a deterministic function
-//! producing rows (any serde record; [`AccuracyRow`] for the recognition curves). [`run`] executes
-//! the units of one [`Shard`] on a thread pool, writing each unit's rows atomically to
-//! `<out>/<experiment>/units/<key>.csv`, so a killed run resumes where it stopped and never
-//! duplicates a row; once every unit is present it assembles `<experiment>.csv`, draws the
+//! producing rows (any serde record; [`AccuracyRow`] for the recognition curves) and, for an
+//! experiment with a second table ([`DetailRow`]; [`PerObjectRow`] beside the recognition curves),
+//! its detail rows. [`run`] executes the units of one [`Shard`] on a thread pool, writing each
+//! unit's rows atomically to `<out>/<experiment>/units/<key>.csv`, so a killed run resumes where it
+//! stopped and never duplicates a row; once every unit is present it assembles `<experiment>.csv`
+//! (and `<experiment>_<table>.csv`), draws the
 //! experiment's plots and rewrites the index `<out>/README.md`. [`merge()`] combines the outputs of
 //! separate shards into exactly the files of one unsharded run. The on-disk layout is in
 //! `layout.rs`.
@@ -16,6 +18,7 @@
 pub(crate) mod accuracy;
 pub(crate) mod assemble;
 pub(crate) mod error;
+pub(crate) mod factor;
 pub mod figure;
 pub(crate) mod files;
 pub(crate) mod font;
@@ -30,9 +33,10 @@ pub(crate) mod shard;
 pub(crate) mod spec;
 pub(crate) mod unit;
 
-pub use accuracy::{AccuracyCurve, AccuracyRow};
+pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, RepeatedObject};
 pub use assemble::Finished;
 pub use error::{ExperimentError, UnitFailure};
+pub use factor::{Factor, FactorError, Factors};
 pub use index::write_index;
 pub use layout::ExperimentDir;
 pub use merge::{MergeReport, merge};
@@ -41,4 +45,4 @@ pub use plot::{Axis, PlotKind, PlotSpec};
 pub use runner::{Experiment, RunOptions, RunReport, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};
-pub use unit::{BoxError, Unit};
+pub use unit::{BoxError, DetailRow, NoDetail, Unit};

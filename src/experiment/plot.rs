@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::accuracy::AccuracyRow;
 use super::error::ExperimentError;
+use super::factor::Factors;
 use super::figure::{Figure, Panel, ReferenceLine, Series};
 use super::layout::ExperimentDir;
 use super::name::SafeName;
@@ -34,9 +35,9 @@ impl Axis {
 #[serde(rename_all = "snake_case")]
 pub enum PlotKind {
     /// Accuracy (the fraction correct, as in the CSV) against the number of readings from
-    /// [`AccuracyRow`] columns: one line per (descriptor, value), the mean over trials at each
+    /// [`AccuracyRow`] columns: one line per (descriptor, factor levels), the mean over trials at each
     /// `n_readings` with the lowest and highest trial as a band. When both the descriptor
-    /// and the value vary, one panel per descriptor with one line per value (the layout of Fig.
+    /// and the levels vary, one panel per descriptor with one line per levels (the layout of Fig.
     /// 11-13); otherwise one panel.
     Accuracy,
     /// `y` against `x` from named columns: one line per distinct combination of the `series`
@@ -59,6 +60,11 @@ pub struct PlotSpec {
     /// is drawn as a dashed line. Absent in manifests written before it existed.
     #[serde(default)]
     pub objects: Option<usize>,
+    /// A line's name in the legend, `{column}` standing for the line's cell in that column, e.g.
+    /// `data = {data} {resolution}`. Absent: an accuracy plot names a line by its factors
+    /// (`factor = level`, joined by commas), a line plot by its series columns.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub legend: Option<String>,
 }
 
 impl PlotSpec {
@@ -68,7 +74,14 @@ impl PlotSpec {
             title: title.to_string(),
             kind: PlotKind::Accuracy,
             objects: None,
+            legend: None,
         }
+    }
+
+    /// Names each line by `template` (see [`PlotSpec::legend`]).
+    pub fn with_legend(mut self, template: &str) -> Self {
+        self.legend = Some(template.to_string());
+        self
     }
 
     /// Draws chance level for `objects` objects (none for fewer than two).
@@ -84,6 +97,7 @@ impl PlotSpec {
             title: title.to_string(),
             kind: PlotKind::Lines { x, y, series },
             objects: None,
+            legend: None,
         }
     }
 }
@@ -105,8 +119,8 @@ pub fn render_plot(
 /// The figure `spec` describes, from the rows of `csv`.
 pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentError> {
     let panels = match &spec.kind {
-        PlotKind::Accuracy => accuracy_panels(csv, spec.objects)?,
-        PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series)?,
+        PlotKind::Accuracy => accuracy_panels(csv, spec.objects, spec.legend.as_deref())?,
+        PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series, spec.legend.as_deref())?,
     };
     Ok(Figure {
         title: spec.title.clone(),
@@ -200,10 +214,32 @@ fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
     }
 }
 
-fn accuracy_panels(csv: &Path, objects: Option<usize>) -> Result<Vec<Panel>, ExperimentError> {
+/// `template` with every `{column}` replaced by `cell(column)`; `Err(column)` names a column `cell`
+/// does not know.
+fn fill_legend(template: &str, cell: impl Fn(&str) -> Option<String>) -> Result<String, String> {
+    let mut label = String::new();
+    let mut rest = template;
+    while let Some(open) = rest.find('{') {
+        label.push_str(&rest[..open]);
+        let Some(close) = rest[open..].find('}') else {
+            break;
+        };
+        let column = &rest[open + 1..open + close];
+        label.push_str(&cell(column).ok_or_else(|| column.to_string())?);
+        rest = &rest[open + close + 1..];
+    }
+    label.push_str(rest);
+    Ok(label)
+}
+
+fn accuracy_panels(
+    csv: &Path,
+    objects: Option<usize>,
+    legend: Option<&str>,
+) -> Result<Vec<Panel>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
-    // (descriptor, parameter, value) -> accuracy over trials per n_readings
-    let mut curves: Ordered<(String, String, String), Means> = Ordered::new();
+    // (descriptor, factor levels) -> accuracy over trials per n_readings
+    let mut curves: Ordered<(String, Factors), Means> = Ordered::new();
     let mut max_n = 1u32;
     for (i, row) in reader.deserialize::<AccuracyRow>().enumerate() {
         let row = row.map_err(|e| csv_error(csv, e))?;
@@ -224,28 +260,41 @@ fn accuracy_panels(csv: &Path, objects: Option<usize>) -> Result<Vec<Panel>, Exp
         }
         max_n = max_n.max(row.n_readings);
         curves
-            .entry((row.descriptor, row.parameter, row.value))
+            .entry((row.descriptor, row.factors))
             .add(row.n_readings as f64, row.accuracy);
     }
     if curves.items.is_empty() {
         return Err(csv_error(csv, "no rows to plot"));
     }
     let mut descriptors: Vec<&str> = Vec::new();
-    let mut values: Vec<&str> = Vec::new();
-    for ((d, _, v), _) in &curves.items {
+    let mut settings: Vec<&Factors> = Vec::new();
+    for ((d, f), _) in &curves.items {
         if !descriptors.contains(&d.as_str()) {
             descriptors.push(d);
         }
-        if !values.contains(&v.as_str()) {
-            values.push(v);
+        if !settings.contains(&f) {
+            settings.push(f);
         }
     }
-    let setting = |parameter: &str, value: &str| {
-        if parameter.is_empty() {
-            value.to_string()
-        } else {
-            format!("{parameter} = {value}")
-        }
+    let setting = |descriptor: &str, factors: &Factors| match legend {
+        None => Ok(factors.to_string()),
+        Some(template) => fill_legend(template, |column| {
+            if column == "descriptor" {
+                return Some(descriptor.to_string());
+            }
+            factors
+                .iter()
+                .find(|(f, _)| f.column() == column)
+                .map(|(_, level)| level.to_string())
+        })
+        .map_err(|column| ExperimentError::MissingColumn {
+            path: csv.to_path_buf(),
+            column,
+            available: std::iter::once("descriptor")
+                .chain(factors.factors().map(|f| f.column()))
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
     };
     let panel = |title: String, series: Vec<Series>| Panel {
         title,
@@ -266,36 +315,42 @@ fn accuracy_panels(csv: &Path, objects: Option<usize>) -> Result<Vec<Panel>, Exp
             label: format!("chance (1/{n})"),
         }),
     };
-    if descriptors.len() > 1 && values.len() > 1 {
-        Ok(descriptors
+    if descriptors.len() > 1 && settings.len() > 1 {
+        descriptors
             .iter()
             .map(|&descriptor| {
                 let series = curves
                     .items
                     .iter()
-                    .filter(|((d, _, _), _)| d == descriptor)
-                    .map(|((_, p, v), m)| m.series(setting(p, v)))
-                    .collect();
-                panel(descriptor.to_string(), series)
+                    .filter(|((d, _), _)| d == descriptor)
+                    .map(|((d, f), m)| Ok(m.series(setting(d, f)?)))
+                    .collect::<Result<_, ExperimentError>>()?;
+                Ok(panel(descriptor.to_string(), series))
             })
-            .collect())
+            .collect()
     } else {
         let series = curves
             .items
             .iter()
-            .map(|((d, p, v), m)| {
-                m.series(if values.len() > 1 {
-                    setting(p, v)
+            .map(|((d, f), m)| {
+                Ok(m.series(if settings.len() > 1 {
+                    setting(d, f)?
                 } else {
                     d.clone()
-                })
+                }))
             })
-            .collect();
+            .collect::<Result<_, ExperimentError>>()?;
         Ok(vec![panel(String::new(), series)])
     }
 }
 
-fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<Vec<Panel>, ExperimentError> {
+fn line_panels(
+    csv: &Path,
+    x: &Axis,
+    ys: &[Axis],
+    series: &[String],
+    legend: Option<&str>,
+) -> Result<Vec<Panel>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
     let headers = reader.headers().map_err(|e| csv_error(csv, e))?.clone();
     let column = |name: &str| {
@@ -333,15 +388,28 @@ fn line_panels(csv: &Path, x: &Axis, ys: &[Axis], series: &[String]) -> Result<V
                 })
         };
         let xv = number(x_col, &x.column)?;
-        let label = match series_cols.as_slice() {
-            [] => String::new(),
-            [one] => record.get(*one).unwrap_or("").to_string(),
-            many => many
-                .iter()
-                .zip(series)
-                .map(|(&c, name)| format!("{name} = {}", record.get(c).unwrap_or("")))
-                .collect::<Vec<_>>()
-                .join(", "),
+        let label = match legend {
+            Some(template) => fill_legend(template, |name| {
+                headers
+                    .iter()
+                    .position(|h| h == name)
+                    .map(|c| record.get(c).unwrap_or("").to_string())
+            })
+            .map_err(|column| ExperimentError::MissingColumn {
+                path: csv.to_path_buf(),
+                column,
+                available: headers.iter().collect::<Vec<_>>().join(", "),
+            })?,
+            None => match series_cols.as_slice() {
+                [] => String::new(),
+                [one] => record.get(*one).unwrap_or("").to_string(),
+                many => many
+                    .iter()
+                    .zip(series)
+                    .map(|(&c, name)| format!("{name} = {}", record.get(c).unwrap_or("")))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            },
         };
         for ((y, &col), acc) in ys.iter().zip(&y_cols).zip(curves.iter_mut()) {
             acc.entry(label.clone()).add(xv, number(col, &y.column)?);

@@ -15,10 +15,11 @@ use super::error::{ExperimentError, UnitFailure};
 use super::files::create_dir_all;
 use super::index::write_index;
 use super::layout::ExperimentDir;
+use super::name::SafeName;
 use super::progress::progress_bar;
 use super::shard::Shard;
 use super::spec::{ExperimentSpec, Manifest, to_json, write_manifest, write_or_check};
-use super::unit::{Unit, parse_rows, read_rows, rows_to_csv};
+use super::unit::{DetailRow, NoDetail, Unit, parse_rows, read_rows, rows_to_csv};
 use crate::atomic::{remove_stale_temporaries, write_atomic};
 
 /// Where and how to run: the flags every experiment command shares.
@@ -56,11 +57,12 @@ impl RunOptions {
 
 /// An experiment ready to run: what it is, its full configuration (written to `config.json`; it
 /// should hold everything the rows depend on, such as the seed, and nothing they do not, such as
-/// the thread count) and its units in their fixed order.
-pub struct Experiment<'a, R, C> {
+/// the thread count) and its units in their fixed order. `D` is the rows of its second table, if
+/// it has one ([`DetailRow`]).
+pub struct Experiment<'a, R, C, D = NoDetail> {
     pub spec: ExperimentSpec,
     pub config: C,
-    pub units: Vec<Unit<'a, R>>,
+    pub units: Vec<Unit<'a, R, D>>,
 }
 
 /// What a run did.
@@ -98,7 +100,7 @@ impl fmt::Display for RunReport {
         match &self.finished {
             Some(done) => {
                 write!(f, "\nwrote {}", done.csv.display())?;
-                for plot in &done.plots {
+                for plot in done.detail.iter().chain(&done.plots) {
                     write!(f, ", {}", plot.display())?;
                 }
                 Ok(())
@@ -117,19 +119,22 @@ impl fmt::Display for RunReport {
 ///    run must have the same units in the same order and the same configuration, or it would mix
 ///    results; its description and plots may change.
 /// 2. Takes this shard's units; a unit whose `units/<key>.csv` exists and reads back as rows of `R`
-///    is reused, one that does not read back is an error naming the file.
+///    is reused, one that does not read back is an error naming the file. (Its detail file is not
+///    required: units saved before their experiment had a detail table are kept as they are.)
 /// 3. Runs the rest on a pool of `--threads` workers, writing each unit's rows atomically as soon
-///    as it finishes, so a run killed at any point loses only the units in flight. After a unit
+///    as it finishes (its detail rows first), so a run killed at any point loses only the units in
+///    flight. After a unit
 ///    fails no new unit starts; the finished ones are kept and the error names every failed unit.
 /// 4. When every unit of the experiment is present (from any shard), assembles the CSV and the
 ///    plots, then rewrites the index `<out>/README.md`.
-pub fn run<R, C>(
-    experiment: &Experiment<'_, R, C>,
+pub fn run<R, C, D>(
+    experiment: &Experiment<'_, R, C, D>,
     options: &RunOptions,
 ) -> Result<RunReport, ExperimentError>
 where
     R: Serialize + DeserializeOwned,
     C: Serialize,
+    D: DetailRow,
 {
     let spec = &experiment.spec;
     let units = &experiment.units;
@@ -146,12 +151,16 @@ where
         });
     }
     let dir = ExperimentDir::new(&options.out, &spec.name);
-    create_dir_all(&dir.units_dir())?;
-    for stale in [options.out.as_path(), dir.root(), &dir.units_dir()] {
-        remove_stale_temporaries(stale)?;
+    let detail = D::TABLE.map(SafeName::new).transpose()?;
+    let mut folders = vec![options.out.clone(), dir.root().to_path_buf(), dir.units_dir()];
+    folders.extend(detail.iter().map(|table| dir.detail_units_dir(table)));
+    for folder in &folders {
+        create_dir_all(folder)?;
+        remove_stale_temporaries(folder)?;
     }
     let manifest = Manifest {
         spec: spec.clone(),
+        detail: detail.clone(),
         units: units.iter().map(|u| u.key().clone()).collect(),
     };
     write_manifest(
@@ -201,7 +210,7 @@ where
                 if stop.load(Ordering::Relaxed) {
                     return None;
                 }
-                let outcome = run_unit(unit, &dir);
+                let outcome = run_unit(unit, &dir, detail.as_ref());
                 if outcome.is_err() {
                     stop.store(true, Ordering::Relaxed);
                 }
@@ -236,27 +245,36 @@ where
     })
 }
 
-/// Runs one unit and saves its rows, after checking they read back as they will on resume: a
-/// header and every row (so rows must be structs with named fields, not tuples or scalars).
-fn run_unit<R: Serialize + DeserializeOwned>(
-    unit: &Unit<'_, R>,
+/// Runs one unit and saves its detail rows into the `detail` table (when the experiment has one),
+/// then its rows, each after checking they read back as they will on resume: a header and every row
+/// (so rows must be structs with named fields, not tuples or scalars).
+fn run_unit<R: Serialize + DeserializeOwned, D: DetailRow>(
+    unit: &Unit<'_, R, D>,
     dir: &ExperimentDir,
+    detail: Option<&SafeName>,
 ) -> Result<(), UnitFailure> {
     let fail = |what: String| UnitFailure {
         key: unit.key().clone(),
         what,
     };
-    let rows = unit.run().map_err(fail)?;
-    let path = dir.unit_csv(unit.key());
-    let bytes = rows_to_csv(&rows, &path).map_err(|e| fail(e.to_string()))?;
-    match parse_rows::<R>(&bytes, &path) {
+    let (rows, detail_rows) = unit.run().map_err(fail)?;
+    if let Some(table) = detail {
+        save_rows(&detail_rows, &dir.detail_unit_csv(table, unit.key())).map_err(fail)?;
+    }
+    save_rows(&rows, &dir.unit_csv(unit.key())).map_err(fail)
+}
+
+/// Writes `rows` to `path` as CSV once they read back from it.
+fn save_rows<R: Serialize + DeserializeOwned>(rows: &[R], path: &std::path::Path) -> Result<(), String> {
+    let bytes = rows_to_csv(rows, path).map_err(|e| e.to_string())?;
+    match parse_rows::<R>(&bytes, path) {
         Ok(back) if back.len() == rows.len() => {}
         _ => {
-            return Err(fail(
+            return Err(
                 "its rows do not read back from CSV: rows must be structs of plain fields (names become the header)"
                     .to_string(),
-            ));
+            );
         }
     }
-    write_atomic(&path, &bytes).map_err(|e| fail(e.to_string()))
+    write_atomic(path, &bytes).map_err(|e| e.to_string())
 }

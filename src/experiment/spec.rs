@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
 use super::files::read;
-use super::name::{ExperimentName, UnitKey};
+use super::name::{ExperimentName, SafeName, UnitKey};
 use super::plot::PlotSpec;
 use crate::atomic::{write_atomic, write_if_changed};
 
@@ -26,6 +26,10 @@ pub struct ExperimentSpec {
 pub struct Manifest {
     #[serde(flatten)]
     pub spec: ExperimentSpec,
+    /// The experiment's second table ([`super::unit::DetailRow::TABLE`]), if it has one: absent
+    /// in experiments without one and in manifests written before there were any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detail: Option<SafeName>,
     pub units: Vec<UnitKey>,
 }
 

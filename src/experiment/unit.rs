@@ -12,21 +12,52 @@ use super::name::UnitKey;
 /// Any error a unit's work can return.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
-type Work<'a, R> = dyn Fn() -> Result<Vec<R>, BoxError> + Send + Sync + 'a;
+type Work<'a, R, D> = dyn Fn() -> Result<(Vec<R>, Vec<D>), BoxError> + Send + Sync + 'a;
 
-/// One resumable piece of an experiment: a stable key and the work producing its rows.
+/// The rows of an experiment's second table, finer than its main rows (the recognition
+/// experiments' per-object outcomes beside their averaged accuracy). Each unit writes them to
+/// `units/<TABLE>/<key>.csv` before its main file, so a unit whose main file exists has both, and
+/// they are assembled into `<experiment>_<TABLE>.csv`.
+pub trait DetailRow: Serialize + DeserializeOwned {
+    /// The table's name; `None` for an experiment without a second table.
+    const TABLE: Option<&'static str>;
+}
+
+/// The detail rows of an experiment that has none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum NoDetail {}
+
+impl DetailRow for NoDetail {
+    const TABLE: Option<&'static str> = None;
+}
+
+/// One resumable piece of an experiment: a stable key and the work producing its rows (and, for an
+/// experiment with a [`DetailRow`] table, its detail rows).
 ///
 /// The rows must be a deterministic function of what the closure captured (settings and a seed
 /// derived from the run seed, e.g. with [`crate::rng::stream`]), never of the thread or the order in
 /// which units run: that is what makes `--threads`, `--shard` and resuming give identical files.
 /// `R` is a struct whose field names become the CSV header.
-pub struct Unit<'a, R> {
+pub struct Unit<'a, R, D = NoDetail> {
     key: UnitKey,
-    work: Box<Work<'a, R>>,
+    work: Box<Work<'a, R, D>>,
 }
 
-impl<'a, R> Unit<'a, R> {
+impl<'a, R: 'a> Unit<'a, R, NoDetail> {
     pub fn new(key: UnitKey, work: impl Fn() -> Result<Vec<R>, BoxError> + Send + Sync + 'a) -> Self {
+        Self {
+            key,
+            work: Box::new(move || Ok((work()?, Vec::new()))),
+        }
+    }
+}
+
+impl<'a, R, D: DetailRow> Unit<'a, R, D> {
+    /// A unit whose work gives its rows and its detail rows.
+    pub fn with_detail(
+        key: UnitKey,
+        work: impl Fn() -> Result<(Vec<R>, Vec<D>), BoxError> + Send + Sync + 'a,
+    ) -> Self {
         Self {
             key,
             work: Box::new(work),
@@ -39,9 +70,12 @@ impl<'a, R> Unit<'a, R> {
 
     /// Runs the work; a panic inside it becomes an error naming the unit, so one bad unit does not
     /// take down the units running beside it.
-    pub(crate) fn run(&self) -> Result<Vec<R>, String> {
+    pub(crate) fn run(&self) -> Result<(Vec<R>, Vec<D>), String> {
         match catch_unwind(AssertUnwindSafe(|| (self.work)())) {
-            Ok(Ok(rows)) if rows.is_empty() => Err("produced no rows".to_string()),
+            Ok(Ok((rows, _))) if rows.is_empty() => Err("produced no rows".to_string()),
+            Ok(Ok((_, detail))) if D::TABLE.is_some() && detail.is_empty() => {
+                Err(format!("produced no {} rows", D::TABLE.unwrap_or_default()))
+            }
             Ok(Ok(rows)) => Ok(rows),
             Ok(Err(e)) => Err(e.to_string()),
             Err(panic) => Err(format!(

@@ -18,6 +18,8 @@
 use std::sync::Arc;
 
 use rayon::prelude::*;
+use serde::de::{self, Deserializer};
+use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
 
 use super::context::Family;
@@ -28,6 +30,8 @@ use super::recognition::{Curve, RecognitionSweep, Setting, TestData, training_co
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, TidyRecord};
+use crate::experiment::factor::{Factor, Factors};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::{Axis, PlotSpec};
@@ -52,28 +56,57 @@ const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
 /// L of the active strategy's proposals: half local, half global candidates.
 const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 
-/// One point of one curve: the columns of [`crate::experiment::AccuracyRow`] (so the accuracy plot
-/// and the headline table read it) and the confidence stop's.
+/// One point of one curve: the columns of an [`AccuracyRow`] (so the accuracy plot and the
+/// headline table read it) and the confidence stop's after them.
 ///
 /// | column | meaning |
 /// |---|---|
-/// | `value` | `L=1 fixed`, `L=0.5 perturbed`, `active fixed`, ... |
+/// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) |
+/// | `local_probability` | L of the planner's moves, or of the active strategy's proposals (0.5) |
+/// | `object_motion` | `fixed` or `perturbed` after every reading |
 /// | `confident` | fraction of objects whose posterior's largest probability reached the stop threshold within `n_readings` readings |
 /// | `correct_at_stop` | fraction of objects stopped within `n_readings` readings whose guess at the stop was right |
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ActiveRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub parameter: String,
-    pub value: String,
-    pub trial: u32,
-    pub n_readings: u32,
-    pub accuracy: f64,
-    pub reliability: f64,
-    pub seed: u64,
-    pub stream_seed: i64,
+    pub accuracy: AccuracyRow,
     pub confident: f64,
     pub correct_at_stop: f64,
+}
+
+impl Serialize for ActiveRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("ActiveRow", self.accuracy.width() + 2)?;
+        self.accuracy.serialize_columns(&mut row)?;
+        row.serialize_field("confident", &self.confident)?;
+        row.serialize_field("correct_at_stop", &self.correct_at_stop)?;
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for ActiveRow {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let record = TidyRecord::deserialize(deserializer)?;
+        let row = || -> Result<Self, String> {
+            Ok(Self {
+                accuracy: AccuracyRow::from_record(&record)?,
+                confident: record.number("confident")?,
+                correct_at_stop: record.number("correct_at_stop")?,
+            })
+        };
+        row().map_err(de::Error::custom)
+    }
+}
+
+/// The legend's name of a curve in both plots.
+const CURVE_LABEL: &str = "{strategy} L={local_probability} {object_motion}";
+
+/// A curve's levels: `strategy` (`blind` or `active`) at L = `local_probability`, the object `motion`.
+fn levels(strategy: &str, local_probability: f64, motion: &str) -> Factors {
+    Factors::new([
+        (Factor::Strategy, strategy.to_string()),
+        (Factor::LocalProbability, local_probability.to_string()),
+        (Factor::ObjectMotion, motion.to_string()),
+    ])
 }
 
 fn perturbed() -> PerturbationBounds {
@@ -90,7 +123,7 @@ pub fn sweep() -> RecognitionSweep {
     for l in [1.0, 0.5] {
         for (state, perturbation) in object_states() {
             curves.push(Curve {
-                value: format!("L={l} {state}"),
+                factors: levels("blind", l, state),
                 test: TestData::Planner {
                     local_probability: l,
                     perturbation,
@@ -102,7 +135,9 @@ pub fn sweep() -> RecognitionSweep {
         name: EXPERIMENT_NAME,
         description: DESCRIPTION,
         title: "Active touch (expected information gain) vs blind exploration",
-        parameter: "strategy",
+        // One unit, keyed by the descriptor alone (`run_active`).
+        key_parameter: "",
+        legend: Some("strategy = {strategy} L={local_probability} {object_motion}"),
         family: Family::Shapes,
         descriptors: vec![DESCRIPTOR],
         settings: vec![Setting {
@@ -147,7 +182,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
         let (sweep, objects, training) = (&sweep, Arc::clone(&objects), training.clone());
-        Unit::new(key, move || {
+        Unit::with_detail(key, move || {
             unit_rows(context, sweep, &objects, counts, &training, neighbourhood_m)
         })
     };
@@ -156,14 +191,15 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                PlotSpec::accuracy(name, sweep.title).with_chance(objects.specs.len()),
+                sweep.plot(name, sweep.title, objects.specs.len()),
                 PlotSpec::lines(
                     SafeName::new("active-confidence")?,
                     "Objects recognised with 95% confidence (the stop's touches, cumulative)",
                     Axis::new("n_readings", "number of readings"),
                     vec![Axis::new("confident", "objects confident (fraction)")],
-                    &["value"],
-                ),
+                    &["strategy", "local_probability", "object_motion"],
+                )
+                .with_legend(CURVE_LABEL),
             ],
         },
         config: ActiveConfig {
@@ -191,7 +227,7 @@ fn unit_rows(
     counts: DataCounts,
     training: &TrainConfig,
     neighbourhood_m: f64,
-) -> Result<Vec<ActiveRow>, BoxError> {
+) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
     let descriptor = DESCRIPTOR.build();
     let model = context.store.model(
         &sweep.training_request(context, objects, 0, counts)?,
@@ -199,7 +235,7 @@ fn unit_rows(
         descriptor.as_ref(),
         training,
     )?;
-    let mut rows = Vec::new();
+    let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     for curve in &sweep.settings[0].curves {
         let trials = sweep.dataset_trials(
             context,
@@ -209,16 +245,12 @@ fn unit_rows(
             counts,
             &model,
             descriptor.as_ref(),
-            &curve.value,
+            &curve.factors,
         )?;
-        rows.extend(curve_rows(
-            sweep,
-            &model,
-            &curve.value,
-            &trials,
-            counts,
-            context.seed,
-        )?);
+        let (curve_rows, curve_objects) =
+            curve_rows(sweep, &model, &curve.factors, &trials, counts, context.seed)?;
+        rows.extend(curve_rows);
+        per_object.extend(curve_objects);
     }
     for (state, perturbation) in object_states() {
         // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
@@ -249,22 +281,24 @@ fn unit_rows(
                 )
             })
             .collect::<Result<_, BoxError>>()?;
-        let per_object = objects.specs.len().max(1);
+        let objects_per_trial = objects.specs.len().max(1);
         let trials: Vec<(u64, Vec<Trial>)> = base
             .iter()
-            .zip(explored.chunks(per_object))
+            .zip(explored.chunks(objects_per_trial))
             .map(|(request, chunk)| (request.plan.seed, chunk.to_vec()))
             .collect();
-        rows.extend(curve_rows(
+        let (curve_rows, curve_objects) = curve_rows(
             sweep,
             &model,
-            &format!("active {state}"),
+            &levels("active", ACTIVE_LOCAL_PROBABILITY, state),
             &trials,
             counts,
             context.seed,
-        )?);
+        )?;
+        rows.extend(curve_rows);
+        per_object.extend(curve_objects);
     }
-    Ok(rows)
+    Ok((rows, per_object))
 }
 
 /// Object `index` explored actively under `plan` (a planner plan) with `model` in the loop: the
@@ -310,22 +344,22 @@ fn active_trial(
 }
 
 /// The rows of one curve: accuracy and reliability as every recognition figure defines them
-/// ([`evaluate`]), and the confidence stop's columns.
+/// ([`evaluate`]) with the confidence stop's columns, and the per-object outcomes they count.
 fn curve_rows(
     sweep: &RecognitionSweep,
     model: &TrainedModel,
-    value: &str,
+    factors: &Factors,
     trials: &[(u64, Vec<Trial>)],
     counts: DataCounts,
     run_seed: u64,
-) -> Result<Vec<ActiveRow>, BoxError> {
+) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
     let threshold = Probability::new(STOP_AT_CONFIDENCE)?;
-    let mut rows = Vec::new();
+    let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     for (trial, (seed, object_trials)) in trials.iter().enumerate() {
         let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
         if longest == 0 {
             return Err(
-                format!("curve '{value}', trial {trial}: no converged test reading of any object").into(),
+                format!("curve '{factors}', trial {trial}: no converged test reading of any object").into(),
             );
         }
         let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
@@ -335,27 +369,27 @@ fn curve_rows(
             threshold,
             counts.test_per_object,
         );
-        for point in &evaluation.accuracy {
-            let n = point.n_readings;
-            let objects = object_trials.len().max(1) as f64;
+        let meta = AccuracyCurve {
+            experiment: sweep.name.to_string(),
+            descriptor: DESCRIPTOR.name().to_string(),
+            factors: factors.clone(),
+            trial: trial as u32,
+            seed: run_seed,
+            stream_seed: *seed,
+        };
+        let objects = object_trials.len().max(1) as f64;
+        for accuracy in meta.rows(&evaluation.accuracy) {
+            let n = accuracy.n_readings as usize;
             let stopped: Vec<&(usize, bool)> = stops.iter().flatten().filter(|(k, _)| *k <= n).collect();
             rows.push(ActiveRow {
-                experiment: sweep.name.to_string(),
-                descriptor: DESCRIPTOR.name().to_string(),
-                parameter: sweep.parameter.to_string(),
-                value: value.to_string(),
-                trial: trial as u32,
-                n_readings: n as u32,
-                accuracy: point.accuracy(),
-                reliability: point.reliability,
-                seed: run_seed,
-                stream_seed: *seed as i64,
+                accuracy,
                 confident: stopped.len() as f64 / objects,
                 correct_at_stop: stopped.iter().filter(|(_, right)| *right).count() as f64 / objects,
             });
         }
+        per_object.extend(meta.object_rows(&evaluation)?);
     }
-    Ok(rows)
+    Ok((rows, per_object))
 }
 
 /// Per object trial: the touch at which the stop fires and whether the guess there is right;
@@ -375,4 +409,22 @@ fn stops(
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blind_and_active_curves_share_the_factor_columns() {
+        let sweep = sweep();
+        sweep.check_factors().unwrap_or_else(|e| panic!("{e}"));
+        let active = levels("active", ACTIVE_LOCAL_PROBABILITY, "fixed");
+        let blind = &sweep.settings[0].curves[0].factors;
+        assert!(active.factors().eq(blind.factors()));
+        assert_eq!(
+            active.to_string(),
+            "strategy = active, local_probability = 0.5, object_motion = fixed"
+        );
+    }
 }

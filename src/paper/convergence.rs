@@ -50,34 +50,38 @@ pub const MIN_CONVERGENCES: usize = 3;
 /// The paper's object (the Dragon, Fig. 5h) in our `shapes` set.
 pub const PAPER_OBJECT: &str = "dragon";
 
-/// One row per (object, noise level): the attempts it took to collect the convergences.
+/// One row per (object, noise level) of `convergence.csv`: the approaches it took to collect the
+/// convergences, and how good the converged readings are.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `object` | the object's name (the paper's: `dragon`) |
+/// | `noise_fraction` | width of the sensor's uniform additive noise, fraction of the sensing range (Sec. V-B7); the controllers are told it |
+/// | `noise_percent` | the same in percent (the x axis of Fig. 14) |
+/// | `attempts` | approaches made: a sampler placement (Sec. V-A3) followed by Approach -> Press <-> Orient, until `converged` reached the wanted number (100 at scale 1) or the sampler's attempt budget ran out |
+/// | `converged` | approaches that ended converged |
+/// | `convergence_rate` | `converged / attempts`, in [0, 1] (Fig. 14's convergence percentage as a fraction) |
+/// | `mean_iterations` | mean Press/Orient iterations of the converged approaches (Fig. 14's iterations); the iteration budget when none converged, so the column is always a number |
+/// | `mean_misalignment_deg` | mean angle between the pad normal and the plane Orient fits to a noise-free reading at each converged pad pose, degrees; 0 when none converged |
+/// | `mean_pressure_error` | mean of abs(mean taxel value - Press's target) of those noise-free readings, fraction of the sensing range; 0 when none converged |
+/// | `no_contact`, `saturated`, `max_iterations` | failed approaches that ended without contact, with a saturated taxel, or out of iterations |
+/// | `other_failures` | the remaining failed approaches (`attempts` minus all of the above) |
+/// | `seed` | the run's seed, as given with `--seed` |
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergenceRow {
     pub object: String,
-    /// Width of the uniform additive noise, fraction of the sensing range.
     pub noise_fraction: f64,
-    /// The same in percent (the x axis of Fig. 14).
     pub noise_percent: f64,
-    /// Approaches made (sampler placements followed by the controllers).
     pub attempts: usize,
-    /// Approaches that ended `Converged`.
     pub converged: usize,
-    /// `converged / attempts`.
     pub convergence_rate: f64,
-    /// Mean Press/Orient iterations of the converged approaches; the iteration budget when none
-    /// converged (so the column is always a number).
     pub mean_iterations: f64,
-    /// Quality of the converged readings, judged with a noise-free sensor at each converged pad
-    /// pose: the mean angle between the pad normal and Orient's plane fit (degrees), and the mean
-    /// |mean pressure - target| (fraction of the range); 0 when none converged.
     pub mean_misalignment_deg: f64,
     pub mean_pressure_error: f64,
-    /// Failed approaches by how they ended.
     pub no_contact: usize,
     pub saturated: usize,
     pub max_iterations: usize,
     pub other_failures: usize,
-    /// The run's seed.
     pub seed: u64,
 }
 

@@ -11,6 +11,7 @@ use super::context::Family;
 use super::recognition::{Curve, RecognitionSweep, Setting, TestData};
 use super::scale::PAPER_TRAINING_READINGS;
 use crate::describe::DescriptorKind;
+use crate::experiment::factor::{Factor, Factors};
 use crate::explore::SamplerConfig;
 use crate::sim::PerturbationBounds;
 use crate::tactile::SensorConfig;
@@ -59,11 +60,13 @@ pub fn descriptors() -> RecognitionSweep {
         name: "descriptors",
         description: "Fig. 7: the six descriptors on the 3D set, 6x6 taxels, 10% covering, planner test data",
         title: "Descriptors (6x6, 10% covering)",
-        parameter: "",
+        key_parameter: "",
+        legend: None,
         family: Family::Shapes,
         descriptors: DescriptorKind::ALL.to_vec(),
         settings: vec![Setting::single(
             "6x6",
+            Factors::none(),
             default_sensor(),
             SamplerConfig::default(),
             explored(DEFAULT_LOCAL_PROBABILITY),
@@ -77,7 +80,8 @@ pub fn strategy() -> RecognitionSweep {
         name: "strategy",
         description: "Fig. 8: exploration with local-strategy probability L = 0, 0.5, 1 (top three descriptors)",
         title: "Exploration strategy (L = probability of the local strategy)",
-        parameter: "local_probability",
+        key_parameter: "local_probability",
+        legend: None,
         family: Family::Shapes,
         descriptors: TOP_THREE.to_vec(),
         settings: vec![Setting {
@@ -88,7 +92,7 @@ pub fn strategy() -> RecognitionSweep {
             curves: [0.0, 0.5, 1.0]
                 .into_iter()
                 .map(|l| Curve {
-                    value: l.to_string(),
+                    factors: Factors::new([(Factor::LocalProbability, l.to_string())]),
                     test: explored(l),
                 })
                 .collect(),
@@ -108,11 +112,17 @@ pub fn validation() -> RecognitionSweep {
             training_fraction: 1.0,
             curves: vec![
                 Curve {
-                    value: format!("validation {size}"),
+                    factors: Factors::new([
+                        (Factor::Data, "validation"),
+                        (Factor::Resolution, size.as_str()),
+                    ]),
                     test: TestData::Validation,
                 },
                 Curve {
-                    value: format!("exploration {size}"),
+                    factors: Factors::new([
+                        (Factor::Data, "exploration"),
+                        (Factor::Resolution, size.as_str()),
+                    ]),
                     test: explored(DEFAULT_LOCAL_PROBABILITY),
                 },
             ],
@@ -122,7 +132,8 @@ pub fn validation() -> RecognitionSweep {
         name: "validation",
         description: "Fig. 9: sampler validation data against planner exploration data (MN, PF; 6x6 and 26x26)",
         title: "Validation (sampler) vs exploration (planner) test data",
-        parameter: "data",
+        key_parameter: "data",
+        legend: Some("data = {data} {resolution}"),
         family: Family::Shapes,
         descriptors: vec![DescriptorKind::MomentNormalized, DescriptorKind::PolarFourier],
         settings: vec![setting(6), setting(26)],
@@ -137,7 +148,8 @@ pub fn perturbation() -> RecognitionSweep {
         name: "perturbation",
         description: "Fig. 10: object fixed vs perturbed (<= 10 deg, <= 10% of its width) after every reading",
         title: "Fixed vs perturbed object",
-        parameter: "object",
+        key_parameter: "object",
+        legend: Some("object = {object_motion}"),
         family: Family::Shapes,
         descriptors: TOP_THREE.to_vec(),
         settings: vec![Setting {
@@ -147,11 +159,11 @@ pub fn perturbation() -> RecognitionSweep {
             training_fraction: 1.0,
             curves: vec![
                 Curve {
-                    value: "fixed".into(),
+                    factors: Factors::new([(Factor::ObjectMotion, "fixed")]),
                     test: explored(DEFAULT_LOCAL_PROBABILITY),
                 },
                 Curve {
-                    value: "perturbed".into(),
+                    factors: Factors::new([(Factor::ObjectMotion, "perturbed")]),
                     test: TestData::Planner {
                         local_probability: DEFAULT_LOCAL_PROBABILITY,
                         perturbation: perturbed,
@@ -162,26 +174,29 @@ pub fn perturbation() -> RecognitionSweep {
     }
 }
 
-/// A sweep of Figs. 11-13: one setting per value, the top three descriptors and Vectorize.
+/// A sweep of Figs. 11-13: one setting per level of `factor`, the top three descriptors and
+/// Vectorize.
 fn sensor_sweep(
     name: &'static str,
     description: &'static str,
     title: &'static str,
-    parameter: &'static str,
-    values: Vec<(String, SensorConfig)>,
+    factor: Factor,
+    levels: Vec<(String, SensorConfig)>,
 ) -> RecognitionSweep {
     RecognitionSweep {
         name,
         description,
         title,
-        parameter,
+        key_parameter: factor.column(),
+        legend: None,
         family: Family::Shapes,
         descriptors: TOP_THREE_AND_VECTORIZE.to_vec(),
-        settings: values
+        settings: levels
             .into_iter()
-            .map(|(value, sensor)| {
+            .map(|(level, sensor)| {
                 Setting::single(
-                    value,
+                    level.clone(),
+                    Factors::new([(factor, level)]),
                     sensor,
                     SamplerConfig::default(),
                     explored(DEFAULT_LOCAL_PROBABILITY),
@@ -198,7 +213,7 @@ pub fn thickness() -> RecognitionSweep {
         "thickness",
         "Fig. 11: covering thickness 5, 10, 20, 30% of the pad side (top three descriptors and Vectorize)",
         "Covering thickness (fraction of the pad side)",
-        "thickness_fraction",
+        Factor::ThicknessFraction,
         [0.05, 0.1, 0.2, 0.3]
             .into_iter()
             .map(|t| (t.to_string(), sensor(6, t, 0.0)))
@@ -213,7 +228,7 @@ pub fn resolution() -> RecognitionSweep {
         "resolution",
         "Fig. 12: sensor resolution 6x6, 14x14, 26x26 on the 12 mm pad (top three descriptors and Vectorize)",
         "Sensor resolution (taxels per side)",
-        "resolution",
+        Factor::Resolution,
         [6, 14, 26]
             .into_iter()
             .map(|n| (format!("{n}x{n}"), sensor(n, 0.1, 0.0)))
@@ -227,7 +242,7 @@ pub fn noise() -> RecognitionSweep {
         "noise",
         "Fig. 13: additive noise 0, 10, 20, 40% of the range in training and test (top three descriptors and Vectorize)",
         "Additive noise (fraction of the sensing range)",
-        "noise_fraction",
+        Factor::NoiseFraction,
         [0.0, 0.1, 0.2, 0.4]
             .into_iter()
             .map(|f| (f.to_string(), sensor(6, 0.1, f)))
@@ -245,11 +260,13 @@ pub fn letters() -> RecognitionSweep {
         name: "letters",
         description: "Fig. 16a: the 52 raised letters, sampler from above for training and test (PF, MNTI, MN)",
         title: "Raised letters (sampler from above)",
-        parameter: "",
+        key_parameter: "",
+        legend: None,
         family: Family::Letters,
         descriptors: TOP_THREE.to_vec(),
         settings: vec![Setting::single(
             "6x6",
+            Factors::none(),
             default_sensor(),
             from_above,
             TestData::Sampler,
@@ -278,7 +295,11 @@ pub fn end_to_end() -> RecognitionSweep {
         ]
         .into_iter()
         .map(|(l, object)| Curve {
-            value: format!("{training} L={l} {object}"),
+            factors: Factors::new([
+                (Factor::Training, training.to_string()),
+                (Factor::LocalProbability, l.to_string()),
+                (Factor::ObjectMotion, object.to_string()),
+            ]),
             test: TestData::Planner {
                 local_probability: l,
                 perturbation: if object == "perturbed" {
@@ -294,7 +315,8 @@ pub fn end_to_end() -> RecognitionSweep {
         name: "end-to-end",
         description: "Beyond the paper: blind arm exploration (L = 0.5, 1; fixed, perturbed) recognised by the paper's sampler training and by ours (3x readings, starts the arm can reach)",
         title: "End to end: the arm's own touches",
-        parameter: "training",
+        key_parameter: "training",
+        legend: Some("training = {training} L={local_probability} {object_motion}"),
         family: Family::Shapes,
         descriptors: vec![DescriptorKind::Mnti, DescriptorKind::PolarFourier],
         settings: vec![
@@ -332,7 +354,8 @@ pub fn training_size() -> RecognitionSweep {
         name: "training-size",
         description: "Beyond the paper: 100, 300, 1000, 3000, 10000 training readings per object (3D set, sampler test data; PF, MNTI, MN)",
         title: "Training readings per object (sampler test data)",
-        parameter: "training_readings",
+        key_parameter: "training_readings",
+        legend: None,
         family: Family::Shapes,
         descriptors: TOP_THREE.to_vec(),
         settings: TRAINING_SIZES
@@ -341,6 +364,7 @@ pub fn training_size() -> RecognitionSweep {
                 training_fraction: n as f64 / paper,
                 ..Setting::single(
                     n.to_string(),
+                    Factors::new([(Factor::TrainingReadings, n.to_string())]),
                     default_sensor(),
                     SamplerConfig::default(),
                     TestData::Sampler,
@@ -362,11 +386,13 @@ pub fn sim_to_real() -> RecognitionSweep {
         name: "sim-to-real",
         description: "Fig. 17: trained on simulated letters (30% noise), tested on recorded real frames (trial 0 in recorded order)",
         title: "Trained on simulated letters, tested on",
-        parameter: "",
+        key_parameter: "",
+        legend: None,
         family: Family::RealLabels,
         descriptors: TOP_THREE.to_vec(),
         settings: vec![Setting::single(
             "real",
+            Factors::none(),
             sensor(6, 0.1, 0.3),
             from_above,
             TestData::Real,
@@ -399,6 +425,39 @@ mod tests {
                 .ends_with("tested on real sensor frames")
         );
         assert_eq!(descriptors().plot_title(None), descriptors().title);
+    }
+
+    #[test]
+    fn every_sweep_writes_one_valid_column_per_factor() {
+        let sweeps = [
+            descriptors(),
+            strategy(),
+            validation(),
+            perturbation(),
+            thickness(),
+            resolution(),
+            noise(),
+            letters(),
+            end_to_end(),
+            training_size(),
+            sim_to_real(),
+        ];
+        for sweep in sweeps {
+            sweep.check_factors().unwrap_or_else(|e| panic!("{e}"));
+        }
+        let columns = |sweep: RecognitionSweep| -> Vec<&str> {
+            sweep.settings[0].curves[0]
+                .factors
+                .factors()
+                .map(Factor::column)
+                .collect()
+        };
+        assert_eq!(columns(validation()), ["data", "resolution"]);
+        assert_eq!(
+            columns(end_to_end()),
+            ["training", "local_probability", "object_motion"]
+        );
+        assert!(columns(descriptors()).is_empty());
     }
 
     #[test]

@@ -27,7 +27,8 @@ use super::real_frames_options::RealFramesOptions;
 use super::recognition::selection_config;
 use crate::dataset::{ContactStatus, Dataset};
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow};
+use crate::experiment::factor::Factors;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
 use crate::experiment::runner::{Experiment, RunReport, run};
@@ -46,9 +47,6 @@ pub const EXPERIMENT_NAME: &str = "real-frames";
 /// Streams of the experiment seed (see [`crate::rng::substream`]).
 const SPLIT_STREAM: u64 = 6;
 const MODEL_STREAM: u64 = 7;
-
-/// The curve's value in the rows (`parameter` is empty: the figure varies only the descriptor).
-const CURVE_VALUE: &str = "real";
 
 /// Frames kept and dropped of one label.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -235,7 +233,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
             let key = SafeName::builder(kind.name()).build()?;
             let kept = Arc::clone(&kept);
             let (labels, training, blur) = (labels.clone(), training.clone(), blur.clone());
-            Ok(Unit::new(key, move || {
+            Ok(Unit::with_detail(key, move || {
                 descriptor_rows(
                     &kept,
                     &labels,
@@ -301,7 +299,7 @@ fn trial_seed(seed: u64, trial: usize) -> u64 {
     rng::substream(rng::substream(seed, SPLIT_STREAM), trial as u64)
 }
 
-/// Every trial's accuracy rows of one descriptor.
+/// Every trial's accuracy rows of one descriptor, and the per-label outcomes they count.
 #[allow(clippy::too_many_arguments)]
 fn descriptor_rows(
     kept: &[RealReading],
@@ -312,7 +310,7 @@ fn descriptor_rows(
     options: &RealFramesOptions,
     blur: &GaussianBlur,
     seed: u64,
-) -> Result<Vec<AccuracyRow>, BoxError> {
+) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
     let descriptor = kind.build();
     let describe = |frames: &[&RealReading]| -> Result<LabelledFeatures, BoxError> {
         let mut per_label: Vec<Vec<Vec<Vec<f64>>>> = vec![Vec::new(); labels.len()];
@@ -325,7 +323,7 @@ fn descriptor_rows(
         }
         Ok(LabelledFeatures::new(labels.to_vec(), per_label)?)
     };
-    let mut rows = Vec::new();
+    let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     for trial in 0..options.trials {
         let split = trial_split(kept, sizes, seed, trial)?;
         let trial_training = TrainConfig {
@@ -350,16 +348,17 @@ fn descriptor_rows(
         let meta = AccuracyCurve {
             experiment: EXPERIMENT_NAME.to_string(),
             descriptor: kind.name().to_string(),
-            parameter: String::new(),
-            value: CURVE_VALUE.to_string(),
+            // The figure varies only the descriptor.
+            factors: Factors::none(),
             trial: trial as u32,
             seed,
             stream_seed: trial_seed(seed, trial),
         };
         // One definition of accuracy (`recognize::AccuracyPoint`): every label counts.
         rows.extend(meta.rows(&evaluation.accuracy));
+        per_object.extend(meta.object_rows(&evaluation)?);
     }
-    Ok(rows)
+    Ok((rows, per_object))
 }
 
 /// One frame's features after the optional preprocessing.

@@ -18,7 +18,8 @@ use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
 use crate::control::ControlConfig;
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow};
+use crate::experiment::factor::Factors;
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
@@ -67,10 +68,11 @@ pub enum TestData {
     Real,
 }
 
-/// One line of a figure: its value of the swept parameter and its test data.
+/// One line of a figure: its levels of the figure's factors (its columns in the rows) and its test
+/// data.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Curve {
-    pub value: String,
+    pub factors: Factors,
     pub test: TestData,
 }
 
@@ -78,7 +80,7 @@ pub struct Curve {
 /// that model.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Setting {
-    /// Names the setting in unit keys (`value` of its curve when it has one).
+    /// Names the setting in unit keys (its curve's level when it has one).
     pub label: String,
     pub sensor: SensorConfig,
     pub sampler: SamplerConfig,
@@ -89,20 +91,20 @@ pub struct Setting {
 }
 
 impl Setting {
-    /// A setting drawing one curve named like it.
+    /// A setting named `label` drawing one curve at `factors`.
     pub fn single(
-        value: impl Into<String>,
+        label: impl Into<String>,
+        factors: Factors,
         sensor: SensorConfig,
         sampler: SamplerConfig,
         test: TestData,
     ) -> Self {
-        let value = value.into();
         Self {
-            label: value.clone(),
+            label: label.into(),
             sensor,
             sampler,
             training_fraction: 1.0,
-            curves: vec![Curve { value, test }],
+            curves: vec![Curve { factors, test }],
         }
     }
 }
@@ -117,8 +119,13 @@ pub struct RecognitionSweep {
     /// ([`RealData::frames_words`]).
     #[serde(skip)]
     pub title: &'static str,
-    /// The column `parameter` of the rows: what the curves vary.
-    pub parameter: &'static str,
+    /// The name settings' labels take in unit keys (`noise_fraction=0.1`); empty when the keys name
+    /// only the descriptor. Keys only: the rows' columns are the curves' [`Factors`].
+    #[serde(skip)]
+    pub key_parameter: &'static str,
+    /// How the plot's legend names a curve ([`PlotSpec::legend`]); `None`: `factor = level`.
+    #[serde(skip)]
+    pub legend: Option<&'static str>,
     pub family: Family,
     pub descriptors: Vec<DescriptorKind>,
     pub settings: Vec<Setting>,
@@ -192,7 +199,7 @@ impl RecognitionSweep {
                 let real = real.clone();
                 let setting = plan.setting;
                 let descriptor = plan.descriptor;
-                Unit::new(plan.key.clone(), move || {
+                Unit::with_detail(plan.key.clone(), move || {
                     self.unit_rows(
                         context,
                         &objects,
@@ -209,10 +216,7 @@ impl RecognitionSweep {
             spec: ExperimentSpec {
                 name: name.clone(),
                 description: self.description.to_string(),
-                plots: vec![
-                    PlotSpec::accuracy(name, &self.plot_title(real.as_deref()))
-                        .with_chance(objects.specs.len()),
-                ],
+                plots: vec![self.plot(name, &self.plot_title(real.as_deref()), objects.specs.len())],
             },
             config: SweepConfig {
                 sweep: self,
@@ -231,13 +235,46 @@ impl RecognitionSweep {
         Ok(run(&experiment, &context.options)?)
     }
 
+    /// The accuracy plot of the sweep's rows, chance level at 1 / `objects`.
+    pub(super) fn plot(&self, name: SafeName, title: &str, objects: usize) -> PlotSpec {
+        let plot = PlotSpec::accuracy(name, title).with_chance(objects);
+        match self.legend {
+            Some(template) => plot.with_legend(template),
+            None => plot,
+        }
+    }
+
+    /// Every curve's levels are valid and of the same factors in the same order, so that every row
+    /// of the experiment has the same columns.
+    pub(super) fn check_factors(&self) -> Result<(), BoxError> {
+        let mut curves = self.settings.iter().flat_map(|s| &s.curves);
+        let Some(first) = curves.next() else {
+            return Ok(());
+        };
+        for curve in std::iter::once(first).chain(curves) {
+            curve
+                .factors
+                .check()
+                .map_err(|e| format!("experiment '{}': {e}", self.name))?;
+            if !curve.factors.factors().eq(first.factors.factors()) {
+                return Err(format!(
+                    "experiment '{}': curve '{}' has other factors than '{}': one header for all rows",
+                    self.name, curve.factors, first.factors
+                )
+                .into());
+            }
+        }
+        Ok(())
+    }
+
     fn unit_plans(&self) -> Result<Vec<UnitPlan>, BoxError> {
+        self.check_factors()?;
         let mut plans = Vec::new();
         for (setting, s) in self.settings.iter().enumerate() {
             for &descriptor in &self.descriptors {
                 let mut key = SafeName::builder(descriptor.name());
-                if !self.parameter.is_empty() {
-                    key = key.param(self.parameter, &s.label);
+                if !self.key_parameter.is_empty() {
+                    key = key.param(self.key_parameter, &s.label);
                 }
                 let key = key.build()?;
                 plans.push(UnitPlan {
@@ -390,7 +427,7 @@ impl RecognitionSweep {
         counts: DataCounts,
         training: &TrainConfig,
         real: Option<&RealData>,
-    ) -> Result<Vec<AccuracyRow>, BoxError> {
+    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
         let descriptor = kind.build();
         let model = context.store.model(
             &self.training_request(context, objects, setting, counts)?,
@@ -398,7 +435,7 @@ impl RecognitionSweep {
             descriptor.as_ref(),
             training,
         )?;
-        let mut rows = Vec::new();
+        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
         for curve in &self.settings[setting].curves {
             let trials = match curve.test {
                 TestData::Real => {
@@ -413,7 +450,7 @@ impl RecognitionSweep {
                     counts,
                     &model,
                     descriptor.as_ref(),
-                    &curve.value,
+                    &curve.factors,
                 )?,
             };
             for (trial, (seed, object_trials)) in trials.iter().enumerate() {
@@ -421,7 +458,7 @@ impl RecognitionSweep {
                 if longest == 0 {
                     return Err(format!(
                         "curve '{}', trial {trial}: no converged test reading of any object",
-                        curve.value
+                        curve.factors
                     )
                     .into());
                 }
@@ -429,18 +466,18 @@ impl RecognitionSweep {
                 let meta = AccuracyCurve {
                     experiment: self.name.to_string(),
                     descriptor: kind.name().to_string(),
-                    parameter: self.parameter.to_string(),
-                    value: curve.value.clone(),
+                    factors: curve.factors.clone(),
                     trial: trial as u32,
                     seed: context.seed,
                     stream_seed: *seed,
                 };
                 // One definition of accuracy (`recognize::AccuracyPoint`): every object counts, an unread one as
-                // a miss.
+                // a miss; the per-object rows are the outcomes it counts.
                 rows.extend(meta.rows(&evaluation.accuracy));
+                per_object.extend(meta.object_rows(&evaluation)?);
             }
         }
-        Ok(rows)
+        Ok((rows, per_object))
     }
 }
 
@@ -457,7 +494,7 @@ impl RecognitionSweep {
         counts: DataCounts,
         model: &TrainedModel,
         descriptor: &dyn Descriptor,
-        curve: &str,
+        curve: &Factors,
     ) -> Result<Vec<(u64, Vec<Trial>)>, BoxError> {
         self.test_requests(context, objects, setting, test, counts)?
             .iter()

@@ -165,9 +165,33 @@ pub struct AccuracyPoint {
     /// Mean probability on the true object: the paper's reliability (Sec. V-B1), the same name in
     /// every CSV and table.
     pub reliability: f64,
+    /// Each trial's outcome, in trial order: what `correct` and `reliability` count.
+    pub outcomes: Vec<TrialOutcome>,
+}
+
+/// One trial after `n_readings` readings (or its last, or none): whether its most probable object
+/// is the true one, and the probability on the true one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrialOutcome {
+    /// The true object, as an index of the model's objects.
+    pub object: usize,
+    pub correct: bool,
+    pub p_true: f64,
 }
 
 impl AccuracyPoint {
+    /// The point of `outcomes`, one per trial: the one place they are counted.
+    pub fn new(n_readings: usize, outcomes: Vec<TrialOutcome>) -> Self {
+        let p_true = outcomes.iter().fold(0.0, |sum, o| sum + o.p_true);
+        Self {
+            n_readings,
+            trials: outcomes.len(),
+            correct: outcomes.iter().filter(|o| o.correct).count(),
+            reliability: p_true / outcomes.len() as f64,
+            outcomes,
+        }
+    }
+
     pub fn accuracy(&self) -> f64 {
         if self.trials == 0 {
             0.0
@@ -242,23 +266,26 @@ where
     let prior = 1.0 / objects.len().max(1) as f64;
     let mut accuracy: Vec<AccuracyPoint> = Vec::new();
     for n in range.first..=range.last.min(longest) {
-        let (mut correct, mut p_true) = (0, 0.0);
-        for beliefs in &per_trial {
-            // The belief after n readings, or after the trial's last; none before any reading.
-            match n.min(beliefs.len()).checked_sub(1).map(|i| &beliefs[i]) {
-                Some(b) => {
-                    correct += usize::from(b.object_guess == b.object_true);
-                    p_true += b.p_true();
+        let outcomes = trials
+            .iter()
+            .zip(&per_trial)
+            .map(|(trial, beliefs)| {
+                // The belief after n readings, or after the trial's last; none before any reading.
+                match n.min(beliefs.len()).checked_sub(1).map(|i| &beliefs[i]) {
+                    Some(b) => TrialOutcome {
+                        object: trial.object,
+                        correct: b.object_guess == b.object_true,
+                        p_true: b.p_true(),
+                    },
+                    None => TrialOutcome {
+                        object: trial.object,
+                        correct: false,
+                        p_true: prior,
+                    },
                 }
-                None => p_true += prior,
-            }
-        }
-        accuracy.push(AccuracyPoint {
-            n_readings: n,
-            trials: per_trial.len(),
-            correct,
-            reliability: p_true / per_trial.len() as f64,
-        });
+            })
+            .collect();
+        accuracy.push(AccuracyPoint::new(n, outcomes));
     }
     let mut touches = Vec::new();
     // The decisions are taken after the range's end or the longest trial's last reading, whichever
