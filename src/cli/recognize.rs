@@ -9,7 +9,7 @@ use indicatif::ProgressBar;
 use taction::atomic::write_atomic;
 use taction::dataset::{Dataset, DatasetHeader};
 use taction::experiment::plot::build_figure;
-use taction::experiment::{AccuracyCurve, AccuracyRow, PlotSpec, SafeName};
+use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
 use taction::recognize::{Evaluation, ReadingRange, RecognizeError, Recognizer};
 
 use crate::cli::dataset::read_dataset;
@@ -115,8 +115,7 @@ fn trial_rows(
     let curve = |trial: usize| AccuracyCurve {
         experiment: "recognize".to_string(),
         descriptor: model.choice().name(),
-        parameter: String::new(),
-        value: String::new(),
+        factors: Factors::none(),
         trial: trial as u32,
         seed: 0,
         stream_seed: 0,
