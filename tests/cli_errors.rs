@@ -271,6 +271,19 @@ fn an_experiment_refuses_a_folder_of_another_scale_before_it_starts() {
     );
     assert!(!stderr(&run).contains("estimated duration"), "{}", stderr(&run));
     assert!(!earlier.join("units").exists());
+    // Same scale, seed and codebook, but another configuration (e.g. written before a field was
+    // added): refused before any dataset is collected.
+    std::fs::write(
+        earlier.join("config.json"),
+        r#"{"scale": 0.1, "seed": 1, "training": {"codebook": "gmm"}}"#,
+    )
+    .unwrap();
+    let line = fails_with(
+        &taction(&["experiment", "strategy", "--scale", "0.1", "--out", &out]),
+        1,
+    );
+    assert!(line.contains("different configuration"), "{line}");
+    assert!(!dir.path().join("data").exists(), "no dataset collected");
 }
 
 #[test]

@@ -42,7 +42,7 @@ pub use layout::ExperimentDir;
 pub use merge::{MergeReport, merge};
 pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
 pub use plot::{Axis, PlotKind, PlotSpec};
-pub use runner::{Experiment, RunOptions, RunReport, run};
+pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};
 pub use unit::{BoxError, DetailRow, NoDetail, Unit};

@@ -18,7 +18,7 @@ use super::layout::ExperimentDir;
 use super::name::SafeName;
 use super::progress::progress_bar;
 use super::shard::Shard;
-use super::spec::{ExperimentSpec, Manifest, to_json, write_manifest, write_or_check};
+use super::spec::{ExperimentSpec, Manifest, check_unchanged, to_json, write_manifest, write_or_check};
 use super::unit::{DetailRow, NoDetail, Unit, parse_rows, read_rows, rows_to_csv};
 use crate::atomic::{remove_stale_temporaries, write_atomic};
 
@@ -111,6 +111,24 @@ impl fmt::Display for RunReport {
             ),
         }
     }
+}
+
+/// Refuses, as [`run`] will, an output folder whose experiment `name` holds another configuration
+/// than `config`. An experiment that prepares data before it runs (collection can take minutes)
+/// checks first, so that a folder of another configuration is refused before any of that work.
+pub fn check_resumable<C: Serialize>(
+    options: &RunOptions,
+    name: &SafeName,
+    config: &C,
+) -> Result<(), ExperimentError> {
+    let dir = ExperimentDir::new(&options.out, name);
+    check_unchanged(
+        &dir.config(),
+        &to_json(config, &dir.config())?,
+        dir.root(),
+        "configuration",
+    )?;
+    Ok(())
 }
 
 /// Runs `experiment` as `options` say.

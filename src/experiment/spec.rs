@@ -67,14 +67,28 @@ pub fn write_or_check(
     dir: &Path,
     what: &'static str,
 ) -> Result<(), ExperimentError> {
+    if !check_unchanged(path, bytes, dir, what)? {
+        write_atomic(path, bytes)?;
+    }
+    Ok(())
+}
+
+/// Whether `path` exists holding exactly `bytes` (`false`: it does not exist); an error when it
+/// holds anything else (see [`write_or_check`]).
+pub fn check_unchanged(
+    path: &Path,
+    bytes: &[u8],
+    dir: &Path,
+    what: &'static str,
+) -> Result<bool, ExperimentError> {
     match std::fs::read(path) {
-        Ok(existing) if existing == bytes => Ok(()),
+        Ok(existing) if existing == bytes => Ok(true),
         Ok(_) => Err(ExperimentError::ChangedSinceLastRun {
             path: path.to_path_buf(),
             dir: dir.to_path_buf(),
             what,
         }),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(write_atomic(path, bytes)?),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
         Err(source) => Err(ExperimentError::Io {
             path: path.to_path_buf(),
             source,

@@ -23,7 +23,7 @@ use crate::experiment::factor::Factors;
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
-use crate::experiment::runner::{Experiment, RunReport, run};
+use crate::experiment::runner::{Experiment, RunReport, check_resumable, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::collect::{CollectMode, CollectPlan};
@@ -173,6 +173,19 @@ impl RecognitionSweep {
         let setting_counts = |setting: usize| self.setting_counts(setting, counts);
 
         let name = SafeName::new(self.name)?;
+        let config = SweepConfig {
+            sweep: self,
+            scale: context.scale.fraction(),
+            counts,
+            seed: context.seed,
+            object_set: objects.set.name.clone(),
+            object_set_id: objects.set.id(),
+            objects: objects.names(),
+            control: ControlConfig::default(),
+            planner: PlannerConfig::default(),
+            training,
+        };
+        check_resumable(&context.options, &name, &config)?;
         let dir = ExperimentDir::new(&context.options.out, &name);
         let pending: Vec<&UnitPlan> = plans
             .iter()
@@ -218,18 +231,7 @@ impl RecognitionSweep {
                 description: self.description.to_string(),
                 plots: vec![self.plot(name, &self.plot_title(real.as_deref()), objects.specs.len())],
             },
-            config: SweepConfig {
-                sweep: self,
-                scale: context.scale.fraction(),
-                counts,
-                seed: context.seed,
-                object_set: objects.set.name.clone(),
-                object_set_id: objects.set.id(),
-                objects: objects.names(),
-                control: ControlConfig::default(),
-                planner: PlannerConfig::default(),
-                training,
-            },
+            config,
             units,
         };
         Ok(run(&experiment, &context.options)?)
