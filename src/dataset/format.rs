@@ -400,16 +400,7 @@ pub fn column_names(rows: usize, cols: usize) -> Vec<String> {
     names
 }
 
-/// `v` in shortest round-trip form: plain decimals for ordinary magnitudes, exponent form for
-/// tiny or huge ones (where plain decimals would run to hundreds of digits).
-pub fn format_f64(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || (1e-5..1e16).contains(&a) {
-        v.to_string()
-    } else {
-        format!("{v:e}")
-    }
-}
+pub use crate::units::round_trip as format_f64;
 
 fn reading_row(r: &Reading, row: &mut Vec<String>) {
     row.clear();
