@@ -28,8 +28,7 @@ pub struct Reading {
 /// The names of what ends an attempt short of convergence: one vocabulary for the dataset's
 /// `cause` column, the causes table `collect` and `dataset show` print, and the planner's count of
 /// stopped expansion steps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum CauseKind {
     /// `pad_on_object`: the pad's body on the object: its rigid back (the covering fully
     /// compressed somewhere while the controllers were still pressing or turning) or, during a
