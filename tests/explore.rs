@@ -754,3 +754,53 @@ fn a_collected_datasets_causes_are_the_names_its_table_prints() {
     let shown = taction(&["dataset", "show", out.to_str().unwrap()]);
     assert_eq!(causes_table(&shown), (names, table));
 }
+
+/// A dataset `collect` wrote in format 2, before the causes had one vocabulary (`taction collect
+/// --mode planner --objects chess --readings 20 --seed 4 --rows 3 --cols 3`, its `cause` column
+/// holding `sensor/object` and no lost contact), reads in this one: the touches are
+/// `pad_on_object` with their bodies kept, the `no_contact` after pressing is `lost_contact`, and
+/// `dataset show` counts them so.
+#[test]
+fn a_format_2_dataset_from_collect_reads_in_the_tables_vocabulary() {
+    use taction::dataset::{AttemptCause, CauseKind, Dataset, FORMAT_VERSION};
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/dataset_v2/chess_planner_seed4.csv");
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("\"format_version\":2")
+    );
+    let dataset = Dataset::read(&path).unwrap();
+    assert_eq!(dataset.header().format_version, FORMAT_VERSION);
+    assert_eq!(dataset.len(), 44);
+    let causes: Vec<&AttemptCause> = dataset
+        .readings()
+        .iter()
+        .filter_map(|r| r.cause.as_ref())
+        .collect();
+    let touched = AttemptCause::Touched {
+        body_a: "sensor".into(),
+        body_b: "object".into(),
+    };
+    assert_eq!(causes, [&touched, &touched, &touched, &AttemptCause::LostContact]);
+    let summary = dataset.summary();
+    assert_eq!(summary.causes[1][&CauseKind::PadOnObject], 3);
+    assert_eq!(summary.causes[1][&CauseKind::LostContact], 1);
+    let shown = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["dataset", "show"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        shown.status.success(),
+        "{}",
+        String::from_utf8_lossy(&shown.stderr)
+    );
+    let (_, table) = causes_table(&String::from_utf8_lossy(&shown.stdout));
+    let expected: std::collections::BTreeMap<(String, String), usize> = [
+        (("rook".to_string(), "pad_on_object".to_string()), 3),
+        (("rook".to_string(), "lost_contact".to_string()), 1),
+    ]
+    .into();
+    assert_eq!(table, expected);
+}
