@@ -1,8 +1,9 @@
 //! The names of the MJCF world's bodies (`mjcf/arm.xml` and the object slot).
 //!
 //! Two modules speak of them: `sim`, which builds the world and looks bodies up by name, and
-//! `dataset`, whose `cause` column records who touched whom (`sensor/object`, `link4/world`) and
-//! must classify those names when a dataset is read back, with no MuJoCo at hand. Both take the
+//! `dataset`, whose `touched_bodies` column records who touched whom (`sensor/object`,
+//! `link4/world`) and must classify those names into the `cause` column's names (`pad_on_object`,
+//! `arm_on_table`) when a dataset is read back, with no MuJoCo at hand. Both take the
 //! names from here, so a renamed body cannot make old datasets misclassified in silence.
 
 /// The body the arm is mounted on, fixed to the world.

@@ -1,6 +1,17 @@
 //! Numbers for people: lengths and plain values with four significant digits, so that a message
 //! says `covering 1.2 mm` rather than the shortest round-trip form `0.0012000000000000001 m`
-//! (files keep the round-trip form; see `dataset::format_f64`).
+//! (files keep the round-trip form, [`round_trip`]).
+
+/// `v` in shortest round-trip form, for files: plain decimals for ordinary magnitudes, exponent
+/// form for tiny or huge ones (where plain decimals would run to hundreds of digits).
+pub fn round_trip(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-5..1e16).contains(&a) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
 
 /// `v` with at most four significant digits, trailing zeros dropped: `1.2`, `0.576`, `12`, and
 /// exponent form outside [1e-4, 1e6): `3e30`.

@@ -517,3 +517,290 @@ fn collect_takes_the_controllers_from_a_control_file() {
         "{stderr}"
     );
 }
+
+/// A reader that corrupts the world's state just before its reads number `at` (counting from 1),
+/// with `corrupt`, then reads as `reader` does.
+fn faulting<R>(
+    mut reader: R,
+    at: &'static [usize],
+    corrupt: fn(&mut taction::sim::Scene),
+) -> impl FnMut(&mut taction::sim::Scene) -> Result<taction::tactile::TactileImage, taction::control::ControlError>
+where
+    R: FnMut(
+        &mut taction::sim::Scene,
+    ) -> Result<taction::tactile::TactileImage, taction::control::ControlError>,
+{
+    let mut reads = 0;
+    move |scene| {
+        reads += 1;
+        if at.contains(&reads) {
+            corrupt(scene);
+        }
+        reader(scene)
+    }
+}
+
+/// The free pad's sampler on the box for 10 converged readings, the state corrupted (the mocap
+/// poses not finite, as a blown-up integration leaves positions) at reads `faults`.
+fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationReport {
+    use taction::explore::collect::sensor_reader;
+    use taction::explore::sample_readings;
+    use taction::tactile::FreeFloatingSensor;
+    let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
+    let mut free = FreeFloatingSensor::new(box_object(), &sensor).unwrap();
+    let reader = faulting(sensor_reader(free.sensor().clone()), faults, |scene| {
+        for p in scene.data_mut().mocap_pos_mut() {
+            p[2] = f64::NAN;
+        }
+    });
+    sample_readings(
+        free.scene_mut(),
+        "box",
+        sensor,
+        &Valid::default(),
+        &Valid::default(),
+        PerturbationBounds::NONE,
+        10,
+        &mut taction::rng::stream(17, 0),
+        reader,
+        &mut || {},
+    )
+    .unwrap()
+}
+
+/// The arm's planner on the box for 8 converged readings, the arm's velocities made NaN (an
+/// unstable step's) at reads `faults`.
+fn faulted_planner(faults: &'static [usize]) -> taction::explore::ExplorationReport {
+    use taction::explore::Planner;
+    use taction::explore::collect::sensor_reader;
+    use taction::sim::SceneBuilder;
+    use taction::sim::arm::PAD_SITE;
+    use taction::tactile::sensor::{CoveringSensor, add_sensor};
+    let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
+    let builder = SceneBuilder::with_arm_and_table().object(box_object());
+    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
+        .unwrap()
+        .build()
+        .unwrap();
+    let reader = faulting(
+        sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).unwrap()),
+        faults,
+        |scene| scene.data_mut().qvel_mut().fill(f64::NAN),
+    );
+    let mut planner = Planner::new(
+        &scene,
+        Valid::default(),
+        Valid::default(),
+        sensor,
+        PerturbationBounds::NONE,
+        taction::rng::stream(17, 0),
+        reader,
+    )
+    .unwrap();
+    planner.explore(&mut scene, "box", 8).unwrap()
+}
+
+/// A physics fault in the middle of a run, for either carrier: the run goes on to its converged
+/// readings, the fault counted as `physics_fault` (an `aborted` reading when it struck during an
+/// attempt), and the same faults give the same run. The sampler's draws do not depend on what
+/// an attempt did, so every other attempt is the one the run without faults made.
+#[test]
+fn a_physics_fault_is_counted_and_the_run_goes_on_with_nothing_else_lost() {
+    use taction::dataset::{AttemptCause, CauseKind};
+    let aborted = |report: &taction::explore::ExplorationReport| -> Vec<usize> {
+        report
+            .readings
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.status == ContactStatus::Aborted)
+            .map(|(i, r)| {
+                assert_eq!(r.cause, Some(AttemptCause::PhysicsFault));
+                i
+            })
+            .collect()
+    };
+
+    let clean = faulted_sampler(&[]);
+    let faulted = faulted_sampler(&[30, 150]);
+    assert_eq!(faulted.physics_faults(), 2);
+    let lost = aborted(&faulted);
+    assert_eq!(lost.len(), 2, "{:?}", faulted.by_status());
+    assert_eq!(faulted.converged(), 10);
+    assert!(aborted(&clean).is_empty());
+    for (i, (with, without)) in faulted.readings.iter().zip(&clean.readings).enumerate() {
+        if !lost.contains(&i) {
+            assert_eq!(with, without, "attempt {i}");
+        }
+    }
+    assert_eq!(faulted_sampler(&[30, 150]), faulted);
+
+    // The planner reads while it expands and while it settles: the first fault strikes an
+    // expansion step, the second an attempt.
+    let clean = faulted_planner(&[]);
+    let faulted = faulted_planner(&[8, 60]);
+    assert_eq!(clean.physics_faults(), 0);
+    assert_eq!(faulted.physics_faults(), 2);
+    assert_eq!(
+        (
+            faulted.expansion_stops.get(&CauseKind::PhysicsFault).copied(),
+            aborted(&faulted).len()
+        ),
+        (Some(1), 1),
+        "{:?}, expansion stops {:?}",
+        faulted.by_status(),
+        faulted.expansion_stops
+    );
+    assert_eq!(faulted.converged(), 8);
+    assert_eq!(faulted_planner(&[8, 60]), faulted);
+}
+
+/// The causes table `collect` and `dataset show` print: its column names, and each object's counts.
+fn causes_table(printed: &str) -> (Vec<String>, std::collections::BTreeMap<(String, String), usize>) {
+    let mut lines = printed.lines().skip_while(|l| !l.starts_with("causes "));
+    let names: Vec<String> = lines
+        .next()
+        .unwrap_or_else(|| panic!("no causes table in {printed}"))
+        .split_whitespace()
+        .skip(1)
+        .map(str::to_string)
+        .collect();
+    let mut counts = std::collections::BTreeMap::new();
+    for line in lines.take_while(|l| !l.starts_with("strategies:")) {
+        let mut fields = line.split_whitespace();
+        let object = fields.next().unwrap().to_string();
+        for (name, n) in names.iter().zip(fields) {
+            let n: usize = n.parse().unwrap();
+            if n > 0 {
+                counts.insert((object.clone(), name.clone()), n);
+            }
+        }
+    }
+    (names, counts)
+}
+
+/// One vocabulary: the `cause` column of a collected dataset holds exactly the names of the table
+/// `collect` prints (and `dataset show` prints again from the file), each counted as the table
+/// counts it; the bodies that touched are beside it in `touched_bodies`.
+#[test]
+fn a_collected_datasets_causes_are_the_names_its_table_prints() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("chess.csv");
+    let taction = |args: &[&str]| {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    };
+    let printed = taction(&[
+        "collect",
+        "--mode",
+        "planner",
+        "--objects",
+        "chess",
+        "--readings",
+        "20",
+        "--seed",
+        "3",
+        "--threads",
+        "2",
+        "--contact-sheet",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (names, table) = causes_table(&printed);
+
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: String = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let mut csv = csv::Reader::from_reader(rows.as_bytes());
+    let columns = csv.headers().unwrap().clone();
+    let column = |name: &str| columns.iter().position(|c| c == name).unwrap();
+    let (object, cause, bodies) = (column("object"), column("cause"), column("touched_bodies"));
+    let mut written = std::collections::BTreeMap::new();
+    for record in csv.records() {
+        let record = record.unwrap();
+        if record[cause].is_empty() {
+            continue;
+        }
+        assert!(
+            names.iter().any(|n| n == &record[cause]),
+            "cause '{}' is not a column of the table {names:?}",
+            &record[cause]
+        );
+        let touch =
+            ["pad_on_object", "arm_on_object", "arm_on_table", "arm_on_arm"].contains(&&record[cause]);
+        assert_eq!(!record[bodies].is_empty(), touch, "{record:?}");
+        *written
+            .entry((record[object].to_string(), record[cause].to_string()))
+            .or_insert(0) += 1;
+    }
+    assert_eq!(written, table);
+    // Not a vacuous run: bodies touched and a contact was lost.
+    let causes: std::collections::BTreeSet<&str> = written.keys().map(|(_, c)| c.as_str()).collect();
+    assert!(
+        causes.contains("pad_on_object") && causes.contains("lost_contact"),
+        "{causes:?}"
+    );
+    let shown = taction(&["dataset", "show", out.to_str().unwrap()]);
+    assert_eq!(causes_table(&shown), (names, table));
+}
+
+/// A dataset `collect` wrote in format 2, before the causes had one vocabulary (`taction collect
+/// --mode planner --objects chess --readings 20 --seed 4 --rows 3 --cols 3`, its `cause` column
+/// holding `sensor/object` and no lost contact), reads in this one: the touches are
+/// `pad_on_object` with their bodies kept, the `no_contact` after pressing is `lost_contact`, and
+/// `dataset show` counts them so.
+#[test]
+fn a_format_2_dataset_from_collect_reads_in_the_tables_vocabulary() {
+    use taction::dataset::{AttemptCause, CauseKind, Dataset, FORMAT_VERSION};
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/dataset_v2/chess_planner_seed4.csv");
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("\"format_version\":2")
+    );
+    let dataset = Dataset::read(&path).unwrap();
+    assert_eq!(dataset.header().format_version, FORMAT_VERSION);
+    assert_eq!(dataset.len(), 44);
+    let causes: Vec<&AttemptCause> = dataset
+        .readings()
+        .iter()
+        .filter_map(|r| r.cause.as_ref())
+        .collect();
+    let touched = AttemptCause::Touched {
+        body_a: "sensor".into(),
+        body_b: "object".into(),
+    };
+    assert_eq!(causes, [&touched, &touched, &touched, &AttemptCause::LostContact]);
+    let summary = dataset.summary();
+    assert_eq!(summary.causes[1][&CauseKind::PadOnObject], 3);
+    assert_eq!(summary.causes[1][&CauseKind::LostContact], 1);
+    let shown = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["dataset", "show"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        shown.status.success(),
+        "{}",
+        String::from_utf8_lossy(&shown.stderr)
+    );
+    let (_, table) = causes_table(&String::from_utf8_lossy(&shown.stdout));
+    let expected: std::collections::BTreeMap<(String, String), usize> = [
+        (("rook".to_string(), "pad_on_object".to_string()), 3),
+        (("rook".to_string(), "lost_contact".to_string()), 1),
+    ]
+    .into();
+    assert_eq!(table, expected);
+}

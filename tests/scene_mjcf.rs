@@ -2,9 +2,10 @@
 //! MuJoCo's visual scene, `taction scene export` and `taction plugin-path`, on the Rust side.
 //! tests/sensor_python.rs checks the same files through MuJoCo's official Python bindings.
 
+mod common;
 mod sensor_support;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::{DMat3, DVec3};
@@ -212,4 +213,170 @@ fn plugin_path_prints_the_library_the_set_up_built() {
     let path = PathBuf::from(stdout.trim());
     assert!(path.is_absolute() && path.is_file(), "{stdout}");
     assert!(path.ends_with("libtaction_covering.so"), "{stdout}");
+}
+
+/// `xml` read by a strict XML parser (as Python's `xml.etree` and dm_control's `mjcf` read MJCF),
+/// or a panic naming `origin` and the parser's complaint.
+fn strictly_parsed<'a>(xml: &'a str, origin: &str) -> roxmltree::Document<'a> {
+    roxmltree::Document::parse(xml).unwrap_or_else(|e| panic!("{origin} is not well-formed XML: {e}"))
+}
+
+/// Runs `taction scene export --object OBJECT` into `out`; the written scene.xml.
+fn export_scene(object: &str, out: &Path) -> String {
+    let run = taction(&[
+        "scene",
+        "export",
+        "--object",
+        object,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    std::fs::read_to_string(out.join("scene.xml")).unwrap()
+}
+
+/// A 5 cm box resting on the table at the origin, written as `name`.obj in `dir`.
+fn box_file(dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(format!("{name}.obj"));
+    taction::mesh::write_obj(&common::box_mesh(DVec3::splat(0.05)), &path, "box").unwrap();
+    path
+}
+
+#[test]
+fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
+    let mjcf = Path::new(env!("CARGO_MANIFEST_DIR")).join("mjcf");
+    let mut shipped = 0;
+    for entry in std::fs::read_dir(&mjcf).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "xml") {
+            strictly_parsed(
+                &std::fs::read_to_string(&path).unwrap(),
+                &path.display().to_string(),
+            );
+            shipped += 1;
+        }
+    }
+    assert!(shipped >= 5, "{shipped} files in mjcf/");
+
+    // What the builders write: the arm's world with a fixed and a free object and the sensor, and
+    // the free-floating pad's. The object's name lands in a comment: `--` must not end it early.
+    let config = SensorConfig::default();
+    let named = |mount| taction::sim::ObjectSpec {
+        mount,
+        ..taction::sim::ObjectSpec::new("a--b -", common::box_mesh(DVec3::splat(0.05)))
+    };
+    for mount in [taction::sim::ObjectMount::Mocap, taction::sim::ObjectMount::Free] {
+        let builder = taction::sim::SceneBuilder::with_arm_and_table().object(named(mount));
+        let xml = taction::tactile::add_sensor(builder, &config, "tactile", "pad")
+            .unwrap()
+            .to_xml()
+            .unwrap();
+        strictly_parsed(&xml, &format!("the arm's scene ({mount:?} object)"));
+    }
+    let free = taction::tactile::free_floating::free_floating_builder(
+        named(taction::sim::ObjectMount::Mocap),
+        &config,
+    )
+    .unwrap()
+    .to_xml()
+    .unwrap();
+    strictly_parsed(&free, "the free-floating pad's scene");
+
+    // `taction scene export` for a mesh file (its name with `--` in it) and a built-in object.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = box_file(dir.path(), "my--box");
+    for (object, out) in [(mesh.to_str().unwrap(), "file"), ("pawn", "pawn")] {
+        let xml = export_scene(object, &dir.path().join(out));
+        let document = strictly_parsed(&xml, &format!("the scene exported for {object}"));
+        let key = document
+            .descendants()
+            .find(|n| n.has_tag_name("key"))
+            .unwrap_or_else(|| panic!("the scene exported for {object} has no keyframe"));
+        assert_eq!(key.attribute("name"), Some("touch"));
+    }
+}
+
+/// Arm bodies in contact with each other in `scene`'s current contacts, by name.
+fn arm_on_arm(scene: &taction::sim::Scene) -> Vec<(String, String)> {
+    let arm = scene.arm().expect("the scene has the arm");
+    scene
+        .contact_bodies()
+        .into_iter()
+        .filter(|&(a, b)| arm.owns_body(scene.model(), a) && arm.owns_body(scene.model(), b))
+        .map(|(a, b)| (scene.body_name(a), scene.body_name(b)))
+        .collect()
+}
+
+#[test]
+fn no_two_arm_bodies_touch_in_the_shipped_or_a_built_scene() {
+    let (mut shipped, _) = shipped_scene_at_touch();
+    let mut built = taction::sim::SceneBuilder::with_arm_and_table()
+        .object(taction::sim::ObjectSpec::new(
+            "box",
+            common::box_mesh(DVec3::splat(0.05)),
+        ))
+        .build()
+        .unwrap();
+    assert_eq!(arm_on_arm(&shipped), [], "at the keyframe 'touch'");
+    // Home, and the arm turned, bent and folded, clear of itself, the table and the object.
+    let configurations_deg: [[f64; 8]; 5] = [
+        [0.0; 8],
+        [90.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [0.0, -45.0, 0.0, 60.0, 0.0, 45.0, 0.0, 0.0],
+        [-60.0, -30.0, 45.0, 60.0, -30.0, 30.0, 20.0, -20.0],
+        [150.0, 20.0, -90.0, -40.0, 60.0, -70.0, -45.0, 80.0],
+    ];
+    for scene in [&mut shipped, &mut built] {
+        let arm = scene.arm().cloned().unwrap();
+        for q_deg in configurations_deg {
+            let q: Vec<f64> = q_deg.iter().map(|d| d.to_radians()).collect();
+            arm.teleport(scene, &q);
+            assert_eq!(arm_on_arm(scene), [], "at {q_deg:?} deg");
+        }
+    }
+}
+
+#[test]
+fn an_exported_scene_opens_at_its_touch_keyframe_with_the_pad_pressed_on_the_object() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = box_file(dir.path(), "box");
+    let target = taction::control::ControlConfig::default().target_mean_pressure;
+    for object in [mesh.to_str().unwrap(), "pawn"] {
+        let out = dir.path().join(Path::new(object).file_stem().unwrap());
+        export_scene(object, &out);
+        ensure_registered();
+        let model = MjModel::from_xml(out.join("scene.xml")).expect("the exported scene compiles");
+        let key = model
+            .name_to_id(MjtObjBase::mjOBJ_KEY, "touch")
+            .unwrap_or_else(|| panic!("{object}: no keyframe 'touch'"));
+        let mut scene = taction::sim::Scene::new(model, None).unwrap();
+        scene.data_mut().reset_keyframe(key).unwrap();
+        scene.forward();
+        let sensor = CoveringSensor::first(scene.model()).unwrap();
+        let image = sensor.read(scene.data()).unwrap();
+        let pose = image.pose().unwrap();
+        assert!(
+            pose.normal.dot(DVec3::NEG_Z) > 0.9,
+            "{object}: the pad looks down: {pose:?}"
+        );
+        assert!(
+            (image.mean() - target).abs() <= 0.05 * target,
+            "{object}: mean pressure {} at the keyframe, the controllers' target {target}",
+            image.mean()
+        );
+        let arm = scene.arm().cloned().unwrap();
+        assert_eq!(
+            arm.collision(&scene),
+            None,
+            "{object}: the arm touches nothing rigid"
+        );
+        // The servos hold the pose: ctrl is the keyframe's joint angles.
+        let q = arm.q(scene.data());
+        let ctrl: Vec<f64> = arm
+            .joints()
+            .iter()
+            .map(|j| scene.data().ctrl()[j.actuator])
+            .collect();
+        assert_eq!(q, ctrl, "{object}");
+    }
 }

@@ -470,3 +470,109 @@ fn the_python_example_saves_the_image_as_a_png() {
     let bytes = std::fs::read(&png).unwrap();
     assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
 }
+
+/// Parses files with Python's strict `xml.etree` (what dm_control's `mjcf` reads MJCF with); loads
+/// an exported scene, puts it at its keyframe `touch`, then at the joint angles `taction touch
+/// --arm` reported; prints `sensordata` for each.
+const KEYFRAME_SCRIPT: &str = r#"
+import sys, mujoco, xml.etree.ElementTree as ET
+lib, xml_path, arm_q = sys.argv[1], sys.argv[2], sys.argv[3]
+for path in sys.argv[4:]:
+    ET.parse(path)
+mujoco.mj_loadPluginLibrary(lib)
+m = mujoco.MjModel.from_xml_path(xml_path)
+d = mujoco.MjData(m)
+mujoco.mj_resetDataKeyframe(m, d, m.key("touch").id)
+mujoco.mj_forward(m, d)
+print(','.join(repr(float(v)) for v in d.sensordata))
+d.qpos[:] = [float(v) for v in arm_q.split(',')]
+mujoco.mj_forward(m, d)
+print(','.join(repr(float(v)) for v in d.sensordata))
+"#;
+
+#[test]
+fn python_parses_the_mjcf_strictly_opens_an_export_at_its_touch_keyframe_and_replays_an_arm_touch() {
+    let Some(python) = python_or_skip() else {
+        return;
+    };
+    let lib = plugin_library();
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("ball.obj");
+    taction::mesh::write_obj(&icosphere(DVec3::new(0.0, 0.0, 0.03), 0.03, 3), &mesh, "ball").unwrap();
+    let mesh_arg = mesh.to_str().unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let out = dir.path().join("scene");
+    run(&[
+        "scene",
+        "export",
+        "--object",
+        mesh_arg,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let touch: serde_json::Value = serde_json::from_str(&run(&[
+        "touch",
+        "--mesh",
+        mesh_arg,
+        "--arm",
+        "--pad-center",
+        "0.004,0.002,0.066",
+        "--pad-normal",
+        "0.1,0,-1",
+    ]))
+    .unwrap();
+    assert_eq!(touch["status"], "converged", "{touch}");
+    let arm_q: Vec<f64> = serde_json::from_value(touch["arm_q_rad"].clone()).unwrap();
+    let image: Vec<f64> = serde_json::from_value::<Vec<Vec<f64>>>(touch["image"].clone())
+        .unwrap()
+        .concat();
+
+    // The same keyframe in the Rust scene builder's world.
+    taction::tactile::ensure_registered();
+    let model = mujoco_rs::prelude::MjModel::from_xml(out.join("scene.xml")).unwrap();
+    let key = model
+        .name_to_id(mujoco_rs::prelude::MjtObjBase::mjOBJ_KEY, "touch")
+        .unwrap();
+    let mut scene = taction::sim::Scene::new(model, None).unwrap();
+    scene.data_mut().reset_keyframe(key).unwrap();
+    scene.forward();
+    let at_key = scene.data().sensordata().to_vec();
+    assert!(at_key.iter().any(|&v| v > 0.2), "{at_key:?}");
+
+    let script = dir.path().join("keyframe.py");
+    std::fs::write(&script, KEYFRAME_SCRIPT).unwrap();
+    let arm_q_text = arm_q
+        .iter()
+        .map(|v| format!("{v:?}"))
+        .collect::<Vec<_>>()
+        .join(",");
+    let mut args: Vec<std::ffi::OsString> = vec![
+        lib.into(),
+        out.join("scene.xml").into(),
+        arm_q_text.into(),
+        out.join("scene.xml").into(),
+    ];
+    for entry in std::fs::read_dir(repo().join("mjcf")).unwrap() {
+        args.push(entry.unwrap().path().into());
+    }
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let stdout = run_python(&python, dir.path(), &script, &args);
+    let mut lines = stdout.lines();
+    let keyframe = floats(lines.next().unwrap_or(""));
+    assert!(
+        max_difference(&keyframe, &at_key) <= 1e-6,
+        "Python {keyframe:?}\nRust {at_key:?}"
+    );
+    let replayed = floats(lines.next().unwrap_or(""));
+    assert!(
+        max_difference(&replayed, &image) <= 1e-6,
+        "Python {replayed:?}\ntouch {image:?}"
+    );
+}

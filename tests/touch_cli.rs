@@ -133,6 +133,80 @@ fn the_arm_settles_on_the_box_top() {
 }
 
 #[test]
+fn an_arm_touch_reports_its_joint_angles_and_replays_in_the_exported_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = box_file(dir.path());
+    let r = report(&touch(&[
+        "--mesh",
+        &mesh,
+        "--pad-center",
+        "0.008,0.004,0.066",
+        "--pad-normal",
+        "0.2,0.1,-1",
+        "--arm",
+    ]));
+    assert_eq!(r["status"], "converged", "{r}");
+    let joints: Vec<String> = serde_json::from_value(r["arm_joints"].clone()).unwrap();
+    assert_eq!(joints, taction::sim::arm::ARM_JOINTS);
+    let q: Vec<f64> = serde_json::from_value(r["arm_q_rad"].clone()).unwrap();
+    let image: Vec<f64> = serde_json::from_value::<Vec<Vec<f64>>>(r["image"].clone())
+        .unwrap()
+        .concat();
+
+    // The scene MuJoCo's tools get for the same mesh, its qpos set to the reported angles.
+    let out = dir.path().join("scene");
+    let export = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["scene", "export", "--object", &mesh, "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        export.status.success(),
+        "{}",
+        String::from_utf8_lossy(&export.stderr)
+    );
+    taction::tactile::ensure_registered();
+    let model = mujoco_rs::prelude::MjModel::from_xml(out.join("scene.xml")).unwrap();
+    let mut scene = taction::sim::Scene::new(model, None).unwrap();
+    assert_eq!(
+        scene.data().qpos().len(),
+        q.len(),
+        "the arm's joints are the whole qpos"
+    );
+    scene.data_mut().qpos_mut().copy_from_slice(&q);
+    scene.forward();
+    let sensor = taction::tactile::CoveringSensor::first(scene.model()).unwrap();
+    let replayed = sensor.read(scene.data()).unwrap();
+    let difference = replayed
+        .values()
+        .iter()
+        .zip(&image)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        difference <= 1e-9,
+        "replayed {:?}\nreported {image:?}",
+        replayed.values()
+    );
+    let center = vec3(&r["pad_center"]);
+    assert!((replayed.pose().unwrap().center_m - center).length() < 1e-9);
+
+    // The free pad has no arm: no joint angles.
+    let r = report(&touch(&[
+        "--mesh",
+        &mesh,
+        "--pad-center",
+        "0,0,0.064",
+        "--pad-normal",
+        "0,0,-1",
+    ]));
+    assert!(
+        r.get("arm_q_rad").is_none() && r.get("arm_joints").is_none(),
+        "{r}"
+    );
+}
+
+#[test]
 fn pointing_away_reports_no_contact_and_noise_is_seeded() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = box_file(dir.path());

@@ -254,21 +254,22 @@ pub fn write_contact_sheets(
 }
 
 /// What the planner did on the way to `object`'s readings, beyond them: iterations, expansion steps
-/// stopped by a collision (by who touched whom) or without an inverse-kinematics solution.
+/// stopped short (by the causes' names: who touched whom, or a physics fault) or without an
+/// inverse-kinematics solution.
 fn planner_line(object: &str, report: &ExplorationReport) -> String {
-    let collisions: Vec<String> = report
-        .expansion_collisions
+    let stops: Vec<String> = report
+        .expansion_stops
         .iter()
         .map(|(kind, n)| format!("{} {n}", kind.name()))
         .collect();
     format!(
-        "planner {object}: {} iterations, {} expansion steps stopped by collisions ({}), {} unreachable steps",
+        "planner {object}: {} iterations, {} expansion steps stopped ({}), {} unreachable steps",
         report.iterations,
-        report.collisions(),
-        if collisions.is_empty() {
+        report.expansion_stops.values().sum::<usize>(),
+        if stops.is_empty() {
             "none".to_string()
         } else {
-            collisions.join(", ")
+            stops.join(", ")
         },
         report.unreachable_steps
     )

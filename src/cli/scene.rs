@@ -4,20 +4,30 @@
 //! with its collision shell in geom group 3) with the `taction.covering` sensor on the pad site,
 //! configured by the sensor flags. The object's mesh goes beside the MJCF as an OBJ file the mesh
 //! asset refers to. The object is a mocap body at the world origin, resting on the table.
+//!
+//! Like `mjcf/scene.xml`, the scene carries a keyframe `touch`: the arm where `taction touch --arm`
+//! leaves it after pressing the pad onto the object from above, so that MuJoCo's own tools open it
+//! with the pad on the object (`mj_resetDataKeyframe`, or "Load key" in the viewer).
 
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
+use glam::DVec3;
+use taction::control::ControlConfig;
+use taction::dataset::ContactStatus;
 use taction::mesh::object_set::BUILTIN_SETS;
 use taction::mesh::{BuildOptions, BuiltObject, MeshError, ObjectSet, write_obj};
 use taction::sim::arm::PAD_SITE;
+use taction::sim::mjcf::{Section, comment, numbers};
 use taction::sim::{ObjectSpec, SceneBuilder};
-use taction::tactile::add_sensor;
+use taction::tactile::{PadPose, SensorConfig, add_sensor};
+use taction::valid::Valid;
 
 use crate::cli::common::ObjectSizeArg;
 use crate::cli::plausible::{Carrier, check_mesh};
 use crate::cli::plugin_path::PLUGIN_LIBRARY;
 use crate::cli::sensor_args::SensorArgs;
+use crate::cli::touch::{ArmTouch, TouchError, touch_arm};
 
 #[derive(Debug, Args)]
 pub struct SceneArgs {
@@ -90,6 +100,55 @@ fn resolve_object(object: &str, object_size_m: Option<f64>) -> Result<BuiltObjec
     Err(SceneExportError::UnknownObject(object.into()))
 }
 
+/// How far above the object's top the touch of the `touch` keyframe starts, metres.
+const TOUCH_START_ABOVE_M: f64 = 0.005;
+
+/// The arm's touch of `object` from above with the default controllers (told to expect `sensor`'s
+/// noise), as `taction touch --arm` runs them: started looking straight down over the centre of the
+/// object's bounding box, then over its highest vertex (a ring has nothing under its centre); the
+/// first that converges, else the first that ends in contact, else `None`.
+fn touch_from_above(object: &ObjectSpec, sensor: &SensorConfig) -> Result<Option<ArmTouch>, TouchError> {
+    let Some((lo, hi)) = object.mesh.bounds() else {
+        return Ok(None);
+    };
+    let highest = object
+        .mesh
+        .vertices
+        .iter()
+        .copied()
+        .reduce(|a, b| if b.z > a.z { b } else { a })
+        .unwrap_or(hi);
+    let control = Valid::new(ControlConfig {
+        expected_noise_fraction: sensor.noise_fraction,
+        ..ControlConfig::default()
+    })
+    .map_err(|e| {
+        TouchError::Sim(taction::sim::SimError::BadConfiguration {
+            message: e.to_string(),
+        })
+    })?;
+    let mut in_contact = None;
+    for (x, y) in [((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5), (highest.x, highest.y)] {
+        let start = PadPose {
+            center_m: DVec3::new(x, y, hi.z + TOUCH_START_ABOVE_M),
+            normal: DVec3::NEG_Z,
+            up: DVec3::X,
+        };
+        let touch = match touch_arm(object.clone(), *sensor, &control, &start) {
+            Ok(touch) => touch,
+            Err(TouchError::Unreachable(_) | TouchError::StartsInCollision { .. }) => continue,
+            Err(e) => return Err(e),
+        };
+        if touch.outcome.status == ContactStatus::Converged {
+            return Ok(Some(touch));
+        }
+        if in_contact.is_none() && touch.outcome.image.max() > control.effective_contact_threshold() {
+            in_contact = Some(touch);
+        }
+    }
+    Ok(in_contact)
+}
+
 /// Writes the scene and its mesh; returns the scene file's path.
 pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let config = args.sensor.config(args.seed)?;
@@ -104,17 +163,43 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     // Named as `taction objects export` names its files.
     let mesh_file = format!("{}.obj", built.name);
     let spec = ObjectSpec::new(built.name.clone(), built.mesh);
-    let builder = SceneBuilder::with_arm_and_table()
+    let mut builder = SceneBuilder::with_arm_and_table()
         .object(spec.clone())
         .object_mesh_file(mesh_file.clone());
+    let keyframe = match touch_from_above(&spec, &config)? {
+        Some(touch) => {
+            builder = builder.add(
+                Section::Keyframe,
+                format!(
+                    "<key name=\"touch\" qpos=\"{}\" ctrl=\"{}\"/>",
+                    numbers(touch.qpos.iter().copied()),
+                    numbers(touch.q_rad.iter().copied())
+                ),
+            );
+            format!(
+                "The keyframe \"touch\" (qpos: the arm's 8 joints, radians; the same angles as the servos' ctrl, so\n  \
+                 stepping holds the pose) is where taction touch with the arm leaves it after pressing the pad onto\n  \
+                 the object from above ({}, mean pressure {:.2} of the range).",
+                touch.outcome.status.name(),
+                touch.outcome.image.mean()
+            )
+        }
+        None => {
+            eprintln!(
+                "taction scene export: warning: {}: the arm could not press the pad onto the object from above; the scene has no keyframe \"touch\"",
+                args.object
+            );
+            "No keyframe: the arm could not press the pad onto the object from above.".to_string()
+        }
+    };
     let xml = add_sensor(builder, &config, "tactile", PAD_SITE)?.to_xml()?;
-    let header = format!(
-        "<!--\n  Written by `taction scene export --object {}`: the arm, the table, the object (mesh in {mesh_file},\n  \
+    let header = comment(&format!(
+        "  Written by taction scene export for the object {}: the arm, the table, the object (mesh in {mesh_file},\n  \
          metres) and the taction.covering sensor on the pad site. Load the plugin library first:\n  \
          mujoco.mj_loadPluginLibrary(path) with the path `taction plugin-path` prints ({PLUGIN_LIBRARY}),\n  \
-         or copy the library into the plugin/ folder of the mujoco Python package.\n-->\n",
-        args.object.replace("--", "- -")
-    );
+         or copy the library into the plugin/ folder of the mujoco Python package.\n  {keyframe}",
+        args.object
+    )) + "\n";
     let write = |path: PathBuf, text: &str| {
         taction::atomic::write_atomic(&path, text.as_bytes()).map_err(|e| SceneExportError::Write {
             path: e.path,

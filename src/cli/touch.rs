@@ -9,15 +9,20 @@
 //! the start pose, and every command goes through the IK and is executed by MuJoCo stepping.
 //!
 //! The output's `pad_center` is metres in the world, `pad_normal` a unit vector, `mean_pressure` and
-//! the `image` values fractions of the sensing range (row 0 the pad's up edge, as in `sense`).
+//! the `image` values fractions of the sensing range (row 0 the pad's up edge, as in `sense`). With
+//! `--arm` it adds `arm_joints` (the arm's joint names, chain order) and `arm_q_rad`, the joint
+//! angles the touch ended at: the `qpos` of the scene `taction scene export --object` writes for the
+//! same mesh (the object there is a mocap body, so the arm's joints are all of `qpos`), so the touch
+//! replays in MuJoCo's own tools.
 
 use clap::Args;
+use serde::Serialize;
 use taction::control::arm_pad::ArmPad;
 use taction::control::free_pad::FreePad;
 use taction::control::{ContactOutcome, ContactReport, ControlConfig, settle};
 use taction::explore::collect::sensor_reader;
 use taction::explore::planner::precise_motion;
-use taction::sim::arm::PAD_SITE;
+use taction::sim::arm::{ARM_JOINTS, PAD_SITE};
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
 use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
 use taction::valid::Valid;
@@ -112,14 +117,23 @@ fn touch_free(
     Ok(settle(&mut pad, control)?)
 }
 
-/// The controllers on the arm, the object on the table at the world origin, from the arm
-/// configuration that puts the pad at `start`.
-fn touch_arm(
+/// A touch of the arm: the controllers' outcome and the state they left the world in.
+pub struct ArmTouch {
+    pub outcome: ContactOutcome,
+    /// The arm's joint angles at the end, radians, in [`ARM_JOINTS`] order.
+    pub q_rad: Vec<f64>,
+    /// The whole `qpos` at the end (the arm's joints, then a free object's pose if it had one).
+    pub qpos: Vec<f64>,
+}
+
+/// The controllers on the arm, the object placed as `object` says (mocap at the world origin for a
+/// mesh given in world metres), from the arm configuration that puts the pad at `start`.
+pub fn touch_arm(
     object: ObjectSpec,
     sensor: SensorConfig,
     control: &Valid<ControlConfig>,
     start: &PadPose,
-) -> Result<ContactOutcome, TouchError> {
+) -> Result<ArmTouch, TouchError> {
     let builder = SceneBuilder::with_arm_and_table().object(object);
     let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)?.build()?;
     let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
@@ -144,7 +158,23 @@ fn touch_arm(
         });
     }
     let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?;
-    Ok(settle(&mut pad, control)?)
+    let outcome = settle(&mut pad, control)?;
+    Ok(ArmTouch {
+        outcome,
+        q_rad: arm.q(scene.data()),
+        qpos: scene.data().qpos().to_vec(),
+    })
+}
+
+/// What `touch` prints: the controllers' outcome and, with `--arm`, where the arm ended.
+#[derive(Serialize)]
+struct TouchReport {
+    #[serde(flatten)]
+    contact: ContactReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_joints: Option<[&'static str; ARM_JOINTS.len()]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_q_rad: Option<Vec<f64>>,
 }
 
 /// Runs the controllers once and prints the outcome as one JSON object.
@@ -159,12 +189,21 @@ pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let carrier = if args.arm { Carrier::Arm } else { Carrier::FreePad };
     let object = args.pad.load_object("touch", carrier)?;
-    let outcome = if args.arm {
-        touch_arm(object, sensor, &control, &start)?
+    let report = if args.arm {
+        let touch = touch_arm(object, sensor, &control, &start)?;
+        TouchReport {
+            contact: ContactReport::from(&touch.outcome),
+            arm_joints: Some(ARM_JOINTS),
+            arm_q_rad: Some(touch.q_rad),
+        }
     } else {
-        touch_free(object, sensor, &control, &start)?
+        TouchReport {
+            contact: ContactReport::from(&touch_free(object, sensor, &control, &start)?),
+            arm_joints: None,
+            arm_q_rad: None,
+        }
     };
-    let json = serde_json::to_string(&ContactReport::from(&outcome)).map_err(TouchError::from)?;
+    let json = serde_json::to_string(&report).map_err(TouchError::from)?;
     println!("{json}");
     Ok(())
 }

@@ -32,6 +32,14 @@ pub enum ControlError {
     ThreadPool(String),
 }
 
+impl ControlError {
+    /// Whether the simulation's state went bad ([`SimError::PhysicsFault`]): the attempt is lost,
+    /// but the world can be restored from a checkpoint and the run go on.
+    pub fn is_physics_fault(&self) -> bool {
+        matches!(self, Self::Sim(e) if e.is_physics_fault())
+    }
+}
+
 /// A pad that can be read and moved.
 pub trait PadCarrier {
     /// The sensor's configuration (pad geometry, covering thickness).

@@ -1,4 +1,4 @@
-//! A dataset on disk (version 2).
+//! A dataset on disk (version 3).
 //!
 //! One UTF-8 text file, so a dataset is a single atomic unit (written to a temporary file in the
 //! same folder, then renamed over the target) and any CSV reader can open it after skipping the
@@ -6,10 +6,11 @@
 //!
 //! ```text
 //! # taction dataset
-//! # {"format_version":2,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
+//! # {"format_version":3,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
 //! #   "generator":"sampler","seed":7,"readings":11000}          <- one line of JSON
-//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,t_0_0,t_0_1,...,t_{rows-1}_{cols-1}
-//! bunny,converged,sampler,4,0.1,...,,0,0.25,...
+//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,touched_bodies,t_0_0,...,t_{rows-1}_{cols-1}
+//! bunny,converged,sampler,4,0.1,...,,,0,0.25,...
+//! bunny,collision,sampler,3,0.1,...,pad_on_object,sensor/object,0,0.31,...
 //! ...
 //! # end 11000
 //! ```
@@ -20,9 +21,18 @@
 //!   the object pose `object_x_m, object_y_m, object_z_m, object_qw, object_qx, object_qy,
 //!   object_qz`, the pad pose `pad_x_m, pad_y_m, pad_z_m, pad_normal_x, pad_normal_y, pad_normal_z,
 //!   pad_up_x, pad_up_y, pad_up_z` (all nine empty when the image carries no pose), `cause`
-//!   ([`AttemptCause::name`]: the two bodies that touched as `arm_body/other_body`, or
-//!   `covering_meets_table`; empty when the status says it all), then the `rows x cols` taxels
-//!   row-major as `t_{row}_{col}`, row 0 being the pad's `+up` edge. Version 1 had no `cause`.
+//!   (what ended the attempt, [`CauseKind::name`], the names `collect` and `dataset show` print:
+//!   `pad_on_object`, `arm_on_object`, `arm_on_table`, `arm_on_arm` for a `collision` of rigid
+//!   bodies, `covering_on_table` for a `collision` of the covering with the table, `lost_contact`
+//!   for a `no_contact` after pressing, `physics_fault` for an `aborted` attempt; empty when the
+//!   status says it all), `touched_bodies` (for the four touches, the two bodies as
+//!   `arm_body/other_body`, e.g. `sensor/object`, `link4/world`, the table being `world`; empty
+//!   otherwise), then the `rows x cols` taxels row-major as `t_{row}_{col}`, row 0 being the pad's
+//!   `+up` edge.
+//! - Older versions are read and brought up to this one: version 2 had no `touched_bodies`, its
+//!   `cause` held the bodies themselves (`sensor/object`, now `pad_on_object` with those bodies) or
+//!   `covering_meets_table` (now `covering_on_table`); version 1 had no `cause`. Neither wrote
+//!   `lost_contact`, which is given to their `no_contact` rows with iterations.
 //! - The last line, `# end N`, repeats the row count, so a file cut anywhere (even inside the
 //!   last number) is reported as truncated rather than read short.
 //! - Numbers are written in shortest round-trip form, so reading back is bit-exact.
@@ -37,12 +47,14 @@ use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::write_atomic;
-use crate::dataset::{AttemptCause, ContactStatus, Dataset, DatasetError, DatasetHeader, Reading, Strategy};
+use crate::dataset::{
+    AttemptCause, CauseKind, ContactStatus, Dataset, DatasetError, DatasetHeader, Reading, Strategy,
+};
 use crate::pose::Pose;
 use crate::tactile::{PadPose, TactileImage};
 
-/// The file format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 2;
+/// The file format version this build writes; it reads this one and every earlier one.
+pub const FORMAT_VERSION: u32 = 3;
 
 const MAGIC: &str = "# taction dataset";
 const END_PREFIX: &str = "# end ";
@@ -71,10 +83,11 @@ pub(super) enum Meta {
     PadUpY,
     PadUpZ,
     Cause,
+    TouchedBodies,
 }
 
 impl Meta {
-    pub(super) const ALL: [Meta; 21] = [
+    pub(super) const ALL: [Meta; 22] = [
         Self::Object,
         Self::Status,
         Self::Strategy,
@@ -96,7 +109,18 @@ impl Meta {
         Self::PadUpY,
         Self::PadUpZ,
         Self::Cause,
+        Self::TouchedBodies,
     ];
+
+    /// The columns before the taxels in a file of format `version` (a prefix of [`ALL`](Self::ALL):
+    /// each version added columns at the end).
+    pub(super) fn of_version(version: u32) -> &'static [Meta] {
+        match version {
+            1 => &Self::ALL[..=Self::PadUpZ.index()],
+            2 => &Self::ALL[..=Self::Cause.index()],
+            _ => &Self::ALL,
+        }
+    }
 
     /// The pad pose's nine columns, `pad_x_m` to `pad_up_z`: all set, or all empty (an image
     /// without a pose).
@@ -132,6 +156,7 @@ impl Meta {
             Self::PadUpY => "pad_up_y",
             Self::PadUpZ => "pad_up_z",
             Self::Cause => "cause",
+            Self::TouchedBodies => "touched_bodies",
         }
     }
 
@@ -162,7 +187,17 @@ impl Meta {
             Self::PadUpX => pad_number(|p| p.up.x),
             Self::PadUpY => pad_number(|p| p.up.y),
             Self::PadUpZ => pad_number(|p| p.up.z),
-            Self::Cause => r.cause.as_ref().map(AttemptCause::name).unwrap_or_default(),
+            Self::Cause => r
+                .cause
+                .as_ref()
+                .map(AttemptCause::name)
+                .unwrap_or_default()
+                .to_string(),
+            Self::TouchedBodies => r
+                .cause
+                .as_ref()
+                .and_then(AttemptCause::touched_bodies)
+                .unwrap_or_default(),
         }
     }
 }
@@ -246,7 +281,7 @@ impl Dataset {
             path: path(),
             what: "the file ends after line 1 (no header)".into(),
         })?;
-        let header = parse_header(header_line, origin)?;
+        let (header, version) = parse_header(header_line, origin)?;
         let body = lines.next().ok_or_else(|| DatasetError::Truncated {
             path: path(),
             what: "the file ends after the header (no column names)".into(),
@@ -267,7 +302,8 @@ impl Dataset {
             readings: declared,
         } = header;
         let (rows, cols) = (header.sensor.rows, header.sensor.cols);
-        let expected_columns = column_names(rows, cols);
+        let metas = Meta::of_version(version);
+        let expected_columns = columns_of(metas, rows, cols);
         let mut csv = csv::ReaderBuilder::new()
             .has_headers(true)
             .flexible(true)
@@ -300,7 +336,7 @@ impl Dataset {
                         "{} column names, expected {} ({} + {rows}x{cols} taxels)",
                         columns.len(),
                         expected_columns.len(),
-                        Meta::ALL.len()
+                        metas.len()
                     ),
                 },
             });
@@ -323,17 +359,21 @@ impl Dataset {
                     line,
                     fields: record.len(),
                     expected: expected_columns.len(),
+                    meta: metas.len(),
                     rows,
                     cols,
                 });
             }
-            let reading = parse_reading(&record, &header, &expected_columns).map_err(|(field, what)| {
-                DatasetError::Field {
-                    path: path(),
-                    line,
-                    field,
-                    what,
-                }
+            let row = Row {
+                record: &record,
+                columns: &expected_columns,
+                version,
+            };
+            let reading = parse_reading(&row, &header).map_err(|(field, what)| DatasetError::Field {
+                path: path(),
+                line,
+                field,
+                what,
             })?;
             readings.push(reading);
         }
@@ -357,7 +397,9 @@ impl Dataset {
     }
 }
 
-fn parse_header(line: &str, origin: &str) -> Result<FileHeader, DatasetError> {
+/// The header line and the file's format version; an older version's header is brought up to this
+/// one (its rows are read by their own version's layout).
+fn parse_header(line: &str, origin: &str) -> Result<(FileHeader, u32), DatasetError> {
     let header_err = |what: String| DatasetError::Header {
         path: origin.to_string(),
         line: 2,
@@ -368,9 +410,8 @@ fn parse_header(line: &str, origin: &str) -> Result<FileHeader, DatasetError> {
         .ok_or_else(|| header_err("should start with '# ' then JSON".into()))?;
     let value: serde_json::Value =
         serde_json::from_str(json).map_err(|e| header_err(format!("bad JSON: {e}")))?;
-    let version = value.get("format_version").and_then(serde_json::Value::as_u64);
-    match version {
-        Some(v) if v == u64::from(FORMAT_VERSION) => {}
+    let version = match value.get("format_version").and_then(serde_json::Value::as_u64) {
+        Some(v) if (1..=u64::from(FORMAT_VERSION)).contains(&v) => v as u32,
         Some(found) => {
             return Err(DatasetError::Version {
                 path: origin.to_string(),
@@ -379,10 +420,11 @@ fn parse_header(line: &str, origin: &str) -> Result<FileHeader, DatasetError> {
             });
         }
         None => return Err(header_err("no unsigned integer 'format_version'".into())),
-    }
-    let header: FileHeader = serde_json::from_value(value).map_err(|e| header_err(e.to_string()))?;
+    };
+    let mut header: FileHeader = serde_json::from_value(value).map_err(|e| header_err(e.to_string()))?;
+    header.header.format_version = FORMAT_VERSION;
     header.header.validate().map_err(header_err)?;
-    Ok(header)
+    Ok((header, version))
 }
 
 fn truncate_for_message(s: &str) -> String {
@@ -391,7 +433,12 @@ fn truncate_for_message(s: &str) -> String {
 
 /// The column names of the module docs for a `rows x cols` sensor.
 pub fn column_names(rows: usize, cols: usize) -> Vec<String> {
-    let mut names: Vec<String> = Meta::ALL.iter().map(|m| m.name().to_string()).collect();
+    columns_of(&Meta::ALL, rows, cols)
+}
+
+/// The names of `metas`, then the taxels of a `rows x cols` sensor.
+fn columns_of(metas: &[Meta], rows: usize, cols: usize) -> Vec<String> {
+    let mut names: Vec<String> = metas.iter().map(|m| m.name().to_string()).collect();
     for r in 0..rows {
         for c in 0..cols {
             names.push(format!("t_{r}_{c}"));
@@ -400,16 +447,7 @@ pub fn column_names(rows: usize, cols: usize) -> Vec<String> {
     names
 }
 
-/// `v` in shortest round-trip form: plain decimals for ordinary magnitudes, exponent form for
-/// tiny or huge ones (where plain decimals would run to hundreds of digits).
-pub fn format_f64(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 || (1e-5..1e16).contains(&a) {
-        v.to_string()
-    } else {
-        format!("{v:e}")
-    }
-}
+pub use crate::units::round_trip as format_f64;
 
 fn reading_row(r: &Reading, row: &mut Vec<String>) {
     row.clear();
@@ -417,15 +455,26 @@ fn reading_row(r: &Reading, row: &mut Vec<String>) {
     row.extend(r.image.values().iter().map(|&v| format_f64(v)));
 }
 
-/// One CSV record, read by column; errors are `(column name, what is wrong)`.
+/// One CSV record of a file of format `version`, read by column; errors are `(column name, what is
+/// wrong)`.
 struct Row<'a> {
     record: &'a csv::StringRecord,
     columns: &'a [String],
+    version: u32,
 }
 
 impl Row<'_> {
+    /// The column's text; empty for a column the file's version did not have.
     fn text(&self, column: Meta) -> &str {
-        &self.record[column.index()]
+        match column.index() < self.first_taxel() {
+            true => &self.record[column.index()],
+            false => "",
+        }
+    }
+
+    /// Where the taxels begin.
+    fn first_taxel(&self) -> usize {
+        Meta::of_version(self.version).len()
     }
 
     fn error(&self, index: usize, what: String) -> (String, String) {
@@ -473,12 +522,8 @@ impl Row<'_> {
 }
 
 /// One record into a reading; the error names the field.
-fn parse_reading(
-    record: &csv::StringRecord,
-    header: &DatasetHeader,
-    columns: &[String],
-) -> Result<Reading, (String, String)> {
-    let row = Row { record, columns };
+fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, String)> {
+    let record = row.record;
     let object = row.text(Meta::Object).to_string();
     if header.object_index(&object).is_none() {
         return Err(row.error(
@@ -528,18 +573,8 @@ fn parse_reading(
             up: row.vector([Meta::PadUpX, Meta::PadUpY, Meta::PadUpZ])?,
         })
     };
-    let cause_text = row.text(Meta::Cause).trim();
-    let cause = if cause_text.is_empty() {
-        None
-    } else {
-        Some(AttemptCause::from_name(cause_text).ok_or_else(|| {
-            row.error(
-                Meta::Cause.index(),
-                format!("'{cause_text}' is neither 'covering_meets_table' nor two bodies 'a/b'"),
-            )
-        })?)
-    };
-    let first_taxel = Meta::ALL.len();
+    let cause = parse_cause(row, status, iterations)?;
+    let first_taxel = row.first_taxel();
     let mut values = Vec::with_capacity(record.len() - first_taxel);
     for i in first_taxel..record.len() {
         let value = row.number_at(i)?;
@@ -563,4 +598,34 @@ fn parse_reading(
         strategy,
         cause,
     })
+}
+
+/// The row's cause, in this format's vocabulary whatever the file's version (see the module docs).
+fn parse_cause(
+    row: &Row,
+    status: ContactStatus,
+    iterations: u32,
+) -> Result<Option<AttemptCause>, (String, String)> {
+    let cause = row.text(Meta::Cause).trim();
+    match row.version {
+        1 => Ok(Reading::inferred_cause(status, iterations)),
+        2 if cause.is_empty() => Ok(Reading::inferred_cause(status, iterations)),
+        2 => AttemptCause::from_format_2(cause).map(Some).ok_or_else(|| {
+            row.error(
+                Meta::Cause.index(),
+                format!("'{cause}' is neither 'covering_meets_table' nor two bodies 'a/b' (format 2)"),
+            )
+        }),
+        _ => {
+            let bodies = row.text(Meta::TouchedBodies).trim();
+            AttemptCause::from_columns(cause, bodies).map_err(|what| {
+                // A known cause (or none) is right; its bodies are not.
+                let column = match cause.is_empty() || CauseKind::from_name(cause).is_some() {
+                    true => Meta::TouchedBodies,
+                    false => Meta::Cause,
+                };
+                row.error(column.index(), what)
+            })
+        }
+    }
 }

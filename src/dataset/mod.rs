@@ -24,7 +24,7 @@ pub use format::{FORMAT_VERSION, column_names, format_f64};
 pub use reading::{AttemptCause, CauseKind, Reading};
 pub use status::ContactStatus;
 pub use strategy::Strategy;
-pub use summary::{DatasetSummary, FailureCause};
+pub use summary::DatasetSummary;
 
 use std::fmt;
 
@@ -41,18 +41,20 @@ pub enum DatasetError {
     Io { path: String, source: std::io::Error },
     #[error("{path}: not a taction dataset: {what}")]
     NotADataset { path: String, what: String },
-    #[error("{path}: dataset format version {found}, but this build reads version {expected}")]
+    #[error("{path}: dataset format version {found}, but this build reads versions 1 to {expected}")]
     Version { path: String, found: u64, expected: u32 },
     #[error("{path}: line {line}: header: {what}")]
     Header { path: String, line: usize, what: String },
     #[error("{path}: truncated: {what}")]
     Truncated { path: String, what: String },
-    #[error("{path}: line {line}: {fields} columns, expected {expected} ({meta} + {rows}x{cols} taxels)", meta = format::Meta::ALL.len())]
+    #[error("{path}: line {line}: {fields} columns, expected {expected} ({meta} + {rows}x{cols} taxels)")]
     ColumnCount {
         path: String,
         line: u64,
         fields: usize,
         expected: usize,
+        /// The columns before the taxels in the file's format version.
+        meta: usize,
         rows: usize,
         cols: usize,
     },
@@ -81,7 +83,8 @@ impl From<FileError> for DatasetError {
 /// What a dataset holds and how it was made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetHeader {
-    /// [`FORMAT_VERSION`] when built by this crate.
+    /// [`FORMAT_VERSION`], whether built by this crate or read from a file of an earlier version
+    /// (which is brought up to this one as it is read).
     pub format_version: u32,
     /// The sensor every image was taken with; its `rows x cols` is every image's shape.
     pub sensor: SensorConfig,
@@ -450,26 +453,161 @@ mod tests {
         assert_eq!(d.len(), 3);
     }
 
-    #[test]
-    fn causes_round_trip_are_counted_and_a_bad_cause_is_named() {
+    /// The dataset with a collision of link4 on the table, a lost contact, and an aborted attempt.
+    fn dataset_with_causes() -> Dataset {
         let mut d = dataset();
+        d.readings[1].cause = Some(AttemptCause::LostContact);
         d.push(reading("c", ContactStatus::Collision, 4.0, true)).unwrap();
+        let mut aborted = reading("c", ContactStatus::Aborted, 0.0, true);
+        aborted.cause = Some(AttemptCause::PhysicsFault);
+        d.push(aborted).unwrap();
+        d
+    }
+
+    #[test]
+    fn causes_round_trip_by_the_tables_names_and_a_bad_cause_is_named() {
+        let d = dataset_with_causes();
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("d.csv");
         d.write(&path).unwrap();
         assert_eq!(Dataset::read(&path).unwrap(), d);
         let s = d.summary();
-        // "c": the no_contact reading after 2 iterations lost contact; the collision is link4/world.
-        assert_eq!(s.causes[1][&FailureCause::LostContact], 1);
-        assert_eq!(s.causes[1][&FailureCause::Cause(CauseKind::ArmOnTable)], 1);
+        assert_eq!(s.causes[1][&CauseKind::LostContact], 1);
+        assert_eq!(s.causes[1][&CauseKind::ArmOnTable], 1);
+        assert_eq!(s.causes[1][&CauseKind::PhysicsFault], 1);
         assert!(s.causes[0].is_empty());
-        assert!(s.to_string().contains("arm_on_table"), "{s}");
+        let shown = s.to_string();
         let t = std::fs::read_to_string(&path).unwrap();
-        let e = parse_err(&t.replace(",link4/world,", ",link4,"));
+        // The file says what the table says: the cause's name, the bodies beside it.
+        for (cause, bodies) in [
+            ("arm_on_table", "link4/world"),
+            ("lost_contact", ""),
+            ("physics_fault", ""),
+        ] {
+            assert!(t.contains(&format!(",{cause},{bodies},")), "{cause}: {t}");
+            assert!(shown.contains(cause), "{cause}: {shown}");
+        }
+        assert!(shown.contains("aborted"), "{shown}");
+        for (from, to, field, what) in [
+            (
+                ",arm_on_table,link4/world,",
+                ",arm_on_table,link4,",
+                "'touched_bodies'",
+                "'link4'",
+            ),
+            (
+                ",arm_on_table,link4/world,",
+                ",arm_on_table,sensor/object,",
+                "'touched_bodies'",
+                "pad_on_object",
+            ),
+            (
+                ",arm_on_table,link4/world,",
+                ",link4/world,,",
+                "'cause'",
+                "unknown cause 'link4/world'",
+            ),
+        ] {
+            let e = parse_err(&t.replace(from, to));
+            assert!(
+                e.contains("line 7") && e.contains(field) && e.contains(what),
+                "{e}"
+            );
+        }
+    }
+
+    /// `text` (a format 3 file) as format 2 wrote it: no `touched_bodies`, the bodies themselves in
+    /// `cause`, `covering_meets_table`, and no `lost_contact`.
+    fn as_format_2(text: &str) -> String {
+        let mut lines: Vec<String> = Vec::new();
+        for line in text.lines() {
+            let mut fields: Vec<String> = line.split(',').map(str::to_string).collect();
+            let cause = format::Meta::Cause.index();
+            if line.starts_with('#') {
+                lines.push(line.replace("\"format_version\":3", "\"format_version\":2"));
+                continue;
+            }
+            // Rows without a quoted comma in the object name split at commas into columns.
+            let offset = usize::from(line.starts_with('"'));
+            let (c, b) = (cause + offset, cause + offset + 1);
+            let old = match (fields[c].as_str(), fields[b].as_str()) {
+                ("cause", _) => "cause".to_string(),
+                (_, bodies) if !bodies.is_empty() => bodies.to_string(),
+                ("covering_on_table", _) => "covering_meets_table".to_string(),
+                ("lost_contact", _) => String::new(),
+                (other, _) => other.to_string(),
+            };
+            fields[c] = old;
+            fields.remove(b);
+            lines.push(fields.join(","));
+        }
+        lines.join("\n") + "\n"
+    }
+
+    #[test]
+    fn a_format_2_file_is_read_in_this_formats_vocabulary() {
+        let mut d = dataset_with_causes();
+        // Format 2 had no physics faults, and no `aborted` status.
+        d.readings.pop();
+        d.readings[2].status = ContactStatus::Collision;
+        d.readings[2].cause = Some(AttemptCause::CoveringOnTable);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("d.csv");
+        d.write(&path).unwrap();
+        let old = as_format_2(&std::fs::read_to_string(&path).unwrap());
         assert!(
-            e.contains("line 7") && e.contains("'cause'") && e.contains("'link4'"),
-            "{e}"
+            old.contains(",link4/world,") && !old.contains("touched_bodies") && !old.contains("lost_contact"),
+            "{old}"
         );
+        let mut read = Dataset::parse(&old, "old.csv").unwrap();
+        assert_eq!(read.header().format_version, FORMAT_VERSION);
+        assert_eq!(
+            read, d,
+            "causes mapped: link4/world -> arm_on_table, lost contact inferred"
+        );
+        d.readings[2].cause = Some(AttemptCause::Touched {
+            body_a: "sensor".into(),
+            body_b: "object".into(),
+        });
+        let old = old.replace(",covering_meets_table,", ",sensor/object,");
+        read = Dataset::parse(&old, "old.csv").unwrap();
+        assert_eq!(
+            read.readings()[2].cause.as_ref().map(AttemptCause::name),
+            Some("pad_on_object")
+        );
+        // Written again, it is format 3.
+        read.write(&path).unwrap();
+        assert!(
+            std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("\"format_version\":3")
+        );
+        let e = parse_err(&old.replace(",sensor/object,", ",sensor,"));
+        assert!(e.contains("'cause'") && e.contains("format 2"), "{e}");
+    }
+
+    #[test]
+    fn a_format_1_file_without_causes_is_read() {
+        let d = dataset();
+        let t = text();
+        let cause = format::Meta::Cause.index();
+        let old: Vec<String> = t
+            .lines()
+            .map(|line| match line.starts_with('#') {
+                true => line.replace("\"format_version\":3", "\"format_version\":1"),
+                false => {
+                    let offset = usize::from(line.starts_with('"'));
+                    let mut fields: Vec<&str> = line.split(',').collect();
+                    fields.drain(cause + offset..cause + offset + 2);
+                    fields.join(",")
+                }
+            })
+            .collect();
+        let read = Dataset::parse(&(old.join("\n") + "\n"), "v1.csv").unwrap();
+        assert_eq!(read.readings().len(), d.len());
+        // "c" lost contact after 2 iterations, which version 1 did not say.
+        assert_eq!(read.readings()[1].cause, Some(AttemptCause::LostContact));
+        assert_eq!(read.readings()[0].cause, None);
     }
 
     #[test]
@@ -480,7 +618,7 @@ mod tests {
         let broken = t.replace(lines[4], short);
         let e = parse_err(&broken);
         assert!(
-            e.contains("d.csv: line 5") && e.contains("26 columns, expected 27 (21 + 2x3 taxels)"),
+            e.contains("d.csv: line 5") && e.contains("27 columns, expected 28 (22 + 2x3 taxels)"),
             "{e}"
         );
     }
@@ -565,7 +703,7 @@ mod tests {
     fn wrong_version_and_wrong_magic_are_named() {
         let t = text();
         let e = Dataset::parse(
-            &t.replace("\"format_version\":2", "\"format_version\":7"),
+            &t.replace("\"format_version\":3", "\"format_version\":7"),
             "d.csv",
         )
         .unwrap_err();
@@ -574,7 +712,7 @@ mod tests {
                 e,
                 DatasetError::Version {
                     found: 7,
-                    expected: 2,
+                    expected: 3,
                     ..
                 }
             ),

@@ -19,16 +19,20 @@ pub enum ContactStatus {
     Collision,
     /// The commanded pad pose has no inverse-kinematics solution within the joint limits.
     Unreachable,
+    /// The simulation's state went bad during the attempt (cause `physics_fault`): the world was
+    /// put back as it was when the attempt began, and exploration went on.
+    Aborted,
 }
 
 impl ContactStatus {
-    pub const ALL: [ContactStatus; 6] = [
+    pub const ALL: [ContactStatus; 7] = [
         Self::Converged,
         Self::NoContact,
         Self::Saturated,
         Self::MaxIterations,
         Self::Collision,
         Self::Unreachable,
+        Self::Aborted,
     ];
 
     /// The snake_case name used in CSV files and JSON.
@@ -40,6 +44,7 @@ impl ContactStatus {
             Self::MaxIterations => "max_iterations",
             Self::Collision => "collision",
             Self::Unreachable => "unreachable",
+            Self::Aborted => "aborted",
         }
     }
 

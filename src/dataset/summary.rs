@@ -1,5 +1,5 @@
 //! What `collect` and `dataset show` print about a dataset: readings per object and status, and
-//! what ended the failed attempts.
+//! what ended the failed attempts, by the names of the dataset's `cause` column.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -22,13 +22,8 @@ impl Dataset {
         }
         let mut causes = vec![BTreeMap::new(); self.header.objects.len()];
         for r in &self.readings {
-            if let Some(i) = self.header.object_index(&r.object) {
-                let kind = match (&r.cause, r.status) {
-                    (Some(cause), _) => FailureCause::Cause(cause.kind()),
-                    (None, ContactStatus::NoContact) if r.iterations > 0 => FailureCause::LostContact,
-                    _ => continue,
-                };
-                *causes[i].entry(kind).or_insert(0) += 1;
+            if let (Some(i), Some(cause)) = (self.header.object_index(&r.object), &r.cause) {
+                *causes[i].entry(cause.kind()).or_insert(0) += 1;
             }
         }
         DatasetSummary {
@@ -47,37 +42,9 @@ pub struct DatasetSummary {
     /// Per object (header order): readings by status.
     pub per_object: Vec<BTreeMap<ContactStatus, usize>>,
     /// Per object (header order): failed attempts by what ended them.
-    pub causes: Vec<BTreeMap<FailureCause, usize>>,
+    pub causes: Vec<BTreeMap<CauseKind, usize>>,
     /// Readings by strategy name.
     pub by_strategy: BTreeMap<&'static str, usize>,
-}
-
-/// What ended a failed attempt, as `collect` and `dataset show` count them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum FailureCause {
-    /// A recorded [`AttemptCause`](crate::dataset::AttemptCause), by kind.
-    Cause(CauseKind),
-    /// `no_contact` after the controllers had pressed (Orient or Press lifted the pad off a narrow
-    /// feature), as opposed to an Approach that met nothing.
-    LostContact,
-}
-
-impl FailureCause {
-    pub const ALL: [FailureCause; 6] = [
-        Self::Cause(CauseKind::PadOnObject),
-        Self::Cause(CauseKind::ArmOnObject),
-        Self::Cause(CauseKind::ArmOnTable),
-        Self::Cause(CauseKind::ArmOnArm),
-        Self::Cause(CauseKind::CoveringOnTable),
-        Self::LostContact,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Cause(kind) => kind.name(),
-            Self::LostContact => "lost_contact",
-        }
-    }
 }
 
 impl DatasetSummary {
@@ -141,13 +108,13 @@ impl fmt::Display for DatasetSummary {
         writeln!(f)?;
         if self.causes.iter().any(|c| !c.is_empty()) {
             write!(f, "{:<width$} {:>8}", "causes", "")?;
-            for cause in FailureCause::ALL {
+            for cause in CauseKind::ALL {
                 write!(f, " {:>17}", cause.name())?;
             }
             writeln!(f)?;
             for (name, counts) in h.objects.iter().zip(&self.causes) {
                 write!(f, "{name:<width$} {:>8}", "")?;
-                for cause in FailureCause::ALL {
+                for cause in CauseKind::ALL {
                     write!(f, " {:>17}", counts.get(&cause).copied().unwrap_or(0))?;
                 }
                 writeln!(f)?;

@@ -68,7 +68,7 @@ pub struct CollectPlan {
 /// returns the image. The dynamics stages of a full `mj_forward` would change nothing the plugin reads.
 pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> {
     move |scene: &mut Scene| {
-        scene.compute_sensors();
+        scene.compute_sensors()?;
         Ok(sensor.read(scene.data())?)
     }
 }

@@ -44,10 +44,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
 use crate::control::{ControlConfig, ControlError, settle};
-use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
+use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
-use crate::explore::report::ExplorationReport;
+use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading};
 use crate::explore::tree::ExplorationTree;
 use crate::mesh::SizeLimit;
 use crate::rng::Rng;
@@ -55,7 +55,7 @@ use crate::sim::arm::{Execution, PAD_SITE, Watch};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
 use crate::sim::{
     Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget,
-    PerturbationBounds, Scene,
+    PerturbationBounds, Scene, SceneState,
 };
 use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
@@ -233,6 +233,15 @@ impl Check for PlannerConfig {
     }
 }
 
+/// Where one iteration expands: from tree vertex `vertex` toward `target`, carried as `strategy`
+/// says, its reading tagged `label`.
+struct Expansion {
+    vertex: usize,
+    strategy: Strategy,
+    label: Strategy,
+    target: DVec3,
+}
+
 /// The planner's state for one exploration run.
 pub struct Planner<R> {
     config: Valid<PlannerConfig>,
@@ -397,7 +406,6 @@ where
     ) -> Result<ExplorationReport, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
         let mut report = ExplorationReport::default();
-        let threshold = self.control.effective_contact_threshold();
         while report.converged() < converged_target && report.iterations < self.config.max_iterations {
             report.iterations += 1;
             let (strategy, target) = match guidance {
@@ -423,7 +431,7 @@ where
             } else {
                 strategy
             };
-            let mut vertex = self.tree.nearest(target);
+            let vertex = self.tree.nearest(target);
             arm.place(scene, &self.tree.vertices()[vertex].q.clone());
             if vertex != 0 && arm.collision(scene).is_some() {
                 // A perturbation moved the object into the arm at this vertex: expanding from it
@@ -431,96 +439,144 @@ where
                 self.tree.block(vertex);
                 continue;
             }
-            let facing = self.tree.vertices()[vertex].pad_normal;
-
-            for _ in 0..self.config.max_steps_per_iteration {
-                let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-                let to_target = target - pad.center_m;
-                let distance = to_target.length();
-                if distance < 1e-3 {
-                    break;
+            // A physics fault anywhere in this iteration puts the world back here (the arm at the
+            // vertex, the object as it lay) and exploration goes on.
+            let checkpoint = scene.checkpoint()?;
+            let expansion = Expansion {
+                vertex,
+                strategy,
+                label,
+                target,
+            };
+            match self.expand(
+                scene,
+                &arm,
+                object,
+                &expansion,
+                &checkpoint,
+                &mut report,
+                on_converged,
+            ) {
+                Ok(()) => {}
+                Err(e) if e.is_physics_fault() => {
+                    scene.restore(&checkpoint)?;
+                    *report.expansion_stops.entry(CauseKind::PhysicsFault).or_insert(0) += 1;
                 }
-                let direction = to_target / distance;
-                let next = pad.center_m + direction * distance.min(self.config.step_m);
-                let normal = match strategy {
-                    Strategy::Local => facing,
-                    _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
-                };
-                let start = arm.q(scene.data());
-                // If the turned pad cannot be reached, try the step keeping the pad's orientation.
-                let solved = self
-                    .expansion_ik
-                    .solve(
-                        &PadTarget {
-                            center_m: next,
-                            normal,
-                        },
-                        &start,
-                    )
-                    .or_else(|_| {
-                        self.expansion_ik.solve(
-                            &PadTarget {
-                                center_m: next,
-                                normal: pad.normal,
-                            },
-                            &start,
-                        )
-                    });
-                let Ok(q) = solved else {
-                    report.unreachable_steps += 1;
-                    break;
-                };
-                let (outcome, sensed) = self.expand_to(scene, &arm, &q, threshold)?;
-                if let MoveOutcome::Collided(c) = outcome {
-                    *report
-                        .expansion_collisions
-                        .entry(AttemptCause::from(&c).kind())
-                        .or_insert(0) += 1;
-                    break;
-                }
-                if !sensed {
-                    let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-                    vertex = self
-                        .tree
-                        .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
-                    continue;
-                }
-                let mut reading = self.settle_here(scene, object, label)?;
-                if reading.status == ContactStatus::Converged
-                    && covering_meets_table(&reading.image, &self.sensor)
-                {
-                    reading.status = ContactStatus::Collision;
-                    reading.cause = Some(AttemptCause::CoveringMeetsTable);
-                }
-                let converged = reading.status == ContactStatus::Converged;
-                if converged {
-                    on_converged();
-                    let pose = reading.image.pose().copied().unwrap_or(pad);
-                    self.grid.add(pose.center_m);
-                    let lifted = PadTarget {
-                        center_m: pose.center_m - pose.normal * self.config.lift_off_m,
-                        normal: pose.normal,
-                    };
-                    let start = arm.q(scene.data());
-                    if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start)
-                        && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)?
-                            == MoveOutcome::Reached
-                    {
-                        let q = arm.q(scene.data());
-                        let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-                        self.tree.add(vertex, q, pad.center_m, pad.normal);
-                    }
-                }
-                report.readings.push(reading);
-                if !self.perturbation.is_none() {
-                    let width = scene.object_width_m().ok_or(crate::sim::SimError::NoObject)?;
-                    let p = self.perturbation.draw(width, &mut self.rng);
-                    scene.perturb_object(&p)?;
-                }
-                break;
+                Err(e) => return Err(e),
             }
         }
         Ok(report)
+    }
+
+    /// One iteration's expansion toward `expansion.target` in small steps, until a step is stopped
+    /// (a collision, no IK solution) or the sensor feels something, when surface contact control
+    /// takes over and its reading is recorded (a physics fault there: an `aborted` reading, the
+    /// world restored to `checkpoint`). A physics fault elsewhere is the caller's to count.
+    #[allow(clippy::too_many_arguments)]
+    fn expand(
+        &mut self,
+        scene: &mut Scene,
+        arm: &Arm,
+        object: &str,
+        expansion: &Expansion,
+        checkpoint: &SceneState,
+        report: &mut ExplorationReport,
+        on_converged: &mut dyn FnMut(),
+    ) -> Result<(), ControlError> {
+        let threshold = self.control.effective_contact_threshold();
+        let &Expansion {
+            mut vertex,
+            strategy,
+            label,
+            target,
+        } = expansion;
+        let facing = self.tree.vertices()[vertex].pad_normal;
+        for _ in 0..self.config.max_steps_per_iteration {
+            let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+            let to_target = target - pad.center_m;
+            let distance = to_target.length();
+            if distance < 1e-3 {
+                break;
+            }
+            let direction = to_target / distance;
+            let next = pad.center_m + direction * distance.min(self.config.step_m);
+            let normal = match strategy {
+                Strategy::Local => facing,
+                _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
+            };
+            let start = arm.q(scene.data());
+            // If the turned pad cannot be reached, try the step keeping the pad's orientation.
+            let solved = self
+                .expansion_ik
+                .solve(
+                    &PadTarget {
+                        center_m: next,
+                        normal,
+                    },
+                    &start,
+                )
+                .or_else(|_| {
+                    self.expansion_ik.solve(
+                        &PadTarget {
+                            center_m: next,
+                            normal: pad.normal,
+                        },
+                        &start,
+                    )
+                });
+            let Ok(q) = solved else {
+                report.unreachable_steps += 1;
+                break;
+            };
+            let (outcome, sensed) = self.expand_to(scene, arm, &q, threshold)?;
+            if let MoveOutcome::Collided(c) = outcome {
+                *report
+                    .expansion_stops
+                    .entry(AttemptCause::from(&c).kind())
+                    .or_insert(0) += 1;
+                break;
+            }
+            if !sensed {
+                let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+                vertex = self
+                    .tree
+                    .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
+                continue;
+            }
+            let mut reading = self.settle_here(scene, arm, object, label, checkpoint)?;
+            if reading.status == ContactStatus::Converged
+                && covering_meets_table(&reading.image, &self.sensor)
+            {
+                reading.status = ContactStatus::Collision;
+                reading.cause = Some(AttemptCause::CoveringOnTable);
+            }
+            let converged = reading.status == ContactStatus::Converged;
+            let pose = reading.image.pose().copied().unwrap_or(pad);
+            report.readings.push(reading);
+            if converged {
+                on_converged();
+                self.grid.add(pose.center_m);
+                let lifted = PadTarget {
+                    center_m: pose.center_m - pose.normal * self.config.lift_off_m,
+                    normal: pose.normal,
+                };
+                let start = arm.q(scene.data());
+                if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start)
+                    && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)? == MoveOutcome::Reached
+                {
+                    let q = arm.q(scene.data());
+                    let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+                    self.tree.add(vertex, q, pad.center_m, pad.normal);
+                }
+            }
+            if !self.perturbation.is_none() {
+                let width = scene.object_width_m().ok_or(crate::sim::SimError::NoObject)?;
+                let p = self.perturbation.draw(width, &mut self.rng);
+                scene.perturb_object(&p)?;
+            }
+            break;
+        }
+        Ok(())
     }
 
     /// One target by the paper's rule (Sec. III-A): local with probability L once a reading exists
@@ -613,14 +669,18 @@ where
         Ok((outcome, sensed))
     }
 
-    /// Hands over to surface contact control at the current pose and packages the outcome.
+    /// Hands over to surface contact control at the current pose and packages the outcome; a
+    /// physics fault on the way restores `checkpoint` and gives an `aborted` reading.
     fn settle_here(
         &mut self,
         scene: &mut Scene,
+        arm: &Arm,
         object: &str,
         strategy: Strategy,
+        checkpoint: &SceneState,
     ) -> Result<Reading, ControlError> {
         let object_pose = scene.object_pose().unwrap_or_default();
+        let start = pad_pose_of_site(&arm.pad_pose(scene.data()));
         let Self {
             ik,
             reader,
@@ -631,16 +691,14 @@ where
             ..
         } = self;
         let mut carrier = ArmPad::new(scene, ik, *sensor, |s: &mut Scene| reader(s), *motion)?;
-        let outcome = settle(&mut carrier, control)?;
-        Ok(Reading {
-            image: outcome.image,
-            object: object.to_string(),
-            object_pose,
-            status: outcome.status,
-            iterations: outcome.iterations,
-            strategy,
-            cause: outcome.collision.as_ref().map(AttemptCause::from),
-        })
+        match settle(&mut carrier, control) {
+            Ok(outcome) => Ok(attempt_reading(outcome, object, object_pose, strategy)),
+            Err(e) if e.is_physics_fault() => {
+                scene.restore(checkpoint)?;
+                Ok(aborted_reading(sensor, start, object, object_pose, strategy)?)
+            }
+            Err(e) => Err(e),
+        }
     }
 }
 

@@ -3,8 +3,11 @@
 use std::collections::BTreeMap;
 
 use crate::bodies::ARM_BODIES;
-use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading};
+use crate::control::ContactOutcome;
+use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
+use crate::pose::Pose;
 use crate::sim::Collision;
+use crate::tactile::{PadPose, SensorConfig, TactileError, TactileImage};
 
 /// The collision that stopped a motion, as a reading's cause: the arm's body first.
 impl From<&Collision> for AttemptCause {
@@ -19,6 +22,56 @@ impl From<&Collision> for AttemptCause {
     }
 }
 
+/// The reading of one settling attempt on `object` (at `object_pose`): the controllers' image and
+/// status, and what ended the attempt (the collision, or a contact lost after pressing). The one
+/// place both carriers' readings are made, so that the planner's and the sampler's causes agree.
+pub(crate) fn attempt_reading(
+    outcome: ContactOutcome,
+    object: &str,
+    object_pose: Pose,
+    strategy: Strategy,
+) -> Reading {
+    let cause = match &outcome.collision {
+        Some(collision) => Some(AttemptCause::from(collision)),
+        None => Reading::inferred_cause(outcome.status, outcome.iterations),
+    };
+    Reading {
+        image: outcome.image,
+        object: object.to_string(),
+        object_pose,
+        status: outcome.status,
+        iterations: outcome.iterations,
+        strategy,
+        cause,
+    }
+}
+
+/// The reading of an attempt a physics fault aborted: no image (all zeros, at the pad's start
+/// pose), status `aborted`, cause `physics_fault`.
+pub(crate) fn aborted_reading(
+    sensor: &SensorConfig,
+    start: PadPose,
+    object: &str,
+    object_pose: Pose,
+    strategy: Strategy,
+) -> Result<Reading, TactileError> {
+    let image = TactileImage::zeros(sensor.rows, sensor.cols)
+        .map_err(|source| TactileError::Image {
+            sensor: "covering".into(),
+            source,
+        })?
+        .with_pose(start);
+    Ok(Reading {
+        image,
+        object: object.to_string(),
+        object_pose,
+        status: ContactStatus::Aborted,
+        iterations: 0,
+        strategy,
+        cause: Some(AttemptCause::PhysicsFault),
+    })
+}
+
 /// The readings of one exploration or sampling run, and what happened on the way.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ExplorationReport {
@@ -26,8 +79,9 @@ pub struct ExplorationReport {
     pub readings: Vec<Reading>,
     /// Planner iterations (or sampler draws) used.
     pub iterations: usize,
-    /// Expansion steps stopped by a collision of the arm, by who touched whom.
-    pub expansion_collisions: BTreeMap<CauseKind, usize>,
+    /// Expansion steps stopped short, by cause: a collision of the arm (who touched whom), or a
+    /// physics fault (the world restored to the iteration's start).
+    pub expansion_stops: BTreeMap<CauseKind, usize>,
     /// Expansion steps with no inverse-kinematics solution.
     pub unreachable_steps: usize,
 }
@@ -43,7 +97,26 @@ impl ExplorationReport {
 
     /// Expansion steps stopped by a collision of the arm.
     pub fn collisions(&self) -> usize {
-        self.expansion_collisions.values().sum()
+        self.expansion_stops
+            .iter()
+            .filter(|(kind, _)| kind.is_touch())
+            .map(|(_, n)| n)
+            .sum()
+    }
+
+    /// Physics faults met, in reading attempts and in expansion steps alike.
+    pub fn physics_faults(&self) -> usize {
+        let in_readings = self
+            .readings
+            .iter()
+            .filter(|r| r.cause == Some(AttemptCause::PhysicsFault))
+            .count();
+        in_readings
+            + self
+                .expansion_stops
+                .get(&CauseKind::PhysicsFault)
+                .copied()
+                .unwrap_or(0)
     }
 
     /// Reading attempts by status.
@@ -69,15 +142,36 @@ mod tests {
             })
         };
         let pad = touched("object", "sensor");
-        assert_eq!(pad.name(), "sensor/object");
-        assert_eq!(pad.kind(), CauseKind::PadOnObject);
+        assert_eq!(pad.touched_bodies().as_deref(), Some("sensor/object"));
+        assert_eq!(pad.name(), "pad_on_object");
         assert_eq!(touched("link3", "object").kind(), CauseKind::ArmOnObject);
         assert_eq!(touched("world", "link4").kind(), CauseKind::ArmOnTable);
         assert_eq!(touched("base", "link3").kind(), CauseKind::ArmOnArm);
-        for cause in [pad, touched("world", "link4"), AttemptCause::CoveringMeetsTable] {
-            assert_eq!(AttemptCause::from_name(&cause.name()), Some(cause));
+        for cause in [
+            pad,
+            touched("world", "link4"),
+            AttemptCause::CoveringOnTable,
+            AttemptCause::LostContact,
+            AttemptCause::PhysicsFault,
+        ] {
+            let bodies = cause.touched_bodies().unwrap_or_default();
+            assert_eq!(AttemptCause::from_columns(cause.name(), &bodies), Ok(Some(cause)));
         }
-        assert_eq!(AttemptCause::from_name("sensor"), None);
-        assert_eq!(AttemptCause::from_name("/object"), None);
+        assert_eq!(AttemptCause::from_columns("", ""), Ok(None));
+        for (cause, bodies, wrong) in [
+            ("pad_on_object", "", "needs the two bodies"),
+            ("pad_on_object", "sensor", "needs the two bodies"),
+            (
+                "pad_on_object",
+                "link4/world",
+                "are arm_on_table, not pad_on_object",
+            ),
+            ("lost_contact", "sensor/object", "names no bodies"),
+            ("", "sensor/object", "without a cause"),
+            ("sensor/object", "", "unknown cause 'sensor/object'"),
+        ] {
+            let e = AttemptCause::from_columns(cause, bodies).unwrap_err();
+            assert!(e.contains(wrong), "{cause} {bodies}: {e}");
+        }
     }
 }

@@ -16,9 +16,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::free_pad::FreePad;
 use crate::control::{ControlConfig, ControlError, settle};
-use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
+use crate::dataset::{ContactStatus, Strategy};
 use crate::explore::reach::{ArmReach, carried};
-use crate::explore::report::ExplorationReport;
+use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading};
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
 use crate::pose::Pose;
@@ -167,18 +167,20 @@ where
                 None => continue,
             }
         }
+        // A physics fault during the attempt puts the world back as it was before it.
+        let checkpoint = pad.scene().checkpoint()?;
         pad.place(&start);
-        let outcome = settle(&mut pad, control)?;
-        report.readings.push(Reading {
-            image: outcome.image,
-            object: object.to_string(),
-            object_pose,
-            status: outcome.status,
-            iterations: outcome.iterations,
-            strategy: Strategy::Sampler,
-            cause: outcome.collision.as_ref().map(AttemptCause::from),
-        });
-        if outcome.status == ContactStatus::Converged {
+        let reading = match settle(&mut pad, control) {
+            Ok(outcome) => attempt_reading(outcome, object, object_pose, Strategy::Sampler),
+            Err(e) if e.is_physics_fault() => {
+                pad.scene().restore(&checkpoint)?;
+                aborted_reading(&sensor, start, object, object_pose, Strategy::Sampler)?
+            }
+            Err(e) => return Err(e),
+        };
+        let converged = reading.status == ContactStatus::Converged;
+        report.readings.push(reading);
+        if converged {
             on_converged();
         }
         if !perturbation.is_none() {

@@ -507,6 +507,7 @@ impl Arm {
                 ds *= (0.9 * limit_m / travel).clamp(0.1, 0.5);
             }
             scene.data_mut().collision();
+            scene.check_state()?;
             if let Some(c) = self.collision(scene) {
                 self.place(scene, &last_free);
                 return Ok(MoveOutcome::Collided(c));

@@ -6,6 +6,7 @@
 //! the files, with the object slot filled by a mesh and extra parts (sensor plugins) added.
 
 use crate::sim::SimError;
+use crate::units::round_trip;
 
 /// `mjcf/arm.xml`: the arm of Sec. V-A1 with the sensor pad site.
 pub const ARM_XML: &str = include_str!("../../mjcf/arm.xml");
@@ -47,6 +48,7 @@ pub enum Section {
     Extension,
     Sensor,
     Contact,
+    Keyframe,
 }
 
 impl Section {
@@ -57,6 +59,7 @@ impl Section {
             Self::Extension => "extension",
             Self::Sensor => "sensor",
             Self::Contact => "contact",
+            Self::Keyframe => "keyframe",
         }
     }
 }
@@ -97,23 +100,54 @@ impl Document {
     }
 }
 
-/// Escapes a string for use inside a double-quoted XML attribute.
+/// Escapes a string for use inside a double-quoted XML attribute. Characters XML 1.0 does not
+/// allow in a document at all (control characters other than tab and line breaks) become U+FFFD.
 pub fn escape_attr(value: &str) -> String {
-    value
+    xml_chars(value)
         .replace('&', "&amp;")
         .replace('"', "&quot;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
 }
 
-/// Space-separated numbers in shortest round-trip form, so the compiled model holds exactly these values.
+/// `text` as an XML comment, `<!--` and `-->` on lines of their own.
+///
+/// A well-formed comment holds no `--` and does not end in `-` (strict parsers such as Python's
+/// `xml.etree` and dm_control's `mjcf` refuse the file otherwise, although MuJoCo reads it): a
+/// hyphen that follows another gets a space before it (`a--b` becomes `a- -b`).
+pub fn comment(text: &str) -> String {
+    let mut body = String::with_capacity(text.len() + 16);
+    for c in xml_chars(text).chars() {
+        if c == '-' && body.ends_with('-') {
+            body.push(' ');
+        }
+        body.push(c);
+    }
+    format!("<!--\n{body}\n-->")
+}
+
+/// `text` with the characters XML 1.0 forbids replaced by U+FFFD.
+fn xml_chars(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() && !matches!(c, '\t' | '\n' | '\r') {
+                char::REPLACEMENT_CHARACTER
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// Space-separated numbers in shortest round-trip form ([`round_trip`]), so the compiled model
+/// holds exactly these values.
 pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
     let mut s = String::new();
     for (i, v) in values.into_iter().enumerate() {
         if i > 0 {
             s.push(' ');
         }
-        s.push_str(&v.to_string());
+        s.push_str(&round_trip(v));
     }
     s
 }
@@ -132,6 +166,18 @@ mod tests {
                 .to_string()
                 .contains("no <mujoco>")
         );
+    }
+
+    #[test]
+    fn comments_and_attributes_stay_well_formed_whatever_the_text() {
+        let text = "a--b --- c-\u{1}";
+        let wrapped = comment(text);
+        let body = &wrapped["<!--".len()..wrapped.len() - "-->".len()];
+        assert!(!body.contains("--") && !body.ends_with('-'), "{wrapped}");
+        assert_eq!(body.trim(), "a- -b - - - c-\u{fffd}");
+        let document = format!("{wrapped}<m a=\"{}\"/>", escape_attr(text));
+        let parsed = roxmltree::Document::parse(&document).expect("well-formed");
+        assert_eq!(parsed.root_element().attribute("a"), Some("a--b --- c-\u{fffd}"));
     }
 
     #[test]

@@ -13,7 +13,7 @@ pub use arm::{Arm, Collision, MoveOptions, MoveOutcome};
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 pub use object::{ObjectMount, ObjectSpec};
 pub use perturb::{Perturbation, PerturbationBounds};
-pub use scene::{Scene, SceneBuilder, SceneObject};
+pub use scene::{Scene, SceneBuilder, SceneObject, SceneState};
 
 /// Errors of the simulated world; each says which part and what is wrong.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +28,17 @@ pub enum SimError {
     NoArm,
     #[error("physics: {message}")]
     Physics { message: String },
+    /// MuJoCo's state went bad (see [`Scene::fault`]): what a caller resets the world from, with
+    /// [`Scene::restore`], rather than giving up.
+    #[error("physics fault at t = {time_s} s: {what}")]
+    PhysicsFault { time_s: f64, what: String },
     #[error("{message}")]
     BadConfiguration { message: String },
+}
+
+impl SimError {
+    /// Whether this is a [`PhysicsFault`](Self::PhysicsFault), which leaves the world to be restored.
+    pub fn is_physics_fault(&self) -> bool {
+        matches!(self, Self::PhysicsFault { .. })
+    }
 }

@@ -8,7 +8,7 @@ use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
-use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, escape_attr, numbers};
+use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers};
 
 use crate::bodies::OBJECT_BODY;
 
@@ -138,11 +138,11 @@ impl ObjectSpec {
             Section::Worldbody,
             format!(
                 "<body name=\"{OBJECT_BODY}\" pos=\"{pos}\" quat=\"{quat}\"{mount_attr}>\n\
-                 <!-- {} -->\n{joint}\n\
+                 {}\n{joint}\n\
                  <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>\n\
                  <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"object\" rgba=\"0.8 0.5 0.3 1\" contype=\"0\" conaffinity=\"0\"/>\n\
                  {shell}</body>",
-                escape_attr(&self.name).replace("--", "- -"),
+                comment(&self.name),
                 numbers(center.to_array()),
                 self.mass_kg
             ),

@@ -169,6 +169,37 @@ pub fn mujoco_message(e: &MjModelError) -> String {
     }
 }
 
+/// MuJoCo's warnings of a state gone bad, and what each says.
+const FAULT_WARNINGS: [(MjtWarning, &str); 3] = [
+    (
+        MjtWarning::mjWARN_BADQPOS,
+        "bad position (NaN, Inf or beyond 1e10)",
+    ),
+    (
+        MjtWarning::mjWARN_BADQVEL,
+        "bad velocity (NaN, Inf or beyond 1e10)",
+    ),
+    (
+        MjtWarning::mjWARN_BADQACC,
+        "bad acceleration (NaN, Inf or beyond 1e10)",
+    ),
+];
+
+/// The largest state value MuJoCo accepts (`mjMAXVAL`, its bound in `mj_checkPos` and
+/// `mj_checkVel`).
+const MAX_STATE_VALUE: f64 = 1e10;
+
+/// What a [`SceneState`] holds: MuJoCo's integration state without the plugins' (see
+/// [`Scene::restore`]).
+const CHECKPOINT_SPEC: u32 = MjtState::mjSTATE_INTEGRATION as u32 & !(MjtState::mjSTATE_PLUGIN as u32);
+const PLUGIN_SPEC: u32 = MjtState::mjSTATE_PLUGIN as u32;
+
+/// A saved state of a scene's world, from [`Scene::checkpoint`] (for the same scene only).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneState {
+    values: Box<[f64]>,
+}
+
 /// The object slot of a compiled scene.
 #[derive(Debug, Clone)]
 pub struct SceneObject {
@@ -254,10 +285,11 @@ impl Scene {
         self.data.forward();
     }
 
-    /// One physics step; an unstable state (non-finite positions or velocities) is an error naming the time.
+    /// One physics step; a state gone bad (see [`fault`](Self::fault)) is a
+    /// [`SimError::PhysicsFault`] naming the time.
     pub fn step(&mut self) -> Result<(), SimError> {
         self.data.step();
-        self.check_finite()
+        self.check_state()
     }
 
     /// One physics step like [`step`](Self::step), but without the sensor stages: `mj_step` with
@@ -283,23 +315,84 @@ impl Scene {
         } else {
             self.data.implicit();
         }
-        self.check_finite()
+        self.check_state()
     }
 
-    fn check_finite(&self) -> Result<(), SimError> {
-        let finite = self
-            .data
-            .qpos()
-            .iter()
-            .chain(self.data.qvel().iter())
-            .all(|v| v.is_finite());
-        if finite {
-            Ok(())
-        } else {
-            Err(SimError::Physics {
-                message: format!("non-finite state at t = {} s", self.data.time()),
-            })
+    /// What is wrong with the state, if it went bad: MuJoCo warned that positions, velocities or
+    /// accelerations were not finite or beyond its bound (`mjWARN_BADQPOS`, `mjWARN_BADQVEL`,
+    /// `mjWARN_BADQACC`, since the last [`restore`](Self::restore)), or a position, velocity or
+    /// mocap pose is so now.
+    ///
+    /// The warnings matter as much as the values: on such a warning `mj_step` resets the whole
+    /// state to the model's initial one and goes on, so after it every value is finite again,
+    /// and the arm and the object have silently jumped to where they were at the start.
+    pub fn fault(&self) -> Option<String> {
+        let warnings = self.data.warning();
+        for (warning, what) in FAULT_WARNINGS {
+            let stat = &warnings[warning as usize];
+            if stat.number > 0 {
+                return Some(format!(
+                    "MuJoCo warned of a {what} at degree of freedom {} ({} times); it reset the state",
+                    stat.lastinfo, stat.number
+                ));
+            }
         }
+        let bad = |values: &[f64]| {
+            values
+                .iter()
+                .position(|v| v.is_nan() || v.abs() > MAX_STATE_VALUE)
+        };
+        let mocap_pos = self.data.mocap_pos().as_flattened();
+        let mocap_quat = self.data.mocap_quat().as_flattened();
+        [
+            ("qpos", self.data.qpos()),
+            ("qvel", self.data.qvel()),
+            ("mocap_pos", mocap_pos),
+            ("mocap_quat", mocap_quat),
+        ]
+        .into_iter()
+        .find_map(|(name, values)| {
+            bad(values).map(|i| format!("{name}[{i}] = {} is not a finite state value", values[i]))
+        })
+    }
+
+    /// `Ok` while the state is sound, else the [`fault`](Self::fault) as a
+    /// [`SimError::PhysicsFault`].
+    pub fn check_state(&self) -> Result<(), SimError> {
+        match self.fault() {
+            None => Ok(()),
+            Some(what) => Err(SimError::PhysicsFault {
+                time_s: self.data.time(),
+                what,
+            }),
+        }
+    }
+
+    /// The state to go back to after a physics fault: MuJoCo's integration state (time, positions,
+    /// velocities, controls, mocap poses, warm start, ...) but for the plugins'. A bad state is
+    /// refused: it could only be restored into the same fault.
+    pub fn checkpoint(&self) -> Result<SceneState, SimError> {
+        self.check_state()?;
+        Ok(SceneState {
+            values: self.data.state(CHECKPOINT_SPEC),
+        })
+    }
+
+    /// Puts the world back at `state` and clears MuJoCo's warnings, then runs `mj_forward`. The
+    /// plugins keep their own state: the covering sensor's reading counter runs on, so no noise
+    /// stream is read twice.
+    pub fn restore(&mut self, state: &SceneState) -> Result<(), SimError> {
+        let plugins = self.data.state(PLUGIN_SPEC);
+        self.data.reset();
+        let physics = |e| SimError::Physics {
+            message: format!("restoring a checkpoint: {e:?}"),
+        };
+        self.data
+            .set_state(&state.values, CHECKPOINT_SPEC)
+            .map_err(physics)?;
+        self.data.set_state(&plugins, PLUGIN_SPEC).map_err(physics)?;
+        self.data.forward();
+        Ok(())
     }
 
     /// Kinematics and MuJoCo's collision detection for the current `qpos` (no dynamics, no sensors):
@@ -314,9 +407,14 @@ impl Scene {
     /// a sensor depending only on poses needs, such as the tactile plugin, which reads site and geom
     /// frames. Contacts and the velocity and acceleration stages are left as they were (the next
     /// `mj_step`/`mj_forward` recomputes them), so a sensor that needs those needs `forward`.
-    pub fn compute_sensors(&mut self) {
+    ///
+    /// Every reading of every carrier passes here, so this is where a state gone bad is caught
+    /// before a sensor reads it: a [`SimError::PhysicsFault`], the sensors not computed.
+    pub fn compute_sensors(&mut self) -> Result<(), SimError> {
+        self.check_state()?;
         self.data.kinematics();
         self.data.sensor_pos();
+        Ok(())
     }
 
     /// Signed distance between geoms `a` and `b` (MuJoCo's `mj_geomDistance`, convex hulls for
@@ -416,6 +514,51 @@ mod tests {
             "<mujoco><asset><mesh name=\"m\" vertex=\"{vertex}\"/></asset>\
              <worldbody><geom type=\"mesh\" mesh=\"m\"/></worldbody></mujoco>"
         )
+    }
+
+    /// A ball on a free joint, 1 m above the origin, nothing to fall onto.
+    fn ball() -> Scene {
+        let xml = "<mujoco><worldbody><body pos=\"0 0 1\"><freejoint/><geom size=\"0.1\"/></body>\
+                   </worldbody></mujoco>";
+        Scene::new(compile_xml(xml).unwrap(), None).unwrap()
+    }
+
+    #[test]
+    fn a_state_gone_bad_is_a_fault_even_after_mujoco_reset_it_and_a_checkpoint_restores_the_world() {
+        let mut scene = ball();
+        scene.data_mut().qpos_mut()[0] = 0.3;
+        scene.forward();
+        scene.step().unwrap();
+        let checkpoint = scene.checkpoint().unwrap();
+        let time_s = scene.data().time();
+        let qvel = scene.data().qvel().to_vec();
+
+        // A velocity gone bad: mj_step warns and resets the whole state, so every value is finite
+        // again and the ball is back at its start (x = 0); only the warning tells.
+        scene.data_mut().qvel_mut()[2] = f64::NAN;
+        let e = scene.step().unwrap_err();
+        assert!(e.is_physics_fault(), "{e}");
+        assert!(e.to_string().contains("bad velocity"), "{e}");
+        assert!(scene.data().qpos().iter().all(|v| v.is_finite()));
+        assert_eq!(scene.data().qpos()[0], 0.0);
+        assert!(scene.checkpoint().unwrap_err().is_physics_fault());
+        scene.restore(&checkpoint).unwrap();
+        assert_eq!(scene.fault(), None);
+        assert_eq!((scene.data().qpos()[0], scene.data().time()), (0.3, time_s));
+        assert_eq!(scene.data().qvel(), qvel.as_slice());
+
+        // An absurd force: the acceleration is out of bounds.
+        scene.data_mut().qfrc_applied_mut()[0] = 1e300;
+        let e = scene.step().unwrap_err();
+        assert!(e.to_string().contains("bad acceleration"), "{e}");
+        scene.restore(&checkpoint).unwrap();
+        scene.data_mut().qfrc_applied_mut()[0] = 0.0;
+        scene.step().unwrap();
+
+        // A position corrupted outside a step is caught before the sensors read it.
+        scene.data_mut().qpos_mut()[1] = f64::INFINITY;
+        let e = scene.compute_sensors().unwrap_err();
+        assert!(e.to_string().contains("qpos[1] = inf"), "{e}");
     }
 
     #[test]
