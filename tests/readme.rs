@@ -149,6 +149,9 @@ fn every_link_between_the_documents_leads_somewhere() {
         root.join("ARCHITECTURE.md"),
         root.join("results/README.md"),
         root.join("results/PAPER.md"),
+        root.join("meshes/README.md"),
+        root.join("data/README.md"),
+        root.join("fonts/README.md"),
     ];
     for entry in std::fs::read_dir(root.join("docs")).expect("docs/ holds the guides") {
         let path = entry.unwrap().path();

@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use taction::control::ControlConfig;
+use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
 use taction::recognize::CodebookKind;
-use taction::valid::Valid;
+use taction::valid::{Check, Valid};
 
 /// The seed a command uses when `--seed` is not given.
 pub const DEFAULT_SEED: u64 = 1;
@@ -45,6 +46,43 @@ fn parse_object_size_m(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(m) if m.is_finite() && m > 0.0 => Ok(m),
         _ => Err(format!("'{text}' is not a positive number of metres")),
+    }
+}
+
+/// How recorded frames are pruned and preprocessed (Sec. V-F), alike for `experiment real-frames`
+/// and `dataset import`, which gives the same frames the same images.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct PreprocessArgs {
+    /// Frames whose largest taxel is below this fraction of the sensing range did not touch:
+    /// `real-frames` (Fig. 16b) drops them before its split (the counts per label go to
+    /// config.json), `dataset import` writes them as `no_contact` readings.
+    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION", allow_hyphen_values = true)]
+    pub contact_threshold: f64,
+    /// Square root of every taxel before describing (Sec. V-F; off because `real-frames` trains and
+    /// tests on frames of the same sensor).
+    #[arg(long)]
+    pub square_root: bool,
+    /// Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "TAXELS",
+        allow_hyphen_values = true
+    )]
+    pub blur_sigma: f64,
+}
+
+impl PreprocessArgs {
+    /// The options these flags give, with `trials` of the whole split-train-test process, checked.
+    pub fn options(&self, trials: usize) -> Result<RealFramesOptions, UsageError> {
+        let options = RealFramesOptions {
+            contact_threshold: self.contact_threshold,
+            square_root: self.square_root,
+            blur_sigma_taxels: self.blur_sigma,
+            trials,
+        };
+        options.check().map_err(|e| UsageError(e.to_string()))?;
+        Ok(options)
     }
 }
 

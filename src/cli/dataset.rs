@@ -8,10 +8,9 @@ use clap::{Args, Subcommand};
 use taction::dataset::recorded::{Calibration, RealImport, import_real_csv};
 use taction::dataset::{Dataset, DatasetError};
 use taction::paper::real_frames::recorded_dataset;
-use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
-use taction::valid::Check;
+use taction::paper::real_frames_options::RealFramesOptions;
 
-use crate::cli::common::UsageError;
+use crate::cli::common::{PreprocessArgs, UsageError};
 
 #[derive(Debug, Args)]
 pub struct DatasetArgs {
@@ -49,21 +48,8 @@ pub struct ImportArgs {
     /// grid exactly once.
     #[arg(long, value_name = "CSV")]
     pub calibration: Option<PathBuf>,
-    /// Frames whose largest taxel is below this fraction of the sensing range did not touch: they
-    /// are written as `no_contact` readings, which training and recognition skip.
-    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION", allow_hyphen_values = true)]
-    pub contact_threshold: f64,
-    /// Square root of every taxel (Sec. V-F), as `experiment real-frames --square-root`.
-    #[arg(long)]
-    pub square_root: bool,
-    /// Gaussian blur width in taxels (Sec. V-F); 0 is off.
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        value_name = "TAXELS",
-        allow_hyphen_values = true
-    )]
-    pub blur_sigma: f64,
+    #[command(flatten)]
+    pub preprocess: PreprocessArgs,
 }
 
 pub fn run(args: &DatasetArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -107,13 +93,7 @@ fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
         ))
         .into());
     }
-    let options = RealFramesOptions {
-        contact_threshold: args.contact_threshold,
-        square_root: args.square_root,
-        blur_sigma_taxels: args.blur_sigma,
-        ..RealFramesOptions::default()
-    };
-    options.check().map_err(|e| UsageError(e.to_string()))?;
+    let options = args.preprocess.options(RealFramesOptions::default().trials)?;
     let calibration = args
         .calibration
         .as_deref()

@@ -11,11 +11,10 @@ use taction::paper::data::{SHORTFALLS_FILE, read_shortfalls};
 use taction::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::paper::headline::headline_table;
 use taction::paper::real_data::Calibration;
-use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
+use taction::paper::real_frames_options::PAPER_TRIALS;
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
-use taction::valid::Check;
 
-use crate::cli::common::{ObjectSizeArg, OutputLock, SeedArg, ThreadsArg, UsageError, parse_codebook};
+use crate::cli::common::{ObjectSizeArg, OutputLock, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook};
 use crate::cli::plausible::{Carrier, build_objects};
 use taction::recognize::CodebookKind;
 
@@ -52,17 +51,11 @@ pub struct PaperArgs {
     /// the grid exactly once.
     #[arg(long, value_name = "CSV", requires = "real")]
     pub calibration: Option<PathBuf>,
-    /// real-frames (Fig. 16b): frames whose largest taxel is below this fraction of the sensing
-    /// range are dropped as non-contacts before the split; the counts per label go to config.json.
-    #[arg(long, default_value_t = DEFAULT_CONTACT_THRESHOLD, value_name = "FRACTION", allow_hyphen_values = true)]
-    pub contact_threshold: f64,
+    #[command(flatten)]
+    pub preprocess: PreprocessArgs,
     /// real-frames (Fig. 16b): trials of the whole split-train-test process.
     #[arg(long, default_value_t = PAPER_TRIALS, value_name = "N", allow_hyphen_values = true)]
     pub trials: usize,
-    /// real-frames (Fig. 16b): square root of every taxel before describing (Sec. V-F; off because
-    /// training and test frames come from the same sensor).
-    #[arg(long)]
-    pub square_root: bool,
     /// Exit 0 even when a dataset got fewer converged readings than asked (the shortfalls are
     /// still listed on stderr). Without it such a run finishes every experiment, saves it, and
     /// then exits 1.
@@ -73,14 +66,6 @@ pub struct PaperArgs {
     /// another codebook needs its own `--out`.
     #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
     pub codebook: CodebookKind,
-    /// real-frames (Fig. 16b): Gaussian blur width in taxels before describing (Sec. V-F); 0 is off.
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        value_name = "TAXELS",
-        allow_hyphen_values = true
-    )]
-    pub blur_sigma: f64,
 }
 
 impl PaperArgs {
@@ -98,13 +83,7 @@ impl PaperArgs {
         if let Some(path) = &self.calibration {
             real.calibration = Some(Calibration::read(path).map_err(|e| format!("--calibration: {e}"))?);
         }
-        let real_frames = RealFramesOptions {
-            contact_threshold: self.contact_threshold,
-            square_root: self.square_root,
-            blur_sigma_taxels: self.blur_sigma,
-            trials: self.trials,
-        };
-        real_frames.check().map_err(|e| UsageError(e.to_string()))?;
+        let real_frames = self.preprocess.options(self.trials)?;
         let run = RunOptions {
             threads: Some(self.threads.count()),
             ..self.run.clone()
