@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use indicatif::ProgressBar;
 use taction::atomic::write_atomic;
-use taction::dataset::{Dataset, DatasetHeader};
+use taction::dataset::Dataset;
 use taction::experiment::plot::build_figure;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
-use taction::recognize::{Evaluation, ReadingRange, RecognizeError, Recognizer};
+use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer};
 
 use crate::cli::dataset::read_dataset;
 
@@ -69,7 +69,7 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
             )
         });
     }
-    let rows = trial_rows(&model, &test, args.readings, &evaluation)?;
+    let rows = trial_rows(&model, &test, args.readings, &evaluation);
     spinner.finish_and_clear();
     let mut paths = evaluation.write_csvs(&args.out)?;
     paths.extend(write_plot(
@@ -103,15 +103,16 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
 
 /// The accuracy rows of the plot, as an experiment's: trial `k` is the `k`-th trial of every object
 /// that has one (the objects' converged readings, in order, cut into trials of `range.last()`), so
-/// that the band spans the lowest to the highest trial as in the paper's figures. With one trial
-/// per object that is `evaluation` itself; otherwise each is recognised on its own, by the same
-/// definition of accuracy.
+/// that the band spans the lowest to the highest trial as in the paper's figures. Each point of
+/// `evaluation` already holds every trial's outcome in that order (`make_trials`: object by object,
+/// trial by trial), so the `k`-th outcome of an object is its `k`-th trial; trial `k`'s curve ends at
+/// its longest trial.
 fn trial_rows(
     model: &Recognizer,
     test: &Dataset,
     range: ReadingRange,
     evaluation: &Evaluation,
-) -> Result<Vec<AccuracyRow>, Box<dyn std::error::Error>> {
+) -> Vec<AccuracyRow> {
     let curve = |trial: usize| AccuracyCurve {
         experiment: "recognize".to_string(),
         descriptor: model.choice().name(),
@@ -120,35 +121,45 @@ fn trial_rows(
         seed: 0,
         stream_seed: 0,
     };
-    let converged = test.converged_only();
-    let by_object = converged.by_object();
-    let rounds = by_object
+    let lengths: Vec<usize> = test.converged_only().by_object().iter().map(Vec::len).collect();
+    let rounds = lengths
         .iter()
-        .map(|readings| readings.len().div_ceil(range.last()))
+        .map(|len| len.div_ceil(range.last()))
         .max()
         .unwrap_or(0);
     if rounds <= 1 {
-        return Ok(curve(0).rows(&evaluation.accuracy));
+        return curve(0).rows(&evaluation.accuracy);
     }
     let mut rows = Vec::new();
     for k in 0..rounds {
-        let (mut objects, mut readings) = (Vec::new(), Vec::new());
-        for (object, of_object) in test.header().objects.iter().zip(&by_object) {
-            let chunk = of_object.iter().skip(k * range.last()).take(range.last());
-            // An object never read is the first trial's miss, as in `evaluation`.
-            if k * range.last() < of_object.len() || k == 0 {
-                objects.push(object.clone());
-                readings.extend(chunk.map(|&reading| reading.clone()));
-            }
-        }
-        let header = DatasetHeader {
-            objects,
-            ..test.header().clone()
-        };
-        let (part, _) = model.evaluate(&Dataset::new(header, readings)?, range)?;
-        rows.extend(curve(k).rows(&part.accuracy));
+        let longest = lengths
+            .iter()
+            .map(|len| len.saturating_sub(k * range.last()).min(range.last()))
+            .max()
+            .unwrap_or(0);
+        let points: Vec<AccuracyPoint> = evaluation
+            .accuracy
+            .iter()
+            .filter(|point| point.n_readings <= longest)
+            .map(|point| {
+                // Outcomes of each object seen so far in this point: the next one's trial number.
+                let mut seen = vec![0usize; model.objects().len()];
+                let outcomes = point
+                    .outcomes
+                    .iter()
+                    .filter_map(|outcome| {
+                        let count = seen.get_mut(outcome.object)?;
+                        let trial = *count;
+                        *count += 1;
+                        (trial == k).then_some(*outcome)
+                    })
+                    .collect();
+                AccuracyPoint::new(point.n_readings, outcomes)
+            })
+            .collect();
+        rows.extend(curve(k).rows(&points));
     }
-    Ok(rows)
+    rows
 }
 
 /// The plot's title: the model and the test data, by file name.
