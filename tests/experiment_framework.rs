@@ -10,17 +10,15 @@ use std::time::{Duration, Instant};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+use taction::dataset::recorded::parse_real_csv;
+use taction::dataset::recorded::{Normalisation, RealImport, import_real_csv};
 use taction::experiment::plot::build_figure;
 use taction::experiment::{
     AccuracyCurve, AccuracyRow, Axis, DetailRow, Experiment, ExperimentError, ExperimentSpec, Factor,
     Factors, PlotSpec, RunOptions, SafeName, Shard, Unit, merge, run,
 };
-use taction::paper::real_data::parse_real_csv;
 use taction::paper::sim_to_real::square_root;
-use taction::paper::{
-    GaussianBlur, Normalisation, RealImport, SimToRealPreprocess, SplitSizes, import_real_csv,
-    split_per_label,
-};
+use taction::paper::{GaussianBlur, SimToRealPreprocess, SplitSizes, split_per_label};
 use taction::recognize::AccuracyPoint;
 use taction::recognize::evaluate::TrialOutcome;
 use taction::tactile::TactileImage;

@@ -12,8 +12,8 @@ use std::path::Path;
 
 use rand::RngExt;
 use taction::dataset::Dataset;
+use taction::dataset::recorded::{Calibration, RealImport, parse_real_csv};
 use taction::mesh::{MeshFormat, parse};
-use taction::paper::real_data::{Calibration, RealImport, parse_real_csv};
 use taction::rng::{Rng, stream};
 use taction::tactile::TactileImage;
 

@@ -6,10 +6,10 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::{Command, Output};
 
+use taction::dataset::recorded::{Calibration, RealImport, parse_real_csv};
 use taction::dataset::{ContactStatus, Dataset, Strategy};
 use taction::experiment::{AccuracyRow, PerObjectRow};
 use taction::paper::context::EXAMPLE_REAL_CSV;
-use taction::paper::real_data::{Calibration, RealImport, parse_real_csv};
 use taction::paper::real_frames::{prune, scaled_split_sizes, trial_split};
 
 /// The figure varies only the descriptor: no factor column.
@@ -210,7 +210,7 @@ fn splits_are_disjoint_seeded_and_differ_across_trials() {
     assert!(counts.values().all(|c| (c.kept, c.dropped) == (8, 0)));
     let kept: Vec<_> = kept.into_iter().cloned().collect();
     let sizes = scaled_split_sizes(8, 1.0).unwrap();
-    let lines = |part: &[&taction::paper::real_data::RealReading]| -> Vec<u64> {
+    let lines = |part: &[&taction::dataset::recorded::RealReading]| -> Vec<u64> {
         part.iter().map(|r| r.line).collect()
     };
     let mut trials = Vec::new();

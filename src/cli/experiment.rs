@@ -4,13 +4,13 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use taction::dataset::recorded::Calibration;
 use taction::experiment::RunOptions;
 use taction::mesh::ObjectSet;
 use taction::mesh::object_set::BUILTIN_SETS;
 use taction::paper::data::{SHORTFALLS_FILE, read_shortfalls};
 use taction::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::paper::headline::headline_table;
-use taction::paper::real_data::Calibration;
 use taction::paper::real_frames_options::PAPER_TRIALS;
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 

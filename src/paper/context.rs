@@ -9,12 +9,12 @@ use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
 use serde::Serialize;
 
+use crate::dataset::recorded::{Calibration, RealData, RealImport, parse_real_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
 use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
 use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
-use crate::paper::real_data::{Calibration, RealData, RealImport, parse_real_csv};
 use crate::recognize::CodebookKind;
 
 /// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):

@@ -403,8 +403,8 @@ pub fn sim_to_real() -> RecognitionSweep {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dataset::recorded::{RealData, RealImport, parse_real_csv};
     use crate::paper::context::EXAMPLE_REAL_CSV;
-    use crate::paper::real_data::{RealData, RealImport, parse_real_csv};
     use crate::paper::scale::DataCounts;
 
     #[test]

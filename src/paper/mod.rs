@@ -32,7 +32,6 @@ pub mod exploration;
 pub(crate) mod figure1;
 pub(crate) mod figures;
 pub mod headline;
-pub mod real_data;
 pub mod real_frames;
 pub mod real_frames_options;
 pub(crate) mod recognition;
@@ -44,7 +43,6 @@ use std::fmt;
 use std::path::PathBuf;
 
 pub use context::{Family, PaperContext, RealRecording};
-pub use real_data::{Normalisation, RealData, RealDataError, RealImport, RealReading, import_real_csv};
 pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
 pub use scale::{DataCounts, Scale, ScaleError};
 pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};

@@ -17,6 +17,7 @@ use super::context::{Family, PaperContext};
 use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
 use crate::control::ControlConfig;
+use crate::dataset::recorded::RealData;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow};
 use crate::experiment::factor::Factors;
@@ -28,7 +29,6 @@ use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
-use crate::paper::real_data::RealData;
 use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
     CodebookKind, LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate,
