@@ -33,7 +33,7 @@ use rand::RngExt;
 use taction::active_touch::InformationGain;
 use taction::explore::TouchScorer;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
-use taction::explore::{ExplorationReport, Planner, PlannerConfig, sample_readings};
+use taction::explore::{ExplorationReport, Planner, PlannerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::recognize::{ClusterHistogram, ObjectModels, PseudoCount};
 use taction::sim::arm::{Execution, PAD_SITE};
@@ -81,19 +81,18 @@ fn bare_reading(free: &mut FreeFloatingSensor, pose: &PadPose) -> f64 {
 
 fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
     let reader = sensor_reader(free.sensor().clone());
-    let mut rng = taction::rng::rng(seed);
-    sample_readings(
-        free.scene_mut(),
-        "pawn",
-        sensor(),
-        &Valid::default(),
-        &Valid::default(),
-        PerturbationBounds::NONE,
-        SAMPLER_READINGS,
-        &mut rng,
+    let rng = taction::rng::rng(seed);
+    taction::explore::TrainingSampler::new(
+        Valid::default(),
+        taction::explore::TouchSetup {
+            sensor: sensor(),
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
+        rng,
         reader,
-        &mut || {},
     )
+    .sample(free.scene_mut(), "pawn", SAMPLER_READINGS)
     .expect("sampler run")
 }
 
@@ -109,9 +108,11 @@ fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u
     let mut planner = Planner::new(
         scene,
         Valid::new(config).expect("the default planner config is valid"),
-        Valid::default(),
-        sensor(),
-        PerturbationBounds::NONE,
+        taction::explore::TouchSetup {
+            sensor: sensor(),
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
         taction::rng::rng(seed),
         reader,
     )

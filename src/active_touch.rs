@@ -308,7 +308,7 @@ where
         let mut converged = report
             .readings
             .into_iter()
-            .filter(|r| r.status == crate::dataset::ContactStatus::Converged)
+            .filter(|r| r.is_converged())
             .peekable();
         if converged.peek().is_none() {
             break;

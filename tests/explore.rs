@@ -311,9 +311,11 @@ fn global_strategy_covers_the_workspace() {
     let mut planner = Planner::new(
         &scene,
         Valid::new(config).unwrap(),
-        Valid::default(),
-        sensor,
-        PerturbationBounds::NONE,
+        taction::explore::TouchSetup {
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
         taction::rng::rng(3),
         reader,
     )
@@ -439,6 +441,40 @@ fn collect_writes_contact_sheets_beside_the_dataset() {
     assert!(!dir.path().join("none.block.png").exists());
 }
 
+/// A `--from-above` dataset says so in its header: the CLI names its generator by the one
+/// definition (`CollectMode::generator_name`), as the experiments do (it wrote `sampler`).
+#[test]
+fn a_from_above_dataset_says_so_in_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("block.obj");
+    taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.10, 0.08, 0.10)), &mesh, "block").unwrap();
+    let out = dir.path().join("above.csv");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "collect",
+            "--from-above",
+            "--readings",
+            "2",
+            "--threads",
+            "1",
+            "--contact-sheet",
+            "0",
+        ])
+        .arg("--objects")
+        .arg(&mesh)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let dataset = taction::dataset::Dataset::read(&out).unwrap();
+    assert_eq!(dataset.header().generator, "sampler from above");
+}
+
 /// `taction collect --control FILE.json` runs the sampler with those controllers: on a raised bar
 /// touched from above, the edge guard keeps the readings level where the default Orient tips the
 /// pad over the bar's edges; a file naming an unknown field is refused, naming the file and the
@@ -544,7 +580,6 @@ where
 /// poses not finite, as a blown-up integration leaves positions) at reads `faults`.
 fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationReport {
     use taction::explore::collect::sensor_reader;
-    use taction::explore::sample_readings;
     use taction::tactile::FreeFloatingSensor;
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let mut free = FreeFloatingSensor::new(box_object(), &sensor).unwrap();
@@ -553,18 +588,17 @@ fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationRep
             p[2] = f64::NAN;
         }
     });
-    sample_readings(
-        free.scene_mut(),
-        "box",
-        sensor,
-        &Valid::default(),
-        &Valid::default(),
-        PerturbationBounds::NONE,
-        10,
-        &mut taction::rng::stream(17, 0),
+    taction::explore::TrainingSampler::new(
+        Valid::default(),
+        taction::explore::TouchSetup {
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
+        taction::rng::stream(17, 0),
         reader,
-        &mut || {},
     )
+    .sample(free.scene_mut(), "box", 10)
     .unwrap()
 }
 
@@ -590,9 +624,11 @@ fn faulted_planner(faults: &'static [usize]) -> taction::explore::ExplorationRep
     let mut planner = Planner::new(
         &scene,
         Valid::default(),
-        Valid::default(),
-        sensor,
-        PerturbationBounds::NONE,
+        taction::explore::TouchSetup {
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
         taction::rng::stream(17, 0),
         reader,
     )

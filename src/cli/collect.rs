@@ -5,16 +5,16 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use taction::dataset::{Dataset, DatasetHeader, describe_shortfalls};
+use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::progress::CollectionProgress;
-use taction::explore::collect::{CollectMode, CollectPlan};
-use taction::explore::{ExplorationReport, PlannerConfig, SamplerConfig};
+use taction::explore::{Collect, ExplorationReport, PlannerConfig};
 use taction::mesh::ObjectSet;
-use taction::sim::PerturbationBounds;
+use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::tactile::SensorConfig;
 use taction::tactile::image::write_contact_sheet;
-use taction::valid::Valid;
+use taction::valid::RangeError;
 
-use crate::cli::common::{ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, flag_error};
+use crate::cli::common::{ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
 
@@ -84,34 +84,7 @@ pub struct CollectArgs {
 }
 
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if !(1..=MAX_READINGS).contains(&args.readings) {
-        return Err(flag_error(
-            "readings",
-            args.readings,
-            format!("want 1 to {MAX_READINGS} per object"),
-        )
-        .into());
-    }
-    let max_iterations = args
-        .max_iterations
-        .unwrap_or_else(|| PlannerConfig::iterations_for(args.readings));
-    if max_iterations == 0 {
-        return Err(flag_error("max-iterations", 0, "want 1 or more").into());
-    }
-    if !(0.0..=1.0).contains(&args.local_prob) {
-        return Err(flag_error("local-prob", args.local_prob, "is outside [0, 1]").into());
-    }
-    if !(0.0..=180.0).contains(&args.perturb_deg) {
-        return Err(flag_error("perturb-deg", args.perturb_deg, "is outside [0, 180] degrees").into());
-    }
-    if !(0.0..=1.0).contains(&args.perturb_frac) {
-        return Err(flag_error(
-            "perturb-frac",
-            args.perturb_frac,
-            "is outside [0, 1] of the object's width",
-        )
-        .into());
-    }
+    check_flags(args)?;
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed.seed)?;
     let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
@@ -120,40 +93,13 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         Mode::Planner => Carrier::Arm,
     };
     let objects = build_objects(&set, "collect", carrier)?;
-    let (mode, generator) = match args.mode {
-        Mode::Sampler => {
-            let config = SamplerConfig {
-                from_above_only: args.from_above,
-                reachable_by_arm: args.reachable,
-                ..SamplerConfig::default()
-            };
-            let generator = match args.reachable {
-                true => "sampler reachable by the arm",
-                false => "sampler",
-            };
-            (CollectMode::Sampler(Valid::new(config)?), generator.to_string())
-        }
-        Mode::Planner => {
-            let config = PlannerConfig {
-                local_probability: args.local_prob,
-                max_iterations,
-                ..PlannerConfig::default()
-            }
-            .fitted_to(&objects);
-            (
-                CollectMode::Planner(Valid::new(config)?),
-                format!("planner L={}", args.local_prob),
-            )
-        }
-    };
-    let plan = CollectPlan {
-        mode,
-        sensor,
-        control: args.control.valid(sensor.noise_fraction)?,
-        perturbation,
-        readings_per_object: args.readings,
-        seed: args.seed.seed,
-    };
+    let collect = collection(args, sensor, &objects)
+        .control(args.control.valid(sensor.noise_fraction)?)
+        .perturbation(perturbation)
+        .per_object(args.readings)
+        .seed(args.seed.seed)
+        .threads(args.threads.count().get());
+    let plan = collect.plan().map_err(named_by_flag)?;
     eprintln!(
         "taction collect: {} objects x {} converged readings, {} threads, into {}",
         objects.len(),
@@ -162,15 +108,8 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         args.out.display()
     );
     let progress = CollectionProgress::new(&format!("collect {}", set.name), objects.len(), args.readings);
-    let reports = plan.collect_reporting(&objects, args.threads.count().get(), &|| progress.converged())?;
+    let reports = collect.progress(&|| progress.converged()).run(&objects)?;
     progress.finish(reports.iter().map(ExplorationReport::converged).sum());
-    let header = DatasetHeader::new(
-        sensor,
-        set.id(),
-        objects.iter().map(|o| o.name.clone()).collect(),
-        generator,
-        args.seed.seed,
-    );
     let planner_lines: Vec<String> = match args.mode {
         Mode::Planner => objects
             .iter()
@@ -179,8 +118,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
         Mode::Sampler => Vec::new(),
     };
-    let readings = reports.into_iter().flat_map(|r| r.readings).collect();
-    let dataset = Dataset::new(header, readings)?;
+    let dataset = plan.dataset_of(&set.id(), &objects, reports)?;
     dataset.write(&args.out)?;
     println!("{}: {}", args.out.display(), dataset.summary());
     for line in planner_lines {
@@ -189,6 +127,76 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     for path in write_contact_sheets(&dataset, &args.out, args.contact_sheet)? {
         println!("{}", path.display());
     }
+    report_shortfalls(&dataset, args)
+}
+
+/// The flags no configuration checks: the readings per object, the perturbation's bounds (named
+/// by their flags before `PerturbationBounds` would name them otherwise).
+fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
+    if !(1..=MAX_READINGS).contains(&args.readings) {
+        return Err(flag_error(
+            "readings",
+            args.readings,
+            format!("want 1 to {MAX_READINGS} per object"),
+        ));
+    }
+    if !(0.0..=180.0).contains(&args.perturb_deg) {
+        return Err(flag_error("perturb-deg", args.perturb_deg, "is outside [0, 180] degrees"));
+    }
+    if !(0.0..=1.0).contains(&args.perturb_frac) {
+        return Err(flag_error(
+            "perturb-frac",
+            args.perturb_frac,
+            "is outside [0, 1] of the object's width",
+        ));
+    }
+    Ok(())
+}
+
+/// The procedure the flags ask for on `objects` (the planner's workspace fitted to them); its
+/// parameters are checked by [`Collect::plan`].
+fn collection(args: &CollectArgs, sensor: SensorConfig, objects: &[ObjectSpec]) -> Collect<'static> {
+    match args.mode {
+        Mode::Sampler => {
+            let collect = Collect::sampler(sensor);
+            let collect = if args.from_above { collect.from_above() } else { collect };
+            if args.reachable {
+                collect.reachable_by_arm()
+            } else {
+                collect
+            }
+        }
+        Mode::Planner => {
+            let max_iterations = args
+                .max_iterations
+                .unwrap_or_else(|| PlannerConfig::iterations_for(args.readings));
+            let config = PlannerConfig {
+                local_probability: args.local_prob,
+                max_iterations,
+                ..PlannerConfig::default()
+            };
+            Collect::planner(sensor, config.fitted_to(objects))
+        }
+    }
+}
+
+/// A planner parameter out of range, named by the flag that set it.
+fn named_by_flag(e: RangeError) -> Box<dyn std::error::Error> {
+    let flag = match e.field {
+        "local_probability" => "local-prob",
+        "max_iterations" => "max-iterations",
+        _ => return e.into(),
+    };
+    let what = match e.allowed.starts_with(['[', '(']) {
+        true => format!("is outside {}", e.allowed),
+        false => format!("want {}", e.allowed),
+    };
+    flag_error(flag, e.value, what).into()
+}
+
+/// The objects that got fewer converged readings than `--readings`: a warning with
+/// `--allow-short`, else an error (the dataset is written either way).
+fn report_shortfalls(dataset: &Dataset, args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let short = dataset.shortfalls(args.readings);
     if short.is_empty() {
         return Ok(());
@@ -227,7 +235,7 @@ pub fn write_contact_sheets(
     for (object, readings) in dataset.header().objects.iter().zip(dataset.by_object()) {
         let images: Vec<_> = readings
             .iter()
-            .filter(|r| r.status == taction::dataset::ContactStatus::Converged)
+            .filter(|r| r.is_converged())
             .take(per_object)
             .map(|r| r.image.clone())
             .collect();

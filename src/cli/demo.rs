@@ -228,9 +228,11 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut planner = Planner::new(
         &scene,
         planner_config,
-        Valid::default(),
-        sensor,
-        PerturbationBounds::NONE,
+        taction::explore::TouchSetup {
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+        },
         rng::stream(args.seed.seed, PLANNER_STREAM),
         reader,
     )?;

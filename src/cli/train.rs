@@ -71,7 +71,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
             let converged: Vec<_> = training
                 .readings()
                 .iter()
-                .filter(|r| r.status == ContactStatus::Converged)
+                .filter(|r| r.is_converged())
                 .collect();
             let objects: BTreeSet<&str> = converged.iter().map(|r| r.object.as_str()).collect();
             codebook_sizes(args.codebook, objects.len(), converged.len())

@@ -52,6 +52,7 @@ use crate::dataset::{
 };
 use crate::pose::Pose;
 use crate::tactile::{PadPose, TactileImage};
+use crate::valid::Check;
 
 /// The file format version this build writes; it reads this one and every earlier one.
 pub const FORMAT_VERSION: u32 = 3;
@@ -266,117 +267,18 @@ impl Dataset {
     /// Parses the text of a dataset file; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Dataset, DatasetError> {
         let path = || origin.to_string();
-        let mut lines = text.splitn(3, '\n');
-        let magic = lines.next().unwrap_or_default();
-        if magic.trim_end() != MAGIC {
-            return Err(DatasetError::NotADataset {
-                path: path(),
-                what: format!(
-                    "line 1 should be '{MAGIC}', found '{}'",
-                    truncate_for_message(magic)
-                ),
-            });
-        }
-        let header_line = lines.next().ok_or_else(|| DatasetError::Truncated {
-            path: path(),
-            what: "the file ends after line 1 (no header)".into(),
-        })?;
+        let (header_line, body) = split_magic_and_header(text, origin)?;
         let (header, version) = parse_header(header_line, origin)?;
-        let body = lines.next().ok_or_else(|| DatasetError::Truncated {
+        let body = body.ok_or_else(|| DatasetError::Truncated {
             path: path(),
             what: "the file ends after the header (no column names)".into(),
         })?;
-        let trailer = format!("{END_PREFIX}{}\n", header.readings);
-        let Some(body) = body.strip_suffix(&trailer) else {
-            return Err(DatasetError::Truncated {
-                path: path(),
-                what: format!(
-                    "the last line should be '{}' (the header declares {} readings)",
-                    trailer.trim_end(),
-                    header.readings
-                ),
-            });
-        };
+        let body = strip_trailer(body, header.readings, origin)?;
         let FileHeader {
             header,
             readings: declared,
         } = header;
-        let (rows, cols) = (header.sensor.rows, header.sensor.cols);
-        let metas = Meta::of_version(version);
-        let expected_columns = columns_of(metas, rows, cols);
-        let mut csv = csv::ReaderBuilder::new()
-            .has_headers(true)
-            .flexible(true)
-            .from_reader(body.as_bytes());
-        // The CSV body starts on line 3 of the file.
-        let file_line = |csv_line: u64| csv_line + 2;
-        let columns = csv
-            .headers()
-            .map_err(|e| DatasetError::Csv {
-                path: path(),
-                line: 3,
-                what: e.to_string(),
-            })?
-            .clone();
-        if columns.len() != expected_columns.len()
-            || columns.iter().zip(&expected_columns).any(|(a, b)| a != b)
-        {
-            let first_bad = columns.iter().zip(&expected_columns).position(|(a, b)| a != b);
-            return Err(DatasetError::Header {
-                path: path(),
-                line: 3,
-                what: match first_bad {
-                    Some(i) => format!(
-                        "column {} is '{}', expected '{}'",
-                        i + 1,
-                        &columns[i],
-                        expected_columns[i]
-                    ),
-                    None => format!(
-                        "{} column names, expected {} ({} + {rows}x{cols} taxels)",
-                        columns.len(),
-                        expected_columns.len(),
-                        metas.len()
-                    ),
-                },
-            });
-        }
-        let mut readings = Vec::with_capacity(declared);
-        let mut record = csv::StringRecord::new();
-        loop {
-            let more = csv.read_record(&mut record).map_err(|e| DatasetError::Csv {
-                path: path(),
-                line: e.position().map_or(0, |p| file_line(p.line())),
-                what: e.to_string(),
-            })?;
-            if !more {
-                break;
-            }
-            let line = file_line(record.position().map_or(0, |p| p.line()));
-            if record.len() != expected_columns.len() {
-                return Err(DatasetError::ColumnCount {
-                    path: path(),
-                    line,
-                    fields: record.len(),
-                    expected: expected_columns.len(),
-                    meta: metas.len(),
-                    rows,
-                    cols,
-                });
-            }
-            let row = Row {
-                record: &record,
-                columns: &expected_columns,
-                version,
-            };
-            let reading = parse_reading(&row, &header).map_err(|(field, what)| DatasetError::Field {
-                path: path(),
-                line,
-                field,
-                what,
-            })?;
-            readings.push(reading);
-        }
+        let readings = parse_body(body, &header, version, declared, origin)?;
         if readings.len() != declared {
             return Err(DatasetError::Truncated {
                 path: path(),
@@ -392,9 +294,141 @@ impl Dataset {
                 line: 2,
                 what,
             },
+            DatasetError::InvalidHeader(e) => DatasetError::Header {
+                path: path(),
+                line: 2,
+                what: e.to_string(),
+            },
             other => other,
         })
     }
+}
+
+/// The header line after the magic line, and the rest of the file (`None`: nothing after the
+/// header line).
+fn split_magic_and_header<'t>(text: &'t str, origin: &str) -> Result<(&'t str, Option<&'t str>), DatasetError> {
+    let mut lines = text.splitn(3, '\n');
+    let magic = lines.next().unwrap_or_default();
+    if magic.trim_end() != MAGIC {
+        return Err(DatasetError::NotADataset {
+            path: origin.to_string(),
+            what: format!(
+                "line 1 should be '{MAGIC}', found '{}'",
+                truncate_for_message(magic)
+            ),
+        });
+    }
+    let header_line = lines.next().ok_or_else(|| DatasetError::Truncated {
+        path: origin.to_string(),
+        what: "the file ends after line 1 (no header)".into(),
+    })?;
+    Ok((header_line, lines.next()))
+}
+
+/// `body` without its last line, which must declare the header's `declared` readings.
+fn strip_trailer<'t>(body: &'t str, declared: usize, origin: &str) -> Result<&'t str, DatasetError> {
+    let trailer = format!("{END_PREFIX}{declared}\n");
+    body.strip_suffix(&trailer).ok_or_else(|| DatasetError::Truncated {
+        path: origin.to_string(),
+        what: format!(
+            "the last line should be '{}' (the header declares {declared} readings)",
+            trailer.trim_end()
+        ),
+    })
+}
+
+/// The readings of the CSV `body` (column names, then one row a reading) of a file of format
+/// `version`; errors name the file's line (the body starts on line 3).
+fn parse_body(
+    body: &str,
+    header: &DatasetHeader,
+    version: u32,
+    declared: usize,
+    origin: &str,
+) -> Result<Vec<Reading>, DatasetError> {
+    let path = || origin.to_string();
+    let (rows, cols) = (header.sensor.rows, header.sensor.cols);
+    let metas = Meta::of_version(version);
+    let expected_columns = columns_of(metas, rows, cols);
+    let mut csv = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(true)
+        .from_reader(body.as_bytes());
+    let file_line = |csv_line: u64| csv_line + 2;
+    let columns = csv
+        .headers()
+        .map_err(|e| DatasetError::Csv {
+            path: path(),
+            line: 3,
+            what: e.to_string(),
+        })?
+        .clone();
+    check_column_names(&columns, &expected_columns, (metas.len(), rows, cols), origin)?;
+    let mut readings = Vec::with_capacity(declared);
+    let mut record = csv::StringRecord::new();
+    while csv.read_record(&mut record).map_err(|e| DatasetError::Csv {
+        path: path(),
+        line: e.position().map_or(0, |p| file_line(p.line())),
+        what: e.to_string(),
+    })? {
+        let line = file_line(record.position().map_or(0, |p| p.line()));
+        if record.len() != expected_columns.len() {
+            return Err(DatasetError::ColumnCount {
+                path: path(),
+                line,
+                fields: record.len(),
+                expected: expected_columns.len(),
+                meta: metas.len(),
+                rows,
+                cols,
+            });
+        }
+        let row = Row {
+            record: &record,
+            columns: &expected_columns,
+            version,
+        };
+        let reading = parse_reading(&row, header).map_err(|(field, what)| DatasetError::Field {
+            path: path(),
+            line,
+            field,
+            what,
+        })?;
+        readings.push(reading);
+    }
+    Ok(readings)
+}
+
+/// The body's column names against this version's (`layout`: the columns before the taxels,
+/// then the sensor's rows and columns): the first that differs, or the count.
+fn check_column_names(
+    columns: &csv::StringRecord,
+    expected: &[String],
+    layout: (usize, usize, usize),
+    origin: &str,
+) -> Result<(), DatasetError> {
+    if columns.len() == expected.len() && columns.iter().zip(expected).all(|(a, b)| a == b) {
+        return Ok(());
+    }
+    let (meta, rows, cols) = layout;
+    let first_bad = columns.iter().zip(expected).position(|(a, b)| a != b);
+    Err(DatasetError::Header {
+        path: origin.to_string(),
+        line: 3,
+        what: match first_bad {
+            Some(i) => format!(
+                "column {} is '{}', expected '{}'",
+                i + 1,
+                &columns[i],
+                expected[i]
+            ),
+            None => format!(
+                "{} column names, expected {} ({meta} + {rows}x{cols} taxels)",
+                columns.len(),
+                expected.len(),
+            ),
+        },
+    })
 }
 
 /// The header line and the file's format version; an older version's header is brought up to this
@@ -423,7 +457,7 @@ fn parse_header(line: &str, origin: &str) -> Result<(FileHeader, u32), DatasetEr
     };
     let mut header: FileHeader = serde_json::from_value(value).map_err(|e| header_err(e.to_string()))?;
     header.header.format_version = FORMAT_VERSION;
-    header.header.validate().map_err(header_err)?;
+    header.header.check().map_err(|e| header_err(e.to_string()))?;
     Ok((header, version))
 }
 
@@ -523,7 +557,6 @@ impl Row<'_> {
 
 /// One record into a reading; the error names the field.
 fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, String)> {
-    let record = row.record;
     let object = row.text(Meta::Object).to_string();
     if header.object_index(&object).is_none() {
         return Err(row.error(
@@ -561,30 +594,9 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
             row.number(Meta::ObjectQw)?,
         ),
     };
-    let is_empty = |column: &&Meta| row.text(**column).trim().is_empty();
-    let pad = if Meta::pad().iter().all(|column| is_empty(&column)) {
-        None
-    } else if let Some(column) = Meta::pad().iter().find(is_empty) {
-        return Err(row.error(column.index(), "empty, but other pad pose fields are set".into()));
-    } else {
-        Some(PadPose {
-            center_m: row.vector([Meta::PadX, Meta::PadY, Meta::PadZ])?,
-            normal: row.vector([Meta::PadNormalX, Meta::PadNormalY, Meta::PadNormalZ])?,
-            up: row.vector([Meta::PadUpX, Meta::PadUpY, Meta::PadUpZ])?,
-        })
-    };
+    let pad = parse_pad_pose(row)?;
     let cause = parse_cause(row, status, iterations)?;
-    let first_taxel = row.first_taxel();
-    let mut values = Vec::with_capacity(record.len() - first_taxel);
-    for i in first_taxel..record.len() {
-        let value = row.number_at(i)?;
-        if !(0.0..=1.0).contains(&value) {
-            return Err(row.error(i, format!("{value} is outside [0, 1]")));
-        }
-        values.push(value);
-    }
-    let image = TactileImage::new(header.sensor.rows, header.sensor.cols, values)
-        .map_err(|e| row.error(first_taxel, e.to_string()))?;
+    let image = parse_image(row, header)?;
     let image = match pad {
         Some(pad) => image.with_pose(pad),
         None => image,
@@ -598,6 +610,37 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
         strategy,
         cause,
     })
+}
+
+/// The row's pad pose: its nine columns all set, or all empty (`None`: an image without a pose).
+fn parse_pad_pose(row: &Row) -> Result<Option<PadPose>, (String, String)> {
+    let is_empty = |column: &&Meta| row.text(**column).trim().is_empty();
+    if Meta::pad().iter().all(|column| is_empty(&column)) {
+        return Ok(None);
+    }
+    if let Some(column) = Meta::pad().iter().find(is_empty) {
+        return Err(row.error(column.index(), "empty, but other pad pose fields are set".into()));
+    }
+    Ok(Some(PadPose {
+        center_m: row.vector([Meta::PadX, Meta::PadY, Meta::PadZ])?,
+        normal: row.vector([Meta::PadNormalX, Meta::PadNormalY, Meta::PadNormalZ])?,
+        up: row.vector([Meta::PadUpX, Meta::PadUpY, Meta::PadUpZ])?,
+    }))
+}
+
+/// The row's taxels, each in [0, 1], as an image of the header's sensor shape.
+fn parse_image(row: &Row, header: &DatasetHeader) -> Result<TactileImage, (String, String)> {
+    let len = row.record.len();
+    let first_taxel = row.first_taxel();
+    let mut values = Vec::with_capacity(len - first_taxel);
+    for i in first_taxel..len {
+        let value = row.number_at(i)?;
+        if !(0.0..=1.0).contains(&value) {
+            return Err(row.error(i, format!("{value} is outside [0, 1]")));
+        }
+        values.push(value);
+    }
+    TactileImage::new(header.sensor.rows, header.sensor.cols, values).map_err(|e| row.error(first_taxel, e.to_string()))
 }
 
 /// The row's cause, in this format's vocabulary whatever the file's version (see the module docs).

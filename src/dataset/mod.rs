@@ -31,7 +31,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::FileError;
-use crate::tactile::SensorConfig;
+use crate::tactile::{ConfigError, SensorConfig};
 use crate::valid::Check;
 
 /// Errors from building, reading or writing a dataset; each names the file, line and field.
@@ -69,6 +69,8 @@ pub enum DatasetError {
     Csv { path: String, line: u64, what: String },
     #[error("invalid dataset: {0}")]
     Invalid(String),
+    #[error("invalid dataset: {0}")]
+    InvalidHeader(#[from] HeaderError),
 }
 
 impl From<FileError> for DatasetError {
@@ -122,20 +124,57 @@ impl DatasetHeader {
         self.objects.iter().position(|o| o == object)
     }
 
-    fn validate(&self) -> Result<(), String> {
-        if self.format_version != FORMAT_VERSION {
-            return Err(format!(
-                "format_version {} (this build writes {FORMAT_VERSION})",
-                self.format_version
-            ));
+}
+
+/// What is wrong with a [`DatasetHeader`], naming the field ([`field`](Self::field)).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HeaderError {
+    #[error("format_version {found} (this build writes {FORMAT_VERSION})")]
+    FormatVersion { found: u32 },
+    #[error("sensor: {0}")]
+    Sensor(ConfigError),
+    #[error("object {index} has an empty name")]
+    EmptyObjectName { index: usize },
+    #[error("object '{name}' is listed twice")]
+    DuplicateObject { name: String },
+}
+
+impl HeaderError {
+    /// The header field at fault.
+    pub fn field(&self) -> &'static str {
+        match self {
+            Self::FormatVersion { .. } => "format_version",
+            Self::Sensor(_) => "sensor",
+            Self::EmptyObjectName { .. } | Self::DuplicateObject { .. } => "objects",
         }
-        self.sensor.check().map_err(|e| format!("sensor: {e}"))?;
-        for (i, name) in self.objects.iter().enumerate() {
+    }
+}
+
+impl Check for DatasetHeader {
+    type Error = HeaderError;
+
+    /// The version is this build's, the sensor in range, every object named once.
+    fn check(&self) -> Result<(), HeaderError> {
+        let Self {
+            format_version,
+            sensor,
+            object_set: _,
+            objects,
+            generator: _,
+            seed: _,
+        } = self;
+        if *format_version != FORMAT_VERSION {
+            return Err(HeaderError::FormatVersion {
+                found: *format_version,
+            });
+        }
+        sensor.check().map_err(HeaderError::Sensor)?;
+        for (index, name) in objects.iter().enumerate() {
             if name.is_empty() {
-                return Err(format!("object {i} has an empty name"));
+                return Err(HeaderError::EmptyObjectName { index });
             }
-            if self.objects[..i].contains(name) {
-                return Err(format!("object '{name}' is listed twice"));
+            if objects[..index].contains(name) {
+                return Err(HeaderError::DuplicateObject { name: name.clone() });
             }
         }
         Ok(())
@@ -153,7 +192,7 @@ pub struct Dataset {
 impl Dataset {
     /// A dataset from readings in memory.
     pub fn new(header: DatasetHeader, readings: Vec<Reading>) -> Result<Self, DatasetError> {
-        header.validate().map_err(DatasetError::Invalid)?;
+        header.check()?;
         let mut dataset = Self {
             header,
             readings: Vec::with_capacity(readings.len()),
@@ -202,17 +241,17 @@ impl Dataset {
         self.readings.is_empty()
     }
 
-    /// The same header with only the [`Converged`](ContactStatus::Converged) readings: the ones
+    /// The [`Converged`](ContactStatus::Converged) readings, in dataset order: the ones
     /// recognition uses (Sec. III-B).
+    pub fn converged(&self) -> impl Iterator<Item = &Reading> {
+        self.readings.iter().filter(|r| r.is_converged())
+    }
+
+    /// The same header with only the [`converged`](Self::converged) readings.
     pub fn converged_only(&self) -> Dataset {
         Dataset {
             header: self.header.clone(),
-            readings: self
-                .readings
-                .iter()
-                .filter(|r| r.status == ContactStatus::Converged)
-                .cloned()
-                .collect(),
+            readings: self.converged().cloned().collect(),
         }
     }
 
@@ -224,10 +263,7 @@ impl Dataset {
             .zip(&self.header.objects)
             .map(|(readings, object)| Shortfall {
                 object: object.clone(),
-                converged: readings
-                    .iter()
-                    .filter(|r| r.status == ContactStatus::Converged)
-                    .count(),
+                converged: readings.iter().filter(|r| r.is_converged()).count(),
                 wanted,
             })
             .filter(|s| s.converged < wanted)

@@ -201,6 +201,11 @@ impl AttemptCause {
 }
 
 impl Reading {
+    /// Whether the contact controllers converged (Sec. III-B): the readings recognition uses.
+    pub fn is_converged(&self) -> bool {
+        self.status == ContactStatus::Converged
+    }
+
     /// The cause a reading with no recorded one has by its status alone: `lost_contact` for a
     /// `no_contact` after the controllers had pressed. What formats 1 and 2, which did not write
     /// it, are read with.

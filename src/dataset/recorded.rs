@@ -129,6 +129,36 @@ pub struct Calibration {
     pub offset: Vec<f64>,
 }
 
+/// A calibration line `r<row>c<col>,gain,offset` as `(line, row, col, gain, offset)`; the gain
+/// must not be negative.
+fn parse_calibration_line(record: &[&str], line: u64, origin: &str) -> Result<(u64, usize, usize, f64, f64), RealDataError> {
+    let invalid = |what: String| RealDataError::Invalid {
+        origin: origin.to_string(),
+        line,
+        what,
+    };
+    if record.len() != 3 {
+        return Err(invalid(format!(
+            "{} columns, expected 3 (taxel,gain,offset)",
+            record.len()
+        )));
+    }
+    let (row, col) = parse_taxel_name(record[0])
+        .ok_or_else(|| invalid(format!("taxel '{}' is not r<row>c<col>", record[0])))?;
+    let number = |column: &str, text: &str| -> Result<f64, RealDataError> {
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(invalid(format!("{column} '{text}' is not a finite number"))),
+        }
+    };
+    let gain = number("gain", record[1])?;
+    if gain < 0.0 {
+        return Err(invalid(format!("gain {gain} is negative")));
+    }
+    let offset = number("offset", record[2])?;
+    Ok((line, row, col, gain, offset))
+}
+
 impl Calibration {
     /// Reads a calibration file.
     pub fn read(path: &Path) -> Result<Self, RealDataError> {
@@ -161,26 +191,7 @@ impl Calibration {
                 header_seen = true;
                 continue;
             }
-            if record.len() != 3 {
-                return Err(invalid(
-                    line,
-                    format!("{} columns, expected 3 (taxel,gain,offset)", record.len()),
-                ));
-            }
-            let (row, col) = parse_taxel_name(record[0])
-                .ok_or_else(|| invalid(line, format!("taxel '{}' is not r<row>c<col>", record[0])))?;
-            let number = |column: &str, text: &str| -> Result<f64, RealDataError> {
-                match text.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(invalid(line, format!("{column} '{text}' is not a finite number"))),
-                }
-            };
-            let gain = number("gain", record[1])?;
-            if gain < 0.0 {
-                return Err(invalid(line, format!("gain {gain} is negative")));
-            }
-            let offset = number("offset", record[2])?;
-            entries.push((line, row, col, gain, offset));
+            entries.push(parse_calibration_line(&record, line, origin)?);
         }
         if !header_seen {
             return Err(RealDataError::NoHeader {
@@ -193,11 +204,22 @@ impl Calibration {
                 "no taxel lines after the header".to_string(),
             ));
         }
+        Self::from_entries(&entries, origin)
+    }
+
+    /// The calibration of the grid `entries` fill (`(line, row, col, gain, offset)`): each taxel
+    /// listed once, none missing.
+    fn from_entries(entries: &[(u64, usize, usize, f64, f64)], origin: &str) -> Result<Self, RealDataError> {
+        let invalid = |line: u64, what: String| RealDataError::Invalid {
+            origin: origin.to_string(),
+            line,
+            what,
+        };
         let rows = entries.iter().map(|e| e.1).max().unwrap_or(0) + 1;
         let cols = entries.iter().map(|e| e.2).max().unwrap_or(0) + 1;
         let mut gain = vec![f64::NAN; rows * cols];
         let mut offset = vec![f64::NAN; rows * cols];
-        for &(line, row, col, g, o) in &entries {
+        for &(line, row, col, g, o) in entries {
             let k = row * cols + col;
             if !gain[k].is_nan() {
                 return Err(invalid(line, format!("taxel r{row}c{col} is listed twice")));
@@ -408,137 +430,28 @@ pub fn import_real_csv(path: &Path, options: &RealImport) -> Result<RealData, Re
 
 /// Parses real-data CSV text; `origin` names the source in errors.
 pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<RealData, RealDataError> {
-    let origin_s = || origin.to_string();
     if let Normalisation::Range(range) = options.normalisation
         && !(range.is_finite() && range > 0.0)
     {
         return Err(RealDataError::BadRange {
-            origin: origin_s(),
+            origin: origin.to_string(),
             range,
         });
     }
     let mut header: Option<(usize, usize, Vec<String>)> = None;
-    let mut raw: Vec<(String, u64, Vec<f64>)> = Vec::new();
+    let mut raw: Vec<RawFrame> = Vec::new();
     for (line, record) in records(text) {
-        let Some((rows, cols, names)) = &header else {
-            let parsed = parse_header(&record, line, origin)?;
-            if let Some(calibration) = &options.calibration
-                && (calibration.rows, calibration.cols) != (parsed.0, parsed.1)
-            {
-                return Err(RealDataError::Header {
-                    origin: origin_s(),
-                    line,
-                    what: format!(
-                        "the frames are {}x{} taxels but the calibration {} is {}x{}",
-                        parsed.0, parsed.1, calibration.origin, calibration.rows, calibration.cols
-                    ),
-                });
-            }
-            header = Some(parsed);
-            continue;
-        };
-        let expected = 1 + rows * cols;
-        if record.len() != expected {
-            return Err(RealDataError::ColumnCount {
-                origin: origin_s(),
-                line,
-                got: record.len(),
-                expected,
-                rows: *rows,
-                cols: *cols,
-            });
+        match &header {
+            None => header = Some(calibrated_header(&record, line, origin, options)?),
+            Some(grid) => raw.push(parse_frame(&record, line, grid, options, origin)?),
         }
-        let label = record[0].to_string();
-        if label.is_empty() {
-            return Err(RealDataError::EmptyLabel {
-                origin: origin_s(),
-                line,
-            });
-        }
-        if let Some(allowed) = &options.allowed_labels
-            && !allowed.contains(&label)
-        {
-            let allowed = allowed.iter().cloned().collect::<Vec<_>>().join(", ");
-            return Err(RealDataError::UnknownLabel {
-                origin: origin_s(),
-                line,
-                label,
-                allowed,
-            });
-        }
-        let mut values = Vec::with_capacity(rows * cols);
-        for (k, (text, column)) in record[1..].iter().zip(names).enumerate() {
-            let column = column.clone();
-            let raw: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
-                origin: origin_s(),
-                line,
-                column: column.clone(),
-                text: text.to_string(),
-            })?;
-            if !raw.is_finite() {
-                return Err(RealDataError::NotFinite {
-                    origin: origin_s(),
-                    line,
-                    column,
-                    value: raw,
-                });
-            }
-            let value = match &options.calibration {
-                Some(calibration) => calibration.apply(k, raw),
-                None => raw,
-            };
-            if value < 0.0 {
-                return Err(RealDataError::Negative {
-                    origin: origin_s(),
-                    line,
-                    column,
-                    value,
-                });
-            }
-            if let Normalisation::Range(range) = options.normalisation
-                && value > range
-            {
-                return Err(RealDataError::AboveRange {
-                    origin: origin_s(),
-                    line,
-                    column,
-                    value,
-                    range,
-                });
-            }
-            values.push(value);
-        }
-        raw.push((label, line, values));
     }
     let Some((rows, cols, _)) = header else {
-        return Err(RealDataError::NoHeader { origin: origin_s() });
+        return Err(RealDataError::NoHeader {
+            origin: origin.to_string(),
+        });
     };
-    if raw.is_empty() {
-        return Err(RealDataError::NoFrames { origin: origin_s() });
-    }
-    let scale = match options.normalisation {
-        Normalisation::Range(range) => range,
-        Normalisation::FileMax => raw
-            .iter()
-            .flat_map(|(_, _, v)| v.iter().copied())
-            .fold(0.0, f64::max),
-    };
-    if scale == 0.0 {
-        return Err(RealDataError::AllZero { origin: origin_s() });
-    }
-    let readings = raw
-        .into_iter()
-        .map(|(label, line, values)| {
-            let values = values.into_iter().map(|v| v / scale).collect();
-            TactileImage::new(rows, cols, values)
-                .map(|image| RealReading { label, line, image })
-                .map_err(|e| RealDataError::Invalid {
-                    origin: origin_s(),
-                    line,
-                    what: e.to_string(),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let readings = normalised(raw, (rows, cols), options, origin)?;
     let synthetic = text
         .lines()
         .any(|line| line.trim_start().starts_with(SYNTHETIC_MARK));
@@ -548,6 +461,174 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
         readings,
         synthetic,
     })
+}
+
+/// One frame as read: its label, its line and its calibrated values, not yet normalised.
+struct RawFrame {
+    label: String,
+    line: u64,
+    values: Vec<f64>,
+}
+
+/// The header line ([`parse_header`]), whose grid must be the calibration's when there is one.
+fn calibrated_header(
+    record: &[&str],
+    line: u64,
+    origin: &str,
+    options: &RealImport,
+) -> Result<(usize, usize, Vec<String>), RealDataError> {
+    let parsed = parse_header(record, line, origin)?;
+    if let Some(calibration) = &options.calibration
+        && (calibration.rows, calibration.cols) != (parsed.0, parsed.1)
+    {
+        return Err(RealDataError::Header {
+            origin: origin.to_string(),
+            line,
+            what: format!(
+                "the frames are {}x{} taxels but the calibration {} is {}x{}",
+                parsed.0, parsed.1, calibration.origin, calibration.rows, calibration.cols
+            ),
+        });
+    }
+    Ok(parsed)
+}
+
+/// A frame line of a `rows x cols` grid with taxel columns `names`: a known, non-empty label and
+/// one calibrated value a taxel.
+fn parse_frame(
+    record: &[&str],
+    line: u64,
+    grid: &(usize, usize, Vec<String>),
+    options: &RealImport,
+    origin: &str,
+) -> Result<RawFrame, RealDataError> {
+    let (rows, cols, names) = grid;
+    let expected = 1 + rows * cols;
+    if record.len() != expected {
+        return Err(RealDataError::ColumnCount {
+            origin: origin.to_string(),
+            line,
+            got: record.len(),
+            expected,
+            rows: *rows,
+            cols: *cols,
+        });
+    }
+    let label = record[0].to_string();
+    if label.is_empty() {
+        return Err(RealDataError::EmptyLabel {
+            origin: origin.to_string(),
+            line,
+        });
+    }
+    if let Some(allowed) = &options.allowed_labels
+        && !allowed.contains(&label)
+    {
+        let allowed = allowed.iter().cloned().collect::<Vec<_>>().join(", ");
+        return Err(RealDataError::UnknownLabel {
+            origin: origin.to_string(),
+            line,
+            label,
+            allowed,
+        });
+    }
+    let values = record[1..]
+        .iter()
+        .zip(names)
+        .enumerate()
+        .map(|(k, (text, column))| parse_value(k, text, column, line, options, origin))
+        .collect::<Result<Vec<f64>, _>>()?;
+    Ok(RawFrame { label, line, values })
+}
+
+/// Taxel `k`'s value `text` (column `column`): a finite number, calibrated, not negative, and
+/// within the range when one is given.
+fn parse_value(
+    k: usize,
+    text: &str,
+    column: &str,
+    line: u64,
+    options: &RealImport,
+    origin: &str,
+) -> Result<f64, RealDataError> {
+    let column = column.to_string();
+    let raw: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
+        origin: origin.to_string(),
+        line,
+        column: column.clone(),
+        text: text.to_string(),
+    })?;
+    if !raw.is_finite() {
+        return Err(RealDataError::NotFinite {
+            origin: origin.to_string(),
+            line,
+            column,
+            value: raw,
+        });
+    }
+    let value = match &options.calibration {
+        Some(calibration) => calibration.apply(k, raw),
+        None => raw,
+    };
+    if value < 0.0 {
+        return Err(RealDataError::Negative {
+            origin: origin.to_string(),
+            line,
+            column,
+            value,
+        });
+    }
+    if let Normalisation::Range(range) = options.normalisation
+        && value > range
+    {
+        return Err(RealDataError::AboveRange {
+            origin: origin.to_string(),
+            line,
+            column,
+            value,
+            range,
+        });
+    }
+    Ok(value)
+}
+
+/// The frames divided by the range, or by the file's largest value: images in [0, 1].
+fn normalised(
+    raw: Vec<RawFrame>,
+    grid: (usize, usize),
+    options: &RealImport,
+    origin: &str,
+) -> Result<Vec<RealReading>, RealDataError> {
+    if raw.is_empty() {
+        return Err(RealDataError::NoFrames {
+            origin: origin.to_string(),
+        });
+    }
+    let scale = match options.normalisation {
+        Normalisation::Range(range) => range,
+        Normalisation::FileMax => raw
+            .iter()
+            .flat_map(|frame| frame.values.iter().copied())
+            .fold(0.0, f64::max),
+    };
+    if scale == 0.0 {
+        return Err(RealDataError::AllZero {
+            origin: origin.to_string(),
+        });
+    }
+    let (rows, cols) = grid;
+    raw.into_iter()
+        .map(|RawFrame { label, line, values }| {
+            let values = values.into_iter().map(|v| v / scale).collect();
+            TactileImage::new(rows, cols, values)
+                .map(|image| RealReading { label, line, image })
+                .map_err(|e| RealDataError::Invalid {
+                    origin: origin.to_string(),
+                    line,
+                    what: e.to_string(),
+                })
+        })
+        .collect()
 }
 
 /// Reads `label,r0c0,...`: the taxel columns must be `r<i>c<j>` in row-major order and fill a grid.

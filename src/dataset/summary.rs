@@ -56,12 +56,40 @@ impl DatasetSummary {
 impl fmt::Display for DatasetSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let h = &self.header;
-        let s = &h.sensor;
         writeln!(
             f,
             "format version {}, object set '{}', generator '{}', seed {}",
             h.format_version, h.object_set, h.generator, h.seed
         )?;
+        self.write_sensor(f)?;
+        let width = h
+            .objects
+            .iter()
+            .map(String::len)
+            .max()
+            .unwrap_or(0)
+            .max("object".len());
+        self.write_statuses(f, width)?;
+        if self.causes.iter().any(|c| !c.is_empty()) {
+            self.write_causes(f, width)?;
+        }
+        let strategies: Vec<String> = self.by_strategy.iter().map(|(k, v)| format!("{k} {v}")).collect();
+        write!(
+            f,
+            "strategies: {}",
+            if strategies.is_empty() {
+                "none".to_string()
+            } else {
+                strategies.join(", ")
+            }
+        )
+    }
+}
+
+impl DatasetSummary {
+    /// The sensor line: shape, pad, covering, PSF, rays, noise.
+    fn write_sensor(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = &self.header.sensor;
         writeln!(
             f,
             "sensor: {}x{} taxels, pad {} x {}, covering {}, PSF sigma {}, {} rays/taxel ({}), noise {} (seed {})",
@@ -78,21 +106,18 @@ impl fmt::Display for DatasetSummary {
             },
             crate::units::significant(s.noise_fraction),
             s.noise_seed
-        )?;
-        let width = h
-            .objects
-            .iter()
-            .map(String::len)
-            .max()
-            .unwrap_or(0)
-            .max("object".len());
+        )
+    }
+
+    /// The table of readings per object and status, with a total row; names `width` wide.
+    fn write_statuses(&self, f: &mut fmt::Formatter<'_>, width: usize) -> fmt::Result {
         write!(f, "{:<width$} {:>8}", "object", "readings")?;
         for status in ContactStatus::ALL {
             write!(f, " {:>14}", status.name())?;
         }
         writeln!(f)?;
         let mut totals = [0usize; ContactStatus::ALL.len()];
-        for (name, counts) in h.objects.iter().zip(&self.per_object) {
+        for (name, counts) in self.header.objects.iter().zip(&self.per_object) {
             write!(f, "{name:<width$} {:>8}", counts.values().sum::<usize>())?;
             for (i, status) in ContactStatus::ALL.iter().enumerate() {
                 let n = counts.get(status).copied().unwrap_or(0);
@@ -105,30 +130,23 @@ impl fmt::Display for DatasetSummary {
         for n in totals {
             write!(f, " {n:>14}")?;
         }
+        writeln!(f)
+    }
+
+    /// The table of failed attempts per object by what ended them; names `width` wide.
+    fn write_causes(&self, f: &mut fmt::Formatter<'_>, width: usize) -> fmt::Result {
+        write!(f, "{:<width$} {:>8}", "causes", "")?;
+        for cause in CauseKind::ALL {
+            write!(f, " {:>17}", cause.name())?;
+        }
         writeln!(f)?;
-        if self.causes.iter().any(|c| !c.is_empty()) {
-            write!(f, "{:<width$} {:>8}", "causes", "")?;
+        for (name, counts) in self.header.objects.iter().zip(&self.causes) {
+            write!(f, "{name:<width$} {:>8}", "")?;
             for cause in CauseKind::ALL {
-                write!(f, " {:>17}", cause.name())?;
+                write!(f, " {:>17}", counts.get(&cause).copied().unwrap_or(0))?;
             }
             writeln!(f)?;
-            for (name, counts) in h.objects.iter().zip(&self.causes) {
-                write!(f, "{name:<width$} {:>8}", "")?;
-                for cause in CauseKind::ALL {
-                    write!(f, " {:>17}", counts.get(&cause).copied().unwrap_or(0))?;
-                }
-                writeln!(f)?;
-            }
         }
-        let strategies: Vec<String> = self.by_strategy.iter().map(|(k, v)| format!("{k} {v}")).collect();
-        write!(
-            f,
-            "strategies: {}",
-            if strategies.is_empty() {
-                "none".to_string()
-            } else {
-                strategies.join(", ")
-            }
-        )
+        Ok(())
     }
 }

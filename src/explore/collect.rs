@@ -12,14 +12,15 @@ use crate::control::{ControlConfig, ControlError};
 use crate::dataset::{Dataset, DatasetError, DatasetHeader};
 use crate::explore::planner::{Planner, PlannerConfig};
 use crate::explore::report::ExplorationReport;
-use crate::explore::sampler::{SamplerConfig, sample_readings};
+use crate::explore::sampler::{SamplerConfig, TrainingSampler};
+use crate::explore::setup::TouchSetup;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use crate::tactile::free_floating::FreeFloatingSensor;
 use crate::tactile::sensor::{CoveringSensor, add_sensor};
 use crate::tactile::{SensorConfig, TactileImage};
-use crate::valid::Valid;
+use crate::valid::{RangeError, Valid};
 
 /// Which procedure collects the readings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -32,11 +33,17 @@ pub enum CollectMode {
 }
 
 impl CollectMode {
-    /// What a dataset's header says produced it: `sampler` (or `sampler from above`), `planner L=0.5`.
+    /// What a dataset's header says produced it: `sampler`, `sampler from above` (Sec. V-D),
+    /// `sampler reachable by the arm`, `sampler from above, reachable by the arm`, `planner L=0.5`.
+    /// The one definition: the CLI and the experiments both name their datasets by it.
     pub fn generator_name(&self) -> String {
         match self {
-            Self::Sampler(c) if c.from_above_only => "sampler from above".to_string(),
-            Self::Sampler(_) => "sampler".to_string(),
+            Self::Sampler(c) => match (c.from_above_only, c.reachable_by_arm) {
+                (false, false) => "sampler".to_string(),
+                (true, false) => "sampler from above".to_string(),
+                (false, true) => "sampler reachable by the arm".to_string(),
+                (true, true) => "sampler from above, reachable by the arm".to_string(),
+            },
             Self::Planner(c) => format!("planner L={}", c.local_probability),
         }
     }
@@ -49,6 +56,9 @@ pub enum CollectError {
     Control(#[from] ControlError),
     #[error(transparent)]
     Dataset(#[from] DatasetError),
+    /// The procedure's parameters failed their check ([`Collect::plan`]).
+    #[error(transparent)]
+    Config(#[from] RangeError),
 }
 
 /// Everything that determines a collection run (besides the objects).
@@ -82,6 +92,15 @@ impl CollectPlan {
         }
     }
 
+    /// What every touch of object `index` shares: its sensor, the controllers, the perturbation.
+    pub fn setup_for(&self, index: usize) -> TouchSetup {
+        TouchSetup {
+            sensor: self.sensor_for(index),
+            control: self.control,
+            perturbation: self.perturbation,
+        }
+    }
+
     /// Collects the readings of object `index` (its name is the object's name).
     pub fn collect_object(
         &self,
@@ -99,22 +118,16 @@ impl CollectPlan {
         index: usize,
         on_converged: &mut dyn FnMut(),
     ) -> Result<ExplorationReport, ControlError> {
-        let sensor = self.sensor_for(index);
-        let mut rng = rng::stream(self.seed, index as u64);
+        let rng = rng::stream(self.seed, index as u64);
         match self.mode {
             CollectMode::Sampler(config) => {
-                let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
+                let setup = self.setup_for(index);
+                let mut free = FreeFloatingSensor::new(object.clone(), &setup.sensor)?;
                 let reader = sensor_reader(free.sensor().clone());
-                sample_readings(
+                TrainingSampler::new(config, setup, rng, reader).sample_reporting(
                     free.scene_mut(),
                     &object.name,
-                    sensor,
-                    &self.control,
-                    &config,
-                    self.perturbation,
                     self.readings_per_object,
-                    &mut rng,
-                    reader,
                     on_converged,
                 )
             }
@@ -141,21 +154,13 @@ impl CollectPlan {
         ),
         ControlError,
     > {
-        let sensor = self.sensor_for(index);
+        let setup = self.setup_for(index);
         let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-        let scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
+        let scene = add_sensor(builder, &setup.sensor, "covering", PAD_SITE)
             .map_err(crate::tactile::sensor::TactileError::from)?
             .build()?;
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-        let planner = Planner::new(
-            &scene,
-            config,
-            self.control,
-            sensor,
-            self.perturbation,
-            rng::stream(self.seed, index as u64),
-            reader,
-        )?;
+        let planner = Planner::new(&scene, config, setup, rng::stream(self.seed, index as u64), reader)?;
         Ok((scene, planner))
     }
 
@@ -189,9 +194,8 @@ impl CollectPlan {
         })
     }
 
-    /// Collects `objects` (of the set with id `object_set`) as [`collect_reporting`](Self::collect_reporting)
-    /// does and gathers the readings, object by object, into a dataset whose header says how they
-    /// were made.
+    /// [`Collect::dataset`] of this plan on `threads` threads (0: all cores), running
+    /// `on_converged` after each converged reading.
     pub fn collect_dataset(
         &self,
         object_set: &str,
@@ -199,7 +203,20 @@ impl CollectPlan {
         threads: usize,
         on_converged: &(dyn Fn() + Sync),
     ) -> Result<Dataset, CollectError> {
-        let reports = self.collect_reporting(objects, threads, on_converged)?;
+        Collect::from_plan(*self)
+            .threads(threads)
+            .progress(on_converged)
+            .dataset(object_set, objects)
+    }
+
+    /// The readings of `reports` (one per object of `objects`, of the set with id `object_set`),
+    /// object by object, as a dataset whose header says how they were made.
+    pub fn dataset_of(
+        &self,
+        object_set: &str,
+        objects: &[ObjectSpec],
+        reports: Vec<ExplorationReport>,
+    ) -> Result<Dataset, DatasetError> {
         let header = DatasetHeader::new(
             self.sensor,
             object_set,
@@ -207,9 +224,245 @@ impl CollectPlan {
             self.mode.generator_name(),
             self.seed,
         );
-        Ok(Dataset::new(
-            header,
-            reports.into_iter().flat_map(|r| r.readings).collect(),
-        )?)
+        Dataset::new(header, reports.into_iter().flat_map(|r| r.readings).collect())
+    }
+}
+
+/// The procedure of a [`Collect`] before its check.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Procedure {
+    Sampler(SamplerConfig),
+    Planner(PlannerConfig),
+}
+
+/// A collection run, set up step by step: the procedure (the training sampler of Sec. V-A3 or the
+/// exploration planner of Sec. III-A) and the sensor, then how many converged readings per
+/// object, the seed, the controllers, the perturbation, the threads and a progress callback.
+/// [`run`](Self::run) checks the procedure's parameters once and collects every object; the
+/// readings depend on the seed only, not on the threads.
+///
+/// ```
+/// use glam::DVec3;
+/// use taction::explore::Collect;
+/// use taction::mesh::TriMesh;
+/// use taction::sim::ObjectSpec;
+/// use taction::tactile::SensorConfig;
+///
+/// let objects = [ObjectSpec::new("box", TriMesh::cuboid(DVec3::new(0.03, 0.03, 0.02)))];
+/// let dataset = Collect::sampler(SensorConfig::default())
+///     .from_above()
+///     .per_object(2)
+///     .seed(1)
+///     .threads(1)
+///     .dataset("boxes", &objects)?;
+/// assert_eq!(dataset.header().generator, "sampler from above");
+/// assert_eq!(dataset.converged().count(), 2);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Copy)]
+pub struct Collect<'p> {
+    procedure: Procedure,
+    sensor: SensorConfig,
+    control: Valid<ControlConfig>,
+    perturbation: PerturbationBounds,
+    per_object: usize,
+    seed: u64,
+    threads: usize,
+    progress: Option<&'p (dyn Fn() + Sync)>,
+}
+
+impl Collect<'static> {
+    /// The training sampler with the paper's parameters ([`SamplerConfig::default`]), 100
+    /// readings per object, seed 0, the default controllers, no perturbation, all cores.
+    pub fn sampler(sensor: SensorConfig) -> Self {
+        Self::with(Procedure::Sampler(SamplerConfig::default()), sensor)
+    }
+
+    /// The exploration planner with `config` (checked by [`run`](Collect::run)), with the
+    /// defaults of [`sampler`](Self::sampler) otherwise.
+    pub fn planner(sensor: SensorConfig, config: PlannerConfig) -> Self {
+        Self::with(Procedure::Planner(config), sensor)
+    }
+
+    /// The run `plan` describes, on all cores.
+    pub fn from_plan(plan: CollectPlan) -> Self {
+        let procedure = match plan.mode {
+            CollectMode::Sampler(c) => Procedure::Sampler(c.into_inner()),
+            CollectMode::Planner(c) => Procedure::Planner(c.into_inner()),
+        };
+        Self {
+            control: plan.control,
+            perturbation: plan.perturbation,
+            per_object: plan.readings_per_object,
+            seed: plan.seed,
+            ..Self::with(procedure, plan.sensor)
+        }
+    }
+
+    fn with(procedure: Procedure, sensor: SensorConfig) -> Self {
+        Self {
+            procedure,
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+            per_object: 100,
+            seed: 0,
+            threads: 0,
+            progress: None,
+        }
+    }
+}
+
+impl<'p> Collect<'p> {
+    /// Converged readings wanted per object.
+    pub fn per_object(self, readings: usize) -> Self {
+        Self {
+            per_object: readings,
+            ..self
+        }
+    }
+
+    /// The run's seed: each object's random stream and sensor noise stream derive from it.
+    pub fn seed(self, seed: u64) -> Self {
+        Self { seed, ..self }
+    }
+
+    /// Worker threads (0: one per core); the readings do not depend on it.
+    pub fn threads(self, threads: usize) -> Self {
+        Self { threads, ..self }
+    }
+
+    /// The surface contact controllers that settle every touch (Sec. III-B).
+    pub fn control(self, control: Valid<ControlConfig>) -> Self {
+        Self { control, ..self }
+    }
+
+    /// How far the object is moved after every reading.
+    pub fn perturbation(self, perturbation: PerturbationBounds) -> Self {
+        Self {
+            perturbation,
+            ..self
+        }
+    }
+
+    /// The sampler's parameters (a planner run ignores them).
+    pub fn sampler_config(self, config: SamplerConfig) -> Self {
+        self.map_sampler(|_| config)
+    }
+
+    /// Sampler: approach only from above (the raised letters, Sec. V-D).
+    pub fn from_above(self) -> Self {
+        self.map_sampler(|c| SamplerConfig {
+            from_above_only: true,
+            ..c
+        })
+    }
+
+    /// Sampler: only starts the exploring arm can reach ([`SamplerConfig::reachable_by_arm`]).
+    pub fn reachable_by_arm(self) -> Self {
+        self.map_sampler(|c| SamplerConfig {
+            reachable_by_arm: true,
+            ..c
+        })
+    }
+
+    fn map_sampler(self, change: impl FnOnce(SamplerConfig) -> SamplerConfig) -> Self {
+        match self.procedure {
+            Procedure::Sampler(c) => Self {
+                procedure: Procedure::Sampler(change(c)),
+                ..self
+            },
+            Procedure::Planner(_) => self,
+        }
+    }
+
+    /// Runs `on_converged` (from any worker thread) after each converged reading of any object:
+    /// what progress bars count.
+    pub fn progress<'q>(self, on_converged: &'q (dyn Fn() + Sync)) -> Collect<'q> {
+        Collect {
+            progress: Some(on_converged),
+            procedure: self.procedure,
+            sensor: self.sensor,
+            control: self.control,
+            perturbation: self.perturbation,
+            per_object: self.per_object,
+            seed: self.seed,
+            threads: self.threads,
+        }
+    }
+
+    /// The checked plan: everything the readings depend on (what an experiment's cache key hashes).
+    pub fn plan(&self) -> Result<CollectPlan, RangeError> {
+        let mode = match self.procedure {
+            Procedure::Sampler(c) => CollectMode::Sampler(Valid::new(c)?),
+            Procedure::Planner(c) => CollectMode::Planner(Valid::new(c)?),
+        };
+        Ok(CollectPlan {
+            mode,
+            sensor: self.sensor,
+            control: self.control,
+            perturbation: self.perturbation,
+            readings_per_object: self.per_object,
+            seed: self.seed,
+        })
+    }
+
+    /// Collects every object, one report per object in object order.
+    pub fn run(&self, objects: &[ObjectSpec]) -> Result<Vec<ExplorationReport>, CollectError> {
+        let plan = self.plan()?;
+        let on_converged = self.progress.unwrap_or(&|| {});
+        Ok(plan.collect_reporting(objects, self.threads, on_converged)?)
+    }
+
+    /// Collects every object (of the set with id `object_set`) into a dataset whose header says
+    /// how the readings were made.
+    pub fn dataset(&self, object_set: &str, objects: &[ObjectSpec]) -> Result<Dataset, CollectError> {
+        let reports = self.run(objects)?;
+        Ok(self.plan()?.dataset_of(object_set, objects, reports)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_generator_name_says_how_the_sampler_was_restricted() {
+        let name = |collect: Collect| collect.plan().unwrap().mode.generator_name();
+        let sampler = || Collect::sampler(SensorConfig::default());
+        assert_eq!(name(sampler()), "sampler");
+        assert_eq!(name(sampler().from_above()), "sampler from above");
+        assert_eq!(name(sampler().reachable_by_arm()), "sampler reachable by the arm");
+        assert_eq!(
+            name(sampler().from_above().reachable_by_arm()),
+            "sampler from above, reachable by the arm"
+        );
+        let planner = PlannerConfig {
+            local_probability: 0.8,
+            ..PlannerConfig::default()
+        };
+        assert_eq!(
+            name(Collect::planner(SensorConfig::default(), planner).from_above()),
+            "planner L=0.8"
+        );
+    }
+
+    #[test]
+    fn a_plan_comes_back_from_its_builder_unchanged() {
+        let plan = CollectPlan {
+            mode: CollectMode::Sampler(Valid::default()),
+            sensor: SensorConfig::default(),
+            control: Valid::default(),
+            perturbation: PerturbationBounds::new(5.0, 0.05).unwrap(),
+            readings_per_object: 7,
+            seed: 3,
+        };
+        assert_eq!(Collect::from_plan(plan).plan().unwrap(), plan);
+        let bad = PlannerConfig {
+            max_iterations: 0,
+            ..PlannerConfig::default()
+        };
+        let error = Collect::planner(SensorConfig::default(), bad).plan().unwrap_err();
+        assert_eq!(error.field, "max_iterations");
     }
 }

@@ -7,6 +7,7 @@ pub mod planner;
 pub(crate) mod reach;
 pub(crate) mod report;
 pub(crate) mod sampler;
+pub(crate) mod setup;
 pub(crate) mod surface_sampling;
 pub(crate) mod tree;
 
@@ -15,6 +16,8 @@ pub use grid::ReadingGrid;
 pub use planner::{Planner, PlannerConfig};
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;
-pub use sampler::{SamplerConfig, sample_readings};
+pub use collect::{Collect, CollectError, CollectMode, CollectPlan, sensor_reader};
+pub use sampler::{SamplerConfig, TrainingSampler};
+pub use setup::TouchSetup;
 pub use surface_sampling::{SurfacePoint, SurfaceSampler};
 pub use tree::{ExplorationTree, Vertex};

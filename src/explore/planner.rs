@@ -43,21 +43,22 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
-use crate::control::{ControlConfig, ControlError, settle};
+use crate::control::{ControlError, settle};
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
 use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading};
+use crate::explore::setup::TouchSetup;
 use crate::explore::tree::ExplorationTree;
 use crate::mesh::SizeLimit;
 use crate::rng::Rng;
 use crate::sim::arm::{Execution, PAD_SITE, Watch};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
 use crate::sim::{
-    Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget,
-    PerturbationBounds, Scene, SceneState,
+    Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget, Scene,
+    SceneState,
 };
-use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
+use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The planner's parameters.
@@ -93,9 +94,9 @@ pub struct PlannerConfig {
 }
 
 /// Planner iterations allowed per converged reading asked for. The default budget (20,000
-/// iterations) was sized for the paper's 100 test readings per object; a training set of 1000 per
-/// object from the arm stopped 11 of 12 shapes short at that budget (390-992 readings) and completed
-/// on every one at 200 per reading.
+/// iterations) was sized for the paper's 100 test readings per object; a training set from the
+/// arm asks for ten times as many, and a budget that does not grow with it stops short (the
+/// measurements are in `docs/measurements.md`, "Training that matches the arm").
 pub const ITERATIONS_PER_READING: usize = 200;
 
 impl PlannerConfig {
@@ -145,9 +146,8 @@ impl PlannerConfig {
     /// by [`WORKSPACE_MARGIN_M`], within the configured box (what the arm reaches; its floor stays
     /// above the table). The box is the set's, the same whichever object is explored: the planner is
     /// still told nothing of the object's identity, pose or shape (Sec. III-A). Fewer global targets
-    /// fall in empty space, which is what bounded the global strategy (L = 0): on the 12 `shapes` in
-    /// the default 30 x 30 x 20 cm box it converged fewer than 100 readings on 8 objects within
-    /// 20,000 iterations.
+    /// fall in empty space, which is what bounds the global strategy (L = 0) in the full box
+    /// (`docs/guide.md`, "Exploration"; `tests/explore_shapes.rs` checks every `shapes` object).
     pub fn fitted_to(self, objects: &[ObjectSpec]) -> Self {
         let spheres = objects.iter().filter_map(|o| {
             let (lo, hi) = o.mesh.bounds()?;
@@ -234,20 +234,37 @@ impl Check for PlannerConfig {
 }
 
 /// Where one iteration expands: from tree vertex `vertex` toward `target`, carried as `strategy`
-/// says, its reading tagged `label`.
-struct Expansion {
+/// says, its reading of `object` tagged `label`; a physics fault while settling restores
+/// `checkpoint`.
+struct Expansion<'a> {
     vertex: usize,
     strategy: Strategy,
     label: Strategy,
     target: DVec3,
+    object: &'a str,
+    checkpoint: &'a SceneState,
+}
+
+/// What a run records as it goes: every reading attempt, and whom to tell of each converged one.
+struct Record<'r> {
+    report: ExplorationReport,
+    on_converged: &'r mut dyn FnMut(),
+}
+
+impl Record<'_> {
+    fn push(&mut self, reading: Reading) {
+        let converged = reading.is_converged();
+        self.report.readings.push(reading);
+        if converged {
+            (self.on_converged)();
+        }
+    }
 }
 
 /// The planner's state for one exploration run.
 pub struct Planner<R> {
     config: Valid<PlannerConfig>,
-    control: Valid<ControlConfig>,
-    sensor: SensorConfig,
-    perturbation: PerturbationBounds,
+    setup: TouchSetup,
     /// Precise solver for the controllers' small commands.
     ik: InverseKinematics,
     /// Solver for expansion steps, where a fraction of a millimetre does not matter.
@@ -317,14 +334,12 @@ where
     pub fn new(
         scene: &Scene,
         config: Valid<PlannerConfig>,
-        control: Valid<ControlConfig>,
-        sensor: SensorConfig,
-        perturbation: PerturbationBounds,
+        setup: TouchSetup,
         rng: Rng,
         reader: R,
     ) -> Result<Self, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
-        let t = sensor.thickness_m;
+        let t = setup.sensor.thickness_m;
         let (ik_options, motion, expansion_motion) = match config.execution {
             Execution::Servo => {
                 let (ik, motion) = precise_motion();
@@ -338,16 +353,14 @@ where
         let ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
         let expansion_ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
         let covering_reach_m = match arm.back_geom() {
-            Some(g) => covering_reach_m(&sensor, scene.model().geom_size()[g]),
+            Some(g) => covering_reach_m(&setup.sensor, scene.model().geom_size()[g]),
             None => f64::INFINITY,
         };
         let q = arm.q(scene.data());
         let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
         Ok(Self {
             config,
-            control,
-            sensor,
-            perturbation,
+            setup,
             ik,
             expansion_ik,
             motion,
@@ -405,24 +418,16 @@ where
         on_converged: &mut dyn FnMut(),
     ) -> Result<ExplorationReport, ControlError> {
         let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
-        let mut report = ExplorationReport::default();
-        while report.converged() < converged_target && report.iterations < self.config.max_iterations {
-            report.iterations += 1;
-            let (strategy, target) = match guidance {
-                None => match self.propose() {
-                    Some(proposal) => proposal,
-                    None => continue,
-                },
-                Some(guide) => {
-                    let proposals: Vec<(Strategy, DVec3)> = (0..guide.candidates.max(1))
-                        .filter_map(|_| self.propose())
-                        .collect();
-                    let targets: Vec<DVec3> = proposals.iter().map(|p| p.1).collect();
-                    let Some(best) = best_candidate(&guide.scorer.score(&targets)) else {
-                        continue;
-                    };
-                    proposals[best]
-                }
+        let mut record = Record {
+            report: ExplorationReport::default(),
+            on_converged,
+        };
+        while record.report.converged() < converged_target
+            && record.report.iterations < self.config.max_iterations
+        {
+            record.report.iterations += 1;
+            let Some((strategy, target)) = self.choose_target(guidance) else {
+                continue;
             };
             // How the pad is carried toward the target follows the proposal's kind; the reading
             // is tagged with the strategy that chose it.
@@ -432,11 +437,7 @@ where
                 strategy
             };
             let vertex = self.tree.nearest(target);
-            arm.place(scene, &self.tree.vertices()[vertex].q.clone());
-            if vertex != 0 && arm.collision(scene).is_some() {
-                // A perturbation moved the object into the arm at this vertex: expanding from it
-                // would only collide again.
-                self.tree.block(vertex);
+            if !self.return_to(scene, &arm, vertex) {
                 continue;
             }
             // A physics fault anywhere in this iteration puts the world back here (the arm at the
@@ -447,90 +448,79 @@ where
                 strategy,
                 label,
                 target,
-            };
-            match self.expand(
-                scene,
-                &arm,
                 object,
-                &expansion,
-                &checkpoint,
-                &mut report,
-                on_converged,
-            ) {
+                checkpoint: &checkpoint,
+            };
+            match self.expand(scene, &arm, &expansion, &mut record) {
                 Ok(()) => {}
                 Err(e) if e.is_physics_fault() => {
                     scene.restore(&checkpoint)?;
-                    *report.expansion_stops.entry(CauseKind::PhysicsFault).or_insert(0) += 1;
+                    *record
+                        .report
+                        .expansion_stops
+                        .entry(CauseKind::PhysicsFault)
+                        .or_insert(0) += 1;
                 }
                 Err(e) => return Err(e),
             }
         }
-        Ok(report)
+        Ok(record.report)
+    }
+
+    /// The iteration's target: one proposal by the paper's rule ([`propose`](Self::propose)), or
+    /// with `guidance` the one of its candidates the scorer rates highest. `None`: no target this
+    /// iteration.
+    fn choose_target(&mut self, guidance: Option<ActiveGuidance<'_>>) -> Option<(Strategy, DVec3)> {
+        let Some(guide) = guidance else {
+            return self.propose();
+        };
+        let proposals: Vec<(Strategy, DVec3)> = (0..guide.candidates.max(1))
+            .filter_map(|_| self.propose())
+            .collect();
+        let targets: Vec<DVec3> = proposals.iter().map(|p| p.1).collect();
+        let best = best_candidate(&guide.scorer.score(&targets))?;
+        Some(proposals[best])
+    }
+
+    /// Resets the arm to tree vertex `vertex` (Sec. III-A; the module docs say why it is not
+    /// retraced); `false` when a perturbation has since moved the object into the arm there: the
+    /// vertex is blocked, expanding from it would only collide again.
+    fn return_to(&mut self, scene: &mut Scene, arm: &Arm, vertex: usize) -> bool {
+        arm.place(scene, &self.tree.vertices()[vertex].q.clone());
+        if vertex != 0 && arm.collision(scene).is_some() {
+            self.tree.block(vertex);
+            return false;
+        }
+        true
     }
 
     /// One iteration's expansion toward `expansion.target` in small steps, until a step is stopped
     /// (a collision, no IK solution) or the sensor feels something, when surface contact control
     /// takes over and its reading is recorded (a physics fault there: an `aborted` reading, the
-    /// world restored to `checkpoint`). A physics fault elsewhere is the caller's to count.
-    #[allow(clippy::too_many_arguments)]
+    /// world restored to the checkpoint). A physics fault elsewhere is the caller's to count.
     fn expand(
         &mut self,
         scene: &mut Scene,
         arm: &Arm,
-        object: &str,
-        expansion: &Expansion,
-        checkpoint: &SceneState,
-        report: &mut ExplorationReport,
-        on_converged: &mut dyn FnMut(),
+        expansion: &Expansion<'_>,
+        record: &mut Record<'_>,
     ) -> Result<(), ControlError> {
-        let threshold = self.control.effective_contact_threshold();
-        let &Expansion {
-            mut vertex,
-            strategy,
-            label,
-            target,
-        } = expansion;
+        let threshold = self.setup.control.effective_contact_threshold();
+        let mut vertex = expansion.vertex;
         let facing = self.tree.vertices()[vertex].pad_normal;
         for _ in 0..self.config.max_steps_per_iteration {
             let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-            let to_target = target - pad.center_m;
-            let distance = to_target.length();
-            if distance < 1e-3 {
+            let Some(step) = self.step_toward(&pad, expansion, facing) else {
                 break;
-            }
-            let direction = to_target / distance;
-            let next = pad.center_m + direction * distance.min(self.config.step_m);
-            let normal = match strategy {
-                Strategy::Local => facing,
-                _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
             };
-            let start = arm.q(scene.data());
-            // If the turned pad cannot be reached, try the step keeping the pad's orientation.
-            let solved = self
-                .expansion_ik
-                .solve(
-                    &PadTarget {
-                        center_m: next,
-                        normal,
-                    },
-                    &start,
-                )
-                .or_else(|_| {
-                    self.expansion_ik.solve(
-                        &PadTarget {
-                            center_m: next,
-                            normal: pad.normal,
-                        },
-                        &start,
-                    )
-                });
-            let Ok(q) = solved else {
-                report.unreachable_steps += 1;
+            let Some(q) = self.solve_step(scene, arm, &step, pad.normal) else {
+                record.report.unreachable_steps += 1;
                 break;
             };
             let (outcome, sensed) = self.expand_to(scene, arm, &q, threshold)?;
             if let MoveOutcome::Collided(c) = outcome {
-                *report
+                *record
+                    .report
                     .expansion_stops
                     .entry(AttemptCause::from(&c).kind())
                     .or_insert(0) += 1;
@@ -543,38 +533,90 @@ where
                     .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
                 continue;
             }
-            let mut reading = self.settle_here(scene, arm, object, label, checkpoint)?;
-            if reading.status == ContactStatus::Converged
-                && covering_meets_table(&reading.image, &self.sensor)
-            {
-                reading.status = ContactStatus::Collision;
-                reading.cause = Some(AttemptCause::CoveringOnTable);
-            }
-            let converged = reading.status == ContactStatus::Converged;
-            let pose = reading.image.pose().copied().unwrap_or(pad);
-            report.readings.push(reading);
-            if converged {
-                on_converged();
-                self.grid.add(pose.center_m);
-                let lifted = PadTarget {
-                    center_m: pose.center_m - pose.normal * self.config.lift_off_m,
-                    normal: pose.normal,
-                };
-                let start = arm.q(scene.data());
-                if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start)
-                    && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)? == MoveOutcome::Reached
-                {
-                    let q = arm.q(scene.data());
-                    let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
-                    self.tree.add(vertex, q, pad.center_m, pad.normal);
-                }
-            }
-            if !self.perturbation.is_none() {
-                let width = scene.object_width_m().ok_or(crate::sim::SimError::NoObject)?;
-                let p = self.perturbation.draw(width, &mut self.rng);
-                scene.perturb_object(&p)?;
-            }
-            break;
+            return self.read_surface(scene, arm, expansion, (vertex, pad), record);
+        }
+        Ok(())
+    }
+
+    /// The next step from the pad at `pad` toward the expansion's target: at most `step_m` along
+    /// the way, the pad facing the vertex's surface on a local expansion, else turned toward the
+    /// motion (at most `max_turn_per_step_rad`). `None` once the target is reached.
+    fn step_toward(&self, pad: &PadPose, expansion: &Expansion<'_>, facing: DVec3) -> Option<PadTarget> {
+        let to_target = expansion.target - pad.center_m;
+        let distance = to_target.length();
+        if distance < 1e-3 {
+            return None;
+        }
+        let direction = to_target / distance;
+        let next = pad.center_m + direction * distance.min(self.config.step_m);
+        let normal = match expansion.strategy {
+            Strategy::Local => facing,
+            _ => turn_toward(pad.normal, direction, self.config.max_turn_per_step_rad),
+        };
+        Some(PadTarget {
+            center_m: next,
+            normal,
+        })
+    }
+
+    /// The arm's configuration for `step`; if the turned pad cannot be reached, the step keeping
+    /// the pad's orientation `normal`. `None`: no solution either way.
+    fn solve_step(&mut self, scene: &Scene, arm: &Arm, step: &PadTarget, normal: DVec3) -> Option<Vec<f64>> {
+        let start = arm.q(scene.data());
+        self.expansion_ik
+            .solve(step, &start)
+            .or_else(|_| {
+                self.expansion_ik.solve(
+                    &PadTarget {
+                        center_m: step.center_m,
+                        normal,
+                    },
+                    &start,
+                )
+            })
+            .ok()
+    }
+
+    /// The sensor felt the object (Sec. III-B): the controllers settle a reading here (a reading
+    /// pressed on the table relabelled a collision), a converged one enters the grid and its
+    /// lifted-off configuration the tree (as a child of `at.0`; `at.1` is the pad's pose before
+    /// the last step, the reading's pose when its image has none), then the object is perturbed.
+    fn read_surface(
+        &mut self,
+        scene: &mut Scene,
+        arm: &Arm,
+        expansion: &Expansion<'_>,
+        at: (usize, PadPose),
+        record: &mut Record<'_>,
+    ) -> Result<(), ControlError> {
+        let (vertex, pad) = at;
+        let mut reading = self.settle_here(scene, arm, expansion.object, expansion.label, expansion.checkpoint)?;
+        relabel_table_contact(&mut reading, &self.setup.sensor);
+        let converged = reading.is_converged();
+        let pose = reading.image.pose().copied().unwrap_or(pad);
+        record.push(reading);
+        if converged {
+            self.grid.add(pose.center_m);
+            self.lift_off(scene, arm, vertex, &pose)?;
+        }
+        self.setup.perturb(scene, &mut self.rng)
+    }
+
+    /// Lifts the pad off the surface it read at `pose` along its normal by `lift_off_m`, and adds
+    /// the configuration the arm reached to the tree as a child of `vertex`, so local expansions
+    /// start facing the surface they read (nothing when no checked motion gets there).
+    fn lift_off(&mut self, scene: &mut Scene, arm: &Arm, vertex: usize, pose: &PadPose) -> Result<(), ControlError> {
+        let lifted = PadTarget {
+            center_m: pose.center_m - pose.normal * self.config.lift_off_m,
+            normal: pose.normal,
+        };
+        let start = arm.q(scene.data());
+        if let Ok(q_lift) = self.expansion_ik.solve(&lifted, &start)
+            && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)? == MoveOutcome::Reached
+        {
+            let q = arm.q(scene.data());
+            let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+            self.tree.add(vertex, q, pad.center_m, pad.normal);
         }
         Ok(())
     }
@@ -638,7 +680,7 @@ where
             Execution::Servo => arm.move_to(scene, q, &self.expansion_motion, read)?,
             Execution::Kinematic => {
                 let reach_m = self.covering_reach_m;
-                let fine_m = self.control.approach_step_thickness * self.sensor.thickness_m;
+                let fine_m = self.setup.control.approach_step_thickness * self.setup.sensor.thickness_m;
                 let horizon_m = reach_m + self.expansion_motion.max_pad_step_m;
                 arm.move_kinematic(scene, q, &self.expansion_motion, |s| {
                     if reach_m.is_finite()
@@ -684,8 +726,7 @@ where
         let Self {
             ik,
             reader,
-            sensor,
-            control,
+            setup: TouchSetup { sensor, control, .. },
             motion,
             covering: _,
             ..
@@ -699,6 +740,15 @@ where
             }
             Err(e) => Err(e),
         }
+    }
+}
+
+/// A converged reading whose covering meets the table ([`covering_meets_table`]) becomes a
+/// `Collision` with the cause [`AttemptCause::CoveringOnTable`].
+fn relabel_table_contact(reading: &mut Reading, sensor: &SensorConfig) {
+    if reading.is_converged() && covering_meets_table(&reading.image, sensor) {
+        reading.status = ContactStatus::Collision;
+        reading.cause = Some(AttemptCause::CoveringOnTable);
     }
 }
 

@@ -3,9 +3,9 @@
 //! testing will.
 //!
 //! The arm stands on the table beside the object and cannot reach the underside resting on the
-//! table, nor, in general, a patch facing down or away behind the object: on the 12 shapes the
-//! arm's pad looked up in 0-11% of its readings, the free sampler's in 15-30%, and the sampler read
-//! within 1 cm of the table 4-42% of the time where the arm never did. A draw passes when the
+//! table, nor, in general, a patch facing down or away behind the object, which the free sampler
+//! reads (how often, on the 12 shapes: `docs/measurements.md`, "Training that matches the arm").
+//! A draw passes when the
 //! arm's inverse kinematics places the pad at the start pose with no part of the arm touching
 //! anything; the start is then the pose the arm actually takes, its roll about the normal
 //! included, which the arm's controllers then hold (`InverseKinematics::solve_with_up`).

@@ -91,7 +91,7 @@ impl ExplorationReport {
     pub fn converged(&self) -> usize {
         self.readings
             .iter()
-            .filter(|r| r.status == ContactStatus::Converged)
+            .filter(|r| r.is_converged())
             .count()
     }
 

@@ -15,16 +15,17 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use crate::control::free_pad::FreePad;
-use crate::control::{ControlConfig, ControlError, settle};
-use crate::dataset::{ContactStatus, Strategy};
+use crate::control::{ControlError, settle};
+use crate::dataset::{Reading, Strategy};
 use crate::explore::reach::{ArmReach, carried};
 use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading};
+use crate::explore::setup::TouchSetup;
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::rng::Rng;
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SimError};
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::sim::{ObjectSpec, Scene, SimError};
+use crate::tactile::{PadPose, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The sampler's parameters.
@@ -97,100 +98,189 @@ fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
     a * phi.cos() + b * phi.sin()
 }
 
-/// Collects `converged_target` converged readings of the object in `scene` (which holds the object and
-/// a free-floating pad), perturbing the object after each reading if `perturbation` allows;
-/// `on_converged` runs after each converged reading (progress reports).
-#[allow(clippy::too_many_arguments)]
-pub fn sample_readings<R>(
-    scene: &mut Scene,
-    object: &str,
-    sensor: SensorConfig,
-    control: &Valid<ControlConfig>,
-    config: &Valid<SamplerConfig>,
-    perturbation: PerturbationBounds,
-    converged_target: usize,
-    rng: &mut Rng,
+/// The training sampler of one object's run (Sec. V-A3): its parameters, what every touch
+/// shares, its random stream and the sensor's reader.
+pub struct TrainingSampler<R> {
+    config: Valid<SamplerConfig>,
+    setup: TouchSetup,
+    rng: Rng,
     reader: R,
-    on_converged: &mut dyn FnMut(),
-) -> Result<ExplorationReport, ControlError>
+}
+
+impl<R> TrainingSampler<R>
 where
     R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
 {
-    let mesh: TriMesh = scene.object().ok_or(SimError::NoObject)?.mesh.clone();
-    let up_only = config.from_above_only;
-    let surface =
-        SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
-            SimError::Object {
-                name: object.to_string(),
-                message: "no surface area to sample".into(),
+    pub fn new(config: Valid<SamplerConfig>, setup: TouchSetup, rng: Rng, reader: R) -> Self {
+        Self {
+            config,
+            setup,
+            rng,
+            reader,
+        }
+    }
+
+    /// Collects `converged_target` converged readings of the object in `scene` (which holds the
+    /// object and a free-floating pad), perturbing the object after each reading if the setup's
+    /// perturbation allows; every attempt, whatever its status, is returned in order.
+    pub fn sample(
+        self,
+        scene: &mut Scene,
+        object: &str,
+        converged_target: usize,
+    ) -> Result<ExplorationReport, ControlError> {
+        self.sample_reporting(scene, object, converged_target, &mut || {})
+    }
+
+    /// [`sample`](Self::sample), running `on_converged` after each converged reading (progress
+    /// reports).
+    pub fn sample_reporting(
+        self,
+        scene: &mut Scene,
+        object: &str,
+        converged_target: usize,
+        on_converged: &mut dyn FnMut(),
+    ) -> Result<ExplorationReport, ControlError> {
+        let Self {
+            config,
+            setup,
+            mut rng,
+            reader,
+        } = self;
+        let mut starts = Starts::on(scene, object, &config)?;
+        let mut pad = FreePad::new(scene, setup.sensor, reader)?;
+        let mut report = ExplorationReport::default();
+        let max_attempts = converged_target
+            .saturating_mul(config.max_attempts_per_reading)
+            .max(1);
+        while report.converged() < converged_target && report.iterations < max_attempts {
+            report.iterations += 1;
+            let object_pose = pad.scene().object_pose().ok_or(SimError::NoObject)?;
+            let Some(start) = starts.draw(object_pose, &mut rng) else {
+                continue;
+            };
+            let reading = settle_from(&mut pad, &start, &setup, object, object_pose)?;
+            let converged = reading.is_converged();
+            report.readings.push(reading);
+            if converged {
+                on_converged();
             }
-        })?;
-    let mut reach = match config.reachable_by_arm {
-        true => Some(ArmReach::new(ObjectSpec::new(object, mesh.clone()))?),
-        false => None,
-    };
-    let mut pad = FreePad::new(scene, sensor, reader)?;
-    let mut report = ExplorationReport::default();
-    let max_attempts = converged_target
-        .saturating_mul(config.max_attempts_per_reading)
-        .max(1);
-    let tilt_max = config.orientation_noise_deg.to_radians();
-    while report.converged() < converged_target && report.iterations < max_attempts {
-        report.iterations += 1;
-        let object_pose = pad.scene().object_pose().ok_or(SimError::NoObject)?;
-        let local = surface.sample(&mesh, rng);
+            setup.perturb(pad.scene(), &mut rng)?;
+        }
+        Ok(report)
+    }
+}
+
+/// Where the sampler's touches start: area-weighted points of the object's faces (only the
+/// upward ones from above), and the arm's reach when only its starts are wanted.
+struct Starts {
+    mesh: TriMesh,
+    surface: SurfaceSampler,
+    reach: Option<ArmReach>,
+    back_off_m: f64,
+    tilt_max_rad: f64,
+    from_above: bool,
+}
+
+impl Starts {
+    /// The starts on the object in `scene` named `object`; an error when it has no face to sample.
+    fn on(scene: &Scene, object: &str, config: &SamplerConfig) -> Result<Self, ControlError> {
+        let mesh: TriMesh = scene.object().ok_or(SimError::NoObject)?.mesh.clone();
+        let up_only = config.from_above_only;
+        let surface =
+            SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
+                SimError::Object {
+                    name: object.to_string(),
+                    message: "no surface area to sample".into(),
+                }
+            })?;
+        let reach = match config.reachable_by_arm {
+            true => Some(ArmReach::new(ObjectSpec::new(object, mesh.clone()))?),
+            false => None,
+        };
+        Ok(Self {
+            mesh,
+            surface,
+            reach,
+            back_off_m: config.back_off_m,
+            tilt_max_rad: config.orientation_noise_deg.to_radians(),
+            from_above: up_only,
+        })
+    }
+
+    /// One start with the object at `object_pose`, or `None` when the arm cannot take it.
+    fn draw(&mut self, object_pose: Pose, rng: &mut Rng) -> Option<PadPose> {
+        let start = self.facing_a_surface_point(object_pose, rng);
+        match &mut self.reach {
+            Some(reach) => reachable_start(reach, start, object_pose, rng),
+            None => Some(start),
+        }
+    }
+
+    /// The paper's start (Sec. V-A3): a surface point drawn by area, moved back along the
+    /// triangle's normal, the pad facing it with a small random tilt and a uniform roll.
+    fn facing_a_surface_point(&self, object_pose: Pose, rng: &mut Rng) -> PadPose {
+        let local = self.surface.sample(&self.mesh, rng);
         let point = object_pose.transform_point(local.point_m);
-        let outward = if up_only {
+        let outward = if self.from_above {
             DVec3::Z
         } else {
             object_pose.transform_vector(local.normal)
         };
         let tilt_axis = random_perpendicular(outward, rng);
-        let tilt = DQuat::from_axis_angle(tilt_axis, rng.random_range(0.0..=1.0) * tilt_max);
+        let tilt = DQuat::from_axis_angle(tilt_axis, rng.random_range(0.0..=1.0) * self.tilt_max_rad);
         let normal = (tilt * -outward).normalize();
         let up = random_perpendicular(normal, rng);
-        let mut start = PadPose {
-            center_m: point + outward * config.back_off_m,
+        PadPose {
+            center_m: point + outward * self.back_off_m,
             normal,
             up,
-        };
-        if let Some(reach) = &mut reach {
-            // The arm knows neither the object nor its heading on the table (Sec. III-A): the
-            // start is tested with the object turned about the vertical by a random angle.
-            let heading = DQuat::from_rotation_z(rng.random_range(0.0..std::f64::consts::TAU));
-            let to_arm = reach
-                .object_pose()
-                .compose(&Pose::new(DVec3::ZERO, heading))
-                .compose(&object_pose.inverse());
-            match reach.start_pose(&carried(&start, &to_arm)) {
-                Some(arm_start) => start = carried(&arm_start, &to_arm.inverse()),
-                None => continue,
-            }
-        }
-        // A physics fault during the attempt puts the world back as it was before it.
-        let checkpoint = pad.scene().checkpoint()?;
-        pad.place(&start);
-        let reading = match settle(&mut pad, control) {
-            Ok(outcome) => attempt_reading(outcome, object, object_pose, Strategy::Sampler),
-            Err(e) if e.is_physics_fault() => {
-                pad.scene().restore(&checkpoint)?;
-                aborted_reading(&sensor, start, object, object_pose, Strategy::Sampler)?
-            }
-            Err(e) => return Err(e),
-        };
-        let converged = reading.status == ContactStatus::Converged;
-        report.readings.push(reading);
-        if converged {
-            on_converged();
-        }
-        if !perturbation.is_none() {
-            let scene = pad.scene();
-            let width = scene.object_width_m().ok_or(SimError::NoObject)?;
-            let p = perturbation.draw(width, rng);
-            scene.perturb_object(&p)?;
         }
     }
-    Ok(report)
+}
+
+/// `start` as the arm would take it, or `None` when it cannot. The arm knows neither the object
+/// nor its heading on the table (Sec. III-A): the start is tested with the object turned about the
+/// vertical by a random angle, and the pad gets the arm's roll.
+fn reachable_start(reach: &mut ArmReach, start: PadPose, object_pose: Pose, rng: &mut Rng) -> Option<PadPose> {
+    let heading = DQuat::from_rotation_z(rng.random_range(0.0..std::f64::consts::TAU));
+    let to_arm = reach
+        .object_pose()
+        .compose(&Pose::new(DVec3::ZERO, heading))
+        .compose(&object_pose.inverse());
+    let arm_start = reach.start_pose(&carried(&start, &to_arm))?;
+    Some(carried(&arm_start, &to_arm.inverse()))
+}
+
+/// Places the pad at `start` and lets the local controllers approach and take a measurement
+/// (Sec. V-A3); a physics fault during the attempt puts the world back as it was before it and
+/// gives an `aborted` reading.
+fn settle_from<R>(
+    pad: &mut FreePad<'_, R>,
+    start: &PadPose,
+    setup: &TouchSetup,
+    object: &str,
+    object_pose: Pose,
+) -> Result<Reading, ControlError>
+where
+    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+{
+    let checkpoint = pad.scene().checkpoint()?;
+    pad.place(start);
+    match settle(pad, &setup.control) {
+        Ok(outcome) => Ok(attempt_reading(outcome, object, object_pose, Strategy::Sampler)),
+        Err(e) if e.is_physics_fault() => {
+            pad.scene().restore(&checkpoint)?;
+            Ok(aborted_reading(
+                &setup.sensor,
+                *start,
+                object,
+                object_pose,
+                Strategy::Sampler,
+            )?)
+        }
+        Err(e) => Err(e),
+    }
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ use crate::control::ControlConfig;
 use crate::control::orient::surface_normal;
 use crate::dataset::ContactStatus;
 use crate::explore::collect::sensor_reader;
-use crate::explore::{SamplerConfig, sample_readings};
+use crate::explore::{SamplerConfig, TouchSetup, TrainingSampler};
 use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
 use crate::rng;
 use crate::sim::{ObjectSpec, PerturbationBounds};
@@ -327,19 +327,18 @@ pub fn run_level(
     })?;
     let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
     let reader = sensor_reader(free.sensor().clone());
-    let mut placement = rng::stream(unit_seed, 0);
-    let report = sample_readings(
-        free.scene_mut(),
-        &object.name,
-        sensor,
-        &control,
-        &config.sampler,
-        PerturbationBounds::NONE,
-        config.convergences,
-        &mut placement,
+    let placement = rng::stream(unit_seed, 0);
+    let report = TrainingSampler::new(
+        *config.sampler,
+        TouchSetup {
+            sensor,
+            control,
+            perturbation: PerturbationBounds::NONE,
+        },
+        placement,
         reader,
-        &mut || {},
-    )?;
+    )
+    .sample(free.scene_mut(), &object.name, config.convergences)?;
     let attempts = report.readings.len();
     let count = |s: ContactStatus| report.readings.iter().filter(|r| r.status == s).count();
     let converged = count(ContactStatus::Converged);
@@ -352,7 +351,7 @@ pub fn run_level(
     let iterations: u64 = report
         .readings
         .iter()
-        .filter(|r| r.status == ContactStatus::Converged)
+        .filter(|r| r.is_converged())
         .map(|r| u64::from(r.iterations))
         .sum();
     Ok(ConvergenceRow {
@@ -401,7 +400,7 @@ fn converged_quality(
     for reading in report
         .readings
         .iter()
-        .filter(|r| r.status == ContactStatus::Converged)
+        .filter(|r| r.is_converged())
     {
         let Some(pose) = reading.image.pose() else {
             continue;

@@ -28,7 +28,7 @@ use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::CollectionProgress;
 use crate::experiment::unit::{BoxError, rows_to_csv};
-use crate::explore::collect::CollectPlan;
+use crate::explore::{Collect, CollectPlan};
 use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
 use crate::recognize::{TrainConfig, TrainedModel};
@@ -191,39 +191,7 @@ impl DataStore {
                     format!("{e} (a dataset cached by an earlier run; delete the file to collect it again)")
                 })?
             } else {
-                let started = Instant::now();
-                eprintln!(
-                    "collecting dataset {}/{total}: {} readings of each of {} objects ({}), {}x{} taxels",
-                    i + 1,
-                    request.plan.readings_per_object,
-                    request.objects.specs.len(),
-                    request.plan.mode.generator_name(),
-                    request.plan.sensor.rows,
-                    request.plan.sensor.cols,
-                );
-                let progress = CollectionProgress::new(
-                    &format!("  dataset {}/{total}", i + 1),
-                    request.objects.specs.len(),
-                    request.plan.readings_per_object,
-                );
-                let dataset = request.plan.collect_dataset(
-                    &request.object_set,
-                    &request.objects.specs,
-                    self.threads,
-                    &|| progress.converged(),
-                )?;
-                progress.finish(dataset.converged_only().len());
-                crate::experiment::files::create_dir_all(&self.root.join("data"))?;
-                dataset.write(&path)?;
-
-                eprintln!(
-                    "  {} readings ({} converged) in {:.1} s -> {}",
-                    dataset.len(),
-                    dataset.converged_only().len(),
-                    started.elapsed().as_secs_f64(),
-                    path.display()
-                );
-                dataset
+                self.collect(request, &path, (i + 1, total))?
             };
             let short = dataset.shortfalls(request.plan.readings_per_object);
             if !short.is_empty() {
@@ -256,6 +224,42 @@ impl DataStore {
             record_shortfalls(experiment_dir, short)?;
         }
         Ok(())
+    }
+
+    /// Collects `request`'s dataset (number `nth.0` of `nth.1` to prepare), in parallel over its
+    /// objects, and writes it to `path`.
+    fn collect(&self, request: &DataRequest, path: &Path, nth: (usize, usize)) -> Result<Dataset, BoxError> {
+        let (n, total) = nth;
+        let started = Instant::now();
+        eprintln!(
+            "collecting dataset {n}/{total}: {} readings of each of {} objects ({}), {}x{} taxels",
+            request.plan.readings_per_object,
+            request.objects.specs.len(),
+            request.plan.mode.generator_name(),
+            request.plan.sensor.rows,
+            request.plan.sensor.cols,
+        );
+        let progress = CollectionProgress::new(
+            &format!("  dataset {n}/{total}"),
+            request.objects.specs.len(),
+            request.plan.readings_per_object,
+        );
+        let dataset = Collect::from_plan(request.plan)
+            .threads(self.threads)
+            .progress(&|| progress.converged())
+            .dataset(&request.object_set, &request.objects.specs)?;
+        progress.finish(dataset.converged().count());
+        crate::experiment::files::create_dir_all(&self.root.join("data"))?;
+        dataset.write(path)?;
+
+        eprintln!(
+            "  {} readings ({} converged) in {:.1} s -> {}",
+            dataset.len(),
+            dataset.converged().count(),
+            started.elapsed().as_secs_f64(),
+            path.display()
+        );
+        Ok(dataset)
     }
 
     /// A dataset made available by [`prepare`](Self::prepare).

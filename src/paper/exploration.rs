@@ -61,7 +61,7 @@ impl Placement {
     pub fn from_readings<'a>(readings: impl IntoIterator<Item = &'a Reading>) -> Vec<Placement> {
         readings
             .into_iter()
-            .filter(|r| r.status == ContactStatus::Converged)
+            .filter(|r| r.is_converged())
             .filter_map(|r| {
                 let pad = r.image.pose()?;
                 let to_object = r.object_pose.inverse();

@@ -41,7 +41,7 @@ impl LabelledFeatures {
             .map(|group| {
                 let converged: Vec<&Reading> = group
                     .into_iter()
-                    .filter(|r| r.status == ContactStatus::Converged)
+                    .filter(|r| r.is_converged())
                     .collect();
                 converged
                     .par_iter()
