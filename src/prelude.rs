@@ -19,7 +19,7 @@
 pub use crate::control::{ContactOutcome, ControlConfig, settle};
 pub use crate::dataset::{ContactStatus, Dataset, DatasetHeader, Reading};
 pub use crate::describe::{Descriptor, DescriptorKind};
-pub use crate::explore::collect::{CollectMode, CollectPlan};
+pub use crate::explore::{Collect, CollectMode, CollectPlan};
 pub use crate::explore::{PlannerConfig, SamplerConfig};
 pub use crate::mesh::{ObjectSet, TriMesh};
 pub use crate::recognize::{

@@ -141,7 +141,11 @@ fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
         ));
     }
     if !(0.0..=180.0).contains(&args.perturb_deg) {
-        return Err(flag_error("perturb-deg", args.perturb_deg, "is outside [0, 180] degrees"));
+        return Err(flag_error(
+            "perturb-deg",
+            args.perturb_deg,
+            "is outside [0, 180] degrees",
+        ));
     }
     if !(0.0..=1.0).contains(&args.perturb_frac) {
         return Err(flag_error(
@@ -159,7 +163,11 @@ fn collection(args: &CollectArgs, sensor: SensorConfig, objects: &[ObjectSpec]) 
     match args.mode {
         Mode::Sampler => {
             let collect = Collect::sampler(sensor);
-            let collect = if args.from_above { collect.from_above() } else { collect };
+            let collect = if args.from_above {
+                collect.from_above()
+            } else {
+                collect
+            };
             if args.reachable {
                 collect.reachable_by_arm()
             } else {

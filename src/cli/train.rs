@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use taction::dataset::ContactStatus;
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
@@ -68,11 +67,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(ks) => ks.clone(),
         None => {
             // One feature per converged reading: the fewest any descriptor gives.
-            let converged: Vec<_> = training
-                .readings()
-                .iter()
-                .filter(|r| r.is_converged())
-                .collect();
+            let converged: Vec<_> = training.readings().iter().filter(|r| r.is_converged()).collect();
             let objects: BTreeSet<&str> = converged.iter().map(|r| r.object.as_str()).collect();
             codebook_sizes(args.codebook, objects.len(), converged.len())
         }

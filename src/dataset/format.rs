@@ -306,7 +306,10 @@ impl Dataset {
 
 /// The header line after the magic line, and the rest of the file (`None`: nothing after the
 /// header line).
-fn split_magic_and_header<'t>(text: &'t str, origin: &str) -> Result<(&'t str, Option<&'t str>), DatasetError> {
+fn split_magic_and_header<'t>(
+    text: &'t str,
+    origin: &str,
+) -> Result<(&'t str, Option<&'t str>), DatasetError> {
     let mut lines = text.splitn(3, '\n');
     let magic = lines.next().unwrap_or_default();
     if magic.trim_end() != MAGIC {
@@ -328,13 +331,14 @@ fn split_magic_and_header<'t>(text: &'t str, origin: &str) -> Result<(&'t str, O
 /// `body` without its last line, which must declare the header's `declared` readings.
 fn strip_trailer<'t>(body: &'t str, declared: usize, origin: &str) -> Result<&'t str, DatasetError> {
     let trailer = format!("{END_PREFIX}{declared}\n");
-    body.strip_suffix(&trailer).ok_or_else(|| DatasetError::Truncated {
-        path: origin.to_string(),
-        what: format!(
-            "the last line should be '{}' (the header declares {declared} readings)",
-            trailer.trim_end()
-        ),
-    })
+    body.strip_suffix(&trailer)
+        .ok_or_else(|| DatasetError::Truncated {
+            path: origin.to_string(),
+            what: format!(
+                "the last line should be '{}' (the header declares {declared} readings)",
+                trailer.trim_end()
+            ),
+        })
 }
 
 /// The readings of the CSV `body` (column names, then one row a reading) of a file of format
@@ -640,7 +644,8 @@ fn parse_image(row: &Row, header: &DatasetHeader) -> Result<TactileImage, (Strin
         }
         values.push(value);
     }
-    TactileImage::new(header.sensor.rows, header.sensor.cols, values).map_err(|e| row.error(first_taxel, e.to_string()))
+    TactileImage::new(header.sensor.rows, header.sensor.cols, values)
+        .map_err(|e| row.error(first_taxel, e.to_string()))
 }
 
 /// The row's cause, in this format's vocabulary whatever the file's version (see the module docs).

@@ -123,7 +123,6 @@ impl DatasetHeader {
     pub fn object_index(&self, object: &str) -> Option<usize> {
         self.objects.iter().position(|o| o == object)
     }
-
 }
 
 /// What is wrong with a [`DatasetHeader`], naming the field ([`field`](Self::field)).

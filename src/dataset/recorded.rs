@@ -131,7 +131,11 @@ pub struct Calibration {
 
 /// A calibration line `r<row>c<col>,gain,offset` as `(line, row, col, gain, offset)`; the gain
 /// must not be negative.
-fn parse_calibration_line(record: &[&str], line: u64, origin: &str) -> Result<(u64, usize, usize, f64, f64), RealDataError> {
+fn parse_calibration_line(
+    record: &[&str],
+    line: u64,
+    origin: &str,
+) -> Result<(u64, usize, usize, f64, f64), RealDataError> {
     let invalid = |what: String| RealDataError::Invalid {
         origin: origin.to_string(),
         line,

@@ -160,7 +160,13 @@ impl CollectPlan {
             .map_err(crate::tactile::sensor::TactileError::from)?
             .build()?;
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-        let planner = Planner::new(&scene, config, setup, rng::stream(self.seed, index as u64), reader)?;
+        let planner = Planner::new(
+            &scene,
+            config,
+            setup,
+            rng::stream(self.seed, index as u64),
+            reader,
+        )?;
         Ok((scene, planner))
     }
 
@@ -339,10 +345,7 @@ impl<'p> Collect<'p> {
 
     /// How far the object is moved after every reading.
     pub fn perturbation(self, perturbation: PerturbationBounds) -> Self {
-        Self {
-            perturbation,
-            ..self
-        }
+        Self { perturbation, ..self }
     }
 
     /// The sampler's parameters (a planner run ignores them).

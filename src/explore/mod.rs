@@ -12,11 +12,11 @@ pub(crate) mod surface_sampling;
 pub(crate) mod tree;
 
 pub use active::{ActiveGuidance, Probability, TouchScorer};
+pub use collect::{Collect, CollectError, CollectMode, CollectPlan, sensor_reader};
 pub use grid::ReadingGrid;
 pub use planner::{Planner, PlannerConfig};
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;
-pub use collect::{Collect, CollectError, CollectMode, CollectPlan, sensor_reader};
 pub use sampler::{SamplerConfig, TrainingSampler};
 pub use setup::TouchSetup;
 pub use surface_sampling::{SurfacePoint, SurfaceSampler};

@@ -590,7 +590,13 @@ where
         record: &mut Record<'_>,
     ) -> Result<(), ControlError> {
         let (vertex, pad) = at;
-        let mut reading = self.settle_here(scene, arm, expansion.object, expansion.label, expansion.checkpoint)?;
+        let mut reading = self.settle_here(
+            scene,
+            arm,
+            expansion.object,
+            expansion.label,
+            expansion.checkpoint,
+        )?;
         relabel_table_contact(&mut reading, &self.setup.sensor);
         let converged = reading.is_converged();
         let pose = reading.image.pose().copied().unwrap_or(pad);
@@ -605,7 +611,13 @@ where
     /// Lifts the pad off the surface it read at `pose` along its normal by `lift_off_m`, and adds
     /// the configuration the arm reached to the tree as a child of `vertex`, so local expansions
     /// start facing the surface they read (nothing when no checked motion gets there).
-    fn lift_off(&mut self, scene: &mut Scene, arm: &Arm, vertex: usize, pose: &PadPose) -> Result<(), ControlError> {
+    fn lift_off(
+        &mut self,
+        scene: &mut Scene,
+        arm: &Arm,
+        vertex: usize,
+        pose: &PadPose,
+    ) -> Result<(), ControlError> {
         let lifted = PadTarget {
             center_m: pose.center_m - pose.normal * self.config.lift_off_m,
             normal: pose.normal,

@@ -89,10 +89,7 @@ pub struct ExplorationReport {
 impl ExplorationReport {
     /// Number of converged readings.
     pub fn converged(&self) -> usize {
-        self.readings
-            .iter()
-            .filter(|r| r.is_converged())
-            .count()
+        self.readings.iter().filter(|r| r.is_converged()).count()
     }
 
     /// Expansion steps stopped by a collision of the arm.

@@ -242,7 +242,12 @@ impl Starts {
 /// `start` as the arm would take it, or `None` when it cannot. The arm knows neither the object
 /// nor its heading on the table (Sec. III-A): the start is tested with the object turned about the
 /// vertical by a random angle, and the pad gets the arm's roll.
-fn reachable_start(reach: &mut ArmReach, start: PadPose, object_pose: Pose, rng: &mut Rng) -> Option<PadPose> {
+fn reachable_start(
+    reach: &mut ArmReach,
+    start: PadPose,
+    object_pose: Pose,
+    rng: &mut Rng,
+) -> Option<PadPose> {
     let heading = DQuat::from_rotation_z(rng.random_range(0.0..std::f64::consts::TAU));
     let to_arm = reach
         .object_pose()

@@ -329,7 +329,7 @@ pub fn run_level(
     let reader = sensor_reader(free.sensor().clone());
     let placement = rng::stream(unit_seed, 0);
     let report = TrainingSampler::new(
-        *config.sampler,
+        config.sampler,
         TouchSetup {
             sensor,
             control,
@@ -397,11 +397,7 @@ fn converged_quality(
     };
     let mut clean = FreeFloatingSensor::new(object.clone(), &clean_sensor)?;
     let (mut angle_sum, mut angles, mut error_sum, mut errors) = (0.0, 0usize, 0.0, 0usize);
-    for reading in report
-        .readings
-        .iter()
-        .filter(|r| r.is_converged())
-    {
+    for reading in report.readings.iter().filter(|r| r.is_converged()) {
         let Some(pose) = reading.image.pose() else {
             continue;
         };

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use crate::dataset::{ContactStatus, Reading};
+use crate::dataset::Reading;
 use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::tactile::image::{CONTACT_SHEET_GUTTER_PX, GrayPicture, contact_sheet, write_rgb_png};

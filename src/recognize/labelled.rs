@@ -2,7 +2,6 @@
 
 use rayon::prelude::*;
 
-use crate::dataset::ContactStatus;
 use crate::dataset::{Dataset, Reading};
 use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
@@ -39,10 +38,7 @@ impl LabelledFeatures {
             .by_object()
             .into_iter()
             .map(|group| {
-                let converged: Vec<&Reading> = group
-                    .into_iter()
-                    .filter(|r| r.is_converged())
-                    .collect();
+                let converged: Vec<&Reading> = group.into_iter().filter(|r| r.is_converged()).collect();
                 converged
                     .par_iter()
                     .map(|r| descriptor.describe(&r.image))
