@@ -182,7 +182,7 @@ pub fn object_of_shapes(name: &str, fetch: bool) -> Result<ObjectSpec, MeshError
             ..BuildOptions::default()
         },
     )?;
-    Ok(ObjectSpec::new(built.name, built.mesh))
+    Ok(ObjectSpec::from(built))
 }
 
 /// What a run of the experiment does, besides its objects: the paper's by [`ConvergencePlan::paper`].

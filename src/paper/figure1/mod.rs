@@ -2,25 +2,29 @@
 //! sensor placements at which local controllers converged ... The corresponding tactile images are
 //! shown to the right" (Sec. I), from "100 tactile images ... extracted using the planner, alongside
 //! depictions of the first 50" (Sec. III-A). One planner run on the set's chess piece (the pawn, else
-//! the first object), drawn by [`crate::paper::exploration`], with the placements as CSV.
+//! the first object), drawn by [`write_exploration_png`], with the placements as CSV.
 
 use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::context::Family;
-use super::context::PaperContext;
-use super::figures::default_sensor;
 use crate::atomic::write_atomic;
 use crate::experiment::index::{PICTURE_FILE, PictureSpec, write_index};
 use crate::experiment::spec::to_json;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::PlannerConfig;
 use crate::explore::collect::{CollectMode, CollectPlan};
-use crate::paper::exploration::{Placement, write_exploration_png};
+use crate::paper::context::{Family, PaperContext};
+use crate::paper::figures::default_sensor;
 use crate::rng;
 use crate::sim::PerturbationBounds;
 use crate::valid::Valid;
+
+mod render;
+
+pub use render::{
+    ExplorationView, PAPER_IMAGES_SHOWN, Placement, RgbPicture, render_exploration, write_exploration_png,
+};
 
 pub const EXPERIMENT_NAME: &str = "exploration";
 pub const DESCRIPTION: &str = "Fig. 1: one planner exploration of the chess piece (L = 0.5, 100 converged readings), a patch at every converged placement, the first 50 tactile images beside it";
