@@ -49,14 +49,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         seed: 1,
         ..TrainConfig::default()
     };
-    let model = TrainedModel::fit(&training, None, DescriptorKind::Mnti.build().as_ref(), config, &mut |_| {})?;
+    let model = TrainedModel::fit(
+        &training,
+        None,
+        DescriptorKind::Mnti.build().as_ref(),
+        config,
+        &mut |_| {},
+    )?;
     let recognizer = Recognizer::Single(Box::new(model));
     let (evaluation, trials) = recognizer.evaluate(&test, ReadingRange::new(1, READINGS)?)?;
 
-    println!("{} objects, {trials} trials of the arm's touches", set.objects.len());
+    println!(
+        "{} objects, {trials} trials of the arm's touches",
+        set.objects.len()
+    );
     println!("readings  accuracy  reliability");
     for point in &evaluation.accuracy {
-        println!("{:>8}  {:>8.3}  {:>11.3}", point.n_readings, point.accuracy(), point.reliability);
+        println!(
+            "{:>8}  {:>8.3}  {:>11.3}",
+            point.n_readings,
+            point.accuracy(),
+            point.reliability
+        );
     }
     let last = evaluation.accuracy.last().map_or(0.0, |p| p.accuracy());
     let chance = 1.0 / set.objects.len() as f64;

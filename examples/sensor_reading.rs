@@ -23,7 +23,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         up: DVec3::Y,
     };
     let image = pad.read_at(&pressed)?;
-    println!("the pawn's top, pressed {} m deep:\n{image}", 0.5 * config.thickness_m);
+    println!(
+        "the pawn's top, pressed {} m deep:\n{image}",
+        0.5 * config.thickness_m
+    );
 
     let peak = image.values().iter().copied().fold(0.0, f64::max);
     if peak <= 0.0 {

@@ -404,7 +404,12 @@ impl<'a> LineColumns<'a> {
 
     /// The series a record belongs to: the `legend` template filled from its columns, else the
     /// series columns' values.
-    fn label(&self, csv: &Path, record: &csv::StringRecord, legend: Option<&str>) -> Result<String, ExperimentError> {
+    fn label(
+        &self,
+        csv: &Path,
+        record: &csv::StringRecord,
+        legend: Option<&str>,
+    ) -> Result<String, ExperimentError> {
         let headers = &self.headers;
         Ok(match legend {
             Some(template) => fill_legend(template, |name| {

@@ -186,7 +186,10 @@ where
 }
 
 /// An experiment has units, each key once.
-fn check_units<R, D: DetailRow>(spec: &ExperimentSpec, units: &[Unit<'_, R, D>]) -> Result<(), ExperimentError> {
+fn check_units<R, D: DetailRow>(
+    spec: &ExperimentSpec,
+    units: &[Unit<'_, R, D>],
+) -> Result<(), ExperimentError> {
     if units.is_empty() {
         return Err(ExperimentError::NoUnits {
             experiment: spec.name.to_string(),

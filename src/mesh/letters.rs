@@ -245,7 +245,11 @@ pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMe
 
 /// The outline's contours moved so that the plate (their bounds grown by `margin_m`) is centred on
 /// the origin, and the plate's corners.
-fn centred_on_plate(outline: &GlyphOutline, nesting: &Nesting, margin_m: f64) -> (Vec<Vec<DVec2>>, DVec2, DVec2) {
+fn centred_on_plate(
+    outline: &GlyphOutline,
+    nesting: &Nesting,
+    margin_m: f64,
+) -> (Vec<Vec<DVec2>>, DVec2, DVec2) {
     let all = || outline.contours.iter().flatten();
     let lo = all().fold(DVec2::splat(f64::INFINITY), |m, &p| m.min(p)) - DVec2::splat(margin_m);
     let hi = all().fold(DVec2::splat(f64::NEG_INFINITY), |m, &p| m.max(p)) + DVec2::splat(margin_m);
@@ -281,7 +285,12 @@ impl Builder {
 
     /// Plate level: the rectangle minus the outermost ink contours, then each counter minus the
     /// ink nested in it. Letter level: each ink contour minus its counters.
-    fn caps(&mut self, letter: &LetterRings, (rect, plate_top): (&[DVec2; 4], &[u32]), ch: char) -> Result<(), MeshError> {
+    fn caps(
+        &mut self,
+        letter: &LetterRings,
+        (rect, plate_top): (&[DVec2; 4], &[u32]),
+        ch: char,
+    ) -> Result<(), MeshError> {
         let (contours, nesting) = (&letter.contours, &letter.nesting);
         let what = |part: &str| format!("glyph '{ch}' {part}");
         let reversed: Vec<(Vec<DVec2>, Vec<u32>)> = contours

@@ -95,9 +95,6 @@ pub(super) fn name_of_file(path: &Path) -> Result<String, MeshError> {
         .map(|s| s.to_string_lossy().into_owned())
         .filter(|s| !s.is_empty())
         .ok_or_else(|| MeshError::ObjectSet {
-            what: format!(
-                "{}: cannot name an object from this file name",
-                path.display()
-            ),
+            what: format!("{}: cannot name an object from this file name", path.display()),
         })
 }

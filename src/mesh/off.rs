@@ -42,7 +42,9 @@ fn read_header<'t>(
     builder: &MeshBuilder,
     path: &Path,
 ) -> Result<(usize, usize), MeshError> {
-    let (header_line, header) = lines.next().ok_or_else(|| truncated(path, "no OFF header".into()))?;
+    let (header_line, header) = lines
+        .next()
+        .ok_or_else(|| truncated(path, "no OFF header".into()))?;
     let mut header_tokens = header.split_whitespace();
     let keyword = header_tokens.next().unwrap_or("");
     if !matches!(keyword, "OFF" | "COFF" | "NOFF" | "CNOFF") {

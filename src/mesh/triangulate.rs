@@ -117,7 +117,12 @@ fn check_every_point_used(points: &[DVec2], triangles: &[[usize; 3]]) -> Result<
 }
 
 /// The triangles cover the polygon's area: the outer ring's less the holes'.
-fn check_area(rings: &[Vec<DVec2>], points: &[DVec2], triangles: &[[usize; 3]], scale: f64) -> Result<(), String> {
+fn check_area(
+    rings: &[Vec<DVec2>],
+    points: &[DVec2],
+    triangles: &[[usize; 3]],
+    scale: f64,
+) -> Result<(), String> {
     let expected = ring_area2(&rings[0]).abs() - rings[1..].iter().map(|r| ring_area2(r).abs()).sum::<f64>();
     let got: f64 = triangles
         .iter()

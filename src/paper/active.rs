@@ -265,7 +265,12 @@ impl ActiveUnit<'_> {
     }
 
     /// An L curve: the planner's test datasets recognised by `model`.
-    fn planner_curve(&self, curve: &Curve, model: &TrainedModel, descriptor: &dyn Descriptor) -> Result<Rows, BoxError> {
+    fn planner_curve(
+        &self,
+        curve: &Curve,
+        model: &TrainedModel,
+        descriptor: &dyn Descriptor,
+    ) -> Result<Rows, BoxError> {
         let trials = self.sweep.dataset_trials(
             self.context,
             &self.objects,
@@ -276,7 +281,14 @@ impl ActiveUnit<'_> {
             descriptor,
             &curve.factors,
         )?;
-        curve_rows(self.sweep, model, &curve.factors, &trials, self.counts, self.context.seed)
+        curve_rows(
+            self.sweep,
+            model,
+            &curve.factors,
+            &trials,
+            self.counts,
+            self.context.seed,
+        )
     }
 
     /// The active curve with the object `state` (`perturbation`): every trial's objects explored

@@ -308,7 +308,10 @@ impl TrialPlan<'_> {
     }
 
     /// Every trial's accuracy rows of one descriptor, and the per-label outcomes they count.
-    fn descriptor_rows(&self, kind: DescriptorKind) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+    fn descriptor_rows(
+        &self,
+        kind: DescriptorKind,
+    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
         let descriptor = kind.build();
         let (mut rows, mut per_object) = (Vec::new(), Vec::new());
         for trial in 0..self.options.trials {
@@ -355,7 +358,11 @@ impl TrialPlan<'_> {
     }
 
     /// The features of `frames`, grouped by label.
-    fn describe(&self, descriptor: &dyn Descriptor, frames: &[&RealReading]) -> Result<LabelledFeatures, BoxError> {
+    fn describe(
+        &self,
+        descriptor: &dyn Descriptor,
+        frames: &[&RealReading],
+    ) -> Result<LabelledFeatures, BoxError> {
         let mut per_label: Vec<Vec<Vec<Vec<f64>>>> = vec![Vec::new(); self.labels.len()];
         for frame in frames {
             let j = self

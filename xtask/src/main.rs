@@ -96,7 +96,15 @@ fn run_examples() -> Result<(), String> {
         .collect();
     names.sort();
     for name in &names {
-        cargo(&os(&["run", "--release", "--quiet", "--package", "taction", "--example", name]))?;
+        cargo(&os(&[
+            "run",
+            "--release",
+            "--quiet",
+            "--package",
+            "taction",
+            "--example",
+            name,
+        ]))?;
     }
     Ok(())
 }

@@ -121,7 +121,10 @@ fn write_figure_files(
     seed: u64,
 ) -> Result<(), BoxError> {
     let csv = dir.join(format!("{EXPERIMENT_NAME}.csv"));
-    write_atomic(&csv, &rows_to_csv(&placement_rows(object, placements, seed), &csv)?)?;
+    write_atomic(
+        &csv,
+        &rows_to_csv(&placement_rows(object, placements, seed), &csv)?,
+    )?;
     let config = dir.join("config.json");
     let config_bytes = to_json(
         &Figure1Config {

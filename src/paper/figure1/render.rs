@@ -214,7 +214,13 @@ pub fn render_exploration(
 
 /// The object's triangles (at `vertices`, in the world), shaded Lambertian from a light beside the
 /// camera, into the z-buffer `depth`.
-fn draw_object(picture: &mut RgbPicture, depth: &mut [f64], camera: &Camera, mesh: &TriMesh, vertices: &[DVec3]) {
+fn draw_object(
+    picture: &mut RgbPicture,
+    depth: &mut [f64],
+    camera: &Camera,
+    mesh: &TriMesh,
+    vertices: &[DVec3],
+) {
     let light = (-camera.view + 0.6 * camera.up - 0.4 * camera.right).normalize();
     for &[a, b, c] in &mesh.triangles {
         let [a, b, c] = [a, b, c].map(|i| vertices[i as usize]);
