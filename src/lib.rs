@@ -1,33 +1,21 @@
 //! taction: tactile object recognition from appearance information.
 //!
 //! A reimplementation of *Tactile Object Recognition From Appearance Information* (Pezzementi,
-//! Plaku, Reyda, Hager). Data flows one way through the modules, each using only those above it:
+//! Plaku, Reyda, Hager). Data flows one way, each module using only those above it: `mesh` (the
+//! objects), `sim` (the MuJoCo world and the arm), `tactile` (the covering sensor), `dataset` (the
+//! readings, MuJoCo-free), `control` (Algorithm 1), `explore` (the planner and the sampler),
+//! `describe` (the six descriptors), `recognize` (bag of features), `active_touch`, `experiment`
+//! (the run framework) and `paper` (the paper's experiments on it); `rng`, `units`, `valid`,
+//! `atomic`, `pose` and `bodies` serve them all. `describe` and `recognize` know nothing of
+//! MuJoCo, so recorded frames of a real sensor feed them the same way.
 //!
-//! ```text
-//! mesh       objects as triangle meshes: loading, validation, object sets, raised letters
-//! sim        the MuJoCo world: arm (FK/IK/move_to), table, perturbable object (Sec. V-A1)
-//! tactile    the covering sensor: a MuJoCo sensor plugin that raycasts penetration (Sec. V-A2)
-//! dataset    the hand-off from exploration to recognition: readings and their file, no MuJoCo
-//! control    Approach / Press / Orient (Sec. III-B, Algorithm 1)
-//! explore    the planner (Sec. III-A), the training sampler (Sec. V-A3), collection into datasets
-//! describe   the six tactile image descriptors (Sec. IV-B)
-//! recognize  bag-of-features: PCA, codebooks, cross-entropy decision (Sec. IV-A, V-B1)
-//! active_touch  the planner steered by expected information gain (beyond the paper, Sec. VI)
-//! experiment the run framework: resumable, shardable runs writing tidy CSV, plots and an index
-//! paper      the paper's figures (Sec. V) as experiments on that framework
-//! ```
-//!
-//! `describe` and `recognize` know nothing of MuJoCo: they work on [`tactile::TactileImage`]s and
-//! datasets, so recorded data from a real sensor can be fed to them. `rng`, `units`, `valid` (configs
-//! checked once, at the edge), `atomic` (the one writer of files), `pose` and `bodies` serve every
-//! module; `tests/architecture.rs` checks the
-//! flow.
+//! The module map, with the paper's section and the files to start from for each module, is
+//! section 2 of `ARCHITECTURE.md` at the repository's root (the one map; `tests/architecture.rs`
+//! checks the flow), beside the decisions the code relies on and the paper's errata.
 //!
 //! [`prelude`] gathers the names a user needs first; each module's root re-exports its own public
-//! types, and the files behind it are private to the crate.
-//!
-//! `ARCHITECTURE.md` at the repository's root holds the module map, the decisions the code relies on
-//! and the paper's errata.
+//! types, and the files behind it are private to the crate. `examples/` holds three short programs
+//! (`cargo run --release --example NAME`): `sensor_reading`, `arm_touch`, `recognize_chess`.
 
 pub mod atomic;
 pub mod bodies;

@@ -27,7 +27,7 @@ use taction::explore::active::DEFAULT_CANDIDATES;
 use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
 use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
-use taction::paper::exploration::{Placement, write_exploration_png};
+use taction::paper::figure1::{Placement, write_exploration_png};
 use taction::recognize::selection::{TrainConfig, codebook_sizes};
 use taction::recognize::{CodebookKind, DescriptorChoice, FusedModel, Recognizer};
 use taction::rng;

@@ -202,7 +202,7 @@ fn export(set: &ObjectSet, options: &BuildOptions, out: &Path) -> Result<(), Box
 
 fn write_export(
     set: &ObjectSet,
-    objects: Vec<taction::mesh::BuiltObject>,
+    objects: Vec<taction::mesh::Object>,
     out: &Path,
     written: &mut Vec<PathBuf>,
 ) -> Result<(), Box<dyn std::error::Error>> {

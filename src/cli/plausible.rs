@@ -56,7 +56,7 @@ pub fn build_objects(
             eprintln!("taction {command}: warning: {what}: {}", object.warnings);
         }
         check_mesh(&what, &object.mesh, carrier)?;
-        objects.push(ObjectSpec::new(object.name, object.mesh));
+        objects.push(ObjectSpec::from(object));
     }
     Ok(objects)
 }

@@ -16,7 +16,7 @@ use glam::DVec3;
 use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::mesh::object_set::BUILTIN_SETS;
-use taction::mesh::{BuildOptions, BuiltObject, MeshError, ObjectSet, write_obj};
+use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
 use taction::sim::arm::PAD_SITE;
 use taction::sim::mjcf::{Section, comment, numbers};
 use taction::sim::{ObjectSpec, SceneBuilder};
@@ -73,20 +73,17 @@ pub enum SceneExportError {
 }
 
 /// The object `--object` names, built as `collect` builds it (resting on z = 0, centred).
-fn resolve_object(object: &str, object_size_m: Option<f64>) -> Result<BuiltObject, SceneExportError> {
+fn resolve_object(object: &str, object_size_m: Option<f64>) -> Result<Object, SceneExportError> {
     let options = BuildOptions {
         fetch: true,
         ..BuildOptions::default()
     };
     let path = Path::new(object);
     if path.is_file() {
-        let set = ObjectSet::from_files("custom", &[path.to_path_buf()], object_size_m)?;
-        let name = set
-            .object_names()
-            .first()
-            .map(|n| n.to_string())
-            .ok_or_else(|| SceneExportError::UnknownObject(object.into()))?;
-        return Ok(set.build_object(&name, &options)?);
+        return Ok(match object_size_m {
+            Some(size_m) => Object::from_file_with_size(path, size_m)?,
+            None => Object::from_file(path)?,
+        });
     }
     for set_name in BUILTIN_SETS {
         // A set that cannot be listed here (the letters without their font) cannot hold the object.
@@ -162,7 +159,7 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     }
     // Named as `taction objects export` names its files.
     let mesh_file = format!("{}.obj", built.name);
-    let spec = ObjectSpec::new(built.name.clone(), built.mesh);
+    let spec = ObjectSpec::from(built);
     let mut builder = SceneBuilder::with_arm_and_table()
         .object(spec.clone())
         .object_mesh_file(mesh_file.clone());

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use glam::DVec3;
+use taction::mesh::Object;
 use taction::sim::ObjectSpec;
 use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
 
@@ -152,35 +153,30 @@ impl PadArgs {
         PadPose::new(self.pad_center, self.pad_normal, up).ok_or(PadFrameError)
     }
 
-    /// Loads `--mesh` as the object (named after the file), warning on stderr (prefixed with
-    /// `command`) about validation problems, reversing inward-wound faces (the sensor tells inside
-    /// from outside by the winding), and refusing a mesh `carrier` cannot explore.
+    /// Loads `--mesh` as the object (named after the file; [`Object::from_file`] reverses
+    /// inward-wound faces, since the sensor tells inside from outside by the winding, and refuses
+    /// an implausible mesh), refusing a mesh `carrier` cannot explore, and warning on stderr
+    /// (prefixed with `command`) about validation problems and reversed faces.
     pub fn load_object(
         &self,
         command: &str,
         carrier: Carrier,
     ) -> Result<ObjectSpec, Box<dyn std::error::Error>> {
-        let loaded = taction::mesh::load(&self.mesh)?;
-        check_mesh(&self.mesh.display().to_string(), &loaded.mesh, carrier)?;
-        if !loaded.warnings.is_clean() {
+        let object = Object::from_file(&self.mesh)?;
+        check_mesh(&self.mesh.display().to_string(), &object.mesh, carrier)?;
+        if !object.warnings.is_clean() {
             eprintln!(
                 "taction {command}: warning: {}: {}",
                 self.mesh.display(),
-                loaded.warnings
+                object.warnings
             );
         }
-        let name = self
-            .mesh
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "object".into());
-        let (mesh, flipped) = taction::mesh::orient_outward(loaded.mesh);
-        if flipped {
+        if object.flipped {
             eprintln!(
                 "taction {command}: note: {}: faces wound inward; reversed",
                 self.mesh.display()
             );
         }
-        Ok(ObjectSpec::new(name, mesh))
+        Ok(ObjectSpec::from(object))
     }
 }

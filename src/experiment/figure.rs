@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::error::ExperimentError;
@@ -161,10 +162,33 @@ impl Figure {
     }
 }
 
-fn draw_panel<DB: DrawingBackend>(
+/// A panel's chart: its axes and the coordinates its series are drawn in.
+type PanelChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// Draws one panel: its axes, the bands, the reference line, the lines, then the legend.
+fn draw_panel<DB: DrawingBackend>(panel: &Panel, area: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+    let mut chart = panel_chart(panel, area)?;
+    draw_bands(panel, &mut chart)?;
+    draw_reference(panel, &mut chart)?;
+    draw_lines(panel, &mut chart)?;
+    if !panel.legend {
+        return Ok(());
+    }
+    chart
+        .configure_series_labels()
+        .position(legend_corner(panel))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font((FAMILY, 14))
+        .draw()
+}
+
+/// The panel's chart with its caption, axes, labels and grid drawn.
+fn panel_chart<'a, DB: DrawingBackend>(
     panel: &Panel,
-    area: &DrawingArea<DB, Shift>,
-) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    area: &'a DrawingArea<DB, Shift>,
+) -> Result<PanelChart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(14)
@@ -201,6 +225,11 @@ fn draw_panel<DB: DrawingBackend>(
         mesh.x_label_formatter(&|v| format_number(*v));
     }
     mesh.draw()?;
+    Ok(chart)
+}
+
+/// Each series' band (lowest to highest trial), shaded in its colour; one legend entry for all.
+fn draw_bands<DB: DrawingBackend>(panel: &Panel, chart: &mut PanelChart<'_, DB>) -> DrawResult<DB> {
     let mut band_explained = false;
     for (i, series) in panel.series.iter().enumerate() {
         if series.band.len() < 2 {
@@ -225,20 +254,32 @@ fn draw_panel<DB: DrawingBackend>(
             });
         }
     }
-    if let Some(reference) = &panel.reference {
-        let style = ShapeStyle::from(RGBColor(90, 90, 90)).stroke_width(1);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(x0, reference.y), (x1, reference.y)],
-                6,
-                4,
-                style,
-            ))?
-            .label(reference.label.as_str())
-            .legend(move |(x, y)| {
-                plotters::element::DashedPathElement::new(vec![(x, y), (x + 22, y)], 6, 4, style)
-            });
-    }
+    Ok(())
+}
+
+/// The panel's reference line (chance), dashed across the whole x range.
+fn draw_reference<DB: DrawingBackend>(panel: &Panel, chart: &mut PanelChart<'_, DB>) -> DrawResult<DB> {
+    let Some(reference) = &panel.reference else {
+        return Ok(());
+    };
+    let (x0, x1) = panel.x_range;
+    let style = ShapeStyle::from(RGBColor(90, 90, 90)).stroke_width(1);
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(x0, reference.y), (x1, reference.y)],
+            6,
+            4,
+            style,
+        ))?
+        .label(reference.label.as_str())
+        .legend(move |(x, y)| {
+            plotters::element::DashedPathElement::new(vec![(x, y), (x + 22, y)], 6, 4, style)
+        });
+    Ok(())
+}
+
+/// Each series as a line in its colour, with a marker at each point when the panel wants them.
+fn draw_lines<DB: DrawingBackend>(panel: &Panel, chart: &mut PanelChart<'_, DB>) -> DrawResult<DB> {
     for (i, series) in panel.series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
         let line = ShapeStyle::from(color).stroke_width(2);
@@ -250,16 +291,7 @@ fn draw_panel<DB: DrawingBackend>(
             chart.draw_series(series.points.iter().map(|&p| Circle::new(p, 4, color.filled())))?;
         }
     }
-    if !panel.legend {
-        return Ok(());
-    }
-    chart
-        .configure_series_labels()
-        .position(legend_corner(panel))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font((FAMILY, 14))
-        .draw()
+    Ok(())
 }
 
 /// The corner of the panel with the fewest data points near it, so the legend hides little.

@@ -232,40 +232,16 @@ fn fill_legend(template: &str, cell: impl Fn(&str) -> Option<String>) -> Result<
     Ok(label)
 }
 
+/// The recognition curves of `csv`: accuracy per number of readings, averaged over trials, per
+/// descriptor and setting (in the order they first appear), and the largest number of readings.
+type AccuracyCurves = Ordered<(String, Factors), Means>;
+
 fn accuracy_panels(
     csv: &Path,
     objects: Option<usize>,
     legend: Option<&str>,
 ) -> Result<Vec<Panel>, ExperimentError> {
-    let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
-    // (descriptor, factor levels) -> accuracy over trials per n_readings
-    let mut curves: Ordered<(String, Factors), Means> = Ordered::new();
-    let mut max_n = 1u32;
-    for (i, row) in reader.deserialize::<AccuracyRow>().enumerate() {
-        let row = row.map_err(|e| csv_error(csv, e))?;
-        let line = i + 2;
-        for (name, v) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
-            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
-                return Err(csv_error(
-                    csv,
-                    format!("line {line}: {name} {v} is not a fraction in [0, 1]"),
-                ));
-            }
-        }
-        if row.n_readings == 0 {
-            return Err(csv_error(
-                csv,
-                format!("line {line}: n_readings must be at least 1"),
-            ));
-        }
-        max_n = max_n.max(row.n_readings);
-        curves
-            .entry((row.descriptor, row.factors))
-            .add(row.n_readings as f64, row.accuracy);
-    }
-    if curves.items.is_empty() {
-        return Err(csv_error(csv, "no rows to plot"));
-    }
+    let (curves, max_n) = read_accuracy_curves(csv)?;
     let mut descriptors: Vec<&str> = Vec::new();
     let mut settings: Vec<&Factors> = Vec::new();
     for ((d, f), _) in &curves.items {
@@ -276,45 +252,8 @@ fn accuracy_panels(
             settings.push(f);
         }
     }
-    let setting = |descriptor: &str, factors: &Factors| match legend {
-        None => Ok(factors.to_string()),
-        Some(template) => fill_legend(template, |column| {
-            if column == "descriptor" {
-                return Some(descriptor.to_string());
-            }
-            factors
-                .iter()
-                .find(|(f, _)| f.column() == column)
-                .map(|(_, level)| level.to_string())
-        })
-        .map_err(|column| ExperimentError::MissingColumn {
-            path: csv.to_path_buf(),
-            column,
-            available: std::iter::once("descriptor")
-                .chain(factors.factors().map(|f| f.column()))
-                .collect::<Vec<_>>()
-                .join(", "),
-        }),
-    };
-    let panel = |title: String, series: Vec<Series>| Panel {
-        title,
-        x_label: "number of readings".to_string(),
-        y_label: ACCURACY_LABEL.to_string(),
-        x_range: if max_n > 1 {
-            (1.0, max_n as f64)
-        } else {
-            (0.5, 1.5)
-        },
-        y_range: (0.0, 1.0),
-        series,
-        markers: max_n <= 12,
-        legend: true,
-        integer_x: true,
-        reference: objects.map(|n| ReferenceLine {
-            y: 1.0 / n as f64,
-            label: format!("chance (1/{n})"),
-        }),
-    };
+    let setting = |descriptor: &str, factors: &Factors| setting_label(csv, legend, descriptor, factors);
+    let panel = |title: String, series: Vec<Series>| accuracy_panel(title, series, max_n, objects);
     if descriptors.len() > 1 && settings.len() > 1 {
         descriptors
             .iter()
@@ -344,6 +283,172 @@ fn accuracy_panels(
     }
 }
 
+/// Reads `csv`'s accuracy rows, each checked (fractions in [0, 1], at least one reading).
+fn read_accuracy_curves(csv: &Path) -> Result<(AccuracyCurves, u32), ExperimentError> {
+    let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
+    let mut curves: AccuracyCurves = Ordered::new();
+    let mut max_n = 1u32;
+    for (i, row) in reader.deserialize::<AccuracyRow>().enumerate() {
+        let row = row.map_err(|e| csv_error(csv, e))?;
+        let line = i + 2;
+        for (name, v) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
+            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                return Err(csv_error(
+                    csv,
+                    format!("line {line}: {name} {v} is not a fraction in [0, 1]"),
+                ));
+            }
+        }
+        if row.n_readings == 0 {
+            return Err(csv_error(
+                csv,
+                format!("line {line}: n_readings must be at least 1"),
+            ));
+        }
+        max_n = max_n.max(row.n_readings);
+        curves
+            .entry((row.descriptor, row.factors))
+            .add(row.n_readings as f64, row.accuracy);
+    }
+    if curves.items.is_empty() {
+        return Err(csv_error(csv, "no rows to plot"));
+    }
+    Ok((curves, max_n))
+}
+
+/// A curve's legend: its factor levels, or the `legend` template filled from its descriptor and
+/// factor columns.
+fn setting_label(
+    csv: &Path,
+    legend: Option<&str>,
+    descriptor: &str,
+    factors: &Factors,
+) -> Result<String, ExperimentError> {
+    match legend {
+        None => Ok(factors.to_string()),
+        Some(template) => fill_legend(template, |column| {
+            if column == "descriptor" {
+                return Some(descriptor.to_string());
+            }
+            factors
+                .iter()
+                .find(|(f, _)| f.column() == column)
+                .map(|(_, level)| level.to_string())
+        })
+        .map_err(|column| ExperimentError::MissingColumn {
+            path: csv.to_path_buf(),
+            column,
+            available: std::iter::once("descriptor")
+                .chain(factors.factors().map(|f| f.column()))
+                .collect::<Vec<_>>()
+                .join(", "),
+        }),
+    }
+}
+
+/// A panel of accuracy against readings (1 to `max_n`), with chance at 1/`objects`.
+fn accuracy_panel(title: String, series: Vec<Series>, max_n: u32, objects: Option<usize>) -> Panel {
+    Panel {
+        title,
+        x_label: "number of readings".to_string(),
+        y_label: ACCURACY_LABEL.to_string(),
+        x_range: if max_n > 1 {
+            (1.0, max_n as f64)
+        } else {
+            (0.5, 1.5)
+        },
+        y_range: (0.0, 1.0),
+        series,
+        markers: max_n <= 12,
+        legend: true,
+        integer_x: true,
+        reference: objects.map(|n| ReferenceLine {
+            y: 1.0 / n as f64,
+            label: format!("chance (1/{n})"),
+        }),
+    }
+}
+
+/// The columns a line plot reads from its CSV, by position.
+struct LineColumns<'a> {
+    headers: csv::StringRecord,
+    x: usize,
+    ys: Vec<usize>,
+    series: Vec<usize>,
+    series_names: &'a [String],
+}
+
+impl<'a> LineColumns<'a> {
+    fn find(
+        csv: &Path,
+        headers: csv::StringRecord,
+        x: &Axis,
+        ys: &[Axis],
+        series: &'a [String],
+    ) -> Result<Self, ExperimentError> {
+        let column = |name: &str| column_index(csv, &headers, name);
+        let x_col = column(&x.column)?;
+        let y_cols = ys
+            .iter()
+            .map(|y| column(&y.column))
+            .collect::<Result<Vec<_>, _>>()?;
+        let series_cols = series.iter().map(|s| column(s)).collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            headers,
+            x: x_col,
+            ys: y_cols,
+            series: series_cols,
+            series_names: series,
+        })
+    }
+
+    /// The series a record belongs to: the `legend` template filled from its columns, else the
+    /// series columns' values.
+    fn label(
+        &self,
+        csv: &Path,
+        record: &csv::StringRecord,
+        legend: Option<&str>,
+    ) -> Result<String, ExperimentError> {
+        let headers = &self.headers;
+        Ok(match legend {
+            Some(template) => fill_legend(template, |name| {
+                headers
+                    .iter()
+                    .position(|h| h == name)
+                    .map(|c| record.get(c).unwrap_or("").to_string())
+            })
+            .map_err(|column| ExperimentError::MissingColumn {
+                path: csv.to_path_buf(),
+                column,
+                available: headers.iter().collect::<Vec<_>>().join(", "),
+            })?,
+            None => match self.series.as_slice() {
+                [] => String::new(),
+                [one] => record.get(*one).unwrap_or("").to_string(),
+                many => many
+                    .iter()
+                    .zip(self.series_names)
+                    .map(|(&c, name)| format!("{name} = {}", record.get(c).unwrap_or("")))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            },
+        })
+    }
+}
+
+/// The position of column `name` in `headers`, or an error listing the columns there are.
+fn column_index(csv: &Path, headers: &csv::StringRecord, name: &str) -> Result<usize, ExperimentError> {
+    headers
+        .iter()
+        .position(|h| h == name)
+        .ok_or_else(|| ExperimentError::MissingColumn {
+            path: csv.to_path_buf(),
+            column: name.to_string(),
+            available: headers.iter().collect::<Vec<_>>().join(", "),
+        })
+}
+
 fn line_panels(
     csv: &Path,
     x: &Axis,
@@ -353,23 +458,27 @@ fn line_panels(
 ) -> Result<Vec<Panel>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
     let headers = reader.headers().map_err(|e| csv_error(csv, e))?.clone();
-    let column = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| ExperimentError::MissingColumn {
-                path: csv.to_path_buf(),
-                column: name.to_string(),
-                available: headers.iter().collect::<Vec<_>>().join(", "),
-            })
-    };
-    let x_col = column(&x.column)?;
-    let y_cols = ys
+    let columns = LineColumns::find(csv, headers, x, ys, series)?;
+    let curves = read_line_curves(csv, &mut reader, &columns, x, ys, legend)?;
+    if curves.first().is_none_or(|c| c.items.is_empty()) {
+        return Err(csv_error(csv, "no rows to plot"));
+    }
+    Ok(ys
         .iter()
-        .map(|y| column(&y.column))
-        .collect::<Result<Vec<_>, _>>()?;
-    let series_cols = series.iter().map(|s| column(s)).collect::<Result<Vec<_>, _>>()?;
-    // one accumulator per y axis, per series label
+        .zip(curves)
+        .map(|(y, acc)| line_panel(x, y, ys.len(), acc, !columns.series.is_empty()))
+        .collect())
+}
+
+/// One accumulator per y axis, per series label: the mean of y at each x over the records.
+fn read_line_curves(
+    csv: &Path,
+    reader: &mut csv::Reader<std::fs::File>,
+    columns: &LineColumns<'_>,
+    x: &Axis,
+    ys: &[Axis],
+    legend: Option<&str>,
+) -> Result<Vec<Ordered<String, Means>>, ExperimentError> {
     let mut curves: Vec<Ordered<String, Means>> = ys.iter().map(|_| Ordered::new()).collect();
     for (i, record) in reader.records().enumerate() {
         let record = record.map_err(|e| csv_error(csv, e))?;
@@ -387,69 +496,44 @@ fn line_panels(
                     )
                 })
         };
-        let xv = number(x_col, &x.column)?;
-        let label = match legend {
-            Some(template) => fill_legend(template, |name| {
-                headers
-                    .iter()
-                    .position(|h| h == name)
-                    .map(|c| record.get(c).unwrap_or("").to_string())
-            })
-            .map_err(|column| ExperimentError::MissingColumn {
-                path: csv.to_path_buf(),
-                column,
-                available: headers.iter().collect::<Vec<_>>().join(", "),
-            })?,
-            None => match series_cols.as_slice() {
-                [] => String::new(),
-                [one] => record.get(*one).unwrap_or("").to_string(),
-                many => many
-                    .iter()
-                    .zip(series)
-                    .map(|(&c, name)| format!("{name} = {}", record.get(c).unwrap_or("")))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            },
-        };
-        for ((y, &col), acc) in ys.iter().zip(&y_cols).zip(curves.iter_mut()) {
+        let xv = number(columns.x, &x.column)?;
+        let label = columns.label(csv, &record, legend)?;
+        for ((y, &col), acc) in ys.iter().zip(&columns.ys).zip(curves.iter_mut()) {
             acc.entry(label.clone()).add(xv, number(col, &y.column)?);
         }
     }
-    if curves.first().is_none_or(|c| c.items.is_empty()) {
-        return Err(csv_error(csv, "no rows to plot"));
+    Ok(curves)
+}
+
+/// The panel of y axis `y` (titled by it when the figure has `y_count` > 1 panels), its range
+/// padded around the points and 0; `by_series`: the curves are told apart by series columns.
+fn line_panel(x: &Axis, y: &Axis, y_count: usize, acc: Ordered<String, Means>, by_series: bool) -> Panel {
+    let series: Vec<Series> = acc
+        .items
+        .into_iter()
+        .map(|(label, m)| m.series(if label.is_empty() { y.label.clone() } else { label }))
+        .collect();
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let (xmin, xmax) = bounds(all().map(|p| p.0));
+    let (ymin, ymax) = bounds(all().map(|p| p.1));
+    // A band needs its legend entry even beside a lone line.
+    let legend = by_series || series.iter().any(|s| !s.band.is_empty());
+    Panel {
+        title: if y_count > 1 {
+            y.label.clone()
+        } else {
+            String::new()
+        },
+        x_label: x.label.clone(),
+        y_label: y.label.clone(),
+        x_range: padded(xmin, xmax, false),
+        y_range: padded(ymin.min(0.0), ymax.max(0.0), true),
+        series,
+        markers: true,
+        legend,
+        integer_x: false,
+        reference: None,
     }
-    Ok(ys
-        .iter()
-        .zip(curves)
-        .map(|(y, acc)| {
-            let series: Vec<Series> = acc
-                .items
-                .into_iter()
-                .map(|(label, m)| m.series(if label.is_empty() { y.label.clone() } else { label }))
-                .collect();
-            let all = || series.iter().flat_map(|s| s.points.iter());
-            let (xmin, xmax) = bounds(all().map(|p| p.0));
-            let (ymin, ymax) = bounds(all().map(|p| p.1));
-            // A band needs its legend entry even beside a lone line.
-            let legend = !series_cols.is_empty() || series.iter().any(|s| !s.band.is_empty());
-            Panel {
-                title: if ys.len() > 1 {
-                    y.label.clone()
-                } else {
-                    String::new()
-                },
-                x_label: x.label.clone(),
-                y_label: y.label.clone(),
-                x_range: padded(xmin, xmax, false),
-                y_range: padded(ymin.min(0.0), ymax.max(0.0), true),
-                series,
-                markers: true,
-                legend,
-                integer_x: false,
-                reference: None,
-            }
-        })
-        .collect())
 }
 
 fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {

@@ -156,93 +156,15 @@ where
 {
     let spec = &experiment.spec;
     let units = &experiment.units;
-    if units.is_empty() {
-        return Err(ExperimentError::NoUnits {
-            experiment: spec.name.to_string(),
-        });
-    }
-    let mut seen = HashSet::new();
-    if let Some(dup) = units.iter().find(|u| !seen.insert(u.key())) {
-        return Err(ExperimentError::DuplicateUnit {
-            experiment: spec.name.to_string(),
-            key: dup.key().clone(),
-        });
-    }
+    check_units(spec, units)?;
     let dir = ExperimentDir::new(&options.out, &spec.name);
     let detail = D::TABLE.map(SafeName::new).transpose()?;
-    let mut folders = vec![options.out.clone(), dir.root().to_path_buf(), dir.units_dir()];
-    folders.extend(detail.iter().map(|table| dir.detail_units_dir(table)));
-    for folder in &folders {
-        create_dir_all(folder)?;
-        remove_stale_temporaries(folder)?;
-    }
-    let manifest = Manifest {
-        spec: spec.clone(),
-        detail: detail.clone(),
-        units: units.iter().map(|u| u.key().clone()).collect(),
-    };
-    write_manifest(
-        &dir.manifest(),
-        &manifest,
-        &manifest.to_json(&dir.manifest())?,
-        dir.root(),
-    )?;
-    write_or_check(
-        &dir.config(),
-        &to_json(&experiment.config, &dir.config())?,
-        dir.root(),
-        "configuration",
-    )?;
+    prepare_folders(options, &dir, detail.as_ref())?;
+    let manifest = record_experiment(experiment, &dir, detail.clone())?;
 
-    let mut in_shard = 0;
-    let mut pending = Vec::new();
-    for (_, unit) in units
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| options.shard.contains(*i))
-    {
-        in_shard += 1;
-        let path = dir.unit_csv(unit.key());
-        if path.exists() {
-            read_rows::<R>(&path)?;
-        } else {
-            pending.push(unit);
-        }
-    }
+    let (in_shard, pending) = pending_in_shard::<R, D>(units, options, &dir)?;
     let reused = in_shard - pending.len();
-
-    let threads = options.thread_count();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| ExperimentError::ThreadPool {
-            threads,
-            what: e.to_string(),
-        })?;
-    let progress = progress_bar(pending.len(), &spec.name.to_string(), "units");
-    let stop = AtomicBool::new(false);
-    let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
-        pending
-            .par_iter()
-            .map(|unit| {
-                if stop.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let outcome = run_unit(unit, &dir, detail.as_ref());
-                if outcome.is_err() {
-                    stop.store(true, Ordering::Relaxed);
-                }
-                progress.inc(1);
-                Some(outcome)
-            })
-            .collect()
-    });
-    progress.finish_and_clear();
-    let ran = outcomes.iter().filter(|o| matches!(o, Some(Ok(())))).count();
-    let failures: Vec<UnitFailure> = outcomes.into_iter().flatten().filter_map(Result::err).collect();
-    if !failures.is_empty() {
-        return Err(ExperimentError::UnitsFailed { failures });
-    }
+    let ran = run_pending(&pending, options, &dir, detail.as_ref(), &spec.name.to_string())?;
 
     let missing = missing_units(&dir, &manifest).len();
     let finished = if missing == 0 {
@@ -261,6 +183,140 @@ where
         missing,
         finished,
     })
+}
+
+/// An experiment has units, each key once.
+fn check_units<R, D: DetailRow>(
+    spec: &ExperimentSpec,
+    units: &[Unit<'_, R, D>],
+) -> Result<(), ExperimentError> {
+    if units.is_empty() {
+        return Err(ExperimentError::NoUnits {
+            experiment: spec.name.to_string(),
+        });
+    }
+    let mut seen = HashSet::new();
+    if let Some(dup) = units.iter().find(|u| !seen.insert(u.key())) {
+        return Err(ExperimentError::DuplicateUnit {
+            experiment: spec.name.to_string(),
+            key: dup.key().clone(),
+        });
+    }
+    Ok(())
+}
+
+/// Step 1: the folders the run writes into, cleared of temporaries left by killed runs.
+fn prepare_folders(
+    options: &RunOptions,
+    dir: &ExperimentDir,
+    detail: Option<&SafeName>,
+) -> Result<(), ExperimentError> {
+    let mut folders = vec![options.out.clone(), dir.root().to_path_buf(), dir.units_dir()];
+    folders.extend(detail.iter().map(|table| dir.detail_units_dir(table)));
+    for folder in &folders {
+        create_dir_all(folder)?;
+        remove_stale_temporaries(folder)?;
+    }
+    Ok(())
+}
+
+/// Step 1: `manifest.json` and `config.json`, written, or checked against a resumed run's.
+fn record_experiment<R, C: Serialize, D: DetailRow>(
+    experiment: &Experiment<'_, R, C, D>,
+    dir: &ExperimentDir,
+    detail: Option<SafeName>,
+) -> Result<Manifest, ExperimentError> {
+    let manifest = Manifest {
+        spec: experiment.spec.clone(),
+        detail,
+        units: experiment.units.iter().map(|u| u.key().clone()).collect(),
+    };
+    write_manifest(
+        &dir.manifest(),
+        &manifest,
+        &manifest.to_json(&dir.manifest())?,
+        dir.root(),
+    )?;
+    write_or_check(
+        &dir.config(),
+        &to_json(&experiment.config, &dir.config())?,
+        dir.root(),
+        "configuration",
+    )?;
+    Ok(manifest)
+}
+
+/// Step 2: this shard's unit count, and those of its units not yet saved (a saved one must read
+/// back as rows of `R`).
+fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
+    units: &'u [Unit<'a, R, D>],
+    options: &RunOptions,
+    dir: &ExperimentDir,
+) -> Result<(usize, Vec<&'u Unit<'a, R, D>>), ExperimentError> {
+    let mut in_shard = 0;
+    let mut pending = Vec::new();
+    for (_, unit) in units
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| options.shard.contains(*i))
+    {
+        in_shard += 1;
+        let path = dir.unit_csv(unit.key());
+        if path.exists() {
+            read_rows::<R>(&path)?;
+        } else {
+            pending.push(unit);
+        }
+    }
+    Ok((in_shard, pending))
+}
+
+/// Step 3: the pending units on a pool of `--threads` workers; no unit starts after one failed.
+/// The units run now, or the error naming every failed one.
+fn run_pending<R, D>(
+    pending: &[&Unit<'_, R, D>],
+    options: &RunOptions,
+    dir: &ExperimentDir,
+    detail: Option<&SafeName>,
+    name: &str,
+) -> Result<usize, ExperimentError>
+where
+    R: Serialize + DeserializeOwned,
+    D: DetailRow,
+{
+    let threads = options.thread_count();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| ExperimentError::ThreadPool {
+            threads,
+            what: e.to_string(),
+        })?;
+    let progress = progress_bar(pending.len(), name, "units");
+    let stop = AtomicBool::new(false);
+    let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
+        pending
+            .par_iter()
+            .map(|unit| {
+                if stop.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let outcome = run_unit(unit, dir, detail);
+                if outcome.is_err() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                progress.inc(1);
+                Some(outcome)
+            })
+            .collect()
+    });
+    progress.finish_and_clear();
+    let ran = outcomes.iter().filter(|o| matches!(o, Some(Ok(())))).count();
+    let failures: Vec<UnitFailure> = outcomes.into_iter().flatten().filter_map(Result::err).collect();
+    if !failures.is_empty() {
+        return Err(ExperimentError::UnitsFailed { failures });
+    }
+    Ok(ran)
 }
 
 /// Runs one unit and saves its detail rows into the `detail` table (when the experiment has one),

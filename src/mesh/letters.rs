@@ -210,16 +210,7 @@ pub fn letter_outline(font: &Font, ch: char, style: &LetterStyle) -> Result<Glyp
 pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMesh, MeshError> {
     let outline = letter_outline(font, ch, style)?;
     let nesting = Nesting::new(&outline);
-    let all = || outline.contours.iter().flatten();
-    let lo = all().fold(DVec2::splat(f64::INFINITY), |m, &p| m.min(p)) - DVec2::splat(style.margin_m);
-    let hi = all().fold(DVec2::splat(f64::NEG_INFINITY), |m, &p| m.max(p)) + DVec2::splat(style.margin_m);
-    let centre = 0.5 * (lo + hi);
-    let contours: Vec<Vec<DVec2>> = nesting
-        .contours
-        .iter()
-        .map(|c| c.iter().map(|&p| p - centre).collect())
-        .collect();
-    let (lo, hi) = (lo - centre, hi - centre);
+    let (contours, lo, hi) = centred_on_plate(&outline, &nesting, style.margin_m);
     let (z_plate, z_top) = (style.plate_thickness_m, style.plate_thickness_m + style.raise_m);
 
     let mut b = Builder {
@@ -227,63 +218,19 @@ pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMe
         triangles: Vec::new(),
     };
     let rect = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
-    let plate_bottom = b.ring(&rect, 0.0);
-    let plate_top = b.ring(&rect, z_plate);
-    b.triangles
-        .push([plate_bottom[0], plate_bottom[2], plate_bottom[1]]);
-    b.triangles
-        .push([plate_bottom[0], plate_bottom[3], plate_bottom[2]]);
-    b.walls(&plate_bottom, &plate_top);
-
+    let plate_top = b.plate(&rect, z_plate);
     let low: Vec<Vec<u32>> = contours.iter().map(|c| b.ring(c, z_plate)).collect();
     let high: Vec<Vec<u32>> = contours.iter().map(|c| b.ring(c, z_top)).collect();
     for i in 0..contours.len() {
         b.walls(&low[i], &high[i]);
     }
-
-    let what = |part: &str| format!("glyph '{ch}' {part}");
-    // Plate level: the rectangle minus the outermost ink contours, then each counter minus the ink
-    // nested in it. Letter level: each ink contour minus its counters.
-    let reversed: Vec<(Vec<DVec2>, Vec<u32>)> = contours
-        .iter()
-        .zip(&low)
-        .map(|(c, ids)| {
-            (
-                c.iter().rev().copied().collect(),
-                ids.iter().rev().copied().collect(),
-            )
-        })
-        .collect();
-    let top_level: Vec<usize> = (0..contours.len()).filter(|&i| nesting.depth[i] == 0).collect();
-    let mut rings: Vec<(&[DVec2], &[u32])> = vec![(&rect, &plate_top)];
-    rings.extend(
-        top_level
-            .iter()
-            .map(|&i| (reversed[i].0.as_slice(), reversed[i].1.as_slice())),
-    );
-    b.cap(&rings, &what("plate"))?;
-    for i in 0..contours.len() {
-        let children: Vec<usize> = nesting.children(i).collect();
-        if nesting.depth[i] % 2 == 1 {
-            let mut rings: Vec<(&[DVec2], &[u32])> = vec![(&reversed[i].0, &reversed[i].1)];
-            rings.extend(
-                children
-                    .iter()
-                    .map(|&j| (reversed[j].0.as_slice(), reversed[j].1.as_slice())),
-            );
-            b.cap(&rings, &what("counter at plate level"))?;
-        } else {
-            let mut rings: Vec<(&[DVec2], &[u32])> = vec![(&contours[i], &high[i])];
-            let counters: Vec<Vec<DVec2>> = children.iter().map(|&j| contours[j].clone()).collect();
-            rings.extend(
-                children
-                    .iter()
-                    .zip(&counters)
-                    .map(|(&j, c)| (c.as_slice(), high[j].as_slice())),
-            );
-            b.cap(&rings, &what("top"))?;
-        }
-    }
+    let rings = LetterRings {
+        contours,
+        low,
+        high,
+        nesting,
+    };
+    b.caps(&rings, (&rect, &plate_top), ch)?;
     let mesh = TriMesh {
         vertices: b.vertices,
         triangles: b.triangles,
@@ -294,6 +241,100 @@ pub fn raised_letter(font: &Font, ch: char, style: &LetterStyle) -> Result<TriMe
         what,
     })?;
     Ok(mesh)
+}
+
+/// The outline's contours moved so that the plate (their bounds grown by `margin_m`) is centred on
+/// the origin, and the plate's corners.
+fn centred_on_plate(
+    outline: &GlyphOutline,
+    nesting: &Nesting,
+    margin_m: f64,
+) -> (Vec<Vec<DVec2>>, DVec2, DVec2) {
+    let all = || outline.contours.iter().flatten();
+    let lo = all().fold(DVec2::splat(f64::INFINITY), |m, &p| m.min(p)) - DVec2::splat(margin_m);
+    let hi = all().fold(DVec2::splat(f64::NEG_INFINITY), |m, &p| m.max(p)) + DVec2::splat(margin_m);
+    let centre = 0.5 * (lo + hi);
+    let contours: Vec<Vec<DVec2>> = nesting
+        .contours
+        .iter()
+        .map(|c| c.iter().map(|&p| p - centre).collect())
+        .collect();
+    (contours, lo - centre, hi - centre)
+}
+
+/// The letter's contours and their rings of vertex ids at plate level and at the top.
+struct LetterRings {
+    contours: Vec<Vec<DVec2>>,
+    low: Vec<Vec<u32>>,
+    high: Vec<Vec<u32>>,
+    nesting: Nesting,
+}
+
+impl Builder {
+    /// The plate under the letter: its bottom and walls; returns the ids of its top ring.
+    fn plate(&mut self, rect: &[DVec2; 4], z_plate: f64) -> Vec<u32> {
+        let plate_bottom = self.ring(rect, 0.0);
+        let plate_top = self.ring(rect, z_plate);
+        self.triangles
+            .push([plate_bottom[0], plate_bottom[2], plate_bottom[1]]);
+        self.triangles
+            .push([plate_bottom[0], plate_bottom[3], plate_bottom[2]]);
+        self.walls(&plate_bottom, &plate_top);
+        plate_top
+    }
+
+    /// Plate level: the rectangle minus the outermost ink contours, then each counter minus the
+    /// ink nested in it. Letter level: each ink contour minus its counters.
+    fn caps(
+        &mut self,
+        letter: &LetterRings,
+        (rect, plate_top): (&[DVec2; 4], &[u32]),
+        ch: char,
+    ) -> Result<(), MeshError> {
+        let (contours, nesting) = (&letter.contours, &letter.nesting);
+        let what = |part: &str| format!("glyph '{ch}' {part}");
+        let reversed: Vec<(Vec<DVec2>, Vec<u32>)> = contours
+            .iter()
+            .zip(&letter.low)
+            .map(|(c, ids)| {
+                (
+                    c.iter().rev().copied().collect(),
+                    ids.iter().rev().copied().collect(),
+                )
+            })
+            .collect();
+        let top_level: Vec<usize> = (0..contours.len()).filter(|&i| nesting.depth[i] == 0).collect();
+        let mut rings: Vec<(&[DVec2], &[u32])> = vec![(rect.as_slice(), plate_top)];
+        rings.extend(
+            top_level
+                .iter()
+                .map(|&i| (reversed[i].0.as_slice(), reversed[i].1.as_slice())),
+        );
+        self.cap(&rings, &what("plate"))?;
+        for i in 0..contours.len() {
+            let children: Vec<usize> = nesting.children(i).collect();
+            if nesting.depth[i] % 2 == 1 {
+                let mut rings: Vec<(&[DVec2], &[u32])> = vec![(&reversed[i].0, &reversed[i].1)];
+                rings.extend(
+                    children
+                        .iter()
+                        .map(|&j| (reversed[j].0.as_slice(), reversed[j].1.as_slice())),
+                );
+                self.cap(&rings, &what("counter at plate level"))?;
+            } else {
+                let mut rings: Vec<(&[DVec2], &[u32])> = vec![(&contours[i], &letter.high[i])];
+                let counters: Vec<Vec<DVec2>> = children.iter().map(|&j| contours[j].clone()).collect();
+                rings.extend(
+                    children
+                        .iter()
+                        .zip(&counters)
+                        .map(|(&j, c)| (c.as_slice(), letter.high[j].as_slice())),
+                );
+                self.cap(&rings, &what("top"))?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Whether `mesh` is what the module docs promise: one closed, consistently oriented shell of

@@ -5,6 +5,7 @@
 //!   and the edge topology behind watertightness and orientation checks ([`EdgeTopology`]);
 //! - the objects: ten real meshes fetched from Debian ([`cgal`]), chess pieces as surfaces of
 //!   revolution ([`chess`], [`revolution`]), raised letters from a font ([`letters`], [`glyph`]);
+//! - one object, loaded, checked and plausible ([`Object::from_file`]);
 //! - object sets: named, versioned manifests that datasets and models refer to ([`ObjectSet`]).
 
 pub mod cgal;
@@ -17,6 +18,7 @@ pub mod letters;
 pub mod load;
 pub(crate) mod normalise;
 pub(crate) mod obj;
+mod object;
 pub mod object_set;
 mod off;
 mod plausible;
@@ -32,7 +34,8 @@ pub use error::{Location, MeshError};
 pub use load::{LoadedMesh, MeshFormat, load, parse};
 pub use normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
 pub use obj::{to_obj_string, write_obj};
-pub use object_set::{BuildOptions, BuiltObject, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
+pub use object::Object;
+pub use object_set::{BuildOptions, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
 pub use plausible::{Implausible, SizeLimit, check_plausible};
 pub use topology::{EdgeTopology, connected_components};
 pub use trimesh::TriMesh;

@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::TriMesh;
 use super::cgal::{CGAL_MESHES, ObjectCache};
 use super::checksum::{sha256_file, sha256_hex};
 use super::chess::ChessPiece;
@@ -22,8 +21,8 @@ use super::error::MeshError;
 use super::glyph::Font;
 use super::letters::{LetterStyle, alphabet, letter_name, raised_letter};
 use super::load::{MeshFormat, load};
-use super::normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
-use super::plausible::{SizeLimit, check_plausible};
+use super::normalise::{UpAxis, rotate_up_to_z};
+use super::object::{Object, name_of_file};
 use super::validate::ValidationReport;
 
 /// The common size of the 3D objects: a 12 cm bounding-box diagonal, table-top objects an arm can
@@ -127,17 +126,6 @@ pub struct ObjectSetRef {
     pub name: String,
     pub version: u32,
     pub id: String,
-}
-
-/// An object ready to place in a scene.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BuiltObject {
-    pub name: String,
-    pub mesh: TriMesh,
-    /// Validation of the mesh as read (user files, CGAL meshes) or generated.
-    pub warnings: ValidationReport,
-    /// Whether the triangles were flipped to face outward.
-    pub flipped: bool,
 }
 
 /// Where building a set finds what it needs.
@@ -275,16 +263,7 @@ impl ObjectSet {
         let mut objects = Vec::with_capacity(paths.len());
         for path in paths {
             MeshFormat::from_path(path)?;
-            let stem = path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .filter(|s| !s.is_empty())
-                .ok_or_else(|| {
-                    set_error(format!(
-                        "{}: cannot name an object from this file name",
-                        path.display()
-                    ))
-                })?;
+            let stem = name_of_file(path)?;
             if let Some(other) = seen.insert(stem.clone(), path.clone()) {
                 return Err(set_error(format!(
                     "{} and {} would both be named '{stem}'",
@@ -401,7 +380,7 @@ impl ObjectSet {
     }
 
     /// Builds every object (see [`ObjectSet::build_object`]).
-    pub fn build(&self, options: &BuildOptions) -> Result<Vec<BuiltObject>, MeshError> {
+    pub fn build(&self, options: &BuildOptions) -> Result<Vec<Object>, MeshError> {
         let mut fonts: BTreeMap<PathBuf, Font> = BTreeMap::new();
         self.objects
             .iter()
@@ -411,7 +390,7 @@ impl ObjectSet {
 
     /// Builds the object named `name`: its mesh from its source (checksums checked), facing out,
     /// scaled to the set's diagonal, centred and resting on z = 0.
-    pub fn build_object(&self, name: &str, options: &BuildOptions) -> Result<BuiltObject, MeshError> {
+    pub fn build_object(&self, name: &str, options: &BuildOptions) -> Result<Object, MeshError> {
         let object = self.objects.iter().find(|o| o.name == name).ok_or_else(|| {
             set_error(format!(
                 "set '{}' has no object '{name}' (it has {})",
@@ -427,7 +406,7 @@ impl ObjectSet {
         object: &NamedObject,
         options: &BuildOptions,
         fonts: &mut BTreeMap<PathBuf, Font>,
-    ) -> Result<BuiltObject, MeshError> {
+    ) -> Result<Object, MeshError> {
         let (mesh, warnings) = match &object.source {
             ObjectSource::Cgal { file, sha256, up } => {
                 let cgal = CGAL_MESHES
@@ -469,21 +448,13 @@ impl ObjectSet {
                 (loaded.mesh, loaded.warnings)
             }
         };
-        let (mesh, flipped) = orient_outward(mesh);
-        let mesh = match self.diagonal_m {
-            Some(d) => normalise_to_diagonal(&mesh, d)?,
-            None => mesh,
-        };
-        check_plausible(&mesh, SizeLimit::TABLE_TOP).map_err(|problem| MeshError::Implausible {
-            object: format!("{} ({})", object.name, object.source),
-            problem,
-        })?;
-        Ok(BuiltObject {
-            name: object.name.clone(),
+        Object::checked(
+            object.name.clone(),
+            &object.source,
             mesh,
             warnings,
-            flipped,
-        })
+            self.diagonal_m,
+        )
     }
 
     /// The manifest as pretty JSON.

@@ -40,6 +40,19 @@ pub fn triangulate_with_holes(rings: &[Vec<DVec2>], what: &str) -> Result<Vec<[u
         return Err(fail("every ring needs at least 3 points".into()));
     }
     let points: Vec<DVec2> = rings.iter().flatten().copied().collect();
+    let mut triangles = earcut_counter_clockwise(rings, &points);
+    let scale = rings[0]
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
+        .max(f64::MIN_POSITIVE);
+    split_at_ring_vertices(&points, &mut triangles, scale);
+    check_every_point_used(&points, &triangles).map_err(fail)?;
+    check_area(rings, &points, &triangles, scale).map_err(fail)?;
+    Ok(triangles)
+}
+
+/// Earcut's triangles of the rings (holes bridged), each turned counter-clockwise.
+fn earcut_counter_clockwise(rings: &[Vec<DVec2>], points: &[DVec2]) -> Vec<[usize; 3]> {
     let mut hole_starts = Vec::with_capacity(rings.len() - 1);
     let mut start = rings[0].len();
     for ring in &rings[1..] {
@@ -48,8 +61,7 @@ pub fn triangulate_with_holes(rings: &[Vec<DVec2>], what: &str) -> Result<Vec<[u
     }
     let mut flat: Vec<u32> = Vec::new();
     earcut::Earcut::new().earcut(points.iter().map(|p| [p.x, p.y]), &hole_starts, &mut flat);
-    let mut triangles: Vec<[usize; 3]> = flat
-        .chunks_exact(3)
+    flat.chunks_exact(3)
         .map(|t| {
             let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
             if area2(points[a], points[b], points[c]) < 0.0 {
@@ -58,12 +70,12 @@ pub fn triangulate_with_holes(rings: &[Vec<DVec2>], what: &str) -> Result<Vec<[u
                 [a, b, c]
             }
         })
-        .collect();
+        .collect()
+}
 
-    let scale = rings[0]
-        .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
-        .max(f64::MIN_POSITIVE);
+/// Splits every triangle with a ring vertex inside one of its edges there (see the module's
+/// doc); `scale` is the polygon's extent, for the collinearity tolerance.
+fn split_at_ring_vertices(points: &[DVec2], triangles: &mut Vec<[usize; 3]>, scale: f64) {
     // Whether `v` lies strictly inside the segment from `a` to `b`.
     let on_edge = |v: usize, a: usize, b: usize| {
         let (p, pa, pb) = (points[v], points[a], points[b]);
@@ -84,33 +96,46 @@ pub fn triangulate_with_holes(rings: &[Vec<DVec2>], what: &str) -> Result<Vec<[u
             triangles.push([v, b, c]);
         }
     }
+}
+
+/// Every ring point is a corner of some triangle.
+fn check_every_point_used(points: &[DVec2], triangles: &[[usize; 3]]) -> Result<(), String> {
     let mut used = vec![false; points.len()];
-    for t in &triangles {
+    for t in triangles {
         for &i in t {
             used[i] = true;
         }
     }
     if let Some(v) = (0..points.len()).find(|&v| !used[v]) {
         let p = points[v];
-        return Err(fail(format!(
+        return Err(format!(
             "point {v} at ({}, {}) is not on the triangulation",
             p.x, p.y
-        )));
+        ));
     }
+    Ok(())
+}
 
+/// The triangles cover the polygon's area: the outer ring's less the holes'.
+fn check_area(
+    rings: &[Vec<DVec2>],
+    points: &[DVec2],
+    triangles: &[[usize; 3]],
+    scale: f64,
+) -> Result<(), String> {
     let expected = ring_area2(&rings[0]).abs() - rings[1..].iter().map(|r| ring_area2(r).abs()).sum::<f64>();
     let got: f64 = triangles
         .iter()
         .map(|&[a, b, c]| area2(points[a], points[b], points[c]))
         .sum();
     if (got - expected).abs() > 1e-9 * expected.abs().max(scale * scale) {
-        return Err(fail(format!(
+        return Err(format!(
             "triangles cover area {} instead of {}",
             got / 2.0,
             expected / 2.0
-        )));
+        ));
     }
-    Ok(triangles)
+    Ok(())
 }
 
 #[cfg(test)]

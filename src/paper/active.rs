@@ -181,10 +181,15 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
-        let (sweep, objects, training) = (&sweep, Arc::clone(&objects), training.clone());
-        Unit::with_detail(key, move || {
-            unit_rows(context, sweep, &objects, counts, &training, neighbourhood_m)
-        })
+        let work = ActiveUnit {
+            context,
+            sweep: &sweep,
+            objects: Arc::clone(&objects),
+            counts,
+            training: training.clone(),
+            neighbourhood_m,
+        };
+        Unit::with_detail(key, move || work.rows())
     };
     let experiment = Experiment {
         spec: ExperimentSpec {
@@ -220,49 +225,92 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     Ok(run(&experiment, &context.options)?)
 }
 
-fn unit_rows(
-    context: &PaperContext,
-    sweep: &RecognitionSweep,
-    objects: &Arc<Objects>,
+/// What the experiment's one unit works from.
+struct ActiveUnit<'a> {
+    context: &'a PaperContext,
+    sweep: &'a RecognitionSweep,
+    objects: Arc<Objects>,
     counts: DataCounts,
-    training: &TrainConfig,
+    training: TrainConfig,
     neighbourhood_m: f64,
-) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
-    let descriptor = DESCRIPTOR.build();
-    let model = context.store.model(
-        &sweep.training_request(context, objects, 0, counts)?,
-        &sweep.validation_request(context, objects, 0, counts)?,
-        descriptor.as_ref(),
-        training,
-    )?;
-    let (mut rows, mut per_object) = (Vec::new(), Vec::new());
-    for curve in &sweep.settings[0].curves {
-        let trials = sweep.dataset_trials(
-            context,
-            objects,
+}
+
+type Rows = (Vec<ActiveRow>, Vec<PerObjectRow>);
+
+impl ActiveUnit<'_> {
+    /// One model, then the planner's L curves (Figs. 8 and 10's datasets), then the active
+    /// curve for the object fixed and perturbed.
+    fn rows(&self) -> Result<Rows, BoxError> {
+        let descriptor = DESCRIPTOR.build();
+        let (context, sweep, objects, counts) = (self.context, self.sweep, &self.objects, self.counts);
+        let model = context.store.model(
+            &sweep.training_request(context, objects, 0, counts)?,
+            &sweep.validation_request(context, objects, 0, counts)?,
+            descriptor.as_ref(),
+            &self.training,
+        )?;
+        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        for curve in &sweep.settings[0].curves {
+            let (curve_rows, curve_objects) = self.planner_curve(curve, &model, descriptor.as_ref())?;
+            rows.extend(curve_rows);
+            per_object.extend(curve_objects);
+        }
+        for (state, perturbation) in object_states() {
+            let (curve_rows, curve_objects) =
+                self.active_curve(state, perturbation, &model, descriptor.as_ref())?;
+            rows.extend(curve_rows);
+            per_object.extend(curve_objects);
+        }
+        Ok((rows, per_object))
+    }
+
+    /// An L curve: the planner's test datasets recognised by `model`.
+    fn planner_curve(
+        &self,
+        curve: &Curve,
+        model: &TrainedModel,
+        descriptor: &dyn Descriptor,
+    ) -> Result<Rows, BoxError> {
+        let trials = self.sweep.dataset_trials(
+            self.context,
+            &self.objects,
             0,
             curve.test,
-            counts,
-            &model,
-            descriptor.as_ref(),
+            self.counts,
+            model,
+            descriptor,
             &curve.factors,
         )?;
-        let (curve_rows, curve_objects) =
-            curve_rows(sweep, &model, &curve.factors, &trials, counts, context.seed)?;
-        rows.extend(curve_rows);
-        per_object.extend(curve_objects);
+        curve_rows(
+            self.sweep,
+            model,
+            &curve.factors,
+            &trials,
+            self.counts,
+            self.context.seed,
+        )
     }
-    for (state, perturbation) in object_states() {
+
+    /// The active curve with the object `state` (`perturbation`): every trial's objects explored
+    /// with `model` in the loop, in parallel, under the plans of the L = 0.5 datasets.
+    fn active_curve(
+        &self,
+        state: &str,
+        perturbation: PerturbationBounds,
+        model: &TrainedModel,
+        descriptor: &dyn Descriptor,
+    ) -> Result<Rows, BoxError> {
+        let objects = &self.objects;
         // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
-        let base = sweep.test_requests(
-            context,
+        let base = self.sweep.test_requests(
+            self.context,
             objects,
             0,
             TestData::Planner {
                 local_probability: ACTIVE_LOCAL_PROBABILITY,
                 perturbation,
             },
-            counts,
+            self.counts,
         )?;
         let jobs: Vec<(usize, usize)> = (0..base.len())
             .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
@@ -274,10 +322,10 @@ fn unit_rows(
                     &base[t].plan,
                     objects,
                     o,
-                    &model,
-                    descriptor.as_ref(),
-                    counts.test_per_object,
-                    neighbourhood_m,
+                    model,
+                    descriptor,
+                    self.counts.test_per_object,
+                    self.neighbourhood_m,
                 )
             })
             .collect::<Result<_, BoxError>>()?;
@@ -287,18 +335,15 @@ fn unit_rows(
             .zip(explored.chunks(objects_per_trial))
             .map(|(request, chunk)| (request.plan.seed, chunk.to_vec()))
             .collect();
-        let (curve_rows, curve_objects) = curve_rows(
-            sweep,
-            &model,
+        curve_rows(
+            self.sweep,
+            model,
             &levels("active", ACTIVE_LOCAL_PROBABILITY, state),
             &trials,
-            counts,
-            context.seed,
-        )?;
-        rows.extend(curve_rows);
-        per_object.extend(curve_objects);
+            self.counts,
+            self.context.seed,
+        )
     }
-    Ok((rows, per_object))
 }
 
 /// Object `index` explored actively under `plan` (a planner plan) with `model` in the loop: the

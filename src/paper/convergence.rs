@@ -182,7 +182,7 @@ pub fn object_of_shapes(name: &str, fetch: bool) -> Result<ObjectSpec, MeshError
             ..BuildOptions::default()
         },
     )?;
-    Ok(ObjectSpec::new(built.name, built.mesh))
+    Ok(ObjectSpec::from(built))
 }
 
 /// What a run of the experiment does, besides its objects: the paper's by [`ConvergencePlan::paper`].
@@ -225,6 +225,28 @@ impl ConvergencePlan {
         objects: Vec<ObjectSpec>,
     ) -> Result<Experiment<'static, ConvergenceRow, ConvergenceConfig>, ConvergenceError> {
         let convergences = convergences_at(self.scale)?;
+        self.check(&objects)?;
+        let config = ConvergenceConfig {
+            objects: objects.iter().map(ObjectIdentity::of).collect(),
+            noise_fractions: self.noise_fractions.clone(),
+            convergences,
+            scale: self.scale,
+            seed: self.seed,
+            sensor: self.sensor,
+            control: self.control,
+            sampler: self.sampler,
+        };
+        let units = self.units(objects, &config)?;
+        Ok(Experiment {
+            spec: spec(convergences)?,
+            config,
+            units,
+        })
+    }
+
+    /// At least one object, each non-empty and named once; noise levels in [0, 2]; the sensor
+    /// valid.
+    fn check(&self, objects: &[ObjectSpec]) -> Result<(), ConvergenceError> {
         if objects.is_empty() {
             return Err(ConvergenceError::NoObjects);
         }
@@ -245,17 +267,15 @@ impl ConvergencePlan {
         }
         self.sensor
             .check()
-            .map_err(|e| ConvergenceError::Sensor(e.to_string()))?;
-        let config = ConvergenceConfig {
-            objects: objects.iter().map(ObjectIdentity::of).collect(),
-            noise_fractions: self.noise_fractions.clone(),
-            convergences,
-            scale: self.scale,
-            seed: self.seed,
-            sensor: self.sensor,
-            control: self.control,
-            sampler: self.sampler,
-        };
+            .map_err(|e| ConvergenceError::Sensor(e.to_string()))
+    }
+
+    /// One unit per (object, noise level), in that order.
+    fn units(
+        &self,
+        objects: Vec<ObjectSpec>,
+        config: &ConvergenceConfig,
+    ) -> Result<Vec<Unit<'static, ConvergenceRow>>, ConvergenceError> {
         let mut units = Vec::with_capacity(objects.len() * self.noise_fractions.len());
         for (object_index, object) in objects.into_iter().enumerate() {
             for (noise_index, &noise) in self.noise_fractions.iter().enumerate() {
@@ -274,27 +294,28 @@ impl ConvergencePlan {
                 }));
             }
         }
-        Ok(Experiment {
-            spec: ExperimentSpec {
-                name: SafeName::new(EXPERIMENT_NAME)?,
-                description: format!(
-                    "Fig. 14 (Sec. V-C): controller convergence vs sensor noise; sampler approaches until {convergences} convergences per noise level"
-                ),
-                plots: vec![PlotSpec::lines(
-                    SafeName::new(EXPERIMENT_NAME)?,
-                    "Convergence of the local controllers vs noise (Fig. 14)",
-                    Axis::new("noise_percent", "noise (% of the sensing range)"),
-                    vec![
-                        Axis::new("convergence_rate", "converged (fraction of approaches)"),
-                        Axis::new("mean_iterations", "iterations per convergence (-)"),
-                    ],
-                    &["object"],
-                )],
-            },
-            config,
-            units,
-        })
+        Ok(units)
     }
+}
+
+/// What Fig. 14's run is and plots: convergence rate and iterations against noise, per object.
+fn spec(convergences: usize) -> Result<ExperimentSpec, ConvergenceError> {
+    Ok(ExperimentSpec {
+        name: SafeName::new(EXPERIMENT_NAME)?,
+        description: format!(
+            "Fig. 14 (Sec. V-C): controller convergence vs sensor noise; sampler approaches until {convergences} convergences per noise level"
+        ),
+        plots: vec![PlotSpec::lines(
+            SafeName::new(EXPERIMENT_NAME)?,
+            "Convergence of the local controllers vs noise (Fig. 14)",
+            Axis::new("noise_percent", "noise (% of the sensing range)"),
+            vec![
+                Axis::new("convergence_rate", "converged (fraction of approaches)"),
+                Axis::new("mean_iterations", "iterations per convergence (-)"),
+            ],
+            &["object"],
+        )],
+    })
 }
 
 /// The Fig. 14 experiment on `objects` (e.g. [`paper_object`]) at `scale` (1 = 100 convergences
@@ -339,6 +360,18 @@ pub fn run_level(
         reader,
     )
     .sample(free.scene_mut(), &object.name, config.convergences)?;
+    level_row(object, noise, &report, control.max_iterations, config)
+}
+
+/// The row of one noise level: the approaches by outcome, the mean iterations of the converged
+/// ones (`max_iterations_cap` when none converged) and their quality.
+fn level_row(
+    object: &ObjectSpec,
+    noise: f64,
+    report: &crate::explore::ExplorationReport,
+    max_iterations_cap: usize,
+    config: &ConvergenceConfig,
+) -> Result<ConvergenceRow, BoxError> {
     let attempts = report.readings.len();
     let count = |s: ContactStatus| report.readings.iter().filter(|r| r.status == s).count();
     let converged = count(ContactStatus::Converged);
@@ -347,7 +380,7 @@ pub fn run_level(
         count(ContactStatus::Saturated),
         count(ContactStatus::MaxIterations),
     );
-    let (mean_misalignment_deg, mean_pressure_error) = converged_quality(object, &report, config)?;
+    let (mean_misalignment_deg, mean_pressure_error) = converged_quality(object, report, config)?;
     let iterations: u64 = report
         .readings
         .iter()
@@ -366,7 +399,7 @@ pub fn run_level(
             converged as f64 / attempts as f64
         },
         mean_iterations: if converged == 0 {
-            control.max_iterations as f64
+            max_iterations_cap as f64
         } else {
             iterations as f64 / converged as f64
         },

@@ -346,8 +346,9 @@ pub const TRAINING_SIZES: [usize; 5] = [100, 300, 1000, 3000, 10_000];
 
 /// Beyond the paper: what training data buys. The paper trains on 1000 sampler readings per object
 /// throughout (Sec. V-B); here the same 3D set is trained on 100 to 10,000 and tested on sampler
-/// readings, so the curves differ only in the model. Sampler readings are cheap (10,000 per object
-/// for the 12 shapes in about 30 s on 2 cores), and the curve had not flattened at 1000.
+/// readings, so the curves differ only in the model. Sampler readings are cheap next to the
+/// arm's, which makes training data the cheapest lever; what it buys, and its cost, are measured in
+/// `results/training-size/` and `docs/measurements.md` ("What training data buys").
 pub fn training_size() -> RecognitionSweep {
     let paper = PAPER_TRAINING_READINGS as f64;
     RecognitionSweep {

@@ -37,7 +37,7 @@ use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::paper::sim_to_real::{GaussianBlur, square_root};
 use crate::paper::split::{SplitSizes, split_per_label};
-use crate::recognize::{LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
+use crate::recognize::{Evaluation, LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
 use crate::rng;
 use crate::tactile::TactileImage;
 use crate::valid::Check;
@@ -198,25 +198,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
     let real = context.real_data()?;
     let (kept, pruning) = prune(&real, options.contact_threshold);
     let labels: Vec<String> = pruning.keys().cloned().collect();
-    if labels.len() < 2 {
-        return Err(format!(
-            "{}: recognition needs at least 2 labels, the recording has {}",
-            context.real.origin,
-            labels.len()
-        )
-        .into());
-    }
-    let (smallest_label, smallest) = pruning
-        .iter()
-        .map(|(label, c)| (label.as_str(), c.kept))
-        .min_by_key(|(_, kept)| *kept)
-        .ok_or("internal: no labels")?;
-    let sizes = scaled_split_sizes(smallest, context.scale.fraction()).map_err(|e| {
-        format!(
-            "{}: label '{smallest_label}': {e} (--contact-threshold {} dropped {} of its frames)",
-            context.real.origin, options.contact_threshold, pruning[smallest_label].dropped
-        )
-    })?;
+    let sizes = split_sizes(context, &pruning)?;
     let training = selection_config(
         context.codebook,
         rng::substream(context.seed, MODEL_STREAM),
@@ -224,27 +206,22 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         sizes.validation,
         labels.len(),
     );
-    let kept: Arc<Vec<RealReading>> = Arc::new(kept.into_iter().cloned().collect());
-    let blur = GaussianBlur::new(options.blur_sigma_taxels)?;
+    let plan = Arc::new(TrialPlan {
+        kept: kept.into_iter().cloned().collect(),
+        labels,
+        sizes,
+        training,
+        options,
+        blur: GaussianBlur::new(options.blur_sigma_taxels)?,
+        seed: context.seed,
+    });
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let units = DescriptorKind::ALL
         .iter()
         .map(|&kind| {
             let key = SafeName::builder(kind.name()).build()?;
-            let kept = Arc::clone(&kept);
-            let (labels, training, blur) = (labels.clone(), training.clone(), blur.clone());
-            Ok(Unit::with_detail(key, move || {
-                descriptor_rows(
-                    &kept,
-                    &labels,
-                    kind,
-                    sizes,
-                    &training,
-                    options,
-                    &blur,
-                    context.seed,
-                )
-            }))
+            let plan = Arc::clone(&plan);
+            Ok(Unit::with_detail(key, move || plan.descriptor_rows(kind)))
         })
         .collect::<Result<Vec<_>, BoxError>>()?;
     let experiment = Experiment {
@@ -253,29 +230,150 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
             description: DESCRIPTION.to_string(),
             plots: vec![
                 PlotSpec::accuracy(name, &format!("Trained and tested on {}", real.frames_words()))
-                    .with_chance(labels.len()),
+                    .with_chance(plan.labels.len()),
             ],
         },
-        config: RealFramesConfig {
+        config: plan.config(context, &real, &pruning),
+        units,
+    };
+    Ok(run(&experiment, &context.options)?)
+}
+
+/// The split's sizes per label (see [`scaled_split_sizes`]), set by the label with the fewest frames
+/// kept; recognition needs at least two labels.
+fn split_sizes(
+    context: &PaperContext,
+    pruning: &BTreeMap<String, PruneCount>,
+) -> Result<SplitSizes, BoxError> {
+    if pruning.len() < 2 {
+        return Err(format!(
+            "{}: recognition needs at least 2 labels, the recording has {}",
+            context.real.origin,
+            pruning.len()
+        )
+        .into());
+    }
+    let (smallest_label, smallest) = pruning
+        .iter()
+        .map(|(label, c)| (label.as_str(), c.kept))
+        .min_by_key(|(_, kept)| *kept)
+        .ok_or("internal: no labels")?;
+    Ok(
+        scaled_split_sizes(smallest, context.scale.fraction()).map_err(|e| {
+            format!(
+                "{}: label '{smallest_label}': {e} (--contact-threshold {} dropped {} of its frames)",
+                context.real.origin, context.real_frames.contact_threshold, pruning[smallest_label].dropped
+            )
+        })?,
+    )
+}
+
+/// What every trial of every descriptor shares: the frames kept, their labels, the split's sizes,
+/// the training (its seed split per trial) and the frames' preprocessing.
+struct TrialPlan<'a> {
+    kept: Vec<RealReading>,
+    labels: Vec<String>,
+    sizes: SplitSizes,
+    training: TrainConfig,
+    options: &'a RealFramesOptions,
+    blur: GaussianBlur,
+    seed: u64,
+}
+
+impl TrialPlan<'_> {
+    /// The run's `config.json`.
+    fn config<'c>(
+        &'c self,
+        context: &'c PaperContext,
+        real: &RealData,
+        pruning: &'c BTreeMap<String, PruneCount>,
+    ) -> RealFramesConfig<'c> {
+        RealFramesConfig {
             recording: &context.real.origin,
             rows: real.rows,
             cols: real.cols,
             scale: context.scale.fraction(),
-            seed: context.seed,
-            options,
-            labels,
-            pruning: &pruning,
+            seed: self.seed,
+            options: self.options,
+            labels: self.labels.clone(),
+            pruning,
             split: SplitPerLabel {
-                train: sizes.train,
-                validation: sizes.validation,
-                test: sizes.test,
+                train: self.sizes.train,
+                validation: self.sizes.validation,
+                test: self.sizes.test,
             },
             descriptors: DescriptorKind::ALL.iter().map(|k| k.name()).collect(),
-            training: &training,
-        },
-        units,
-    };
-    Ok(run(&experiment, &context.options)?)
+            training: &self.training,
+        }
+    }
+
+    /// Every trial's accuracy rows of one descriptor, and the per-label outcomes they count.
+    fn descriptor_rows(
+        &self,
+        kind: DescriptorKind,
+    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+        let descriptor = kind.build();
+        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        for trial in 0..self.options.trials {
+            let evaluation = self.evaluate_trial(descriptor.as_ref(), trial)?;
+            let meta = AccuracyCurve {
+                experiment: EXPERIMENT_NAME.to_string(),
+                descriptor: kind.name().to_string(),
+                // The figure varies only the descriptor.
+                factors: Factors::none(),
+                trial: trial as u32,
+                seed: self.seed,
+                stream_seed: trial_seed(self.seed, trial),
+            };
+            // One definition of accuracy (`recognize::AccuracyPoint`): every label counts.
+            rows.extend(meta.rows(&evaluation.accuracy));
+            per_object.extend(meta.object_rows(&evaluation)?);
+        }
+        Ok((rows, per_object))
+    }
+
+    /// Trial `trial`: its split, a model trained and selected on it, each label's test frames
+    /// recognised touch by touch.
+    fn evaluate_trial(&self, descriptor: &dyn Descriptor, trial: usize) -> Result<Evaluation, BoxError> {
+        let split = trial_split(&self.kept, self.sizes, self.seed, trial)?;
+        let trial_training = TrainConfig {
+            seed: rng::substream(self.training.seed, trial as u64),
+            ..self.training.clone()
+        };
+        let trained = train(
+            &self.describe(descriptor, &split.train)?,
+            Some(&self.describe(descriptor, &split.validation)?),
+            &trial_training,
+            &mut |_| {},
+        )?;
+        let test = self.describe(descriptor, &split.test)?;
+        let trials: Vec<Trial> = (0..self.labels.len())
+            .map(|object| Trial {
+                object,
+                readings: test.readings(object).to_vec(),
+            })
+            .collect();
+        let longest = trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
+        Ok(evaluate(&trained.bag, &trials, ReadingRange::new(1, longest)?)?)
+    }
+
+    /// The features of `frames`, grouped by label.
+    fn describe(
+        &self,
+        descriptor: &dyn Descriptor,
+        frames: &[&RealReading],
+    ) -> Result<LabelledFeatures, BoxError> {
+        let mut per_label: Vec<Vec<Vec<Vec<f64>>>> = vec![Vec::new(); self.labels.len()];
+        for frame in frames {
+            let j = self
+                .labels
+                .iter()
+                .position(|l| *l == frame.label)
+                .ok_or("internal: a frame of an unknown label")?;
+            per_label[j].push(describe_frame(descriptor, &frame.image, self.options, &self.blur));
+        }
+        Ok(LabelledFeatures::new(self.labels.to_vec(), per_label)?)
+    }
 }
 
 /// The split of trial `trial`: per label, disjoint training, validation and test frames.
@@ -297,68 +395,6 @@ pub fn trial_split(
 /// The seed of trial `trial`'s split (also the `stream_seed` column of its rows).
 fn trial_seed(seed: u64, trial: usize) -> u64 {
     rng::substream(rng::substream(seed, SPLIT_STREAM), trial as u64)
-}
-
-/// Every trial's accuracy rows of one descriptor, and the per-label outcomes they count.
-#[allow(clippy::too_many_arguments)]
-fn descriptor_rows(
-    kept: &[RealReading],
-    labels: &[String],
-    kind: DescriptorKind,
-    sizes: SplitSizes,
-    training: &TrainConfig,
-    options: &RealFramesOptions,
-    blur: &GaussianBlur,
-    seed: u64,
-) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
-    let descriptor = kind.build();
-    let describe = |frames: &[&RealReading]| -> Result<LabelledFeatures, BoxError> {
-        let mut per_label: Vec<Vec<Vec<Vec<f64>>>> = vec![Vec::new(); labels.len()];
-        for frame in frames {
-            let j = labels
-                .iter()
-                .position(|l| *l == frame.label)
-                .ok_or("internal: a frame of an unknown label")?;
-            per_label[j].push(describe_frame(descriptor.as_ref(), &frame.image, options, blur));
-        }
-        Ok(LabelledFeatures::new(labels.to_vec(), per_label)?)
-    };
-    let (mut rows, mut per_object) = (Vec::new(), Vec::new());
-    for trial in 0..options.trials {
-        let split = trial_split(kept, sizes, seed, trial)?;
-        let trial_training = TrainConfig {
-            seed: rng::substream(training.seed, trial as u64),
-            ..training.clone()
-        };
-        let trained = train(
-            &describe(&split.train)?,
-            Some(&describe(&split.validation)?),
-            &trial_training,
-            &mut |_| {},
-        )?;
-        let test = describe(&split.test)?;
-        let trials: Vec<Trial> = (0..labels.len())
-            .map(|object| Trial {
-                object,
-                readings: test.readings(object).to_vec(),
-            })
-            .collect();
-        let longest = trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
-        let evaluation = evaluate(&trained.bag, &trials, ReadingRange::new(1, longest)?)?;
-        let meta = AccuracyCurve {
-            experiment: EXPERIMENT_NAME.to_string(),
-            descriptor: kind.name().to_string(),
-            // The figure varies only the descriptor.
-            factors: Factors::none(),
-            trial: trial as u32,
-            seed,
-            stream_seed: trial_seed(seed, trial),
-        };
-        // One definition of accuracy (`recognize::AccuracyPoint`): every label counts.
-        rows.extend(meta.rows(&evaluation.accuracy));
-        per_object.extend(meta.object_rows(&evaluation)?);
-    }
-    Ok((rows, per_object))
 }
 
 /// One frame's features after the optional preprocessing.

@@ -4,7 +4,7 @@
 //! the mesh's own frame (vertices are written as given, metres), so the object's pose in MuJoCo is
 //! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
 
-use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
+use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh};
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
@@ -42,6 +42,13 @@ pub struct ObjectSpec {
     pub mass_kg: f64,
 }
 
+/// A checked object, resting at the origin as it was built.
+impl From<Object> for ObjectSpec {
+    fn from(object: Object) -> Self {
+        Self::new(object.name, object.mesh)
+    }
+}
+
 impl ObjectSpec {
     /// An object resting at the origin as given (its coordinates are already world metres).
     pub fn new(name: impl Into<String>, mesh: TriMesh) -> Self {
@@ -61,7 +68,7 @@ impl ObjectSpec {
             fetch: true,
             ..BuildOptions::default()
         })?;
-        Ok(built.into_iter().map(|b| Self::new(b.name, b.mesh)).collect())
+        Ok(built.into_iter().map(Self::from).collect())
     }
 
     /// Adds the mesh asset (its vertices and faces inline) and the object body to `doc`.

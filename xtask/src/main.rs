@@ -29,7 +29,8 @@ tasks:
                  (target/release/libtaction_covering.so, for Python and MuJoCo's viewer); object meshes
                  are fetched on first use
   demo [args]    setup, then `cargo run --release -- demo [args]`
-  test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`)
+  test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`), then each
+                 example (`cargo run --release --example NAME`, see examples/)
   bench [args]   setup, then `cargo bench [args]`
   run [args]     setup, then `cargo run --release -- [args]` (any taction subcommand)";
 
@@ -60,7 +61,8 @@ fn main() -> ExitCode {
         Some("test") => setup().and_then(|()| {
             let mut a = os(&["test", "--workspace"]);
             a.extend(rest);
-            cargo(&a)
+            cargo(&a)?;
+            run_examples()
         }),
         Some("bench") => setup().and_then(|()| {
             let mut a = os(&["bench", "--package", "taction"]);
@@ -80,6 +82,31 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Runs every example of the library (`examples/*.rs`, in name order) as a user would; each checks
+/// what it shows and exits non-zero when the check fails.
+fn run_examples() -> Result<(), String> {
+    let dir = project_root().join("examples");
+    let entries = fs::read_dir(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut names: Vec<String> = entries
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|e| e == "rs"))
+        .filter_map(|path| path.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    for name in &names {
+        cargo(&os(&[
+            "run",
+            "--release",
+            "--quiet",
+            "--package",
+            "taction",
+            "--example",
+            name,
+        ]))?;
+    }
+    Ok(())
 }
 
 fn os(items: &[&str]) -> Vec<OsString> {

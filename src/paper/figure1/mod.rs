@@ -2,25 +2,29 @@
 //! sensor placements at which local controllers converged ... The corresponding tactile images are
 //! shown to the right" (Sec. I), from "100 tactile images ... extracted using the planner, alongside
 //! depictions of the first 50" (Sec. III-A). One planner run on the set's chess piece (the pawn, else
-//! the first object), drawn by [`crate::paper::exploration`], with the placements as CSV.
+//! the first object), drawn by [`write_exploration_png`], with the placements as CSV.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::context::Family;
-use super::context::PaperContext;
-use super::figures::default_sensor;
 use crate::atomic::write_atomic;
 use crate::experiment::index::{PICTURE_FILE, PictureSpec, write_index};
 use crate::experiment::spec::to_json;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::PlannerConfig;
 use crate::explore::collect::{CollectMode, CollectPlan};
-use crate::paper::exploration::{Placement, write_exploration_png};
+use crate::paper::context::{Family, PaperContext};
+use crate::paper::figures::default_sensor;
 use crate::rng;
-use crate::sim::PerturbationBounds;
+use crate::sim::{ObjectSpec, PerturbationBounds};
 use crate::valid::Valid;
+
+mod render;
+
+pub use render::{
+    ExplorationView, PAPER_IMAGES_SHOWN, Placement, RgbPicture, render_exploration, write_exploration_png,
+};
 
 pub const EXPERIMENT_NAME: &str = "exploration";
 pub const DESCRIPTION: &str = "Fig. 1: one planner exploration of the chess piece (L = 0.5, 100 converged readings), a patch at every converged placement, the first 50 tactile images beside it";
@@ -63,20 +67,7 @@ pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
         .find(|o| o.name == PAPER_OBJECT)
         .or_else(|| objects.specs.first())
         .ok_or("the 3D set has no object to explore")?;
-    let plan = CollectPlan {
-        mode: CollectMode::Planner(Valid::new(
-            PlannerConfig {
-                local_probability: 0.5,
-                ..PlannerConfig::default()
-            }
-            .fitted_to(std::slice::from_ref(object)),
-        )?),
-        sensor: default_sensor(),
-        control: Valid::default(),
-        perturbation: PerturbationBounds::NONE,
-        readings_per_object: READINGS,
-        seed: rng::substream(context.seed, STREAM),
-    };
+    let plan = figure_plan(object, context.seed)?;
     let report = plan.collect_object(object, 0)?;
     let placements = Placement::from_readings(&report.readings);
     if placements.is_empty() {
@@ -90,29 +81,55 @@ pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
     let dir = context.options.out.join(EXPERIMENT_NAME);
     let picture = dir.join(format!("{EXPERIMENT_NAME}.png"));
     write_exploration_png(&picture, &object.mesh, &object.pose, &placements, &plan.sensor)?;
-    let rows: Vec<PlacementRow> = placements
-        .iter()
-        .enumerate()
-        .map(|(k, p)| PlacementRow {
-            object: object.name.clone(),
-            reading: k + 1,
-            center_x_m: p.pad_in_object.center_m.x,
-            center_y_m: p.pad_in_object.center_m.y,
-            center_z_m: p.pad_in_object.center_m.z,
-            normal_x: p.pad_in_object.normal.x,
-            normal_y: p.pad_in_object.normal.y,
-            normal_z: p.pad_in_object.normal.z,
-            max_taxel: p.image.values().iter().copied().fold(0.0, f64::max),
-            seed: context.seed,
-        })
-        .collect();
+    write_figure_files(&dir, object, &plan, &placements, context.seed)?;
+    write_index(&context.options.out)?;
+    if placements.len() < READINGS {
+        eprintln!(
+            "warning: Fig. 1: {} of {READINGS} converged readings of '{}' (the planner ran out of iterations)",
+            placements.len(),
+            object.name
+        );
+    }
+    Ok(picture)
+}
+
+/// One planner run of [`READINGS`] converged readings, L = 0.5 (Sec. III-A), the object fixed.
+fn figure_plan(object: &ObjectSpec, seed: u64) -> Result<CollectPlan, BoxError> {
+    Ok(CollectPlan {
+        mode: CollectMode::Planner(Valid::new(
+            PlannerConfig {
+                local_probability: 0.5,
+                ..PlannerConfig::default()
+            }
+            .fitted_to(std::slice::from_ref(object)),
+        )?),
+        sensor: default_sensor(),
+        control: Valid::default(),
+        perturbation: PerturbationBounds::NONE,
+        readings_per_object: READINGS,
+        seed: rng::substream(seed, STREAM),
+    })
+}
+
+/// Beside the picture: the placements as CSV, `config.json` and `picture.json` (which the index
+/// lists the picture by).
+fn write_figure_files(
+    dir: &Path,
+    object: &ObjectSpec,
+    plan: &CollectPlan,
+    placements: &[Placement],
+    seed: u64,
+) -> Result<(), BoxError> {
     let csv = dir.join(format!("{EXPERIMENT_NAME}.csv"));
-    write_atomic(&csv, &rows_to_csv(&rows, &csv)?)?;
+    write_atomic(
+        &csv,
+        &rows_to_csv(&placement_rows(object, placements, seed), &csv)?,
+    )?;
     let config = dir.join("config.json");
     let config_bytes = to_json(
         &Figure1Config {
             object: &object.name,
-            plan: &plan,
+            plan,
         },
         &config,
     )?;
@@ -127,13 +144,25 @@ pub fn run_figure1(context: &PaperContext) -> Result<PathBuf, BoxError> {
         ),
     };
     write_atomic(&spec_path, &to_json(&spec, &spec_path)?)?;
-    write_index(&context.options.out)?;
-    if placements.len() < READINGS {
-        eprintln!(
-            "warning: Fig. 1: {} of {READINGS} converged readings of '{}' (the planner ran out of iterations)",
-            placements.len(),
-            object.name
-        );
-    }
-    Ok(picture)
+    Ok(())
+}
+
+/// One row per converged placement, numbered from 1.
+fn placement_rows(object: &ObjectSpec, placements: &[Placement], seed: u64) -> Vec<PlacementRow> {
+    placements
+        .iter()
+        .enumerate()
+        .map(|(k, p)| PlacementRow {
+            object: object.name.clone(),
+            reading: k + 1,
+            center_x_m: p.pad_in_object.center_m.x,
+            center_y_m: p.pad_in_object.center_m.y,
+            center_z_m: p.pad_in_object.center_m.z,
+            normal_x: p.pad_in_object.normal.x,
+            normal_y: p.pad_in_object.normal.y,
+            normal_z: p.pad_in_object.normal.z,
+            max_taxel: p.image.values().iter().copied().fold(0.0, f64::max),
+            seed,
+        })
+        .collect()
 }

@@ -199,36 +199,8 @@ pub fn render_exploration(
     let mut picture = RgbPicture::filled(view.panel_px + sheet_w, view.panel_px.max(sheet_h), BACKGROUND);
     let mut depth = vec![f64::INFINITY; view.panel_px * view.panel_px];
 
-    let light = (-camera.view + 0.6 * camera.up - 0.4 * camera.right).normalize();
-    for &[a, b, c] in &mesh.triangles {
-        let [a, b, c] = [a, b, c].map(|i| vertices[i as usize]);
-        let Some(normal) = (b - a).cross(c - a).try_normalize() else {
-            continue;
-        };
-        let shade = AMBIENT + (1.0 - AMBIENT) * normal.dot(light).abs();
-        let color = OBJECT.map(|c| (c * shade).round().clamp(0.0, 255.0) as u8);
-        let screen = [a, b, c].map(|p| camera.project(p));
-        fill_convex(
-            &mut picture,
-            &mut depth,
-            &camera,
-            &screen,
-            DepthTest::Opaque,
-            |_| color,
-        );
-    }
-    // A patch shows if it is at most this far behind the nearest object surface: the covering's
-    // thickness plus a millimetre for the object's curvature under the pad.
-    let overlay = DepthTest::Overlay {
-        bias_m: sensor.thickness_m + 1e-3,
-    };
-    for corners in &patches {
-        let screen = corners.map(|p| camera.project(p));
-        let edge_px = 1.5;
-        fill_convex(&mut picture, &mut depth, &camera, &screen, overlay, |inset_px| {
-            if inset_px < edge_px { PATCH_EDGE } else { PATCH }
-        });
-    }
+    draw_object(&mut picture, &mut depth, &camera, mesh, &vertices);
+    draw_patches(&mut picture, &mut depth, &camera, &patches, sensor);
     if let Some(sheet) = sheet {
         for y in 0..sheet.height {
             for x in 0..sheet.width {
@@ -238,6 +210,50 @@ pub fn render_exploration(
         }
     }
     Ok(picture)
+}
+
+/// The object's triangles (at `vertices`, in the world), shaded Lambertian from a light beside the
+/// camera, into the z-buffer `depth`.
+fn draw_object(
+    picture: &mut RgbPicture,
+    depth: &mut [f64],
+    camera: &Camera,
+    mesh: &TriMesh,
+    vertices: &[DVec3],
+) {
+    let light = (-camera.view + 0.6 * camera.up - 0.4 * camera.right).normalize();
+    for &[a, b, c] in &mesh.triangles {
+        let [a, b, c] = [a, b, c].map(|i| vertices[i as usize]);
+        let Some(normal) = (b - a).cross(c - a).try_normalize() else {
+            continue;
+        };
+        let shade = AMBIENT + (1.0 - AMBIENT) * normal.dot(light).abs();
+        let color = OBJECT.map(|c| (c * shade).round().clamp(0.0, 255.0) as u8);
+        let screen = [a, b, c].map(|p| camera.project(p));
+        fill_convex(picture, depth, camera, &screen, DepthTest::Opaque, |_| color);
+    }
+}
+
+/// Each placement's patch, with an edge, where it is not hidden behind the object.
+fn draw_patches(
+    picture: &mut RgbPicture,
+    depth: &mut [f64],
+    camera: &Camera,
+    patches: &[[DVec3; 4]],
+    sensor: &SensorConfig,
+) {
+    // A patch shows if it is at most this far behind the nearest object surface: the covering's
+    // thickness plus a millimetre for the object's curvature under the pad.
+    let overlay = DepthTest::Overlay {
+        bias_m: sensor.thickness_m + 1e-3,
+    };
+    for corners in patches {
+        let screen = corners.map(|p| camera.project(p));
+        let edge_px = 1.5;
+        fill_convex(picture, depth, camera, &screen, overlay, |inset_px| {
+            if inset_px < edge_px { PATCH_EDGE } else { PATCH }
+        });
+    }
 }
 
 /// The contact sheet of `images` in `view.image_columns` columns, its taxels as large as lets the
