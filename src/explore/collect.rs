@@ -8,7 +8,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::control::{ControlConfig, ControlError};
+use crate::control::{ControlConfig, ControlError, FreePad, ReadTactile};
 use crate::dataset::{Dataset, DatasetError, DatasetHeader};
 use crate::explore::planner::{Planner, PlannerConfig};
 use crate::explore::report::ExplorationReport;
@@ -16,9 +16,8 @@ use crate::explore::sampler::{SamplerConfig, sample_readings};
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
-use crate::tactile::free_floating::FreeFloatingSensor;
-use crate::tactile::sensor::{CoveringSensor, add_sensor};
-use crate::tactile::{SensorConfig, TactileImage};
+use crate::tactile::SensorConfig;
+use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::valid::Valid;
 
 /// Which procedure collects the readings.
@@ -63,15 +62,8 @@ pub struct CollectPlan {
     pub seed: u64,
 }
 
-/// A reading function for a scene's covering sensor: computes kinematics and the position-stage
-/// sensors ([`Scene::compute_sensors`]; the plugin computes there, from the site and geom frames) and
-/// returns the image. The dynamics stages of a full `mj_forward` would change nothing the plugin reads.
-pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> {
-    move |scene: &mut Scene| {
-        scene.compute_sensors()?;
-        Ok(sensor.read(scene.data())?)
-    }
-}
+/// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
+pub use crate::control::sensor_reader;
 
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.
@@ -103,10 +95,10 @@ impl CollectPlan {
         let mut rng = rng::stream(self.seed, index as u64);
         match self.mode {
             CollectMode::Sampler(config) => {
-                let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
-                let reader = sensor_reader(free.sensor().clone());
+                let valid = Valid::new(sensor).map_err(TactileError::from)?;
+                let mut pad = FreePad::new(object.clone(), &valid)?;
                 sample_readings(
-                    free.scene_mut(),
+                    &mut pad,
                     &object.name,
                     sensor,
                     &self.control,
@@ -114,7 +106,6 @@ impl CollectPlan {
                     self.perturbation,
                     self.readings_per_object,
                     &mut rng,
-                    reader,
                     on_converged,
                 )
             }
@@ -134,18 +125,11 @@ impl CollectPlan {
         object: &ObjectSpec,
         index: usize,
         config: Valid<PlannerConfig>,
-    ) -> Result<
-        (
-            Scene,
-            Planner<impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> + use<>>,
-        ),
-        ControlError,
-    > {
+    ) -> Result<(Scene, Planner<impl ReadTactile + use<>>), ControlError> {
         let sensor = self.sensor_for(index);
         let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-        let scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
-            .map_err(crate::tactile::sensor::TactileError::from)?
-            .build()?;
+        let valid = Valid::new(sensor).map_err(TactileError::from)?;
+        let scene = add_sensor(builder, &valid, "covering", PAD_SITE).build()?;
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
         let planner = Planner::new(
             &scene,

@@ -23,8 +23,8 @@ use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::rng::Rng;
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SimError};
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::sim::{ObjectSpec, PerturbationBounds, SimError};
+use crate::tactile::{PadPose, SensorConfig};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The sampler's parameters.
@@ -101,8 +101,8 @@ fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
 /// a free-floating pad), perturbing the object after each reading if `perturbation` allows;
 /// `on_converged` runs after each converged reading (progress reports).
 #[allow(clippy::too_many_arguments)]
-pub fn sample_readings<R>(
-    scene: &mut Scene,
+pub fn sample_readings(
+    pad: &mut FreePad,
     object: &str,
     sensor: SensorConfig,
     control: &Valid<ControlConfig>,
@@ -110,13 +110,9 @@ pub fn sample_readings<R>(
     perturbation: PerturbationBounds,
     converged_target: usize,
     rng: &mut Rng,
-    reader: R,
     on_converged: &mut dyn FnMut(),
-) -> Result<ExplorationReport, ControlError>
-where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
-{
-    let mesh: TriMesh = scene.object().ok_or(SimError::NoObject)?.mesh.clone();
+) -> Result<ExplorationReport, ControlError> {
+    let mesh: TriMesh = pad.scene().object().ok_or(SimError::NoObject)?.mesh.clone();
     let up_only = config.from_above_only;
     let surface =
         SurfaceSampler::new(&mesh, |n| !up_only || n.z > 30f64.to_radians().cos()).ok_or_else(|| {
@@ -129,7 +125,6 @@ where
         true => Some(ArmReach::new(ObjectSpec::new(object, mesh.clone()))?),
         false => None,
     };
-    let mut pad = FreePad::new(scene, sensor, reader)?;
     let mut report = ExplorationReport::default();
     let max_attempts = converged_target
         .saturating_mul(config.max_attempts_per_reading)
@@ -168,12 +163,12 @@ where
             }
         }
         // A physics fault during the attempt puts the world back as it was before it.
-        let checkpoint = pad.scene().checkpoint()?;
+        let checkpoint = pad.scene_mut().checkpoint()?;
         pad.place(&start);
-        let reading = match settle(&mut pad, control) {
+        let reading = match settle(pad, control) {
             Ok(outcome) => attempt_reading(outcome, object, object_pose, Strategy::Sampler),
             Err(e) if e.is_physics_fault() => {
-                pad.scene().restore(&checkpoint)?;
+                pad.scene_mut().restore(&checkpoint)?;
                 aborted_reading(&sensor, start, object, object_pose, Strategy::Sampler)?
             }
             Err(e) => return Err(e),
@@ -184,7 +179,7 @@ where
             on_converged();
         }
         if !perturbation.is_none() {
-            let scene = pad.scene();
+            let scene = pad.scene_mut();
             let width = scene.object_width_m().ok_or(SimError::NoObject)?;
             let p = perturbation.draw(width, rng);
             scene.perturb_object(&p)?;
