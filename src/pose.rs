@@ -214,4 +214,14 @@ mod tests {
         assert_eq!(PadPose::of_site_xmat([0.0; 3], &[0.0; 9]), None);
         assert!((from_xmat.normal - pad.normal).length() < 1e-12 && (from_xmat.up - pad.up).length() < 1e-12);
     }
+
+    #[test]
+    fn pad_right_is_the_image_right_seen_from_behind() {
+        let pose = PadPose::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0), DVec3::new(0.0, 1.0, 0.3)).unwrap();
+        assert!((pose.normal - DVec3::NEG_Z).length() < 1e-12);
+        assert!((pose.up - DVec3::Y).length() < 1e-12);
+        // Looking down -z with +y up, the right of the image is +x.
+        assert!((pose.right() - DVec3::X).length() < 1e-12);
+        assert!(PadPose::new(DVec3::ZERO, DVec3::Z, DVec3::Z).is_none());
+    }
 }

@@ -113,7 +113,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         .into());
     }
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
-    let sensor = args.sensor.config(args.seed.seed)?;
+    let sensor = args.sensor.config(args.seed.seed)?.into_inner();
     let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
     let carrier = match args.mode {
         Mode::Sampler => Carrier::FreePad,

@@ -182,7 +182,6 @@ mod tests {
             .object(object)
             .add(Section::Worldbody, body);
         let scene = add_sensor(builder, config, "covering", FREE_PAD_SITE)
-            .unwrap()
             .build()
             .unwrap();
         FreePad::from_scene(scene).unwrap()

@@ -327,6 +327,7 @@ mod tests {
 
     fn parse(pairs: &[(&str, &str)]) -> Result<SensorConfig, ConfigError> {
         SensorConfig::from_key_values(|key| pairs.iter().find(|(k, _)| *k == key.name()).map(|(_, v)| *v))
+            .map(Valid::into_inner)
     }
 
     #[test]
@@ -368,7 +369,7 @@ mod tests {
             Some(text)
         })
         .unwrap();
-        assert_eq!(back, config);
+        assert_eq!(*back, config);
     }
 
     #[test]
