@@ -417,45 +417,55 @@ impl Covering {
                     }
                 }
                 Shape::Solid(solid) => {
-                    let to_geom = m.transpose();
-                    let (right, up, dir) = (to_geom.x_axis, to_geom.y_axis, to_geom.z_axis);
-                    let base = -(to_geom * o);
-                    let (rows, cols) = if r > 0.0 {
-                        (
-                            self.grid.row_range(o.y - r, o.y + r),
-                            self.grid.col_range(o.x - r, o.x + r),
-                        )
-                    } else {
-                        (0..self.grid.rows, 0..self.grid.cols)
-                    };
-                    for i in rows {
-                        let row_origin = base + up * self.grid.y(i);
-                        for j in cols.clone() {
-                            let origin = row_origin + right * self.grid.x(j);
-                            if let Some((s_in, s_out)) = solid.line_interval(origin, dir)
-                                && s_out >= 0.0
-                            {
-                                let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
-                                let s = i * self.grid.cols + j;
-                                if z < self.depth.nearest_m[s] {
-                                    self.depth.nearest_m[s] = z;
-                                }
-                            }
-                        }
-                    }
+                    draw_solid(&self.grid, &mut self.depth.nearest_m, solid, (&m, o), r);
                 }
             }
         }
-        let mut full = 0;
-        for row in self.depth.nearest_m.chunks_exact_mut(self.grid.cols) {
-            row.reverse();
-            for z in row {
-                *z = (t - *z).clamp(0.0, t);
-                full += usize::from(*z >= t);
+        penetration_from_depths(&mut self.depth.nearest_m, self.grid.cols, t)
+    }
+}
+
+/// Lowers `nearest_m` (pad-frame depths, sample order) to the depth of `solid` placed by
+/// `x -> placement.0 x + placement.1` where its ray meets it nearer; within `rbound_m` of its
+/// origin only (0: unbounded, every ray). A pad point inside the solid is at depth `-inf`.
+fn draw_solid(grid: &SampleGrid, nearest_m: &mut [f64], solid: Solid, (m, o): (&DMat3, DVec3), r: f64) {
+    let to_geom = m.transpose();
+    let (right, up, dir) = (to_geom.x_axis, to_geom.y_axis, to_geom.z_axis);
+    let base = -(to_geom * o);
+    let (rows, cols) = if r > 0.0 {
+        (grid.row_range(o.y - r, o.y + r), grid.col_range(o.x - r, o.x + r))
+    } else {
+        (0..grid.rows, 0..grid.cols)
+    };
+    for i in rows {
+        let row_origin = base + up * grid.y(i);
+        for j in cols.clone() {
+            let origin = row_origin + right * grid.x(j);
+            if let Some((s_in, s_out)) = solid.line_interval(origin, dir)
+                && s_out >= 0.0
+            {
+                let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
+                let s = i * grid.cols + j;
+                if z < nearest_m[s] {
+                    nearest_m[s] = z;
+                }
             }
         }
-        full
     }
+}
+
+/// Turns the per-sample depths into penetrations `clamp(t - z, 0, t)` in the image's column order
+/// (mirrored left-right, see the module docs); returns how many samples are fully penetrated.
+fn penetration_from_depths(nearest_m: &mut [f64], cols: usize, t: f64) -> usize {
+    let mut full = 0;
+    for row in nearest_m.chunks_exact_mut(cols) {
+        row.reverse();
+        for z in row {
+            *z = (t - *z).clamp(0.0, t);
+            full += usize::from(*z >= t);
+        }
+    }
+    full
 }
 
 #[cfg(test)]
