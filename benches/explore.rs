@@ -31,15 +31,16 @@ use criterion::{Criterion, Throughput, criterion_group};
 use glam::DVec3;
 use rand::RngExt;
 use taction::active_touch::InformationGain;
+use taction::control::{FreePad, sensor_reader};
 use taction::explore::TouchScorer;
-use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
+use taction::explore::collect::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::recognize::{ClusterHistogram, ObjectModels, PseudoCount};
 use taction::sim::arm::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
 use taction::tactile::sensor::{CoveringSensor, add_sensor};
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+use taction::tactile::{PadPose, SensorConfig};
 use taction::valid::Valid;
 
 /// Converged readings per timed run.
@@ -61,10 +62,14 @@ fn pawn() -> ObjectSpec {
 
 fn arm_scene(object: &ObjectSpec) -> Scene {
     let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-    add_sensor(builder, &sensor(), "covering", PAD_SITE)
-        .expect("sensor xml")
-        .build()
-        .expect("arm scene compiles")
+    add_sensor(
+        builder,
+        &Valid::new(sensor()).expect("a valid sensor"),
+        "covering",
+        PAD_SITE,
+    )
+    .build()
+    .expect("arm scene compiles")
 }
 
 /// A pad 0.3 t into the side of the pawn's base, level: a reading with contact.
@@ -75,12 +80,11 @@ fn touching_pose() -> PadPose {
     PadPose::new(DVec3::new(lo.x + 0.3 * 0.0012, 0.0, z), DVec3::X, DVec3::Z).expect("unit frame")
 }
 
-fn bare_reading(free: &mut FreeFloatingSensor, pose: &PadPose) -> f64 {
+fn bare_reading(free: &mut FreePad, pose: &PadPose) -> f64 {
     free.read_at(pose).expect("reading").mean()
 }
 
-fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
-    let reader = sensor_reader(free.sensor().clone());
+fn sampler_run(free: &mut FreePad, seed: u64) -> ExplorationReport {
     let rng = taction::rng::rng(seed);
     taction::explore::TrainingSampler::new(
         Valid::default(),
@@ -90,9 +94,8 @@ fn sampler_run(free: &mut FreeFloatingSensor, seed: u64) -> ExplorationReport {
             perturbation: PerturbationBounds::NONE,
         },
         rng,
-        reader,
     )
-    .sample(free.scene_mut(), "pawn", SAMPLER_READINGS)
+    .sample(free, "pawn", SAMPLER_READINGS)
     .expect("sampler run")
 }
 
@@ -195,7 +198,8 @@ fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
 fn benches(c: &mut Criterion) {
     let object = pawn();
     let pose = touching_pose();
-    let mut free = FreeFloatingSensor::new(object.clone(), &sensor()).expect("free-floating scene");
+    let mut free = FreePad::new(object.clone(), &Valid::new(sensor()).expect("a valid sensor"))
+        .expect("free-floating scene");
     let mut group = c.benchmark_group("explore");
     group
         .sample_size(10)
@@ -254,7 +258,8 @@ fn rate(runs: u64, mut run: impl FnMut(u64) -> ExplorationReport) -> (f64, f64, 
 fn summary() {
     let object = pawn();
     let pose = touching_pose();
-    let mut free = FreeFloatingSensor::new(object.clone(), &sensor()).expect("free-floating scene");
+    let mut free = FreePad::new(object.clone(), &Valid::new(sensor()).expect("a valid sensor"))
+        .expect("free-floating scene");
     let n = 2000;
     let start = Instant::now();
     for _ in 0..n {

@@ -37,16 +37,18 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use sensor_support::{geodesic_sphere, icosphere, taxel_centre};
+use taction::control::FreePad;
 use taction::mesh::TriMesh;
 use taction::sim::mjcf::COLLISION_GROUP;
 use taction::sim::mjcf::numbers;
 use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::tactile::formation::ImageFormation;
-use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml, pad_rotation};
+use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml};
 use taction::tactile::grid::SampleGrid;
 use taction::tactile::mesh_bvh::MeshBvh;
 use taction::tactile::raster::DepthBuffer;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, query_region};
+use taction::tactile::{PadPose, SensorConfig, query_region};
+use taction::valid::Valid;
 
 const RADIUS_M: f64 = 0.05;
 const RESOLUTIONS: [usize; 3] = [6, 14, 26];
@@ -148,7 +150,7 @@ struct RawScene {
 }
 
 impl RawScene {
-    fn of(free: &mut FreeFloatingSensor) -> Self {
+    fn of(free: &mut FreePad) -> Self {
         let m: *const mjModel = free.scene().model().ffi();
         // SAFETY: the pointer is only used while `free` is alive and not moved, by one thread.
         let d: *mut mjData = unsafe { free.scene_mut().data_mut().ffi_mut() };
@@ -178,16 +180,16 @@ struct MultiRay {
 }
 
 impl MultiRay {
-    fn new(free: &FreeFloatingSensor, pose: &PadPose, points: &[DVec3]) -> Self {
+    fn new(free: &FreePad, pose: &PadPose, points: &[DVec3]) -> Self {
         let eye = pose.center_m - pose.normal;
         Self {
             eye: eye.to_array(),
             dirs: points.iter().map(|p| (*p - eye).to_array()).collect(),
-            pad_body: free.scene().model().site_bodyid()[free.sensor().site_id()] as usize,
+            pad_body: free.scene().model().site_bodyid()[free.covering().site_id()] as usize,
         }
     }
 
-    fn cast(&self, free: &mut FreeFloatingSensor) -> f64 {
+    fn cast(&self, free: &mut FreePad) -> f64 {
         let data = free.scene_mut().data_mut();
         let (_, dist) = data.multi_ray(
             &self.eye,
@@ -231,7 +233,7 @@ fn native_scene(
             faces.extend_from_slice(&[a, b, d, b, e, d]);
         }
     }
-    let q = pad_rotation(pose);
+    let q = pose.site_rotation();
     let sensor = if with_sensor {
         "<sensor><tactile name=\"native\" geom=\"pad_taxels\" mesh=\"taxels\"/></sensor>"
     } else {
@@ -311,12 +313,16 @@ fn sensor(c: &mut Criterion) {
             let mut group = c.benchmark_group(format!("sensor/{n}x{n}x{rays_per_taxel}rays"));
             group_settings(&mut group);
 
-            let mut free = FreeFloatingSensor::new(ObjectSpec::new("sphere", mesh.clone()), &config).unwrap();
+            let mut free = FreePad::new(
+                ObjectSpec::new("sphere", mesh.clone()),
+                &Valid::new(config).unwrap(),
+            )
+            .unwrap();
             free.place(&pose);
             let image = free.read().unwrap();
             assert!(image.max() > 0.3, "the pad should touch the sphere");
             let stats = free
-                .sensor()
+                .covering()
                 .stats(free.scene().model(), free.scene().data())
                 .unwrap();
             eprintln!(
@@ -331,7 +337,7 @@ fn sensor(c: &mut Criterion) {
             // The stage alone recomputes the same image.
             raw.sensor_pos();
             assert_eq!(
-                free.sensor().read(free.scene().data()).unwrap().values(),
+                free.covering().read(free.scene().data()).unwrap().values(),
                 image.values()
             );
             group.bench_function(BenchmarkId::new("plugin", "sensor_stage"), |b| {
@@ -347,7 +353,7 @@ fn sensor(c: &mut Criterion) {
                 .build()
                 .unwrap();
             {
-                let q = pad_rotation(&pose);
+                let q = pose.site_rotation();
                 let data = bare.data_mut();
                 data.mocap_pos_mut()[1] = pose.center_m.to_array();
                 data.mocap_quat_mut()[1] = [q.w, q.x, q.y, q.z];
@@ -362,7 +368,7 @@ fn sensor(c: &mut Criterion) {
             });
 
             if rays_per_taxel == 4 {
-                let pad_body = free.scene().model().site_bodyid()[free.sensor().site_id()] as usize;
+                let pad_body = free.scene().model().site_bodyid()[free.covering().site_id()] as usize;
                 let dir = pose.normal.to_array();
                 group.bench_function(BenchmarkId::new("mujoco", "mj_ray_each"), |b| {
                     b.iter(|| {
@@ -416,13 +422,14 @@ fn sensor(c: &mut Criterion) {
                 native.forward();
                 assert!(native.ncon() > 0, "the native pad should touch the sphere");
                 let native_values = native_image(&native, &config);
-                let mut sharp = FreeFloatingSensor::new(
+                let mut sharp = FreePad::new(
                     ObjectSpec::new("sphere", mesh.clone()),
-                    &SensorConfig {
+                    &Valid::new(SensorConfig {
                         rays_per_taxel: 1,
                         psf_sigma_m: 0.0,
                         ..config
-                    },
+                    })
+                    .unwrap(),
                 )
                 .unwrap();
                 let sharp_values = sharp.read_at(&pose).unwrap().values().to_vec();
@@ -484,7 +491,11 @@ fn mesh_size(c: &mut Criterion) {
         let config = config(SERIES_TAXELS, 4);
         let pose = pad_pose(&config);
         let start = Instant::now();
-        let mut free = FreeFloatingSensor::new(ObjectSpec::new("sphere", mesh.clone()), &config).unwrap();
+        let mut free = FreePad::new(
+            ObjectSpec::new("sphere", mesh.clone()),
+            &Valid::new(config).unwrap(),
+        )
+        .unwrap();
         let compile_s = start.elapsed().as_secs_f64();
         eprintln!("{triangles} triangles: MuJoCo scene compiled in {compile_s:.2} s");
         record_extra(&format!("mesh_{triangles}/compile_s"), compile_s);
@@ -517,10 +528,12 @@ fn build(c: &mut Criterion) {
     group.bench_function("compile_scene_with_20k_triangle_bvh", |b| {
         b.iter(|| {
             black_box(
-                free_floating_builder(ObjectSpec::new("sphere", mesh.clone()), &config(6, 4))
-                    .unwrap()
-                    .build()
-                    .unwrap(),
+                free_floating_builder(
+                    ObjectSpec::new("sphere", mesh.clone()),
+                    &Valid::new(config(6, 4)).unwrap(),
+                )
+                .build()
+                .unwrap(),
             )
         })
     });

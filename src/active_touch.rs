@@ -291,7 +291,7 @@ pub fn explore_recognizing<R>(
     on_touch: &mut dyn FnMut(&Touch),
 ) -> Result<TouchRun, TouchError>
 where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+    R: crate::control::ReadTactile,
 {
     let mut run = TouchRun {
         touches: Vec::new(),

@@ -1,7 +1,27 @@
-//! Rigid poses in the world frame (metres, unit quaternions).
+//! Poses in the world frame (metres, unit quaternions): the rigid transform of a body ([`Pose`]:
+//! objects, mocap bodies, the arm's links) and where the sensor pad is ([`PadPose`]: its centre,
+//! normal and up, the frame a tactile image is taken in and the dataset's nine `pad_*` columns).
+//!
+//! The two meet at the pad site (`mjcf/arm.xml`'s `pad`, the free pad's `pad`), whose frame is the
+//! pad frame by this convention: site +z is the pad normal, site +y is `up` (toward image row 0),
+//! and site +x is `up x normal`, which is `-PadPose::right()` (the image's columns run along
+//! `normal x up`, the viewer's right looking along the normal from behind the pad; a rotation needs
+//! the right-handed frame). [`PadPose::of_site`] and [`PadPose::site_pose`] are the one conversion
+//! between the two, and [`rotation_from_xmat`] the one reading of MuJoCo's `xmat`.
 
-use glam::{DQuat, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 use serde::{Deserialize, Serialize};
+
+/// The world rotation of MuJoCo's row-major 3x3 `xmat` (`site_xmat`, `geom_xmat`, `xmat`, nine
+/// values from `xmat[0]`): its columns are the frame's x, y and z axes in world coordinates.
+#[inline]
+pub fn rotation_from_xmat(xmat: &[f64]) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(xmat[0], xmat[3], xmat[6]),
+        DVec3::new(xmat[1], xmat[4], xmat[7]),
+        DVec3::new(xmat[2], xmat[5], xmat[8]),
+    )
+}
 
 /// A rigid transform: a point `p` of the body frame is at `rotation * p + position_m` in the world.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -61,12 +81,94 @@ impl Pose {
         [self.rotation.w, self.rotation.x, self.rotation.y, self.rotation.z]
     }
 
+    /// From MuJoCo's position and row-major rotation matrix (`site_xpos`, `site_xmat`).
+    pub fn from_xmat(pos: [f64; 3], xmat: &[f64]) -> Self {
+        Self::new(
+            DVec3::from_array(pos),
+            DQuat::from_mat3(&rotation_from_xmat(xmat)),
+        )
+    }
+
     /// From MuJoCo's position and (w, x, y, z) quaternion.
     pub fn from_mujoco(pos: [f64; 3], quat: [f64; 4]) -> Self {
         Self::new(
             DVec3::from_array(pos),
             DQuat::from_xyzw(quat[1], quat[2], quat[3], quat[0]),
         )
+    }
+}
+
+/// Where the pad is: its frame in world coordinates, as a tactile image records it (see the module
+/// docs for how it relates to the pad site's [`Pose`]).
+///
+/// ```
+/// use glam::DVec3;
+/// use taction::pose::PadPose;
+///
+/// // A pad 5 cm above the origin, pressing down, image row 0 toward +y.
+/// let pad = PadPose::new(DVec3::new(0.0, 0.0, 0.05), -DVec3::Z, DVec3::Y).unwrap();
+/// let back = PadPose::of_site(&pad.site_pose());
+/// assert!((back.normal - pad.normal).length() < 1e-12 && (back.up - pad.up).length() < 1e-12);
+/// assert_eq!(pad.right(), DVec3::X);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PadPose {
+    /// Centre of the pad surface (the back of the covering), metres.
+    pub center_m: DVec3,
+    /// Unit normal pointing from the pad into the covering, toward the object.
+    pub normal: DVec3,
+    /// Unit vector in the pad plane toward image row 0.
+    pub up: DVec3,
+}
+
+impl PadPose {
+    /// Builds a pose from any normal and a hint for `up`; `up` is made orthogonal to the normal
+    /// (Gram-Schmidt). Returns `None` when the normal is zero or not finite, or `up` is parallel to it.
+    pub fn new(center_m: DVec3, normal: DVec3, up_hint: DVec3) -> Option<Self> {
+        let normal = normal.try_normalize()?;
+        let up = (up_hint - normal * up_hint.dot(normal)).try_normalize()?;
+        center_m.is_finite().then_some(Self { center_m, normal, up })
+    }
+
+    /// Unit vector in the pad plane toward the last image column: `normal x up`: the image's right
+    /// as seen from behind the pad, looking along the normal ((right, up, -normal) is right-handed).
+    pub fn right(&self) -> DVec3 {
+        self.normal.cross(self.up)
+    }
+
+    /// The pad frame of a pad site at world pose `site`: centre at the site, normal its +z, up its
+    /// +y (the module's convention).
+    pub fn of_site(site: &Pose) -> Self {
+        Self {
+            center_m: site.position_m,
+            normal: site.transform_vector(DVec3::Z).normalize(),
+            up: site.transform_vector(DVec3::Y).normalize(),
+        }
+    }
+
+    /// The pad frame of the site at MuJoCo's `site_xpos` / `site_xmat`; `None` when `xmat` is no
+    /// rotation (all zeros before the first kinematics) or the position is not finite.
+    pub fn of_site_xmat(pos: [f64; 3], xmat: &[f64]) -> Option<Self> {
+        let frame = rotation_from_xmat(xmat);
+        let rotation = frame.is_finite() && (frame.determinant() - 1.0).abs() < 1e-6;
+        let pose = Self::of_site(&Pose::from_xmat(pos, xmat));
+        (rotation && pose.center_m.is_finite()).then_some(pose)
+    }
+
+    /// The world rotation of the pad site at this pose: site (x, y, z) = (`up x normal`, `up`,
+    /// `normal`), the module's convention.
+    pub fn site_rotation(&self) -> DQuat {
+        DQuat::from_mat3(&DMat3::from_cols(
+            self.up.cross(self.normal),
+            self.up,
+            self.normal,
+        ))
+        .normalize()
+    }
+
+    /// The world pose of the pad site at this pose; [`PadPose::of_site`] inverts it.
+    pub fn site_pose(&self) -> Pose {
+        Pose::new(self.center_m, self.site_rotation())
     }
 }
 
@@ -88,5 +190,38 @@ mod tests {
         );
         let m = Pose::from_mujoco(a.position_m.to_array(), a.mujoco_quat());
         assert!((m.transform_point(p) - a.transform_point(p)).length() < 1e-12);
+    }
+
+    #[test]
+    fn the_site_frame_and_the_pad_frame_convert_both_ways() {
+        let pad = PadPose::new(
+            DVec3::new(0.1, -0.2, 0.3),
+            DVec3::new(0.3, -1.0, 0.2),
+            DVec3::new(0.5, 0.2, 1.0),
+        )
+        .unwrap();
+        let site = pad.site_pose();
+        // Site x is up x normal = -right; the frame is right-handed.
+        assert!((site.transform_vector(DVec3::X) + pad.right()).length() < 1e-12);
+        let back = PadPose::of_site(&site);
+        assert!((back.center_m - pad.center_m).length() < 1e-15);
+        assert!((back.normal - pad.normal).length() < 1e-12 && (back.up - pad.up).length() < 1e-12);
+        // The same frame read from MuJoCo's row-major xmat.
+        let m = DMat3::from_quat(site.rotation);
+        let xmat = m.transpose().to_cols_array();
+        assert_eq!(rotation_from_xmat(&xmat), m);
+        let from_xmat = PadPose::of_site_xmat(pad.center_m.to_array(), &xmat).unwrap();
+        assert_eq!(PadPose::of_site_xmat([0.0; 3], &[0.0; 9]), None);
+        assert!((from_xmat.normal - pad.normal).length() < 1e-12 && (from_xmat.up - pad.up).length() < 1e-12);
+    }
+
+    #[test]
+    fn pad_right_is_the_image_right_seen_from_behind() {
+        let pose = PadPose::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0), DVec3::new(0.0, 1.0, 0.3)).unwrap();
+        assert!((pose.normal - DVec3::NEG_Z).length() < 1e-12);
+        assert!((pose.up - DVec3::Y).length() < 1e-12);
+        // Looking down -z with +y up, the right of the image is +x.
+        assert!((pose.right() - DVec3::X).length() < 1e-12);
+        assert!(PadPose::new(DVec3::ZERO, DVec3::Z, DVec3::Z).is_none());
     }
 }

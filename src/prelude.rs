@@ -26,5 +26,5 @@ pub use crate::recognize::{
     DescriptorChoice, OnlinePosterior, ReadingRange, Recognizer, TrainConfig, TrainedModel, evaluate, train,
 };
 pub use crate::sim::{ObjectSpec, PerturbationBounds};
-pub use crate::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, TactileImage};
+pub use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
 pub use crate::valid::{Check, Valid};

@@ -9,17 +9,14 @@
 //! by the free pad placed at the arm's own start pose (its roll included), and the settled images
 //! are compared.
 
-use taction::control::arm_pad::{ArmPad, pad_pose_of_site};
-use taction::control::free_pad::FreePad;
-use taction::control::{ContactOutcome, ControlConfig, settle};
+use taction::control::{ArmPad, ContactOutcome, ControlConfig, FreePad, sensor_reader, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::collect::sensor_reader;
 use taction::explore::planner::precise_kinematic_motion;
 use taction::explore::{SurfaceSampler, carried};
 use taction::mesh::ObjectSet;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{InverseKinematics, ObjectSpec, PadTarget, Scene, SceneBuilder};
-use taction::tactile::{CoveringSensor, FreeFloatingSensor, SensorConfig, TactileImage, add_sensor};
+use taction::tactile::{CoveringSensor, SensorConfig, TactileImage, add_sensor};
 use taction::valid::Valid;
 
 /// Surface points per object at which the arm's start pose is reachable and free of collision.
@@ -58,8 +55,8 @@ struct Pair {
 fn touch_both(object: &ObjectSpec, sensor: SensorConfig, seed: u64) -> (Vec<Pair>, usize) {
     let control = Valid::new(ControlConfig::default()).expect("defaults are valid");
     let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-    let mut scene: Scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
-        .expect("sensor")
+    let valid_sensor = Valid::new(sensor).expect("a valid sensor");
+    let mut scene: Scene = add_sensor(builder, &valid_sensor, "covering", PAD_SITE)
         .build()
         .expect("arm scene");
     let arm = scene.arm().cloned().expect("arm");
@@ -67,7 +64,7 @@ fn touch_both(object: &ObjectSpec, sensor: SensorConfig, seed: u64) -> (Vec<Pair
     let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
     let home = arm.q(scene.data());
     let arm_object = scene.object_pose().expect("object");
-    let mut free = FreeFloatingSensor::new(object.clone(), &sensor).expect("free pad scene");
+    let mut free = FreePad::new(object.clone(), &valid_sensor).expect("free pad scene");
     let free_object = free.scene().object_pose().expect("object");
     // The arm scene's object frame carried onto the free pad scene's.
     let to_free = free_object.compose(&arm_object.inverse());
@@ -90,15 +87,13 @@ fn touch_both(object: &ObjectSpec, sensor: SensorConfig, seed: u64) -> (Vec<Pair
         if arm.collision(&scene).is_some() {
             continue;
         }
-        let start = pad_pose_of_site(&arm.pad_pose(scene.data()));
+        let start = arm.pad_pose(scene.data());
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).expect("covering"));
         let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion).expect("arm pad");
         let arm_outcome = settle(&mut pad, &control).expect("arm settles");
         let free_start = carried(&start, &to_free);
-        let reader = sensor_reader(free.sensor().clone());
-        let mut pad = FreePad::new(free.scene_mut(), sensor, reader).expect("free pad");
-        pad.place(&free_start);
-        let free_outcome = settle(&mut pad, &control).expect("free pad settles");
+        free.place(&free_start);
+        let free_outcome = settle(&mut free, &control).expect("free pad settles");
         pairs.push(Pair {
             arm: arm_outcome,
             free: free_outcome,

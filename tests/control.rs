@@ -4,15 +4,12 @@ mod common;
 
 use glam::{DQuat, DVec3};
 use rand::RngExt;
-use taction::control::free_pad::FreePad;
-use taction::control::{ControlConfig, settle};
+use taction::control::{ControlConfig, FreePad, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::collect::sensor_reader;
 use taction::mesh::TriMesh;
 use taction::pose::Pose;
 use taction::rng;
 use taction::sim::ObjectSpec;
-use taction::tactile::free_floating::FreeFloatingSensor;
 use taction::tactile::{PadPose, SensorConfig};
 use taction::valid::Valid;
 
@@ -20,20 +17,18 @@ fn sensor() -> SensorConfig {
     SensorConfig::square(6, 6, 0.012, 0.0012)
 }
 
-fn free_sensor(object: ObjectSpec) -> FreeFloatingSensor {
-    FreeFloatingSensor::new(object, &sensor()).unwrap()
+fn free_sensor(object: ObjectSpec) -> FreePad {
+    FreePad::new(object, &Valid::new(sensor()).unwrap()).unwrap()
 }
 
 /// Runs the controllers from `start` and returns the outcome.
 fn settle_from(
-    free: &mut FreeFloatingSensor,
+    pad: &mut FreePad,
     start: &PadPose,
     config: &ControlConfig,
 ) -> taction::control::ContactOutcome {
-    let reader = sensor_reader(free.sensor().clone());
-    let mut pad = FreePad::new(free.scene_mut(), sensor(), reader).unwrap();
     pad.place(start);
-    settle(&mut pad, &Valid::new(*config).unwrap()).unwrap()
+    settle(pad, &Valid::new(*config).unwrap()).unwrap()
 }
 
 /// A 20 cm slab whose top face passes through the origin with normal `n`.
@@ -215,10 +210,12 @@ fn same_seed_same_commands_and_readings() {
             noise_seed: seed,
             ..sensor()
         };
-        let mut free = FreeFloatingSensor::new(tilted_plane(DQuat::from_rotation_x(0.3)), &sensor).unwrap();
+        let mut pad = FreePad::new(
+            tilted_plane(DQuat::from_rotation_x(0.3)),
+            &Valid::new(sensor).unwrap(),
+        )
+        .unwrap();
         let start = PadPose::new(DVec3::new(0.0, 0.0, 0.004), -DVec3::Z, DVec3::Y).unwrap();
-        let reader = sensor_reader(free.sensor().clone());
-        let mut pad = FreePad::new(free.scene_mut(), sensor, reader).unwrap();
         pad.place(&start);
         let o = settle(&mut pad, &Valid::new(config).unwrap()).unwrap();
         (o.trace, o.image, o.status)

@@ -298,10 +298,14 @@ fn global_strategy_covers_the_workspace() {
 
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     // No object: nothing stops the expansion, so the tree shows the strategy alone.
-    let mut scene = add_sensor(SceneBuilder::with_arm_and_table(), &sensor, "covering", PAD_SITE)
-        .unwrap()
-        .build()
-        .unwrap();
+    let mut scene = add_sensor(
+        SceneBuilder::with_arm_and_table(),
+        &Valid::new(sensor).unwrap(),
+        "covering",
+        PAD_SITE,
+    )
+    .build()
+    .unwrap();
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).unwrap());
     let config = PlannerConfig {
         local_probability: 0.0,
@@ -556,18 +560,13 @@ fn collect_takes_the_controllers_from_a_control_file() {
 
 /// A reader that corrupts the world's state just before its reads number `at` (counting from 1),
 /// with `corrupt`, then reads as `reader` does.
-fn faulting<R>(
+fn faulting<R: taction::control::ReadTactile + Send>(
     mut reader: R,
     at: &'static [usize],
     corrupt: fn(&mut taction::sim::Scene),
-) -> impl FnMut(&mut taction::sim::Scene) -> Result<taction::tactile::TactileImage, taction::control::ControlError>
-where
-    R: FnMut(
-        &mut taction::sim::Scene,
-    ) -> Result<taction::tactile::TactileImage, taction::control::ControlError>,
-{
+) -> impl taction::control::ReadTactile + Send {
     let mut reads = 0;
-    move |scene| {
+    move |scene: &mut taction::sim::Scene| {
         reads += 1;
         if at.contains(&reads) {
             corrupt(scene);
@@ -579,15 +578,15 @@ where
 /// The free pad's sampler on the box for 10 converged readings, the state corrupted (the mocap
 /// poses not finite, as a blown-up integration leaves positions) at reads `faults`.
 fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationReport {
-    use taction::explore::collect::sensor_reader;
-    use taction::tactile::FreeFloatingSensor;
+    use taction::control::{FreePad, sensor_reader};
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
-    let mut free = FreeFloatingSensor::new(box_object(), &sensor).unwrap();
-    let reader = faulting(sensor_reader(free.sensor().clone()), faults, |scene| {
+    let pad = FreePad::new(box_object(), &Valid::new(sensor).unwrap()).unwrap();
+    let reader = faulting(sensor_reader(pad.covering().clone()), faults, |scene| {
         for p in scene.data_mut().mocap_pos_mut() {
             p[2] = f64::NAN;
         }
     });
+    let mut pad = pad.with_reader(reader);
     taction::explore::TrainingSampler::new(
         Valid::default(),
         taction::explore::TouchSetup {
@@ -596,9 +595,8 @@ fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationRep
             perturbation: PerturbationBounds::NONE,
         },
         taction::rng::stream(17, 0),
-        reader,
     )
-    .sample(free.scene_mut(), "box", 10)
+    .sample(&mut pad, "box", 10)
     .unwrap()
 }
 
@@ -612,8 +610,7 @@ fn faulted_planner(faults: &'static [usize]) -> taction::explore::ExplorationRep
     use taction::tactile::sensor::{CoveringSensor, add_sensor};
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let builder = SceneBuilder::with_arm_and_table().object(box_object());
-    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)
-        .unwrap()
+    let mut scene = add_sensor(builder, &Valid::new(sensor).unwrap(), "covering", PAD_SITE)
         .build()
         .unwrap();
     let reader = faulting(

@@ -174,7 +174,6 @@ fn scene_export_writes_the_builders_scene_with_its_mesh_beside_it() {
     let builder = taction::sim::SceneBuilder::with_arm_and_table()
         .object(taction::sim::ObjectSpec::new("pawn", pawn.mesh));
     let built = taction::tactile::add_sensor(builder, sensor.config(), "tactile", "pad")
-        .unwrap()
         .build()
         .unwrap();
     let model = built.model();
@@ -260,7 +259,7 @@ fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
 
     // What the builders write: the arm's world with a fixed and a free object and the sensor, and
     // the free-floating pad's. The object's name lands in a comment: `--` must not end it early.
-    let config = SensorConfig::default();
+    let config = taction::valid::Valid::new(SensorConfig::default()).unwrap();
     let named = |mount| taction::sim::ObjectSpec {
         mount,
         ..taction::sim::ObjectSpec::new("a--b -", common::box_mesh(DVec3::splat(0.05)))
@@ -268,7 +267,6 @@ fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
     for mount in [taction::sim::ObjectMount::Mocap, taction::sim::ObjectMount::Free] {
         let builder = taction::sim::SceneBuilder::with_arm_and_table().object(named(mount));
         let xml = taction::tactile::add_sensor(builder, &config, "tactile", "pad")
-            .unwrap()
             .to_xml()
             .unwrap();
         strictly_parsed(&xml, &format!("the arm's scene ({mount:?} object)"));
@@ -277,7 +275,6 @@ fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
         named(taction::sim::ObjectMount::Mocap),
         &config,
     )
-    .unwrap()
     .to_xml()
     .unwrap();
     strictly_parsed(&free, "the free-floating pad's scene");

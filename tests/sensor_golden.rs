@@ -13,10 +13,12 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 use sensor_support::{box_between, icosphere};
+use taction::control::FreePad;
 use taction::mesh::TriMesh;
 use taction::mesh::cgal::{cgal_mesh, ensure_fetched};
 use taction::sim::ObjectSpec;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, psf_sigma_for_thickness};
+use taction::tactile::{PadPose, SensorConfig, psf_sigma_for_thickness};
+use taction::valid::Valid;
 
 const TOLERANCE: f64 = 1e-6;
 
@@ -138,7 +140,8 @@ fn meshes() -> Vec<(&'static str, TriMesh)> {
 fn read_all(name: &str, mesh: &TriMesh) -> String {
     let mut out = String::new();
     for (config_name, config) in configs() {
-        let mut sensor = FreeFloatingSensor::new(ObjectSpec::new(name, mesh.clone()), &config).unwrap();
+        let mut sensor =
+            FreePad::new(ObjectSpec::new(name, mesh.clone()), &Valid::new(config).unwrap()).unwrap();
         for (pose_name, pose) in poses(mesh, &config) {
             // Two readings at each pose: the second continues the noise stream.
             for reading in 0..2 {

@@ -83,10 +83,12 @@ fn bad_config_fails_compilation_naming_the_key_and_range() {
 }
 
 use glam::DQuat;
+use taction::control::FreePad;
 use taction::pose::Pose;
 use taction::sim::mjcf::COLLISION_GROUP;
 use taction::sim::{ObjectMount, ObjectSpec};
-use taction::tactile::{FreeFloatingSensor, PadPose, TactileImage};
+use taction::tactile::{PadPose, TactileImage};
+use taction::valid::Valid;
 
 /// The analytic depth of the ray through pad point (x, y) to the plane z = 0 (pad above it).
 fn depth_to_floor(pose: &PadPose, x: f64, y: f64) -> f64 {
@@ -129,7 +131,7 @@ fn tilted_plane_follows_the_analytic_ramp() {
     let mut plane = free_sensor_with("<geom type=\"plane\" size=\"1 1 0.1\"/>", &config);
     assert!(max_abs_diff(&plane.read_at(&pose).unwrap(), &want) < 1e-4);
     let slab = box_between(DVec3::new(-0.04, -0.03, -0.02), DVec3::new(0.05, 0.04, 0.0));
-    let mut mesh = FreeFloatingSensor::new(ObjectSpec::new("slab", slab), &config).unwrap();
+    let mut mesh = FreePad::new(ObjectSpec::new("slab", slab), &Valid::new(config).unwrap()).unwrap();
     let image = mesh.read_at(&pose).unwrap();
     assert!(max_abs_diff(&image, &want) < 1e-4, "{image}");
 }
@@ -170,7 +172,7 @@ fn pressed_sphere_matches_the_spherical_cap() {
         max_abs_diff(&exact, &want)
     );
     let mesh = icosphere(centre, r, 4);
-    let mut sensor = FreeFloatingSensor::new(ObjectSpec::new("sphere", mesh), &config).unwrap();
+    let mut sensor = FreePad::new(ObjectSpec::new("sphere", mesh), &Valid::new(config).unwrap()).unwrap();
     let image = sensor.read_at(&pose).unwrap();
     let err = max_abs_diff(&image, &want);
     assert!(
@@ -201,7 +203,7 @@ fn turning_the_object_about_the_normal_turns_the_image() {
         mount: ObjectMount::Free,
         ..ObjectSpec::new("wedge", wedge())
     };
-    let mut sensor = FreeFloatingSensor::new(spec, &config).unwrap();
+    let mut sensor = FreePad::new(spec, &Valid::new(config).unwrap()).unwrap();
     sensor.place(&pose);
     let before = sensor.read().unwrap();
     assert!(
@@ -235,13 +237,13 @@ fn moving_the_object_changes_the_reading_without_rebuilding() {
         mount: ObjectMount::Free,
         ..ObjectSpec::new("ball", icosphere(DVec3::ZERO, r, 3))
     };
-    let mut sensor = FreeFloatingSensor::new(spec, &config).unwrap();
+    let mut sensor = FreePad::new(spec, &Valid::new(config).unwrap()).unwrap();
     sensor.place(&pad_looking_down(DVec3::ZERO));
     let at = |x: f64| Pose::new(DVec3::new(x, -0.001, -(r + 0.3 * t)), DQuat::IDENTITY);
     sensor.scene_mut().set_object_pose(at(-0.001)).unwrap();
     let first = sensor.read().unwrap();
     let model = sensor.scene().model_arc();
-    let stats = sensor.sensor().stats(&model, sensor.scene().data()).unwrap();
+    let stats = sensor.covering().stats(&model, sensor.scene().data()).unwrap();
     assert_eq!(stats.bvh_builds, 1);
     // One taxel (2 mm) to the right: the image shifts by one column.
     sensor.scene_mut().set_object_pose(at(0.001)).unwrap();
@@ -255,7 +257,7 @@ fn moving_the_object_changes_the_reading_without_rebuilding() {
             );
         }
     }
-    let after = sensor.sensor().stats(&model, sensor.scene().data()).unwrap();
+    let after = sensor.covering().stats(&model, sensor.scene().data()).unwrap();
     assert_eq!(after.bvh_builds, 1, "no BVH is rebuilt when the object moves");
     assert!(after.readings > stats.readings);
 }
@@ -264,7 +266,7 @@ fn moving_the_object_changes_the_reading_without_rebuilding() {
 fn no_contact_reads_zero_and_pushed_through_reads_saturated() {
     let config = SensorConfig::default();
     let ball = icosphere(DVec3::ZERO, 0.01, 3);
-    let mut sensor = FreeFloatingSensor::new(ObjectSpec::new("ball", ball), &config).unwrap();
+    let mut sensor = FreePad::new(ObjectSpec::new("ball", ball), &Valid::new(config).unwrap()).unwrap();
     let far = sensor
         .read_at(&pad_looking_down(DVec3::new(
             0.0,
@@ -317,12 +319,12 @@ fn mesh_depths_agree_with_mj_ray() {
         ),
         ..ObjectSpec::new("ball", ball)
     };
-    let mut sensor = FreeFloatingSensor::new(spec, &config).unwrap();
+    let mut sensor = FreePad::new(spec, &Valid::new(config).unwrap()).unwrap();
     let world_centre = sensor.scene().object_center().unwrap();
     let normal = DVec3::new(0.2, -0.3, -1.0).normalize();
     let pose = PadPose::new(world_centre - normal * (0.006 - 0.6 * t), normal, DVec3::Y).unwrap();
     let image = sensor.read_at(&pose).unwrap();
-    let pad_body = sensor.scene().model().site_bodyid()[sensor.sensor().site_id()] as usize;
+    let pad_body = sensor.scene().model().site_bodyid()[sensor.covering().site_id()] as usize;
     let mut checked = 0;
     for i in 0..config.rows {
         for j in 0..config.cols {
@@ -378,7 +380,7 @@ fn the_pads_own_tree_is_not_sensed() {
         let builder = taction::sim::SceneBuilder::new()
             .table(false)
             .add(taction::sim::mjcf::Section::Worldbody, tree(other));
-        let builder = taction::tactile::add_sensor(builder, &config, "covering", "pad").unwrap();
+        let builder = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad");
         let scene = builder.build().unwrap();
         let sensor = taction::tactile::CoveringSensor::on_site(scene.model(), "pad").unwrap();
         let image = sensor.read(scene.data()).unwrap();
@@ -399,8 +401,7 @@ fn the_pads_own_tree_is_not_sensed() {
             taction::sim::mjcf::Section::Worldbody,
             format!("<site name=\"pad\"/>{world}"),
         );
-        let scene = taction::tactile::add_sensor(builder, &config, "covering", "pad")
-            .unwrap()
+        let scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad")
             .build()
             .unwrap();
         let image = taction::tactile::CoveringSensor::first(scene.model())

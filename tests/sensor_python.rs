@@ -14,10 +14,12 @@ use std::process::Command;
 
 use glam::DVec3;
 use sensor_support::{icosphere, pad_looking_down, shipped_scene_at_touch};
+use taction::control::FreePad;
 use taction::sim::arm::PAD_SITE;
 use taction::sim::{IkOptions, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::free_floating::{free_floating_builder, pad_rotation};
-use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig};
+use taction::tactile::free_floating::free_floating_builder;
+use taction::tactile::{CoveringSensor, PadPose, SensorConfig};
+use taction::valid::Valid;
 
 fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
@@ -202,16 +204,14 @@ fn python_loads_the_plugin_and_reads_the_same_image() {
     };
     let object = ObjectSpec::new("ball", icosphere(DVec3::ZERO, 0.01, 3));
     let pose: PadPose = pad_looking_down(DVec3::new(0.001, 0.0, 0.0102));
-    let mut sensor = FreeFloatingSensor::new(object.clone(), &config).unwrap();
+    let config = Valid::new(config).unwrap();
+    let mut sensor = FreePad::new(object.clone(), &config).unwrap();
     sensor.place(&pose);
     // Python's MjData runs mj_forward once, as the Rust scene did when it was built; read the second.
     let rust = sensor.read().unwrap();
 
     let dir = tempfile::tempdir().unwrap();
-    let xml = free_floating_builder(object.clone(), &config)
-        .unwrap()
-        .to_xml()
-        .unwrap();
+    let xml = free_floating_builder(object.clone(), &config).to_xml().unwrap();
     std::fs::write(dir.path().join("scene.xml"), &xml).unwrap();
     let bad = xml.replace(
         "key=\"rays_per_taxel\" value=\"4\"",
@@ -220,7 +220,7 @@ fn python_loads_the_plugin_and_reads_the_same_image() {
     assert_ne!(bad, xml);
     std::fs::write(dir.path().join("bad.xml"), bad).unwrap();
     std::fs::write(dir.path().join("check.py"), SCRIPT).unwrap();
-    let q = pad_rotation(&pose);
+    let q = pose.site_rotation();
     let pos = format!("{},{},{}", pose.center_m.x, pose.center_m.y, pose.center_m.z);
     let quat = format!("{},{},{},{}", q.w, q.x, q.y, q.z);
     let out = Command::new(&python)
@@ -249,8 +249,8 @@ fn python_loads_the_plugin_and_reads_the_same_image() {
     assert!(rust.max() > 0.2);
     // The first mj_forward of Python's MjData is reading 0 (noise stream 0); Rust's scene read
     // reading 1 above, so compare the noise-free structure and the exact noise of reading 0 apart.
-    let mut first = FreeFloatingSensor::new(object, &config).unwrap();
-    let handle = first.sensor().clone();
+    let mut first = FreePad::new(object, &config).unwrap();
+    let handle = first.covering().clone();
     first.place(&pose);
     first.scene_mut().data_mut().reset();
     let data = first.scene_mut().data_mut();
@@ -378,8 +378,7 @@ fn python_reads_an_exported_scene_as_the_rust_scene_builder_does() {
         .unwrap();
     let top_z_m = pawn.mesh.bounds().unwrap().1.z;
     let builder = SceneBuilder::with_arm_and_table().object(ObjectSpec::new("pawn", pawn.mesh));
-    let mut scene = taction::tactile::add_sensor(builder, &config, "tactile", PAD_SITE)
-        .unwrap()
+    let mut scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "tactile", PAD_SITE)
         .build()
         .unwrap();
     let arm = scene.arm().cloned().unwrap();

@@ -49,11 +49,11 @@ fn initial_pad_pose_is_along_x_at_shoulder_height() {
     let arm = scene.arm().unwrap();
     let pose = arm.pad_pose(scene.data());
     assert!(
-        (pose.position_m - DVec3::new(0.34, 0.0, 0.30)).length() < 1e-9,
+        (pose.center_m - DVec3::new(0.34, 0.0, 0.30)).length() < 1e-9,
         "{:?}",
-        pose.position_m
+        pose.center_m
     );
-    assert!((pose.transform_vector(DVec3::Z) - DVec3::X).length() < 1e-9);
+    assert!((pose.normal - DVec3::X).length() < 1e-9);
 }
 
 /// 200 seeded pad targets around the object (10-13 cm from its centre, from every side but below,
@@ -123,7 +123,7 @@ fn move_through_the_object_reports_the_collision_and_a_free_path_completes() {
         .move_to(&mut scene, &above, &MoveOptions::default(), |_| false)
         .unwrap();
     assert_eq!(outcome, MoveOutcome::Reached);
-    assert!((arm.pad_pose(scene.data()).position_m - DVec3::new(0.0, 0.0, 0.25)).length() < 5e-3);
+    assert!((arm.pad_pose(scene.data()).center_m - DVec3::new(0.0, 0.0, 0.25)).length() < 5e-3);
     // Straight down through the box (its top is at 0.12 m).
     let inside = ik
         .solve(

@@ -86,7 +86,7 @@ pub struct CollectArgs {
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_flags(args)?;
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
-    let sensor = args.sensor.config(args.seed.seed)?;
+    let sensor = args.sensor.config(args.seed.seed)?.into_inner();
     let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
     let carrier = match args.mode {
         Mode::Sampler => Carrier::FreePad,

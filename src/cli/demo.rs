@@ -191,10 +191,10 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let unknown = objects[index].clone();
     let mut scene = add_sensor(
         SceneBuilder::with_arm_and_table().object(unknown.clone()),
-        &sensor,
+        &Valid::new(sensor)?,
         "covering",
         PAD_SITE,
-    )?
+    )
     .build()?;
     // Any heading about the vertical, then the perturbation of Sec. V-B4 (a tilt of up to 10
     // degrees about a random axis, a shift of up to 10% of the width): the object stands on the

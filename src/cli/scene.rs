@@ -104,7 +104,10 @@ const TOUCH_START_ABOVE_M: f64 = 0.005;
 /// noise), as `taction touch --arm` runs them: started looking straight down over the centre of the
 /// object's bounding box, then over its highest vertex (a ring has nothing under its centre); the
 /// first that converges, else the first that ends in contact, else `None`.
-fn touch_from_above(object: &ObjectSpec, sensor: &SensorConfig) -> Result<Option<ArmTouch>, TouchError> {
+fn touch_from_above(
+    object: &ObjectSpec,
+    sensor: &Valid<SensorConfig>,
+) -> Result<Option<ArmTouch>, TouchError> {
     let Some((lo, hi)) = object.mesh.bounds() else {
         return Ok(None);
     };
@@ -131,7 +134,7 @@ fn touch_from_above(object: &ObjectSpec, sensor: &SensorConfig) -> Result<Option
             normal: DVec3::NEG_Z,
             up: DVec3::X,
         };
-        let touch = match touch_arm(object.clone(), *sensor, &control, &start) {
+        let touch = match touch_arm(object.clone(), sensor, &control, &start) {
             Ok(touch) => touch,
             Err(TouchError::Unreachable(_) | TouchError::StartsInCollision { .. }) => continue,
             Err(e) => return Err(e),
@@ -189,7 +192,7 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
             "No keyframe: the arm could not press the pad onto the object from above.".to_string()
         }
     };
-    let xml = add_sensor(builder, &config, "tactile", PAD_SITE)?.to_xml()?;
+    let xml = add_sensor(builder, &config, "tactile", PAD_SITE).to_xml()?;
     let header = comment(&format!(
         "  Written by taction scene export for the object {}: the arm, the table, the object (mesh in {mesh_file},\n  \
          metres) and the taction.covering sensor on the pad site. Load the plugin library first:\n  \

@@ -10,7 +10,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+use taction::control::{ControlError, FreePad};
+use taction::tactile::{PadPose, SensorConfig};
+use taction::valid::Valid;
 
 use crate::cli::common::SeedArg;
 use crate::cli::plausible::Carrier;
@@ -41,14 +43,14 @@ pub enum SenseError {
     #[error(transparent)]
     Mesh(#[from] taction::mesh::MeshError),
     #[error(transparent)]
-    Tactile(#[from] taction::tactile::TactileError),
+    Pad(#[from] ControlError),
     #[error(transparent)]
     Image(#[from] taction::tactile::ImageError),
 }
 
 impl SenseArgs {
     /// The sensor configuration the flags describe, validated.
-    pub fn config(&self) -> Result<SensorConfig, SenseError> {
+    pub fn config(&self) -> Result<Valid<SensorConfig>, SenseError> {
         Ok(self.sensor.config(self.seed.seed)?)
     }
 
@@ -78,8 +80,8 @@ pub fn run(args: &SenseArgs) -> Result<(), Box<dyn std::error::Error>> {
     let pose = args.pad_pose()?;
     let png = wants_png(&args.out)?;
     let object = args.pad.load_object("sense", Carrier::FreePad)?;
-    let mut sensor = FreeFloatingSensor::new(object, &config).map_err(SenseError::from)?;
-    let image = sensor.read_at(&pose).map_err(SenseError::from)?;
+    let mut pad = FreePad::new(object, &config).map_err(SenseError::from)?;
+    let image = pad.read_at(&pose).map_err(SenseError::from)?;
     if png {
         image.write_png(&args.out, 0).map_err(SenseError::from)?;
     } else {

@@ -10,7 +10,7 @@ use taction::sim::ObjectSpec;
 use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
 
 use crate::cli::plausible::{Carrier, check_mesh};
-use taction::valid::Check;
+use taction::valid::Valid;
 
 #[derive(Debug, Clone, Args)]
 pub struct SensorArgs {
@@ -62,7 +62,7 @@ pub fn flag_of(key: ConfigKey) -> &'static str {
 
 impl SensorArgs {
     /// The sensor configuration the flags describe, with noise seed `noise_seed`, validated.
-    pub fn config(&self, noise_seed: u64) -> Result<SensorConfig, SensorFlagError> {
+    pub fn config(&self, noise_seed: u64) -> Result<Valid<SensorConfig>, SensorFlagError> {
         let thickness_m = self.thickness_m.unwrap_or(0.1 * self.pad_m);
         let config = SensorConfig {
             rows: self.rows,
@@ -77,7 +77,7 @@ impl SensorArgs {
             noise_fraction: self.noise,
             noise_seed,
         };
-        config.check().map_err(|e| SensorFlagError {
+        let config = Valid::new(config).map_err(|e| SensorFlagError {
             flag: flag_of(e.key),
             value: e.value.clone(),
             allowed: e.key.allowed(),

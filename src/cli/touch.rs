@@ -17,14 +17,13 @@
 
 use clap::Args;
 use serde::Serialize;
-use taction::control::arm_pad::ArmPad;
-use taction::control::free_pad::FreePad;
-use taction::control::{ContactOutcome, ContactReport, ControlConfig, settle};
-use taction::explore::collect::sensor_reader;
+use taction::control::{
+    ArmPad, ContactOutcome, ContactReport, ControlConfig, FreePad, sensor_reader, settle,
+};
 use taction::explore::planner::precise_motion;
 use taction::sim::arm::{ARM_JOINTS, PAD_SITE};
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::{CoveringSensor, FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
+use taction::tactile::{CoveringSensor, PadPose, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ControlArg, ControlFileError, SeedArg};
@@ -106,13 +105,11 @@ impl TouchArgs {
 /// The controllers on the free-floating pad, from `start`.
 fn touch_free(
     object: ObjectSpec,
-    sensor: SensorConfig,
+    sensor: &Valid<SensorConfig>,
     control: &Valid<ControlConfig>,
     start: &PadPose,
 ) -> Result<ContactOutcome, TouchError> {
-    let mut free = FreeFloatingSensor::new(object, &sensor)?;
-    let reader = sensor_reader(free.sensor().clone());
-    let mut pad = FreePad::new(free.scene_mut(), sensor, reader)?;
+    let mut pad = FreePad::new(object, sensor)?;
     pad.place(start);
     Ok(settle(&mut pad, control)?)
 }
@@ -130,12 +127,12 @@ pub struct ArmTouch {
 /// mesh given in world metres), from the arm configuration that puts the pad at `start`.
 pub fn touch_arm(
     object: ObjectSpec,
-    sensor: SensorConfig,
+    sensor: &Valid<SensorConfig>,
     control: &Valid<ControlConfig>,
     start: &PadPose,
 ) -> Result<ArmTouch, TouchError> {
     let builder = SceneBuilder::with_arm_and_table().object(object);
-    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)?.build()?;
+    let mut scene = add_sensor(builder, sensor, "covering", PAD_SITE).build()?;
     let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
     let (ik_options, motion) = precise_motion();
@@ -157,7 +154,7 @@ pub fn touch_arm(
             b: c.body_b,
         });
     }
-    let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?;
+    let mut pad = ArmPad::new(&mut scene, &mut ik, **sensor, reader, motion)?;
     let outcome = settle(&mut pad, control)?;
     Ok(ArmTouch {
         outcome,
@@ -190,7 +187,7 @@ pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
     let carrier = if args.arm { Carrier::Arm } else { Carrier::FreePad };
     let object = args.pad.load_object("touch", carrier)?;
     let report = if args.arm {
-        let touch = touch_arm(object, sensor, &control, &start)?;
+        let touch = touch_arm(object, &sensor, &control, &start)?;
         TouchReport {
             contact: ContactReport::from(&touch.outcome),
             arm_joints: Some(ARM_JOINTS),
@@ -198,7 +195,7 @@ pub fn run(args: &TouchArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     } else {
         TouchReport {
-            contact: ContactReport::from(&touch_free(object, sensor, &control, &start)?),
+            contact: ContactReport::from(&touch_free(object, &sensor, &control, &start)?),
             arm_joints: None,
             arm_q_rad: None,
         }

@@ -23,22 +23,10 @@
 //! clear, as a compliant wrist would; Press then closes the gap. The IK holds the pad's roll
 //! through both (`InverseKinematics::solve_with_up`).
 
-use glam::DVec3;
-
-use crate::control::carrier::{ControlError, PadCarrier, PadMotion, backed_off};
-use crate::pose::Pose;
+use crate::control::carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, backed_off};
 use crate::sim::arm::Execution;
 use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
 use crate::tactile::{PadPose, SensorConfig, TactileImage};
-
-/// The pad frame of a pad site pose: centre at the site, normal its +z, up its +y.
-pub fn pad_pose_of_site(site: &Pose) -> PadPose {
-    PadPose {
-        center_m: site.position_m,
-        normal: site.transform_vector(DVec3::Z).normalize(),
-        up: site.transform_vector(DVec3::Y).normalize(),
-    }
-}
 
 /// The arm-mounted pad: a scene with an arm, an IK solver, and a way to read the sensor.
 pub struct ArmPad<'s, R> {
@@ -54,7 +42,7 @@ pub struct ArmPad<'s, R> {
 
 impl<'s, R> ArmPad<'s, R>
 where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+    R: ReadTactile,
 {
     /// `reader` returns the current tactile image of the scene's pad.
     pub fn new(
@@ -106,14 +94,14 @@ impl<R> ArmPad<'_, R> {
 
 impl<R> PadCarrier for ArmPad<'_, R>
 where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+    R: ReadTactile,
 {
     fn sensor(&self) -> &SensorConfig {
         &self.sensor
     }
 
     fn pad_pose(&self) -> PadPose {
-        pad_pose_of_site(&self.arm.pad_pose(self.scene.data()))
+        self.arm.pad_pose(self.scene.data())
     }
 
     fn read(&mut self) -> Result<TactileImage, ControlError> {
@@ -157,7 +145,7 @@ where
 
 impl<R> ArmPad<'_, R>
 where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+    R: ReadTactile,
 {
     /// One command from configuration `start` (where the arm is): IK, then the guarded motion; with
     /// [`PadMotion::RigidContact`] the contact. At a rigid contact of the pad the kinematic execution

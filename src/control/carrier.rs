@@ -3,8 +3,8 @@
 //! One controller implementation drives both the free-floating pad (a mocap body, Sec. V-A3) and the
 //! arm-mounted pad (pose commands through inverse kinematics, executed by MuJoCo stepping).
 
-use crate::sim::{Collision, SimError};
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::sim::{Collision, Scene, SimError};
+use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
 
 /// How a pose command went.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,6 +37,24 @@ impl ControlError {
     /// but the world can be restored from a checkpoint and the run go on.
     pub fn is_physics_fault(&self) -> bool {
         matches!(self, Self::Sim(e) if e.is_physics_fault())
+    }
+}
+
+/// How a carrier reads its pad: the tactile image of the scene as it is now. Any closure
+/// `FnMut(&mut Scene) -> Result<TactileImage, ControlError>` is one (a blanket impl); the plain
+/// one is [`sensor_reader`], and wrapping it is how a caller counts reads or injects a fault.
+pub trait ReadTactile: FnMut(&mut Scene) -> Result<TactileImage, ControlError> {}
+
+impl<F> ReadTactile for F where F: FnMut(&mut Scene) -> Result<TactileImage, ControlError> {}
+
+/// The reader of a scene's covering sensor: computes kinematics and the position-stage sensors
+/// ([`Scene::compute_sensors`]; the plugin computes there, from the site and geom frames) and
+/// returns the image. The dynamics stages of a full `mj_forward` would change nothing the plugin
+/// reads.
+pub fn sensor_reader(sensor: CoveringSensor) -> impl ReadTactile + Send + use<> {
+    move |scene: &mut Scene| {
+        scene.compute_sensors()?;
+        Ok(sensor.read(scene.data())?)
     }
 }
 

@@ -21,11 +21,9 @@ pub struct ControlConfig {
     /// Distance Approach travels before giving up with `NoContact`, metres.
     pub approach_max_distance_m: f64,
     /// Press target: the mean taxel value ("the average pressure of all sensor elements", Sec. III-B,
-    /// which gives no value). A firmer press shows more of a curved patch: at 0.5 the 12 shapes
-    /// (6x6, sampler, 1000 training readings per object, MNTI, neighbour codebook, 600 test trials)
-    /// were recognised 81.7 / 90.8% of the time at 10 / 20 readings against 75.7 / 89.2% at 0.3.
-    /// It stays 0.3 because the firmer press converges less often through noise: on the dragon
-    /// (Fig. 14) at 75% noise 88.5% of approaches converged against 100% at 0.3.
+    /// which gives no value). A firmer press shows more of a curved patch but converges less often
+    /// through noise; 0.3 keeps the controllers converging at high noise (Fig. 14). The
+    /// measurements behind the choice: `docs/measurements.md`, "How firmly Press presses".
     pub target_mean_pressure: f64,
     /// Press stops commanding when |target - mean| is below this (fraction of range).
     pub pressure_tolerance: f64,
@@ -38,20 +36,18 @@ pub struct ControlConfig {
     /// Press steps allowed in one Press phase.
     pub press_max_steps: usize,
     /// Press's second termination: a taxel at or above this value is "close to fully saturated"
-    /// (Sec. III-B gives no value). Raising it to the clip level (0.999) seems to help recognition
-    /// (with target 0.5: 85.7 / 94.3% at 10 / 20 readings on the data above) but only by
-    /// selection: Press then oscillates between clipping and backing off wherever the pad cannot
-    /// reach the target without bottoming out, 40% of the sampler's approaches end at the
-    /// iteration limit, and the sharp patches they would have read drop out of training and test
-    /// data alike (on the dragon, 66% of noise-free approaches converged).
+    /// (Sec. III-B gives no value). Kept below the clip level: at the clip level Press oscillates
+    /// between clipping and backing off wherever the pad cannot reach the target without bottoming
+    /// out, and the patches it would have read drop out of the data (`docs/measurements.md`, "How
+    /// firmly Press presses").
     pub saturation_threshold: f64,
     /// Orient rotates the pad normal this fraction of the way to the fitted surface normal
     /// (Algorithm 1, line 11: step = 0.3).
     pub orient_step: f64,
     /// Orient issues no command when pad and surface normals agree within this angle, radians.
-    /// Deliberately not widened with the expected noise: on the dragon (Fig. 14) widening it by 0.5
-    /// to 2.5 standard errors of the noisy plane fit left the convergence rates at 95-100% while
-    /// the converged pad's misalignment (judged by a noise-free reading) grew 1.5-3 times.
+    /// Deliberately not widened with the expected noise: a wider tolerance converges no more
+    /// often and leaves the converged pad more misaligned (`docs/measurements.md`, "How Orient
+    /// turns").
     pub orient_tolerance_rad: f64,
     /// Largest rotation of one Orient command, radians.
     pub orient_max_step_rad: f64,
@@ -60,11 +56,9 @@ pub struct ControlConfig {
     /// Keep Orient from tilting over an edge ([`surface_normal`](crate::control::orient::surface_normal)):
     /// fit the plane to the taxels inside the contact patch, whose coverage is whole, and issue no
     /// tilt when the fitted plane says the surface comes well into the covering where a taxel reads
-    /// no contact. Off by default, because it costs recognition: on the 52 raised letters (sampler
-    /// from above, 6x6, 1000 training readings per letter, MNTI, k = 200) the readings tilted more
-    /// than 10 degrees fell from 44% to 12%, and accuracy at 10 / 20 / 60 readings from 51.5 / 76.9
-    /// / 94.2% to 33.1 / 54.2 / 87.3%: a pad tipped over a stroke's edge onto the plate shows the
-    /// stroke's edge and the plate, which tells letters apart better than a level stroke top.
+    /// no contact. Off by default, because it costs recognition: a pad tipped over a stroke's edge
+    /// onto the plate shows the stroke's edge and the plate, which tells letters apart better than
+    /// a level stroke top (`docs/measurements.md`, "How Orient turns").
     pub orient_edge_guard: bool,
 }
 
@@ -114,86 +108,159 @@ impl Check for ControlConfig {
             max_iterations,
             orient_edge_guard: _,
         } = *self;
-        FieldChecks::of("control config")
-            .real(
-                "contact_threshold",
-                contact_threshold,
-                (0.0..1.0).contains(&contact_threshold),
-                "[0, 1)",
-            )
-            .real(
-                "expected_noise_fraction",
-                expected_noise_fraction,
-                (0.0..=2.0).contains(&expected_noise_fraction),
-                "[0, 2]",
-            )
-            .real(
-                "approach_step_thickness",
-                approach_step_thickness,
-                approach_step_thickness > 0.0 && approach_step_thickness <= 1.0,
-                "(0, 1]",
-            )
-            .real(
-                "approach_max_distance_m",
-                approach_max_distance_m,
-                approach_max_distance_m > 0.0,
-                "(0, inf)",
-            )
-            .real(
-                "target_mean_pressure",
+        let mut checks = FieldChecks::of("control config");
+        check_contact(&mut checks, contact_threshold, expected_noise_fraction);
+        check_approach(&mut checks, approach_step_thickness, approach_max_distance_m);
+        check_press(
+            &mut checks,
+            PressFields {
                 target_mean_pressure,
-                target_mean_pressure > 0.0 && target_mean_pressure < 1.0,
-                "(0, 1)",
-            )
-            .real(
-                "pressure_tolerance",
                 pressure_tolerance,
-                pressure_tolerance > 0.0,
-                "(0, inf)",
-            )
-            .real("press_kp", press_kp, press_kp > 0.0 && press_kp <= 2.0, "(0, 2]")
-            .real("press_kd", press_kd, (0.0..=2.0).contains(&press_kd), "[0, 2]")
-            .real(
-                "press_max_step_thickness",
+                press_kp,
+                press_kd,
                 press_max_step_thickness,
-                press_max_step_thickness > 0.0,
-                "(0, inf)",
-            )
-            .count(
-                "press_max_steps",
                 press_max_steps,
-                press_max_steps > 0,
-                "1 or more",
-            )
-            .real(
-                "saturation_threshold",
                 saturation_threshold,
-                saturation_threshold > target_mean_pressure && saturation_threshold <= 1.0,
-                "(target_mean_pressure, 1]",
-            )
-            .real(
-                "orient_step",
-                orient_step,
-                orient_step > 0.0 && orient_step <= 1.0,
-                "(0, 1]",
-            )
-            .real(
-                "orient_tolerance_rad",
-                orient_tolerance_rad,
-                orient_tolerance_rad > 0.0,
-                "(0, inf)",
-            )
-            // A negative step would turn the pad away from the surface; beyond a half turn the
-            // rotation is no longer the short way round.
-            .real(
-                "orient_max_step_rad",
-                orient_max_step_rad,
-                orient_max_step_rad > 0.0 && orient_max_step_rad <= std::f64::consts::PI,
-                "(0, pi]",
-            )
-            .count("max_iterations", max_iterations, max_iterations > 0, "1 or more")
-            .finish()
+            },
+        );
+        check_orient(
+            &mut checks,
+            orient_step,
+            orient_tolerance_rad,
+            orient_max_step_rad,
+        )
+        .count("max_iterations", max_iterations, max_iterations > 0, "1 or more")
+        .finish()
     }
+}
+
+/// What counts as contact: the threshold and the noise the controllers expect.
+fn check_contact(
+    checks: &mut FieldChecks,
+    contact_threshold: f64,
+    expected_noise_fraction: f64,
+) -> &mut FieldChecks {
+    checks
+        .real(
+            "contact_threshold",
+            contact_threshold,
+            (0.0..1.0).contains(&contact_threshold),
+            "[0, 1)",
+        )
+        .real(
+            "expected_noise_fraction",
+            expected_noise_fraction,
+            (0.0..=2.0).contains(&expected_noise_fraction),
+            "[0, 2]",
+        )
+}
+
+/// Approach's step and reach.
+fn check_approach(
+    checks: &mut FieldChecks,
+    approach_step_thickness: f64,
+    approach_max_distance_m: f64,
+) -> &mut FieldChecks {
+    checks
+        .real(
+            "approach_step_thickness",
+            approach_step_thickness,
+            approach_step_thickness > 0.0 && approach_step_thickness <= 1.0,
+            "(0, 1]",
+        )
+        .real(
+            "approach_max_distance_m",
+            approach_max_distance_m,
+            approach_max_distance_m > 0.0,
+            "(0, inf)",
+        )
+}
+
+/// Press's fields, as [`ControlConfig`] names them.
+struct PressFields {
+    target_mean_pressure: f64,
+    pressure_tolerance: f64,
+    press_kp: f64,
+    press_kd: f64,
+    press_max_step_thickness: f64,
+    press_max_steps: usize,
+    saturation_threshold: f64,
+}
+
+/// Press's target, gains, steps and saturation.
+fn check_press(checks: &mut FieldChecks, press: PressFields) -> &mut FieldChecks {
+    let PressFields {
+        target_mean_pressure,
+        pressure_tolerance,
+        press_kp,
+        press_kd,
+        press_max_step_thickness,
+        press_max_steps,
+        saturation_threshold,
+    } = press;
+    checks
+        .real(
+            "target_mean_pressure",
+            target_mean_pressure,
+            target_mean_pressure > 0.0 && target_mean_pressure < 1.0,
+            "(0, 1)",
+        )
+        .real(
+            "pressure_tolerance",
+            pressure_tolerance,
+            pressure_tolerance > 0.0,
+            "(0, inf)",
+        )
+        .real("press_kp", press_kp, press_kp > 0.0 && press_kp <= 2.0, "(0, 2]")
+        .real("press_kd", press_kd, (0.0..=2.0).contains(&press_kd), "[0, 2]")
+        .real(
+            "press_max_step_thickness",
+            press_max_step_thickness,
+            press_max_step_thickness > 0.0,
+            "(0, inf)",
+        )
+        .count(
+            "press_max_steps",
+            press_max_steps,
+            press_max_steps > 0,
+            "1 or more",
+        )
+        .real(
+            "saturation_threshold",
+            saturation_threshold,
+            saturation_threshold > target_mean_pressure && saturation_threshold <= 1.0,
+            "(target_mean_pressure, 1]",
+        )
+}
+
+/// Orient's step, tolerance and largest turn.
+fn check_orient(
+    checks: &mut FieldChecks,
+    orient_step: f64,
+    orient_tolerance_rad: f64,
+    orient_max_step_rad: f64,
+) -> &mut FieldChecks {
+    checks
+        .real(
+            "orient_step",
+            orient_step,
+            orient_step > 0.0 && orient_step <= 1.0,
+            "(0, 1]",
+        )
+        .real(
+            "orient_tolerance_rad",
+            orient_tolerance_rad,
+            orient_tolerance_rad > 0.0,
+            "(0, inf)",
+        )
+        // A negative step would turn the pad away from the surface; beyond a half turn the
+        // rotation is no longer the short way round.
+        .real(
+            "orient_max_step_rad",
+            orient_max_step_rad,
+            orient_max_step_rad > 0.0 && orient_max_step_rad <= std::f64::consts::PI,
+            "(0, pi]",
+        )
 }
 
 impl ControlConfig {

@@ -11,7 +11,9 @@ pub(crate) mod press;
 pub(crate) mod surface_contact;
 pub(crate) mod trace;
 
-pub use carrier::{ControlError, PadCarrier, PadMotion};
+pub use arm_pad::ArmPad;
+pub use carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, sensor_reader};
 pub use config::ControlConfig;
+pub use free_pad::FreePad;
 pub use surface_contact::{ContactOutcome, ContactReport, settle};
 pub use trace::{Command, Trace};

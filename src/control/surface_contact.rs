@@ -31,98 +31,174 @@ pub struct ContactOutcome {
     pub collision: Option<Collision>,
 }
 
-/// Runs the controllers on `carrier` from its current pose, approaching along the pad normal.
+/// Runs the controllers on `carrier` from its current pose, approaching along the pad normal
+/// (Algorithm 1): Approach until contact, then Press and Orient in turn until neither issues a
+/// command, contact is lost, a motion is blocked, or the iteration budget runs out.
+///
+/// ```
+/// use glam::DVec3;
+/// use taction::control::{ControlConfig, FreePad, settle};
+/// use taction::dataset::ContactStatus;
+/// use taction::mesh::TriMesh;
+/// use taction::sim::ObjectSpec;
+/// use taction::tactile::{PadPose, SensorConfig};
+/// use taction::valid::Valid;
+///
+/// let object = ObjectSpec::new("box", TriMesh::cuboid(DVec3::new(0.03, 0.03, 0.02)));
+/// let mut pad = FreePad::new(object, &Valid::new(SensorConfig::paper())?)?;
+/// pad.place(&PadPose::new(DVec3::new(0.0, 0.0, 0.025), -DVec3::Z, DVec3::Y).unwrap());
+/// let control = Valid::new(ControlConfig::default())?;
+/// let touch = settle(&mut pad, &control)?;
+/// assert_eq!(touch.status, ContactStatus::Converged);
+/// assert!((touch.image.mean() - control.target_mean_pressure).abs() <= control.pressure_tolerance);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn settle<C: PadCarrier + ?Sized>(
     carrier: &mut C,
     config: &Valid<ControlConfig>,
 ) -> Result<ContactOutcome, ControlError> {
     let config: &ControlConfig = config;
-    let mut trace = Trace::default();
-    let finish = |carrier: &mut C, status, image: TactileImage, iterations, trace, collision| {
-        let pose = carrier.pad_pose();
+    let mut run = Settling {
+        carrier,
+        config,
+        trace: Trace::default(),
+    };
+    let mut image = match run.approach()? {
+        Step::On(image) => image,
+        Step::Ended(outcome) => return Ok(outcome),
+    };
+    for iteration in 1..=config.max_iterations as u32 {
+        let pressed = match run.press(iteration, &mut image)? {
+            Step::On(commanded) => commanded,
+            Step::Ended(outcome) => return Ok(outcome),
+        };
+        let oriented = match run.orient(iteration, &mut image)? {
+            Step::On(commanded) => commanded,
+            Step::Ended(outcome) => return Ok(outcome),
+        };
+        if let Some(status) = settled(&image, pressed, oriented, config) {
+            return run.finish(status, image, iteration, None);
+        }
+    }
+    run.finish(
+        ContactStatus::MaxIterations,
+        image,
+        config.max_iterations as u32,
+        None,
+    )
+}
+
+/// Where one step of the loop leaves a run: going on (with what the step gives), or ended.
+enum Step<T> {
+    On(T),
+    Ended(ContactOutcome),
+}
+
+/// One run of the controllers: the carrier, the configuration and the commands issued so far.
+struct Settling<'c, C: ?Sized> {
+    carrier: &'c mut C,
+    config: &'c ControlConfig,
+    trace: Trace,
+}
+
+impl<C: PadCarrier + ?Sized> Settling<'_, C> {
+    /// Approach (Fig. 3c): along the pad normal until a taxel feels contact; the image then.
+    fn approach(&mut self) -> Result<Step<TactileImage>, ControlError> {
+        Ok(match approach(self.carrier, self.config, &mut self.trace)? {
+            ApproachOutcome::Contact(image) => Step::On(image),
+            ApproachOutcome::NoContact => {
+                let image = self.carrier.read()?;
+                Step::Ended(self.finish(ContactStatus::NoContact, image, 0, None)?)
+            }
+            ApproachOutcome::Blocked(motion) => Step::Ended(self.blocked(&motion, 0)?),
+        })
+    }
+
+    /// Press (Fig. 3b): toward the target mean pressure; whether it commanded a motion, and the
+    /// image it ended on in `image`.
+    fn press(&mut self, iteration: u32, image: &mut TactileImage) -> Result<Step<bool>, ControlError> {
+        Ok(match press(self.carrier, self.config, &mut self.trace)? {
+            PressOutcome::Done {
+                image: pressed,
+                commanded,
+            } => {
+                *image = pressed;
+                Step::On(commanded)
+            }
+            PressOutcome::Blocked(motion) => Step::Ended(self.blocked(&motion, iteration)?),
+        })
+    }
+
+    /// Orient (Fig. 3d, Algorithm 1, line 11): turns the pad toward the surface normal fitted to
+    /// `image`; whether it commanded a turn, and the image after it in `image`. A turn whose rigid
+    /// back would meet a surface was backed off by the carrier, and Press closes the gap.
+    fn orient(&mut self, iteration: u32, image: &mut TactileImage) -> Result<Step<bool>, ControlError> {
+        let pose = self.carrier.pad_pose();
+        let Some(command) = orient_command(image, &pose, self.carrier.sensor(), self.config) else {
+            return Ok(Step::On(false));
+        };
+        let target = command.apply(&pose);
+        self.trace.push(Command::Orient, target);
+        match self.carrier.move_pad(&target)? {
+            PadMotion::Moved | PadMotion::RigidContact => {}
+            motion => return Ok(Step::Ended(self.blocked(&motion, iteration)?)),
+        }
+        *image = self.carrier.read()?;
+        Ok(Step::On(true))
+    }
+
+    /// The end of a run whose motion was blocked: a collision, a rigid contact (the covering
+    /// cannot be pressed further: saturated), or a pose out of reach.
+    fn blocked(&mut self, motion: &PadMotion, iteration: u32) -> Result<ContactOutcome, ControlError> {
+        let (status, collision) = match motion {
+            PadMotion::Collided(c) => (ContactStatus::Collision, Some(c.clone())),
+            PadMotion::RigidContact => (ContactStatus::Saturated, None),
+            PadMotion::Unreachable | PadMotion::Moved => (ContactStatus::Unreachable, None),
+        };
+        let image = self.carrier.read()?;
+        self.finish(status, image, iteration, collision)
+    }
+
+    /// The outcome: `image` tagged with where the pad ended, and the commands issued.
+    fn finish(
+        &mut self,
+        status: ContactStatus,
+        image: TactileImage,
+        iterations: u32,
+        collision: Option<Collision>,
+    ) -> Result<ContactOutcome, ControlError> {
+        let pose = self.carrier.pad_pose();
         Ok(ContactOutcome {
             status,
             image: image.with_pose(pose),
             pose,
             iterations,
-            trace,
+            trace: std::mem::take(&mut self.trace),
             collision,
         })
-    };
-    let blocked_status = |motion: &PadMotion| match motion {
-        PadMotion::Collided(c) => (ContactStatus::Collision, Some(c.clone())),
-        PadMotion::RigidContact => (ContactStatus::Saturated, None),
-        PadMotion::Unreachable | PadMotion::Moved => (ContactStatus::Unreachable, None),
-    };
-
-    let mut image = match approach(carrier, config, &mut trace)? {
-        ApproachOutcome::Contact(image) => image,
-        ApproachOutcome::NoContact => {
-            let image = carrier.read()?;
-            return finish(carrier, ContactStatus::NoContact, image, 0, trace, None);
-        }
-        ApproachOutcome::Blocked(motion) => {
-            let (status, collision) = blocked_status(&motion);
-            let image = carrier.read()?;
-            return finish(carrier, status, image, 0, trace, collision);
-        }
-    };
-
-    for iteration in 1..=config.max_iterations as u32 {
-        let pressed = match press(carrier, config, &mut trace)? {
-            PressOutcome::Done {
-                image: pressed_image,
-                commanded,
-            } => {
-                image = pressed_image;
-                commanded
-            }
-            PressOutcome::Blocked(motion) => {
-                let (status, collision) = blocked_status(&motion);
-                let image = carrier.read()?;
-                return finish(carrier, status, image, iteration, trace, collision);
-            }
-        };
-        let pose = carrier.pad_pose();
-        let oriented = match orient_command(&image, &pose, carrier.sensor(), config) {
-            None => false,
-            Some(command) => {
-                let target = command.apply(&pose);
-                trace.push(Command::Orient, target);
-                match carrier.move_pad(&target)? {
-                    PadMotion::Moved => {}
-                    PadMotion::RigidContact => {}
-                    motion => {
-                        let (status, collision) = blocked_status(&motion);
-                        let image = carrier.read()?;
-                        return finish(carrier, status, image, iteration, trace, collision);
-                    }
-                }
-                image = carrier.read()?;
-                true
-            }
-        };
-        if touches_nothing(&image, config) {
-            // Orient lifted the pad off a narrow feature: nothing is touched any more.
-            return finish(carrier, ContactStatus::NoContact, image, iteration, trace, None);
-        }
-        if !pressed && !oriented {
-            let status = if is_clipped(&image, config) {
-                ContactStatus::Saturated
-            } else {
-                ContactStatus::Converged
-            };
-            return finish(carrier, status, image, iteration, trace, None);
-        }
     }
-    finish(
-        carrier,
-        ContactStatus::MaxIterations,
-        image,
-        config.max_iterations as u32,
-        trace,
-        None,
-    )
+}
+
+/// How a Press and Orient round ended the run, if it did: no contact when Orient lifted the pad
+/// off a narrow feature, else, when neither issued a command, converged (saturated when a taxel
+/// is clipped).
+fn settled(
+    image: &TactileImage,
+    pressed: bool,
+    oriented: bool,
+    config: &ControlConfig,
+) -> Option<ContactStatus> {
+    if touches_nothing(image, config) {
+        return Some(ContactStatus::NoContact);
+    }
+    if pressed || oriented {
+        return None;
+    }
+    Some(if is_clipped(image, config) {
+        ContactStatus::Saturated
+    } else {
+        ContactStatus::Converged
+    })
 }
 
 /// Whether the pad has lost contact. Without noise: no taxel above the contact threshold. With noise

@@ -8,7 +8,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::control::{ControlConfig, ControlError};
+use crate::control::{ControlConfig, ControlError, FreePad, ReadTactile};
 use crate::dataset::{Dataset, DatasetError, DatasetHeader};
 use crate::explore::planner::{Planner, PlannerConfig};
 use crate::explore::report::ExplorationReport;
@@ -17,9 +17,8 @@ use crate::explore::setup::TouchSetup;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
-use crate::tactile::free_floating::FreeFloatingSensor;
-use crate::tactile::sensor::{CoveringSensor, add_sensor};
-use crate::tactile::{SensorConfig, TactileImage};
+use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
+use crate::tactile::SensorConfig;
 use crate::valid::{RangeError, Valid};
 
 /// Which procedure collects the readings.
@@ -73,15 +72,8 @@ pub struct CollectPlan {
     pub seed: u64,
 }
 
-/// A reading function for a scene's covering sensor: computes kinematics and the position-stage
-/// sensors ([`Scene::compute_sensors`]; the plugin computes there, from the site and geom frames) and
-/// returns the image. The dynamics stages of a full `mj_forward` would change nothing the plugin reads.
-pub fn sensor_reader(sensor: CoveringSensor) -> impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> {
-    move |scene: &mut Scene| {
-        scene.compute_sensors()?;
-        Ok(sensor.read(scene.data())?)
-    }
-}
+/// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
+pub use crate::control::sensor_reader;
 
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.
@@ -122,10 +114,10 @@ impl CollectPlan {
         match self.mode {
             CollectMode::Sampler(config) => {
                 let setup = self.setup_for(index);
-                let mut free = FreeFloatingSensor::new(object.clone(), &setup.sensor)?;
-                let reader = sensor_reader(free.sensor().clone());
-                TrainingSampler::new(config, setup, rng, reader).sample_reporting(
-                    free.scene_mut(),
+                let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
+                let mut pad = FreePad::new(object.clone(), &sensor)?;
+                TrainingSampler::new(config, setup, rng).sample_reporting(
+                    &mut pad,
                     &object.name,
                     self.readings_per_object,
                     on_converged,
@@ -141,24 +133,16 @@ impl CollectPlan {
     /// The arm's scene with `object` and the planner that explores it as object `index` of this
     /// plan (its sensor noise stream and random stream), for callers that drive the planner
     /// themselves (active exploration, `active_touch`).
-    #[allow(clippy::type_complexity)]
     pub fn planner_for(
         &self,
         object: &ObjectSpec,
         index: usize,
         config: Valid<PlannerConfig>,
-    ) -> Result<
-        (
-            Scene,
-            Planner<impl FnMut(&mut Scene) -> Result<TactileImage, ControlError> + use<>>,
-        ),
-        ControlError,
-    > {
+    ) -> Result<(Scene, Planner<impl ReadTactile + use<>>), ControlError> {
         let setup = self.setup_for(index);
         let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-        let scene = add_sensor(builder, &setup.sensor, "covering", PAD_SITE)
-            .map_err(crate::tactile::sensor::TactileError::from)?
-            .build()?;
+        let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
+        let scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
         let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
         let planner = Planner::new(
             &scene,

@@ -42,8 +42,8 @@ use glam::DVec3;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use crate::control::arm_pad::{ArmPad, pad_pose_of_site};
-use crate::control::{ControlError, settle};
+use crate::control::arm_pad::ArmPad;
+use crate::control::{ControlError, ReadTactile, settle};
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::explore::active::{ActiveGuidance, best_candidate};
 use crate::explore::grid::ReadingGrid;
@@ -328,7 +328,7 @@ pub fn covering_reach_m(sensor: &SensorConfig, back_half_size_m: [f64; 3]) -> f6
 
 impl<R> Planner<R>
 where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
+    R: ReadTactile,
 {
     /// A planner for `scene` (which must have an arm), starting from the arm's current configuration.
     pub fn new(
@@ -357,7 +357,7 @@ where
             None => f64::INFINITY,
         };
         let q = arm.q(scene.data());
-        let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+        let pad = arm.pad_pose(scene.data());
         Ok(Self {
             config,
             setup,
@@ -509,7 +509,7 @@ where
         let mut vertex = expansion.vertex;
         let facing = self.tree.vertices()[vertex].pad_normal;
         for _ in 0..self.config.max_steps_per_iteration {
-            let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+            let pad = arm.pad_pose(scene.data());
             let Some(step) = self.step_toward(&pad, expansion, facing) else {
                 break;
             };
@@ -527,7 +527,7 @@ where
                 break;
             }
             if !sensed {
-                let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+                let pad = arm.pad_pose(scene.data());
                 vertex = self
                     .tree
                     .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
@@ -627,7 +627,7 @@ where
             && arm.move_to(scene, &q_lift, &self.expansion_motion, |_| false)? == MoveOutcome::Reached
         {
             let q = arm.q(scene.data());
-            let pad = pad_pose_of_site(&arm.pad_pose(scene.data()));
+            let pad = arm.pad_pose(scene.data());
             self.tree.add(vertex, q, pad.center_m, pad.normal);
         }
         Ok(())
@@ -734,7 +734,7 @@ where
         checkpoint: &SceneState,
     ) -> Result<Reading, ControlError> {
         let object_pose = scene.object_pose().unwrap_or_default();
-        let start = pad_pose_of_site(&arm.pad_pose(scene.data()));
+        let start = arm.pad_pose(scene.data());
         let Self {
             ik,
             reader,

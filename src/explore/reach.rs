@@ -10,7 +10,6 @@
 //! anything; the start is then the pose the arm actually takes, its roll about the normal
 //! included, which the arm's controllers then hold (`InverseKinematics::solve_with_up`).
 
-use crate::control::arm_pad::pad_pose_of_site;
 use crate::explore::planner::precise_motion;
 use crate::pose::Pose;
 use crate::sim::{Arm, InverseKinematics, ObjectSpec, PadTarget, Scene, SceneBuilder, SimError};
@@ -53,7 +52,7 @@ impl ArmReach {
         if self.arm.collision(&self.scene).is_some() {
             return None;
         }
-        Some(pad_pose_of_site(&self.arm.pad_pose(self.scene.data())))
+        Some(self.arm.pad_pose(self.scene.data()))
     }
 }
 

@@ -25,7 +25,7 @@ use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::rng::Rng;
 use crate::sim::{ObjectSpec, Scene, SimError};
-use crate::tactile::{PadPose, TactileImage};
+use crate::tactile::PadPose;
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The sampler's parameters.
@@ -99,44 +99,35 @@ fn random_perpendicular(n: DVec3, rng: &mut Rng) -> DVec3 {
 }
 
 /// The training sampler of one object's run (Sec. V-A3): its parameters, what every touch
-/// shares, its random stream and the sensor's reader.
-pub struct TrainingSampler<R> {
+/// shares and its random stream; the free pad it moves carries the sensor's reader.
+pub struct TrainingSampler {
     config: Valid<SamplerConfig>,
     setup: TouchSetup,
     rng: Rng,
-    reader: R,
 }
 
-impl<R> TrainingSampler<R>
-where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
-{
-    pub fn new(config: Valid<SamplerConfig>, setup: TouchSetup, rng: Rng, reader: R) -> Self {
-        Self {
-            config,
-            setup,
-            rng,
-            reader,
-        }
+impl TrainingSampler {
+    pub fn new(config: Valid<SamplerConfig>, setup: TouchSetup, rng: Rng) -> Self {
+        Self { config, setup, rng }
     }
 
-    /// Collects `converged_target` converged readings of the object in `scene` (which holds the
-    /// object and a free-floating pad), perturbing the object after each reading if the setup's
+    /// Collects `converged_target` converged readings of the object in `pad`'s scene with that
+    /// free-floating pad, perturbing the object after each reading if the setup's
     /// perturbation allows; every attempt, whatever its status, is returned in order.
     pub fn sample(
         self,
-        scene: &mut Scene,
+        pad: &mut FreePad,
         object: &str,
         converged_target: usize,
     ) -> Result<ExplorationReport, ControlError> {
-        self.sample_reporting(scene, object, converged_target, &mut || {})
+        self.sample_reporting(pad, object, converged_target, &mut || {})
     }
 
     /// [`sample`](Self::sample), running `on_converged` after each converged reading (progress
     /// reports).
     pub fn sample_reporting(
         self,
-        scene: &mut Scene,
+        pad: &mut FreePad,
         object: &str,
         converged_target: usize,
         on_converged: &mut dyn FnMut(),
@@ -145,10 +136,8 @@ where
             config,
             setup,
             mut rng,
-            reader,
         } = self;
-        let mut starts = Starts::on(scene, object, &config)?;
-        let mut pad = FreePad::new(scene, setup.sensor, reader)?;
+        let mut starts = Starts::on(pad.scene(), object, &config)?;
         let mut report = ExplorationReport::default();
         let max_attempts = converged_target
             .saturating_mul(config.max_attempts_per_reading)
@@ -159,13 +148,13 @@ where
             let Some(start) = starts.draw(object_pose, &mut rng) else {
                 continue;
             };
-            let reading = settle_from(&mut pad, &start, &setup, object, object_pose)?;
+            let reading = settle_from(pad, &start, &setup, object, object_pose)?;
             let converged = reading.is_converged();
             report.readings.push(reading);
             if converged {
                 on_converged();
             }
-            setup.perturb(pad.scene(), &mut rng)?;
+            setup.perturb(pad.scene_mut(), &mut rng)?;
         }
         Ok(report)
     }
@@ -260,22 +249,19 @@ fn reachable_start(
 /// Places the pad at `start` and lets the local controllers approach and take a measurement
 /// (Sec. V-A3); a physics fault during the attempt puts the world back as it was before it and
 /// gives an `aborted` reading.
-fn settle_from<R>(
-    pad: &mut FreePad<'_, R>,
+fn settle_from(
+    pad: &mut FreePad,
     start: &PadPose,
     setup: &TouchSetup,
     object: &str,
     object_pose: Pose,
-) -> Result<Reading, ControlError>
-where
-    R: FnMut(&mut Scene) -> Result<TactileImage, ControlError>,
-{
-    let checkpoint = pad.scene().checkpoint()?;
+) -> Result<Reading, ControlError> {
+    let checkpoint = pad.scene_mut().checkpoint()?;
     pad.place(start);
     match settle(pad, &setup.control) {
         Ok(outcome) => Ok(attempt_reading(outcome, object, object_pose, Strategy::Sampler)),
         Err(e) if e.is_physics_fault() => {
-            pad.scene().restore(&checkpoint)?;
+            pad.scene_mut().restore(&checkpoint)?;
             Ok(aborted_reading(
                 &setup.sensor,
                 *start,

@@ -19,14 +19,14 @@
 use serde::{Deserialize, Serialize};
 
 use crate::control::ControlConfig;
+use crate::control::FreePad;
 use crate::control::orient::surface_normal;
 use crate::dataset::ContactStatus;
-use crate::explore::collect::sensor_reader;
 use crate::explore::{SamplerConfig, TouchSetup, TrainingSampler};
 use crate::mesh::{BuildOptions, MeshError, ObjectSet, TriMesh};
 use crate::rng;
 use crate::sim::{ObjectSpec, PerturbationBounds};
-use crate::tactile::{FreeFloatingSensor, SensorConfig};
+use crate::tactile::SensorConfig;
 use crate::valid::{Check, Valid};
 
 use crate::experiment::name::SafeName;
@@ -346,8 +346,7 @@ pub fn run_level(
         expected_noise_fraction: noise,
         ..*config.control
     })?;
-    let mut free = FreeFloatingSensor::new(object.clone(), &sensor)?;
-    let reader = sensor_reader(free.sensor().clone());
+    let mut pad = FreePad::new(object.clone(), &Valid::new(sensor)?)?;
     let placement = rng::stream(unit_seed, 0);
     let report = TrainingSampler::new(
         config.sampler,
@@ -357,9 +356,8 @@ pub fn run_level(
             perturbation: PerturbationBounds::NONE,
         },
         placement,
-        reader,
     )
-    .sample(free.scene_mut(), &object.name, config.convergences)?;
+    .sample(&mut pad, &object.name, config.convergences)?;
     level_row(object, noise, &report, control.max_iterations, config)
 }
 
@@ -428,7 +426,7 @@ fn converged_quality(
         expected_noise_fraction: 0.0,
         ..*config.control
     };
-    let mut clean = FreeFloatingSensor::new(object.clone(), &clean_sensor)?;
+    let mut clean = FreePad::new(object.clone(), &Valid::new(clean_sensor)?)?;
     let (mut angle_sum, mut angles, mut error_sum, mut errors) = (0.0, 0usize, 0.0, 0usize);
     for reading in report.readings.iter().filter(|r| r.is_converged()) {
         let Some(pose) = reading.image.pose() else {

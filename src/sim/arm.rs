@@ -20,13 +20,13 @@
 //!   executions, the transient between two commands changes no reading. It costs a few kinematics and
 //!   collision evaluations per motion instead of hundreds of physics steps.
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::DVec3;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use serde::{Deserialize, Serialize};
 
 use crate::bodies::{ARM_BASE, OBJECT_BODY, PAD_BODY};
-use crate::pose::Pose;
+use crate::pose::{PadPose, Pose};
 use crate::sim::SimError;
 use crate::sim::mjcf::COLLISION_GROUP;
 use crate::sim::scene::Scene;
@@ -276,8 +276,14 @@ impl Arm {
             .all(|(j, &v)| v >= j.range_rad[0] - 1e-12 && v <= j.range_rad[1] + 1e-12)
     }
 
-    /// The pad frame in the world from the current kinematics (`site_xpos`, `site_xmat`).
-    pub fn pad_pose<M: ModelType>(&self, data: &MjData<M>) -> Pose {
+    /// Where the pad is, from the current kinematics (`site_xpos`, `site_xmat`).
+    pub fn pad_pose<M: ModelType>(&self, data: &MjData<M>) -> PadPose {
+        PadPose::of_site(&self.site_pose(data))
+    }
+
+    /// The pad site's rigid pose in the world (what inverse kinematics and the motion's travel
+    /// measure); [`Arm::pad_pose`] is the same frame as a [`PadPose`].
+    pub fn site_pose<M: ModelType>(&self, data: &MjData<M>) -> Pose {
         site_pose(data, self.site)
     }
 
@@ -480,7 +486,7 @@ impl Arm {
         let mut q = start.clone();
         let mut last_free = start.clone();
         scene.data_mut().kinematics();
-        let mut previous = self.pad_pose(scene.data());
+        let mut previous = self.site_pose(scene.data());
         let mut s = 0.0_f64;
         while s < 1.0 {
             let mut ds = (1.0 - s).min(max_step_rad / span.max(1e-12));
@@ -496,7 +502,7 @@ impl Arm {
                 }
                 self.set_q(scene.data_mut(), &q);
                 scene.data_mut().kinematics();
-                let pose = self.pad_pose(scene.data());
+                let pose = self.site_pose(scene.data());
                 let travel = (pose.position_m - previous.position_m).length()
                     + pose.rotation.angle_between(previous.rotation) * reach_m;
                 if travel <= limit_m || ds * span <= 1e-7 {
@@ -536,12 +542,5 @@ impl Arm {
 
 /// The world pose of site `site`.
 pub fn site_pose<M: ModelType>(data: &MjData<M>, site: usize) -> Pose {
-    let m = data.site_xmat()[site];
-    // MuJoCo's xmat is row-major; the site's axes are its columns.
-    let rot = DMat3::from_cols(
-        DVec3::new(m[0], m[3], m[6]),
-        DVec3::new(m[1], m[4], m[7]),
-        DVec3::new(m[2], m[5], m[8]),
-    );
-    Pose::new(DVec3::from_array(data.site_xpos()[site]), DQuat::from_mat3(&rot))
+    Pose::from_xmat(data.site_xpos()[site], &data.site_xmat()[site])
 }

@@ -105,7 +105,7 @@ impl InverseKinematics {
     pub fn forward(&mut self, q: &[f64]) -> crate::pose::Pose {
         self.arm.set_q(&mut self.data, q);
         self.data.kinematics();
-        self.arm.pad_pose(&self.data)
+        self.arm.site_pose(&self.data)
     }
 
     /// A configuration within the joint limits placing the pad at `target`, starting the search at
@@ -198,7 +198,7 @@ impl InverseKinematics {
             self.arm.set_q(&mut self.data, q);
             self.data.kinematics();
             self.data.com_pos();
-            let pose = self.arm.pad_pose(&self.data);
+            let pose = self.arm.site_pose(&self.data);
             let n = pose.transform_vector(DVec3::Z);
             let dp = target_p - pose.position_m;
             let (axis, angle) = match target_rotation {

@@ -6,7 +6,7 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::valid::Check;
+use crate::valid::{Check, Valid};
 
 /// Everything that determines how the covering sensor forms an image. Lengths in metres.
 ///
@@ -60,9 +60,26 @@ pub fn psf_sigma_for_thickness(thickness_m: f64) -> f64 {
 }
 
 impl Default for SensorConfig {
-    /// The paper's letters sensor: 6x6 taxels on a 12 mm pad, 1.2 mm covering, the PSF law,
-    /// 4 rays per taxel, no noise.
+    /// [`SensorConfig::paper`].
     fn default() -> Self {
+        Self::paper()
+    }
+}
+
+impl SensorConfig {
+    /// The paper's letters sensor (Sec. V-D; "10% covering thickness", Figs. 7-8): 6x6 taxels on
+    /// a 12 mm pad, a 1.2 mm covering, the PSF law's point-spread, 4 rays per taxel, no noise.
+    ///
+    /// ```
+    /// use taction::tactile::SensorConfig;
+    /// use taction::valid::Valid;
+    ///
+    /// let sensor = Valid::new(SensorConfig::paper())?;
+    /// assert_eq!((sensor.rows, sensor.cols, sensor.taxel_count()), (6, 6, 36));
+    /// assert_eq!((sensor.pad_width_m, sensor.thickness_m), (0.012, 0.1 * 0.012));
+    /// # Ok::<(), taction::tactile::ConfigError>(())
+    /// ```
+    pub fn paper() -> Self {
         Self {
             rows: 6,
             cols: 6,
@@ -242,7 +259,9 @@ impl SensorConfig {
     /// Parses `key -> text` pairs as MJCF `<config>` gives them. A key that is absent or empty
     /// keeps its default; `psf_sigma_m` absent or empty follows the thickness by the PSF law. The
     /// result is validated.
-    pub fn from_key_values<'a>(lookup: impl Fn(ConfigKey) -> Option<&'a str>) -> Result<Self, ConfigError> {
+    pub fn from_key_values<'a>(
+        lookup: impl Fn(ConfigKey) -> Option<&'a str>,
+    ) -> Result<Valid<Self>, ConfigError> {
         let mut config = Self::default();
         let text = |key| lookup(key).map(str::trim).filter(|s| !s.is_empty());
         let bad = |key: ConfigKey, value: &str| ConfigError {
@@ -277,8 +296,7 @@ impl SensorConfig {
             None => config.noise_seed,
             Some(s) => s.parse().map_err(|_| bad(ConfigKey::NoiseSeed, s))?,
         };
-        config.check()?;
-        Ok(config)
+        Valid::new(config)
     }
 
     /// The value of `key` as MJCF config text, in shortest round-trip form (so that parsing it back
@@ -309,6 +327,7 @@ mod tests {
 
     fn parse(pairs: &[(&str, &str)]) -> Result<SensorConfig, ConfigError> {
         SensorConfig::from_key_values(|key| pairs.iter().find(|(k, _)| *k == key.name()).map(|(_, v)| *v))
+            .map(Valid::into_inner)
     }
 
     #[test]
@@ -350,7 +369,7 @@ mod tests {
             Some(text)
         })
         .unwrap();
-        assert_eq!(back, config);
+        assert_eq!(*back, config);
     }
 
     #[test]

@@ -23,6 +23,7 @@
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
 
+use crate::pose::rotation_from_xmat;
 use crate::sim::mjcf::COLLISION_GROUP;
 use crate::tactile::SensorConfig;
 use crate::tactile::back_contact::triangle_overlaps_box;
@@ -31,9 +32,9 @@ use crate::tactile::formation::ImageFormation;
 use crate::tactile::grid::SampleGrid;
 use crate::tactile::mesh_bvh::{Leaf, MeshBvh, MeshBvhError, OrientedBox};
 use crate::tactile::model_view::{ModelView, PoseView};
-use crate::tactile::primitive::Solid;
+use crate::tactile::primitive::{GeomShape, Solid};
 use crate::tactile::raster::DepthBuffer;
-use crate::valid::Check;
+use crate::valid::Valid;
 
 /// Why a plugin instance cannot be set up; each names the offending part of the model, briefly
 /// (MuJoCo keeps about 80 characters of a plugin's compile error).
@@ -122,16 +123,6 @@ pub struct Covering {
     stats: CoveringStats,
 }
 
-/// The world rotation of row-major `xmat` (its columns are the frame's axes).
-#[inline]
-fn rotation(xmat: &[f64]) -> DMat3 {
-    DMat3::from_cols(
-        DVec3::new(xmat[0], xmat[3], xmat[6]),
-        DVec3::new(xmat[1], xmat[4], xmat[7]),
-        DVec3::new(xmat[2], xmat[5], xmat[8]),
-    )
-}
-
 /// The box, in a mesh's geom frame, that holds every face that can change a reading's depths:
 /// the mesh placed in the pad frame by `x -> placement.0 x + placement.1`, within `rbound_m` of
 /// `placement.1` (0: no bound known), under a covering `thickness_m` thick.
@@ -205,125 +196,141 @@ fn rigid_back_touched(
         })
 }
 
+/// One BVH per mesh the sensed geoms use, built once at init (a reading never builds one), shared
+/// by every geom and sensor that uses the mesh.
+struct MeshCache {
+    meshes: Vec<MeshBvh>,
+    /// The index into `meshes` of each model mesh, once built.
+    slot: Vec<Option<usize>>,
+    stats: CoveringStats,
+}
+
+impl MeshCache {
+    fn new(model: &ModelView) -> Self {
+        Self {
+            meshes: Vec::new(),
+            slot: vec![None; model.mesh_vertadr.len()],
+            stats: CoveringStats::default(),
+        }
+    }
+
+    /// The slot of model mesh `mesh`, building its BVH the first time.
+    fn slot(&mut self, model: &ModelView, mesh: usize) -> Result<usize, CoveringError> {
+        if let Some(slot) = self.slot[mesh] {
+            return Ok(slot);
+        }
+        let (va, vn) = (
+            model.mesh_vertadr[mesh] as usize,
+            model.mesh_vertnum[mesh] as usize,
+        );
+        let (fa, fnum) = (
+            model.mesh_faceadr[mesh] as usize,
+            model.mesh_facenum[mesh] as usize,
+        );
+        let bvh = MeshBvh::new(
+            &model.mesh_vert[3 * va..3 * (va + vn)],
+            &model.mesh_face[3 * fa..3 * (fa + fnum)],
+        )
+        .map_err(|source| CoveringError::Mesh {
+            mesh: model.name(mjtObj::mjOBJ_MESH, mesh),
+            source,
+        })?;
+        self.stats.bvh_builds += 1;
+        self.stats.bvh_triangles += bvh.triangle_count();
+        self.meshes.push(bvh);
+        self.slot[mesh] = Some(self.meshes.len() - 1);
+        Ok(self.meshes.len() - 1)
+    }
+}
+
+/// Checks that `sensor` is on a site and has one value per taxel; returns its site.
+fn sensor_site(model: &ModelView, config: &SensorConfig, sensor: usize) -> Result<usize, CoveringError> {
+    let sensor_name = || model.name(mjtObj::mjOBJ_SENSOR, sensor);
+    let objtype = model.sensor_objtype[sensor];
+    if objtype != mjtObj::mjOBJ_SITE as i32 {
+        return Err(CoveringError::NotASite {
+            sensor: sensor_name(),
+            objtype,
+        });
+    }
+    if model.sensor_dim[sensor] as i64 != config.taxel_count() as i64 {
+        return Err(CoveringError::Dimension {
+            sensor: sensor_name(),
+            got: model.sensor_dim[sensor],
+            expected: config.taxel_count(),
+        });
+    }
+    Ok(model.sensor_objid[sensor] as usize)
+}
+
+/// The geoms the sensor on `site` senses (see the module docs): all but those of the kinematic
+/// tree carrying the pad, and but collision-only geoms (an object's collision shell is not the
+/// surface the covering presses on).
+fn sensed_geoms(
+    model: &ModelView,
+    site: usize,
+    cache: &mut MeshCache,
+) -> Result<Vec<SensedGeom>, CoveringError> {
+    let body = model.site_bodyid[site] as usize;
+    let root = model.body_rootid[body] as usize;
+    let own = |geom_body: usize| {
+        if root == 0 {
+            geom_body == body
+        } else {
+            model.body_rootid[geom_body] as usize == root
+        }
+    };
+    (0..model.ngeom())
+        .filter(|&geom| !own(model.geom_bodyid[geom] as usize) && model.geom_group[geom] != COLLISION_GROUP)
+        .map(|geom| sensed_geom(model, geom, cache))
+        .collect()
+}
+
+/// How the rays cut `geom`, and its bound.
+fn sensed_geom(model: &ModelView, geom: usize, cache: &mut MeshCache) -> Result<SensedGeom, CoveringError> {
+    let t = model.geom_type[geom];
+    let shape = match GeomShape::of_geom(t, &model.geom_size[3 * geom..3 * geom + 3]) {
+        GeomShape::Solid(solid) => Shape::Solid(solid),
+        GeomShape::Mesh => Shape::Mesh(cache.slot(model, model.geom_dataid[geom] as usize)?),
+        GeomShape::Unsupported(kind) => {
+            return Err(CoveringError::UnsupportedGeom {
+                geom: model.name(mjtObj::mjOBJ_GEOM, geom),
+                kind,
+            });
+        }
+    };
+    // A mesh's own bound is tight (MuJoCo's `geom_rbound` of a mesh is looser): it skips more
+    // geoms out of reach and keeps the queries off empty space.
+    let rbound_m = match shape {
+        _ if t == mjtGeom::mjGEOM_PLANE as i32 => 0.0,
+        Shape::Mesh(slot) => cache.meshes[slot].bounding_radius_m(),
+        Shape::Solid(_) => model.geom_rbound[geom],
+    };
+    Ok(SensedGeom {
+        geom,
+        shape,
+        rbound_m,
+    })
+}
+
 impl Covering {
     /// Sets up the instance whose sensors are `sensor_ids` (the model's sensors using it): checks
     /// each is on a site with the right dimension, chooses the sensed geoms, and builds one BVH per
     /// mesh they use.
-    pub fn new(model: &ModelView, config: SensorConfig, sensor_ids: &[usize]) -> Result<Self, CoveringError> {
-        config.check()?;
+    pub fn new(
+        model: &ModelView,
+        config: Valid<SensorConfig>,
+        sensor_ids: &[usize],
+    ) -> Result<Self, CoveringError> {
+        let config = config.into_inner();
         let grid = SampleGrid::new(&config);
         let formation = ImageFormation::new(&config, &grid);
-        let mut meshes: Vec<MeshBvh> = Vec::new();
-        let mut mesh_slot: Vec<Option<usize>> = vec![None; model.mesh_vertadr.len()];
-        let mut stats = CoveringStats::default();
+        let mut cache = MeshCache::new(model);
         let mut sensors = Vec::with_capacity(sensor_ids.len());
         for (k, &sensor) in sensor_ids.iter().enumerate() {
-            let sensor_name = || model.name(mjtObj::mjOBJ_SENSOR, sensor);
-            let objtype = model.sensor_objtype[sensor];
-            if objtype != mjtObj::mjOBJ_SITE as i32 {
-                return Err(CoveringError::NotASite {
-                    sensor: sensor_name(),
-                    objtype,
-                });
-            }
-            if model.sensor_dim[sensor] as i64 != config.taxel_count() as i64 {
-                return Err(CoveringError::Dimension {
-                    sensor: sensor_name(),
-                    got: model.sensor_dim[sensor],
-                    expected: config.taxel_count(),
-                });
-            }
-            let site = model.sensor_objid[sensor] as usize;
-            let body = model.site_bodyid[site] as usize;
-            let root = model.body_rootid[body] as usize;
-            let mut sensed = Vec::new();
-            for geom in 0..model.ngeom() {
-                let geom_body = model.geom_bodyid[geom] as usize;
-                let own = if root == 0 {
-                    geom_body == body
-                } else {
-                    model.body_rootid[geom_body] as usize == root
-                };
-                // Collision-only geoms (an object's collision shell) are not the surface the
-                // covering presses on.
-                if own || model.geom_group[geom] == COLLISION_GROUP {
-                    continue;
-                }
-                let size = &model.geom_size[3 * geom..3 * geom + 3];
-                let unsupported = |kind| CoveringError::UnsupportedGeom {
-                    geom: model.name(mjtObj::mjOBJ_GEOM, geom),
-                    kind,
-                };
-                let t = model.geom_type[geom];
-                let shape = if t == mjtGeom::mjGEOM_PLANE as i32 {
-                    Shape::Solid(Solid::HalfSpace)
-                } else if t == mjtGeom::mjGEOM_SPHERE as i32 {
-                    Shape::Solid(Solid::Sphere { radius_m: size[0] })
-                } else if t == mjtGeom::mjGEOM_CAPSULE as i32 {
-                    Shape::Solid(Solid::Capsule {
-                        radius_m: size[0],
-                        half_length_m: size[1],
-                    })
-                } else if t == mjtGeom::mjGEOM_ELLIPSOID as i32 {
-                    Shape::Solid(Solid::Ellipsoid {
-                        radii_m: DVec3::from_slice(size),
-                    })
-                } else if t == mjtGeom::mjGEOM_CYLINDER as i32 {
-                    Shape::Solid(Solid::Cylinder {
-                        radius_m: size[0],
-                        half_length_m: size[1],
-                    })
-                } else if t == mjtGeom::mjGEOM_BOX as i32 {
-                    Shape::Solid(Solid::Box {
-                        half_m: DVec3::from_slice(size),
-                    })
-                } else if t == mjtGeom::mjGEOM_MESH as i32 {
-                    let mesh = model.geom_dataid[geom] as usize;
-                    let slot = match mesh_slot[mesh] {
-                        Some(slot) => slot,
-                        None => {
-                            let (va, vn) = (
-                                model.mesh_vertadr[mesh] as usize,
-                                model.mesh_vertnum[mesh] as usize,
-                            );
-                            let (fa, fnum) = (
-                                model.mesh_faceadr[mesh] as usize,
-                                model.mesh_facenum[mesh] as usize,
-                            );
-                            let bvh = MeshBvh::new(
-                                &model.mesh_vert[3 * va..3 * (va + vn)],
-                                &model.mesh_face[3 * fa..3 * (fa + fnum)],
-                            )
-                            .map_err(|source| CoveringError::Mesh {
-                                mesh: model.name(mjtObj::mjOBJ_MESH, mesh),
-                                source,
-                            })?;
-                            stats.bvh_builds += 1;
-                            stats.bvh_triangles += bvh.triangle_count();
-                            meshes.push(bvh);
-                            mesh_slot[mesh] = Some(meshes.len() - 1);
-                            meshes.len() - 1
-                        }
-                    };
-                    Shape::Mesh(slot)
-                } else if t == mjtGeom::mjGEOM_HFIELD as i32 {
-                    return Err(unsupported("height field"));
-                } else {
-                    return Err(unsupported("signed distance field"));
-                };
-                // A mesh's own bound is tight (MuJoCo's `geom_rbound` of a mesh is looser): it
-                // skips more geoms out of reach and keeps the queries off empty space.
-                let rbound_m = match shape {
-                    _ if t == mjtGeom::mjGEOM_PLANE as i32 => 0.0,
-                    Shape::Mesh(slot) => meshes[slot].bounding_radius_m(),
-                    Shape::Solid(_) => model.geom_rbound[geom],
-                };
-                sensed.push(SensedGeom {
-                    geom,
-                    shape,
-                    rbound_m,
-                });
-            }
+            let site = sensor_site(model, &config, sensor)?;
+            let sensed = sensed_geoms(model, site, &mut cache)?;
+            // The first sensor keeps the configured stream; further ones get substreams.
             let noise_seed = if k == 0 {
                 config.noise_seed
             } else {
@@ -342,11 +349,11 @@ impl Covering {
             grid,
             formation,
             sensors,
-            meshes,
+            meshes: cache.meshes,
             depth,
             leaves: Vec::new(),
             stack: Vec::new(),
-            stats,
+            stats: cache.stats,
         })
     }
 
@@ -381,13 +388,13 @@ impl Covering {
         let sensor = &self.sensors[k];
         let t = self.config.thickness_m;
         let pad_origin = DVec3::from_slice(&poses.site_xpos[3 * sensor.site..3 * sensor.site + 3]);
-        let pad_rotation = rotation(&poses.site_xmat[9 * sensor.site..9 * sensor.site + 9]);
+        let pad_rotation = rotation_from_xmat(&poses.site_xmat[9 * sensor.site..9 * sensor.site + 9]);
         let to_pad = pad_rotation.transpose();
         let (hw, hh) = (self.grid.half_width_m, self.grid.half_height_m);
         self.depth.nearest_m.fill(f64::INFINITY);
         for g in &sensor.sensed {
             let geom_origin = DVec3::from_slice(&poses.geom_xpos[3 * g.geom..3 * g.geom + 3]);
-            let geom_rotation = rotation(&poses.geom_xmat[9 * g.geom..9 * g.geom + 9]);
+            let geom_rotation = rotation_from_xmat(&poses.geom_xmat[9 * g.geom..9 * g.geom + 9]);
             // Geom frame -> pad frame: p_pad = m p_geom + o.
             let m = to_pad * geom_rotation;
             let o = to_pad * (geom_origin - pad_origin);
@@ -410,45 +417,55 @@ impl Covering {
                     }
                 }
                 Shape::Solid(solid) => {
-                    let to_geom = m.transpose();
-                    let (right, up, dir) = (to_geom.x_axis, to_geom.y_axis, to_geom.z_axis);
-                    let base = -(to_geom * o);
-                    let (rows, cols) = if r > 0.0 {
-                        (
-                            self.grid.row_range(o.y - r, o.y + r),
-                            self.grid.col_range(o.x - r, o.x + r),
-                        )
-                    } else {
-                        (0..self.grid.rows, 0..self.grid.cols)
-                    };
-                    for i in rows {
-                        let row_origin = base + up * self.grid.y(i);
-                        for j in cols.clone() {
-                            let origin = row_origin + right * self.grid.x(j);
-                            if let Some((s_in, s_out)) = solid.line_interval(origin, dir)
-                                && s_out >= 0.0
-                            {
-                                let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
-                                let s = i * self.grid.cols + j;
-                                if z < self.depth.nearest_m[s] {
-                                    self.depth.nearest_m[s] = z;
-                                }
-                            }
-                        }
-                    }
+                    draw_solid(&self.grid, &mut self.depth.nearest_m, solid, (&m, o), r);
                 }
             }
         }
-        let mut full = 0;
-        for row in self.depth.nearest_m.chunks_exact_mut(self.grid.cols) {
-            row.reverse();
-            for z in row {
-                *z = (t - *z).clamp(0.0, t);
-                full += usize::from(*z >= t);
+        penetration_from_depths(&mut self.depth.nearest_m, self.grid.cols, t)
+    }
+}
+
+/// Lowers `nearest_m` (pad-frame depths, sample order) to the depth of `solid` placed by
+/// `x -> placement.0 x + placement.1` where its ray meets it nearer; within `rbound_m` of its
+/// origin only (0: unbounded, every ray). A pad point inside the solid is at depth `-inf`.
+fn draw_solid(grid: &SampleGrid, nearest_m: &mut [f64], solid: Solid, (m, o): (&DMat3, DVec3), r: f64) {
+    let to_geom = m.transpose();
+    let (right, up, dir) = (to_geom.x_axis, to_geom.y_axis, to_geom.z_axis);
+    let base = -(to_geom * o);
+    let (rows, cols) = if r > 0.0 {
+        (grid.row_range(o.y - r, o.y + r), grid.col_range(o.x - r, o.x + r))
+    } else {
+        (0..grid.rows, 0..grid.cols)
+    };
+    for i in rows {
+        let row_origin = base + up * grid.y(i);
+        for j in cols.clone() {
+            let origin = row_origin + right * grid.x(j);
+            if let Some((s_in, s_out)) = solid.line_interval(origin, dir)
+                && s_out >= 0.0
+            {
+                let z = if s_in <= 0.0 { f64::NEG_INFINITY } else { s_in };
+                let s = i * grid.cols + j;
+                if z < nearest_m[s] {
+                    nearest_m[s] = z;
+                }
             }
         }
-        full
     }
+}
+
+/// Turns the per-sample depths into penetrations `clamp(t - z, 0, t)` in the image's column order
+/// (mirrored left-right, see the module docs); returns how many samples are fully penetrated.
+fn penetration_from_depths(nearest_m: &mut [f64], cols: usize, t: f64) -> usize {
+    let mut full = 0;
+    for row in nearest_m.chunks_exact_mut(cols) {
+        row.reverse();
+        for z in row {
+            *z = (t - *z).clamp(0.0, t);
+            full += usize::from(*z >= t);
+        }
+    }
+    full
 }
 
 #[cfg(test)]

@@ -8,37 +8,10 @@
 use std::fmt;
 use std::path::Path;
 
-use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::{FileError, write_atomic};
-
-/// Where the pad was when it took a reading, in world coordinates.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PadPose {
-    /// Centre of the pad surface (the back of the covering), metres.
-    pub center_m: DVec3,
-    /// Unit normal pointing from the pad into the covering, toward the object.
-    pub normal: DVec3,
-    /// Unit vector in the pad plane toward image row 0.
-    pub up: DVec3,
-}
-
-impl PadPose {
-    /// Builds a pose from any normal and a hint for `up`; `up` is made orthogonal to the normal
-    /// (Gram-Schmidt). Returns `None` when the normal is zero or not finite, or `up` is parallel to it.
-    pub fn new(center_m: DVec3, normal: DVec3, up_hint: DVec3) -> Option<Self> {
-        let normal = normal.try_normalize()?;
-        let up = (up_hint - normal * up_hint.dot(normal)).try_normalize()?;
-        center_m.is_finite().then_some(Self { center_m, normal, up })
-    }
-
-    /// Unit vector in the pad plane toward the last image column: `normal x up`: the image's right
-    /// as seen from behind the pad, looking along the normal ((right, up, -normal) is right-handed).
-    pub fn right(&self) -> DVec3 {
-        self.normal.cross(self.up)
-    }
-}
+pub use crate::pose::PadPose;
 
 /// Errors from building or reading a tactile image; each names the offending place.
 #[derive(Debug, thiserror::Error)]
@@ -408,15 +381,5 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("line 1"), "{e}");
-    }
-
-    #[test]
-    fn pad_right_is_the_image_right_seen_from_behind() {
-        let pose = PadPose::new(DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0), DVec3::new(0.0, 1.0, 0.3)).unwrap();
-        assert!((pose.normal - DVec3::NEG_Z).length() < 1e-12);
-        assert!((pose.up - DVec3::Y).length() < 1e-12);
-        // Looking down -z with +y up, the right of the image is +x.
-        assert!((pose.right() - DVec3::X).length() < 1e-12);
-        assert!(PadPose::new(DVec3::ZERO, DVec3::Z, DVec3::Z).is_none());
     }
 }

@@ -12,8 +12,8 @@
 //! grid        where the (supersampled) rays pierce the pad
 //! formation   penetration -> PSF -> taxels -> [0, 1] -> noise
 //! sensor      the Rust handle (read an image from sensordata) and the MJCF helpers
-//! free_floating  the pad on a mocap body, no arm (Sec. V-A3, `taction sense`)
-//! image       TactileImage and PadPose
+//! free_floating  the scene of the pad on a mocap body, no arm (Sec. V-A3; `control::FreePad`)
+//! image       TactileImage (and PadPose, from `pose`)
 //! ```
 
 pub(crate) mod back_contact;
@@ -32,7 +32,7 @@ pub mod sensor;
 
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
 pub use covering::{Covering, CoveringError, CoveringStats, query_region};
-pub use free_floating::{FreeFloatingSensor, free_floating_builder};
+pub use free_floating::free_floating_builder;
 pub use image::{ImageError, PadPose, TactileImage};
 pub use model_view::{ModelView, PoseView};
 pub use plugin::{PLUGIN_NAME, ensure_registered, register};

@@ -36,9 +36,11 @@ use mujoco_rs::mujoco_c::{
     mju_warning, mjv_initGeom, mjvOption, mjvScene,
 };
 
+use crate::pose::rotation_from_xmat;
 use crate::tactile::config::{ConfigKey, SensorConfig};
 use crate::tactile::covering::Covering;
 use crate::tactile::model_view::{ModelView, PoseView};
+use crate::valid::Valid;
 
 /// The plugin's registered name.
 pub const PLUGIN_NAME: &str = "taction.covering";
@@ -109,7 +111,10 @@ pub fn is_covering_instance(m: &mjModel, instance: usize) -> bool {
 }
 
 /// The config of plugin instance `instance`, parsed and validated.
-pub fn instance_config(m: &mjModel, instance: usize) -> Result<SensorConfig, crate::tactile::ConfigError> {
+pub fn instance_config(
+    m: &mjModel,
+    instance: usize,
+) -> Result<Valid<SensorConfig>, crate::tactile::ConfigError> {
     let values: Vec<Option<String>> = ConfigKey::ALL
         .iter()
         .zip(ATTRIBUTES.0.iter())
@@ -359,12 +364,7 @@ unsafe extern "C" fn visualize(
             let values = sensordata.get(adr..adr + config.taxel_count()).unwrap_or(&[]);
             let p = &poses.site_xpos[3 * site..3 * site + 3];
             let r = &poses.site_xmat[9 * site..9 * site + 9];
-            // site_xmat is row-major; DMat3 takes columns.
-            let frame = DMat3::from_cols(
-                DVec3::new(r[0], r[3], r[6]),
-                DVec3::new(r[1], r[4], r[7]),
-                DVec3::new(r[2], r[5], r[8]),
-            );
+            let frame = rotation_from_xmat(r);
             for tile in taxel_tiles(&config, DVec3::new(p[0], p[1], p[2]), frame, values) {
                 if scn.ngeom >= scn.maxgeom {
                     if scn.status == 0 {

@@ -10,6 +10,7 @@
 //! `z <= 0` of its frame, unbounded as in MuJoCo's collisions (its size only sets how it is drawn).
 
 use glam::DVec3;
+use mujoco_rs::mujoco_c::mjtGeom;
 
 /// Directions closer than this (squared sine) to parallel count as parallel.
 const PARALLEL_EPS: f64 = 1e-30;
@@ -23,6 +24,54 @@ pub enum Solid {
     Ellipsoid { radii_m: DVec3 },
     Cylinder { radius_m: f64, half_length_m: f64 },
     Box { half_m: DVec3 },
+}
+
+/// What a MuJoCo geom type is to the covering's rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GeomShape {
+    /// A primitive, cut analytically.
+    Solid(Solid),
+    /// A mesh, rasterised from its BVH (`mesh_bvh`).
+    Mesh,
+    /// A geom the covering cannot sense, by kind (a height field, a signed distance field).
+    Unsupported(&'static str),
+}
+
+impl GeomShape {
+    /// The shape of a geom of MuJoCo type `geom_type` (`mjtGeom`) and `geom_size` `size` (three
+    /// values, read as the module docs say).
+    pub fn of_geom(geom_type: i32, size: &[f64]) -> Self {
+        let is = |t: mjtGeom| geom_type == t as i32;
+        if is(mjtGeom::mjGEOM_PLANE) {
+            Self::Solid(Solid::HalfSpace)
+        } else if is(mjtGeom::mjGEOM_SPHERE) {
+            Self::Solid(Solid::Sphere { radius_m: size[0] })
+        } else if is(mjtGeom::mjGEOM_CAPSULE) {
+            Self::Solid(Solid::Capsule {
+                radius_m: size[0],
+                half_length_m: size[1],
+            })
+        } else if is(mjtGeom::mjGEOM_ELLIPSOID) {
+            Self::Solid(Solid::Ellipsoid {
+                radii_m: DVec3::from_slice(size),
+            })
+        } else if is(mjtGeom::mjGEOM_CYLINDER) {
+            Self::Solid(Solid::Cylinder {
+                radius_m: size[0],
+                half_length_m: size[1],
+            })
+        } else if is(mjtGeom::mjGEOM_BOX) {
+            Self::Solid(Solid::Box {
+                half_m: DVec3::from_slice(size),
+            })
+        } else if is(mjtGeom::mjGEOM_MESH) {
+            Self::Mesh
+        } else if is(mjtGeom::mjGEOM_HFIELD) {
+            Self::Unsupported("height field")
+        } else {
+            Self::Unsupported("signed distance field")
+        }
+    }
 }
 
 /// A parameter interval `[s_in, s_out]` of a line inside a solid.

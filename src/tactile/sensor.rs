@@ -1,7 +1,6 @@
 //! The Rust side of a `taction.covering` sensor in a compiled model: find it, read its image from
 //! `sensordata` together with the pad pose, and write the MJCF that inserts it into a scene.
 
-use glam::DVec3;
 use mujoco_rs::mujoco_c::mjtObj;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
@@ -15,7 +14,7 @@ use crate::tactile::model_view::ModelView;
 use crate::tactile::plugin::{
     PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state, is_covering_instance,
 };
-use crate::valid::Check;
+use crate::valid::Valid;
 
 /// Errors of the tactile module; each names the sensor, site or key concerned.
 #[derive(Debug, thiserror::Error)]
@@ -43,7 +42,7 @@ pub struct CoveringSensor {
     site: usize,
     site_name: String,
     adr: usize,
-    config: SensorConfig,
+    config: Valid<SensorConfig>,
 }
 
 impl CoveringSensor {
@@ -93,7 +92,8 @@ impl CoveringSensor {
         &self.name
     }
 
-    pub fn config(&self) -> &SensorConfig {
+    /// The sensor's configuration, as the plugin parsed (and checked) it from the model.
+    pub fn config(&self) -> &Valid<SensorConfig> {
         &self.config
     }
 
@@ -109,9 +109,7 @@ impl CoveringSensor {
 
     /// The pad frame of the site, from `site_xpos` / `site_xmat` (valid after kinematics).
     pub fn pad_pose<M: ModelType>(&self, data: &MjData<M>) -> Result<PadPose, TactileError> {
-        let m = data.site_xmat()[self.site];
-        let center = DVec3::from_array(data.site_xpos()[self.site]);
-        PadPose::new(center, DVec3::new(m[2], m[5], m[8]), DVec3::new(m[1], m[4], m[7])).ok_or_else(|| {
+        PadPose::of_site_xmat(data.site_xpos()[self.site], &data.site_xmat()[self.site]).ok_or_else(|| {
             TactileError::BadPadFrame {
                 sensor: self.name.clone(),
                 site: self.site_name.clone(),
@@ -155,8 +153,7 @@ pub fn extension_xml() -> String {
 }
 
 /// The `<sensor>` content of a covering sensor named `name` on site `site` with every config key.
-pub fn sensor_xml(config: &SensorConfig, name: &str, site: &str) -> Result<String, ConfigError> {
-    config.check()?;
+pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str) -> String {
     let mut xml = format!(
         "<plugin name=\"{}\" plugin=\"{PLUGIN_NAME}\" objtype=\"site\" objname=\"{}\">\n",
         escape_attr(name),
@@ -169,20 +166,19 @@ pub fn sensor_xml(config: &SensorConfig, name: &str, site: &str) -> Result<Strin
         ));
     }
     xml.push_str("</plugin>");
-    Ok(xml)
+    xml
 }
 
 /// Adds the plugin declaration and a covering sensor on site `site` to a scene, and registers the
 /// plugin so the scene compiles.
 pub fn add_sensor(
     builder: SceneBuilder,
-    config: &SensorConfig,
+    config: &Valid<SensorConfig>,
     name: &str,
     site: &str,
-) -> Result<SceneBuilder, ConfigError> {
+) -> SceneBuilder {
     ensure_registered();
-    let sensor = sensor_xml(config, name, site)?;
-    Ok(builder
+    builder
         .add(Section::Extension, extension_xml())
-        .add(Section::Sensor, sensor))
+        .add(Section::Sensor, sensor_xml(config, name, site))
 }

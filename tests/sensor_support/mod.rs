@@ -4,11 +4,13 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
+use taction::control::FreePad;
 use taction::mesh::TriMesh;
 use taction::sim::SceneBuilder;
 use taction::sim::mjcf::Section;
 use taction::tactile::free_floating::free_pad_body_xml;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig, add_sensor};
+use taction::tactile::{PadPose, SensorConfig, add_sensor};
+use taction::valid::Valid;
 
 /// The unit icosahedron: 12 vertices, 20 outward faces.
 fn icosahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
@@ -162,13 +164,13 @@ pub fn box_between(lo: DVec3, hi: DVec3) -> TriMesh {
 }
 
 /// A free-floating sensor scene around arbitrary world MJCF (primitive geoms etc.).
-pub fn free_sensor_with(world_xml: &str, config: &SensorConfig) -> FreeFloatingSensor {
+pub fn free_sensor_with(world_xml: &str, config: &SensorConfig) -> FreePad {
     let builder = SceneBuilder::new()
         .table(false)
         .add(Section::Worldbody, world_xml)
         .add(Section::Worldbody, free_pad_body_xml(config));
-    let builder = add_sensor(builder, config, "covering", "pad").unwrap();
-    FreeFloatingSensor::from_scene(builder.build().unwrap()).unwrap()
+    let builder = add_sensor(builder, &Valid::new(*config).unwrap(), "covering", "pad");
+    FreePad::from_scene(builder.build().unwrap()).unwrap()
 }
 
 /// A pad at `center` looking straight down (-z), image up along +y.
