@@ -16,7 +16,7 @@
 //! Everything else stays at its module's root (`taction::recognize::GaussianMixture`, ...); the
 //! modules' own files are not part of the interface.
 
-pub use crate::control::{ContactOutcome, ControlConfig, settle};
+pub use crate::control::{ContactOutcome, ControlConfig, FreePad, PadCarrier, settle};
 pub use crate::dataset::{ContactStatus, Dataset, DatasetHeader, Reading};
 pub use crate::describe::{Descriptor, DescriptorKind};
 pub use crate::explore::{Collect, CollectMode, CollectPlan};

@@ -65,16 +65,16 @@ pub fn settle<C: PadCarrier + ?Sized>(
     };
     let mut image = match run.approach()? {
         Step::On(image) => image,
-        Step::Ended(outcome) => return Ok(outcome),
+        Step::Ended(outcome) => return Ok(*outcome),
     };
     for iteration in 1..=config.max_iterations as u32 {
         let pressed = match run.press(iteration, &mut image)? {
             Step::On(commanded) => commanded,
-            Step::Ended(outcome) => return Ok(outcome),
+            Step::Ended(outcome) => return Ok(*outcome),
         };
         let oriented = match run.orient(iteration, &mut image)? {
             Step::On(commanded) => commanded,
-            Step::Ended(outcome) => return Ok(outcome),
+            Step::Ended(outcome) => return Ok(*outcome),
         };
         if let Some(status) = settled(&image, pressed, oriented, config) {
             return run.finish(status, image, iteration, None);
@@ -88,10 +88,11 @@ pub fn settle<C: PadCarrier + ?Sized>(
     )
 }
 
-/// Where one step of the loop leaves a run: going on (with what the step gives), or ended.
+/// Where one step of the loop leaves a run: going on (with what the step gives), or ended (boxed:
+/// an outcome is large, and a step goes on far more often than it ends).
 enum Step<T> {
     On(T),
-    Ended(ContactOutcome),
+    Ended(Box<ContactOutcome>),
 }
 
 /// One run of the controllers: the carrier, the configuration and the commands issued so far.
@@ -108,9 +109,9 @@ impl<C: PadCarrier + ?Sized> Settling<'_, C> {
             ApproachOutcome::Contact(image) => Step::On(image),
             ApproachOutcome::NoContact => {
                 let image = self.carrier.read()?;
-                Step::Ended(self.finish(ContactStatus::NoContact, image, 0, None)?)
+                Step::Ended(Box::new(self.finish(ContactStatus::NoContact, image, 0, None)?))
             }
-            ApproachOutcome::Blocked(motion) => Step::Ended(self.blocked(&motion, 0)?),
+            ApproachOutcome::Blocked(motion) => Step::Ended(Box::new(self.blocked(&motion, 0)?)),
         })
     }
 
@@ -125,7 +126,7 @@ impl<C: PadCarrier + ?Sized> Settling<'_, C> {
                 *image = pressed;
                 Step::On(commanded)
             }
-            PressOutcome::Blocked(motion) => Step::Ended(self.blocked(&motion, iteration)?),
+            PressOutcome::Blocked(motion) => Step::Ended(Box::new(self.blocked(&motion, iteration)?)),
         })
     }
 
@@ -141,7 +142,7 @@ impl<C: PadCarrier + ?Sized> Settling<'_, C> {
         self.trace.push(Command::Orient, target);
         match self.carrier.move_pad(&target)? {
             PadMotion::Moved | PadMotion::RigidContact => {}
-            motion => return Ok(Step::Ended(self.blocked(&motion, iteration)?)),
+            motion => return Ok(Step::Ended(Box::new(self.blocked(&motion, iteration)?))),
         }
         *image = self.carrier.read()?;
         Ok(Step::On(true))
