@@ -42,14 +42,13 @@ use glam::DVec3;
 
 use crate::control::ControlError;
 use crate::dataset::Reading;
-use crate::describe::Descriptor;
 use crate::explore::Planner;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
-use crate::recognize::posterior::{Belief, OnlinePosterior};
-use crate::recognize::{FusedModel, FusedPosterior, RecognizeError};
+use crate::recognize::posterior::{Belief, ModelPosterior};
+use crate::recognize::{FusedModel, RecognizeError, TrainedModel};
 use crate::sim::Scene;
 use crate::tactile::TactileImage;
 
@@ -164,62 +163,43 @@ impl TouchScorer for InformationGain<'_> {
     }
 }
 
-/// A recogniser that also scores where to touch next: the online posterior (Eq. 16) and the
-/// [`InformationGain`] state fed with the same readings. A fused model (several descriptors, their
-/// likelihoods multiplied, `recognize::fusion`) gives the belief; its first model's clusters give
-/// the gain's predictions.
+/// A recogniser that also scores where to touch next: the model's posterior (Eq. 16, fed with
+/// images, [`ModelPosterior`]) and the [`InformationGain`] state fed with the same readings. A
+/// fused model (several descriptors, their likelihoods multiplied, `recognize::fusion`) gives the
+/// belief; its first model's clusters give the gain's predictions.
 pub struct ActiveRecognition<'a> {
     bag: &'a BagOfFeatures,
-    descriptors: Vec<&'a dyn Descriptor>,
-    posterior: Posterior<'a>,
+    posterior: ModelPosterior<'a>,
     gain: InformationGain<'a>,
 }
 
-/// The belief of one model or of a fused one.
-enum Posterior<'a> {
-    Single(OnlinePosterior<'a>),
-    Fused(FusedPosterior<'a>),
-}
-
 impl<'a> ActiveRecognition<'a> {
-    pub fn new(bag: &'a BagOfFeatures, descriptor: &'a dyn Descriptor, neighbourhood_m: f64) -> Self {
-        Self {
-            bag,
-            descriptors: vec![descriptor],
-            posterior: Posterior::Single(bag.posterior()),
-            gain: InformationGain::new(bag.models(), neighbourhood_m),
-        }
+    /// The recogniser of one model, describing images with the model's descriptor.
+    pub fn new(model: &'a TrainedModel, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+        Ok(Self::with(&model.bag, model.posterior()?, neighbourhood_m))
     }
 
-    /// The recogniser of a fused model; `descriptors[m]` describes readings for `model.fused[m]`.
-    pub fn fused(
-        model: &'a FusedModel,
-        descriptors: Vec<&'a dyn Descriptor>,
-        neighbourhood_m: f64,
-    ) -> Result<Self, RecognizeError> {
-        let kinds: Vec<_> = model.fused.iter().map(|m| m.descriptor.kind()).collect();
-        if descriptors.iter().map(|d| d.kind()).ne(kinds.iter().copied()) {
-            return Err(RecognizeError::InvalidParameter {
-                name: "fused recogniser",
-                what: format!("descriptors do not match the fused model's {kinds:?}"),
-            });
-        }
-        let bag = &model.fused[0].bag;
-        Ok(Self {
+    /// The recogniser of a fused model, describing images with each model's descriptor.
+    pub fn fused(model: &'a FusedModel, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+        Ok(Self::with(
+            &model.fused[0].bag,
+            model.image_posterior()?,
+            neighbourhood_m,
+        ))
+    }
+
+    fn with(bag: &'a BagOfFeatures, posterior: ModelPosterior<'a>, neighbourhood_m: f64) -> Self {
+        Self {
             bag,
-            descriptors,
-            posterior: Posterior::Fused(model.posterior()),
+            posterior,
             gain: InformationGain::new(bag.models(), neighbourhood_m),
-        })
+        }
     }
 
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
-        let features: Vec<_> = self.descriptors.iter().map(|d| d.describe(image)).collect();
-        let belief = match &mut self.posterior {
-            Posterior::Single(p) => p.observe(&features[0])?,
-            Posterior::Fused(p) => p.observe(&features)?,
-        };
+        let features = self.posterior.describe(image);
+        let belief = self.posterior.observe_features(&features)?;
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
         self.gain
@@ -228,10 +208,7 @@ impl<'a> ActiveRecognition<'a> {
     }
 
     pub fn belief(&self) -> Belief {
-        match &self.posterior {
-            Posterior::Single(p) => p.belief(),
-            Posterior::Fused(p) => p.belief(),
-        }
+        self.posterior.belief()
     }
 
     pub fn scorer(&self) -> &InformationGain<'a> {

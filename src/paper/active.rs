@@ -322,7 +322,7 @@ fn active_trial(
         .object_index(&spec.name)
         .ok_or_else(|| format!("object '{}' is not in the trained model", spec.name))?;
     let (mut scene, mut planner) = plan.planner_for(spec, index, config)?;
-    let mut recognition = ActiveRecognition::new(&model.bag, descriptor, neighbourhood_m);
+    let mut recognition = ActiveRecognition::new(model, neighbourhood_m)?;
     let run = explore_recognizing(
         &mut planner,
         &mut scene,

@@ -40,7 +40,7 @@ use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
 use crate::rng;
 use crate::tactile::TactileImage;
-use crate::valid::Check;
+use crate::valid::{Check, Valid};
 
 /// The command-line name.
 pub const EXPERIMENT_NAME: &str = "real-frames";
@@ -331,9 +331,9 @@ fn descriptor_rows(
             ..training.clone()
         };
         let trained = train(
+            &Valid::new(trial_training)?,
             &describe(&split.train)?,
             Some(&describe(&split.validation)?),
-            &trial_training,
             &mut |_| {},
         )?;
         let test = describe(&split.test)?;

@@ -1,11 +1,14 @@
 //! The belief over object identity after every touch: the histogram of all features so far, and
-//! the distribution of Eq. 16 it implies.
+//! the distribution of Eq. 16 it implies. [`OnlinePosterior`] takes described readings;
+//! [`ModelPosterior`] takes tactile images and describes them as the model's training did.
 
-use crate::describe::Feature;
+use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::Decision;
+use crate::recognize::fusion::FusedPosterior;
 use crate::recognize::object_model::ClusterHistogram;
+use crate::tactile::TactileImage;
 
 impl BagOfFeatures {
     /// A posterior over the objects that takes readings one at a time. (Defined here, beside the
@@ -90,5 +93,88 @@ impl<'a> OnlinePosterior<'a> {
     /// The summed cluster memberships of every feature so far.
     pub fn histogram(&self) -> &ClusterHistogram {
         &self.histogram
+    }
+}
+
+/// The posterior of a trained model (one descriptor or several fused), fed with tactile images:
+/// each image is described by the model's own descriptors, so that test images are described as
+/// the training images were. What [`TrainedModel::posterior`](crate::recognize::TrainedModel::posterior)
+/// and [`Recognizer::posterior`](crate::recognize::Recognizer::posterior) give.
+pub struct ModelPosterior<'a> {
+    descriptors: Vec<Box<dyn Descriptor>>,
+    beliefs: Beliefs<'a>,
+}
+
+/// The belief of one model, or of several fused (their likelihoods multiplied).
+#[derive(Clone)]
+enum Beliefs<'a> {
+    Single(OnlinePosterior<'a>),
+    Fused(FusedPosterior<'a>),
+}
+
+impl<'a> ModelPosterior<'a> {
+    /// The posterior of one model whose images `descriptor` describes.
+    pub(crate) fn single(bag: &'a BagOfFeatures, descriptor: Box<dyn Descriptor>) -> Self {
+        Self {
+            descriptors: vec![descriptor],
+            beliefs: Beliefs::Single(bag.posterior()),
+        }
+    }
+
+    /// The posterior of a fused model; `descriptors[m]` describes images for its model `m`.
+    pub(crate) fn fused(posterior: FusedPosterior<'a>, descriptors: Vec<Box<dyn Descriptor>>) -> Self {
+        Self {
+            descriptors,
+            beliefs: Beliefs::Fused(posterior),
+        }
+    }
+
+    /// The features of `image` under each of the model's descriptors, in the model's order.
+    pub fn describe(&self, image: &TactileImage) -> Vec<Vec<Feature>> {
+        self.descriptors.iter().map(|d| d.describe(image)).collect()
+    }
+
+    /// Describes one reading's image, adds it and returns the belief after it.
+    pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
+        let features = self.describe(image);
+        self.observe_features(&features)
+    }
+
+    /// Adds one reading already described: `features[m]` its features under descriptor `m` (one
+    /// list for a model of one descriptor). On error (a count or a length that does not match) the
+    /// state is unchanged.
+    pub fn observe_features(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
+        match &mut self.beliefs {
+            Beliefs::Single(p) => match features {
+                [one] => p.observe(one),
+                _ => Err(RecognizeError::InvalidParameter {
+                    name: "reading",
+                    what: format!("{} feature lists for a model of one descriptor", features.len()),
+                }),
+            },
+            Beliefs::Fused(p) => p.observe(features),
+        }
+    }
+
+    /// The belief now.
+    pub fn belief(&self) -> Belief {
+        match &self.beliefs {
+            Beliefs::Single(p) => p.belief(),
+            Beliefs::Fused(p) => p.belief(),
+        }
+    }
+
+    /// `p(O_j | readings so far)` for every object of the model; sums to 1 (uniform before any
+    /// reading).
+    pub fn probabilities(&self) -> Vec<f64> {
+        self.belief().decision.probabilities
+    }
+
+    /// Readings observed so far.
+    pub fn readings(&self) -> usize {
+        match &self.beliefs {
+            Beliefs::Single(p) => p.readings(),
+            Beliefs::Fused(p) => p.readings(),
+        }
     }
 }
