@@ -41,16 +41,22 @@
 use glam::DVec3;
 
 use crate::control::ControlError;
-use crate::dataset::Reading;
-use crate::explore::Planner;
+use crate::dataset::{Dataset, Reading};
+use crate::describe::DescriptorKind;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
+use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::explore::{Planner, SamplerConfig};
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, ModelPosterior};
-use crate::recognize::{FusedModel, RecognizeError, TrainedModel};
-use crate::sim::Scene;
-use crate::tactile::TactileImage;
+use crate::recognize::{
+    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, TrainConfig,
+    TrainedModel,
+};
+use crate::sim::{PerturbationBounds, Scene};
+use crate::tactile::{SensorConfig, TactileImage};
+use crate::valid::{RangeError, Valid};
 
 /// `kappa`: how many readings' worth of weight the belief's own prediction has against the readings
 /// of a neighbourhood (see the module docs). One: a single nearby reading already counts as much as
@@ -213,6 +219,86 @@ impl<'a> ActiveRecognition<'a> {
 
     pub fn scorer(&self) -> &InformationGain<'a> {
         &self.gain
+    }
+}
+
+/// How the demo trains a recogniser on what the arm's pad feels (the README's "Training that
+/// matches the arm"; docs/measurements.md has the measurements behind each choice): sampler
+/// readings restricted to the starts the arm can take from any heading of the object, pressed by
+/// the same controllers as the arm's pad; MNTI and SIFT fused ([`Self::DESCRIPTORS`]: SIFT's
+/// gradient orientations with MNTI's moments gained on the arm's own touches as on sampler data)
+/// over the neighbour codebook, one restart (the neighbour codebook draws nothing at random), the
+/// `k` grid sized to the converged readings left after the hold-out
+/// ([`TrainConfig::with_grid_for_dataset`]). Library users get the model `taction demo` gets.
+///
+/// ```
+/// use taction::active_touch::ArmTrainingRecipe;
+///
+/// let recipe = ArmTrainingRecipe { readings_per_object: 3000, seed: 1 };
+/// assert_eq!(recipe.descriptors()?.name(), "mnti+sift");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArmTrainingRecipe {
+    /// Converged sampler readings per object.
+    pub readings_per_object: usize,
+    /// Seeds the training data and the model selection.
+    pub seed: u64,
+}
+
+impl ArmTrainingRecipe {
+    /// The fused descriptors.
+    pub const DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
+    /// The codebook every descriptor's model uses.
+    pub const CODEBOOK: CodebookKind = CodebookKind::Knn;
+
+    /// [`Self::DESCRIPTORS`], fused.
+    pub fn descriptors(&self) -> Result<DescriptorChoice, DescriptorChoiceError> {
+        DescriptorChoice::fused(Self::DESCRIPTORS.to_vec())
+    }
+
+    /// The training data's collection: the sampler from starts the arm can reach, the default
+    /// controllers, the object unperturbed.
+    pub fn collect_plan(&self, sensor: SensorConfig) -> Result<CollectPlan, RangeError> {
+        Ok(CollectPlan {
+            mode: CollectMode::Sampler(Valid::new(SamplerConfig {
+                reachable_by_arm: true,
+                ..SamplerConfig::default()
+            })?),
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+            readings_per_object: self.readings_per_object,
+            seed: self.seed,
+        })
+    }
+
+    /// Model selection for `training` (validation held out of it).
+    pub fn train_config(&self, training: &Dataset) -> Result<Valid<TrainConfig>, RecognizeError> {
+        let codebook = Self::CODEBOOK;
+        let config = TrainConfig {
+            codebook,
+            restarts: 1,
+            seed: self.seed,
+            variance_kept: codebook.default_variance_kept(),
+            ..TrainConfig::default()
+        };
+        Valid::new(config.with_grid_for_dataset(training, false))
+    }
+
+    /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan)).
+    pub fn fit(&self, training: &Dataset) -> Result<FusedModel, RecognizeError> {
+        let choice = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
+            name: "descriptors",
+            what: e.to_string(),
+        })?;
+        FusedModel::fit(
+            &self.train_config(training)?,
+            training,
+            None,
+            &choice,
+            &mut |_| {},
+        )
     }
 }
 

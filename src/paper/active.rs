@@ -26,7 +26,7 @@ use super::context::Family;
 use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::default_sensor;
-use super::recognition::{Curve, RecognitionSweep, Setting, TestData, training_config};
+use super::recognition::{Curve, RecognitionSweep, Setting, SettingData, TestData, training_config};
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};
@@ -175,9 +175,10 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     let key = SafeName::builder(DESCRIPTOR.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
-        context
-            .store
-            .prepare(&sweep.requests(context, &objects, 0, counts)?, dir.root())?;
+        context.store.prepare(
+            &SettingData::new(context, &objects, &sweep.settings[0], counts).requests()?,
+            dir.root(),
+        )?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -229,24 +230,16 @@ fn unit_rows(
     neighbourhood_m: f64,
 ) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
     let descriptor = DESCRIPTOR.build();
+    let data = SettingData::new(context, objects, &sweep.settings[0], counts);
     let model = context.store.model(
-        &sweep.training_request(context, objects, 0, counts)?,
-        &sweep.validation_request(context, objects, 0, counts)?,
+        &data.training_request()?,
+        &data.validation_request()?,
         descriptor.as_ref(),
         training,
     )?;
     let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     for curve in &sweep.settings[0].curves {
-        let trials = sweep.dataset_trials(
-            context,
-            objects,
-            0,
-            curve.test,
-            counts,
-            &model,
-            descriptor.as_ref(),
-            &curve.factors,
-        )?;
+        let trials = data.dataset_trials(curve.test, &model, descriptor.as_ref(), &curve.factors)?;
         let (curve_rows, curve_objects) =
             curve_rows(sweep, &model, &curve.factors, &trials, counts, context.seed)?;
         rows.extend(curve_rows);
@@ -254,16 +247,10 @@ fn unit_rows(
     }
     for (state, perturbation) in object_states() {
         // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
-        let base = sweep.test_requests(
-            context,
-            objects,
-            0,
-            TestData::Planner {
-                local_probability: ACTIVE_LOCAL_PROBABILITY,
-                perturbation,
-            },
-            counts,
-        )?;
+        let base = data.test_requests(TestData::Planner {
+            local_probability: ACTIVE_LOCAL_PROBABILITY,
+            perturbation,
+        })?;
         let jobs: Vec<(usize, usize)> = (0..base.len())
             .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
             .collect();

@@ -32,8 +32,8 @@ use crate::explore::collect::CollectPlan;
 use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
 use crate::recognize::{TrainConfig, TrainedModel};
-use crate::valid::Valid;
 use crate::sim::ObjectSpec;
+use crate::valid::Valid;
 
 /// An object set with its meshes built and placed, ready for collection.
 pub struct Objects {

@@ -17,8 +17,8 @@ use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
-use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
+use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::posterior::ModelPosterior;
 use crate::recognize::selection::{SelectionReport, TrainConfig, TrainProgress, train};
 use crate::tactile::{SensorConfig, TactileImage};
@@ -228,10 +228,12 @@ impl TrainedModel {
                 path: origin.to_string(),
                 what: e.to_string(),
             })?;
-        model.check_parts_agree().map_err(|what| RecognizeError::Inconsistent {
-            path: origin.to_string(),
-            what,
-        })?;
+        model
+            .check_parts_agree()
+            .map_err(|what| RecognizeError::Inconsistent {
+                path: origin.to_string(),
+                what,
+            })?;
         Ok(model)
     }
 
@@ -239,14 +241,12 @@ impl TrainedModel {
     /// what the descriptor gives for an image of the model's sensor is what the PCA takes.
     fn check_parts_agree(&self) -> Result<(), String> {
         self.bag.check()?;
-        let descriptor = self.descriptor.build().map_err(|e| {
-            format!(
-                "the descriptor parameters {:?} are invalid: {e}",
-                self.descriptor
-            )
-        })?;
-        let blank = TactileImage::zeros(self.sensor.rows, self.sensor.cols)
-            .map_err(|e| format!("sensor: {e}"))?;
+        let descriptor = self
+            .descriptor
+            .build()
+            .map_err(|e| format!("the descriptor parameters {:?} are invalid: {e}", self.descriptor))?;
+        let blank =
+            TactileImage::zeros(self.sensor.rows, self.sensor.cols).map_err(|e| format!("sensor: {e}"))?;
         let produced = descriptor.describe(&blank).first().map_or(0, Vec::len);
         if produced != self.bag.input_dim() {
             return Err(format!(
