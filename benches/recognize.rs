@@ -23,10 +23,10 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use taction::dataset::format_f64;
 use taction::describe::Feature;
-use taction::recognize::{
-    CodebookConfig, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LabelledFeatures,
-    LeaveOneReadingOut, TrainConfig, TrainingFeatures, train,
+use taction::recognize::pipeline::{
+    FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LeaveOneReadingOut, TrainingFeatures,
 };
+use taction::recognize::{CodebookConfig, CodebookKind, LabelledFeatures, TrainConfig, train};
 use taction::rng::{Rng, stream};
 use taction::valid::Valid;
 

@@ -7,10 +7,13 @@ mod recognize_toy;
 use rand::RngExt;
 use recognize_toy::{OBJECTS, normal};
 use taction::describe::{DescriptorKind, Feature};
+use taction::recognize::pipeline::{
+    ClusterHistogram, CodebookModel, FeatureMatrix, GaussianMixture, GmmConfig, KMeans, KMeansConfig,
+    ObjectModels, kmeans_plus_plus,
+};
 use taction::recognize::{
-    ClusterHistogram, CodebookKind, CodebookModel, FeatureMatrix, GaussianMixture, GmmConfig, KMeans,
-    KMeansConfig, LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, TrainProgress,
-    cross_entropy, evaluate, kmeans_plus_plus, make_trials, train,
+    CodebookKind, LabelledFeatures, PseudoCount, ReadingRange, TrainConfig, TrainProgress, cross_entropy,
+    evaluate, make_trials, train,
 };
 use taction::rng::stream;
 use taction::valid::Valid;

@@ -256,18 +256,8 @@ fn explore_unknown(
     unknown: &mut Unknown,
     sensor: SensorConfig,
 ) -> Result<Explored, Box<dyn std::error::Error>> {
+    let planner_config = arm_planner_config(args, objects)?;
     let reader = sensor_reader(CoveringSensor::on_site(unknown.scene.model(), PAD_SITE)?);
-    let planner_config = Valid::new(
-        PlannerConfig {
-            local_probability: match args.strategy {
-                DemoStrategy::Blind => 0.5,
-                // Candidates half local, half global: the scorer picks among both kinds.
-                DemoStrategy::Active => 0.5,
-            },
-            ..PlannerConfig::default()
-        }
-        .fitted_to(objects),
-    )?;
     let mut planner = Planner::new(
         &unknown.scene,
         planner_config,
@@ -309,6 +299,25 @@ fn explore_unknown(
         p_true: shown.p_true,
         belief: recognition.belief(),
     })
+}
+
+/// The paper's planner settings, fitted to the objects: the local strategy with probability 0.5,
+/// the setting the recipe was measured at.
+fn arm_planner_config(
+    args: &DemoArgs,
+    objects: &[ObjectSpec],
+) -> Result<Valid<PlannerConfig>, Box<dyn std::error::Error>> {
+    Ok(Valid::new(
+        PlannerConfig {
+            local_probability: match args.strategy {
+                DemoStrategy::Blind => 0.5,
+                // Candidates half local, half global: the scorer picks among both kinds.
+                DemoStrategy::Active => 0.5,
+            },
+            ..PlannerConfig::default()
+        }
+        .fitted_to(objects),
+    )?)
 }
 
 /// The belief after every touch, printed as a table and kept as `touches.csv` and the series of

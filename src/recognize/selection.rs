@@ -9,15 +9,16 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::{ContactStatus, Dataset};
+use crate::recognize::RecognizeError;
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
 use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 use crate::recognize::evaluate::{Trial, make_trials};
+use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::TrainingFeatures;
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::neighbours::LeaveOneReadingOut;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 use crate::recognize::pca::{Pca, VarianceFraction};
-use crate::recognize::{FeatureMatrix, RecognizeError};
 use crate::rng::{stream, substream};
 use crate::valid::{Check, Valid};
 
