@@ -19,12 +19,11 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::Dataset;
 use crate::describe::{DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
-use crate::recognize::decision::Decision;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
 use crate::recognize::model::{
     MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, read_model_file, save_json,
 };
-use crate::recognize::posterior::{Belief, ModelPosterior, OnlinePosterior};
+use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
 use crate::valid::Valid;
 
@@ -280,62 +279,6 @@ fn zip_trials(per_model: Vec<Vec<Trial>>) -> Vec<Trial<Vec<Vec<Feature>>>> {
         }
     }
     zipped
-}
-
-/// The fused belief after each reading (the module docs).
-#[derive(Debug, Clone)]
-pub struct FusedPosterior<'a> {
-    parts: Vec<OnlinePosterior<'a>>,
-}
-
-impl FusedPosterior<'_> {
-    /// Adds one reading, `features[m]` being its features under model `m`'s descriptor. On error
-    /// (a count or length that does not match) the state is unchanged.
-    pub fn observe(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
-        if features.len() != self.parts.len() {
-            return Err(RecognizeError::InvalidParameter {
-                name: "fused reading",
-                what: format!(
-                    "{} feature lists for {} fused models",
-                    features.len(),
-                    self.parts.len()
-                ),
-            });
-        }
-        let mut updated = self.parts.clone();
-        for (part, f) in updated.iter_mut().zip(features) {
-            part.observe(f)?;
-        }
-        self.parts = updated;
-        Ok(self.belief())
-    }
-
-    /// Readings observed so far.
-    pub fn readings(&self) -> usize {
-        self.parts.first().map_or(0, OnlinePosterior::readings)
-    }
-
-    /// The fused belief now: the softmax of the summed log-likelihoods.
-    pub fn belief(&self) -> Belief {
-        let mut log_likelihood: Vec<f64> = Vec::new();
-        let mut features = 0;
-        for part in &self.parts {
-            let models = part.bag().models();
-            let l = models.log_likelihoods(part.histogram());
-            if log_likelihood.is_empty() {
-                log_likelihood = l;
-            } else {
-                for (sum, x) in log_likelihood.iter_mut().zip(l) {
-                    *sum += x;
-                }
-            }
-            features += part.histogram().features();
-        }
-        Belief {
-            readings: self.readings(),
-            decision: Decision::from_log_likelihoods(log_likelihood, features),
-        }
-    }
 }
 
 /// A model file of either kind, as `taction recognize` takes it.

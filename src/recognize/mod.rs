@@ -38,7 +38,7 @@ pub(crate) mod selection;
 // The model: trained, saved and loaded, one descriptor or several fused.
 pub use bag::BagOfFeatures;
 pub use error::RecognizeError;
-pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, FusedPosterior, Recognizer};
+pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, Recognizer};
 pub use labelled::LabelledFeatures;
 pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
 
@@ -53,7 +53,7 @@ pub use selection::{
 
 // The posterior over objects, touch by touch (Eq. 15-16).
 pub use decision::{Decision, cross_entropy, entropy_nats};
-pub use posterior::{Belief, ModelPosterior, OnlinePosterior};
+pub use posterior::{Belief, FusedPosterior, ModelPosterior, OnlinePosterior};
 
 // Evaluation over a test set (Sec. V-B2).
 pub use confusion::ConfusionMatrix;

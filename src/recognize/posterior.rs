@@ -6,7 +6,6 @@ use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::Decision;
-use crate::recognize::fusion::FusedPosterior;
 use crate::recognize::object_model::ClusterHistogram;
 use crate::tactile::TactileImage;
 
@@ -93,6 +92,63 @@ impl<'a> OnlinePosterior<'a> {
     /// The summed cluster memberships of every feature so far.
     pub fn histogram(&self) -> &ClusterHistogram {
         &self.histogram
+    }
+}
+
+/// The fused belief after each reading of a fused model (`recognize::fusion`): the softmax of the
+/// models' summed log-likelihoods.
+#[derive(Debug, Clone)]
+pub struct FusedPosterior<'a> {
+    pub(crate) parts: Vec<OnlinePosterior<'a>>,
+}
+
+impl FusedPosterior<'_> {
+    /// Adds one reading, `features[m]` being its features under model `m`'s descriptor. On error
+    /// (a count or length that does not match) the state is unchanged.
+    pub fn observe(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
+        if features.len() != self.parts.len() {
+            return Err(RecognizeError::InvalidParameter {
+                name: "fused reading",
+                what: format!(
+                    "{} feature lists for {} fused models",
+                    features.len(),
+                    self.parts.len()
+                ),
+            });
+        }
+        let mut updated = self.parts.clone();
+        for (part, f) in updated.iter_mut().zip(features) {
+            part.observe(f)?;
+        }
+        self.parts = updated;
+        Ok(self.belief())
+    }
+
+    /// Readings observed so far.
+    pub fn readings(&self) -> usize {
+        self.parts.first().map_or(0, OnlinePosterior::readings)
+    }
+
+    /// The fused belief now: the softmax of the summed log-likelihoods.
+    pub fn belief(&self) -> Belief {
+        let mut log_likelihood: Vec<f64> = Vec::new();
+        let mut features = 0;
+        for part in &self.parts {
+            let models = part.bag().models();
+            let l = models.log_likelihoods(part.histogram());
+            if log_likelihood.is_empty() {
+                log_likelihood = l;
+            } else {
+                for (sum, x) in log_likelihood.iter_mut().zip(l) {
+                    *sum += x;
+                }
+            }
+            features += part.histogram().features();
+        }
+        Belief {
+            readings: self.readings(),
+            decision: Decision::from_log_likelihoods(log_likelihood, features),
+        }
     }
 }
 
