@@ -708,6 +708,17 @@ mod tests {
         assert_eq!(codebook_sizes(CodebookKind::Knn, 3, 0), vec![1]);
     }
 
+    /// The grid counts the readings that reach the codebook: without a separate validation set
+    /// the held-out 1/11 does not (105 readings of 2 objects support k = 20 only with all of them).
+    #[test]
+    fn the_grid_counts_the_training_readings_left_after_the_hold_out() {
+        let config = TrainConfig::default();
+        assert_eq!(config.grid_training_features(105, true), 105);
+        assert_eq!(config.grid_training_features(105, false), 95);
+        assert_eq!(config.clone().with_grid_for(2, 105, true).ks, vec![10, 20]);
+        assert_eq!(config.with_grid_for(2, 105, false).ks, vec![10]);
+    }
+
     fn score(correct: usize, reliability: f64, failure: bool) -> CandidateScore {
         CandidateScore {
             k: 1,
