@@ -11,7 +11,7 @@ iterations and log-likelihoods, and criterion's timings under target/):
 `python3 -m venv target/parity-venv && target/parity-venv/bin/pip install numpy scikit-learn`.
 
 Data: target/bench-data/gmm_features.csv, 10 objects x 1000 readings x 20 dimensions, written by the
-benchmark from its fixed seed. Settings, as in `taction::recognize::GmmConfig` and the benchmark:
+benchmark from its fixed seed. Settings, as in `taction::recognize::pipeline::GmmConfig` and the benchmark:
 full covariances, reg_covar 1e-6, responsibilities initialised from one k-means run (k-means++
 seeding, at most 300 Lloyd iterations, tolerance 1e-4; scikit-learn's `init_params="kmeans"`,
 which is KMeans(n_init=1)), k = 10, 20, 50, and two stopping rules:

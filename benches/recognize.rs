@@ -23,11 +23,12 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
 use taction::dataset::format_f64;
 use taction::describe::Feature;
-use taction::recognize::{
-    CodebookConfig, CodebookKind, FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LabelledFeatures,
-    LeaveOneReadingOut, TrainConfig, TrainingFeatures, train,
+use taction::recognize::pipeline::{
+    FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LeaveOneReadingOut, TrainingFeatures,
 };
+use taction::recognize::{CodebookConfig, CodebookKind, LabelledFeatures, TrainConfig, train};
 use taction::rng::{Rng, stream};
+use taction::valid::Valid;
 
 const OBJECTS: usize = 10;
 const READINGS: usize = 1000;
@@ -199,7 +200,8 @@ fn per_touch(c: &mut Criterion) {
     let touch = training.readings(3)[17].clone();
     let mut group = c.benchmark_group("per_touch");
     for (name, config) in [("gmm_k50", gmm), ("knn_k20", knn)] {
-        let trained = train(&training, None, &config, &mut |_| {}).expect("train");
+        let config = Valid::new(config).expect("a valid configuration");
+        let trained = train(&config, &training, None, &mut |_| {}).expect("train");
         group.bench_function(
             format!("{name}_{}objects_pca{}", OBJECTS, trained.bag.pca().output_dim()),
             |b| {

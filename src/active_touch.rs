@@ -41,17 +41,22 @@
 use glam::DVec3;
 
 use crate::control::ControlError;
-use crate::dataset::Reading;
-use crate::describe::Descriptor;
-use crate::explore::Planner;
+use crate::dataset::{Dataset, Reading};
+use crate::describe::DescriptorKind;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
+use crate::explore::collect::{CollectMode, CollectPlan};
+use crate::explore::{Planner, SamplerConfig};
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
-use crate::recognize::posterior::{Belief, OnlinePosterior};
-use crate::recognize::{FusedModel, FusedPosterior, RecognizeError};
-use crate::sim::Scene;
-use crate::tactile::TactileImage;
+use crate::recognize::posterior::{Belief, ModelPosterior};
+use crate::recognize::{
+    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, TrainConfig,
+    TrainedModel,
+};
+use crate::sim::{PerturbationBounds, Scene};
+use crate::tactile::{SensorConfig, TactileImage};
+use crate::valid::{RangeError, Valid};
 
 /// `kappa`: how many readings' worth of weight the belief's own prediction has against the readings
 /// of a neighbourhood (see the module docs). One: a single nearby reading already counts as much as
@@ -164,62 +169,43 @@ impl TouchScorer for InformationGain<'_> {
     }
 }
 
-/// A recogniser that also scores where to touch next: the online posterior (Eq. 16) and the
-/// [`InformationGain`] state fed with the same readings. A fused model (several descriptors, their
-/// likelihoods multiplied, `recognize::fusion`) gives the belief; its first model's clusters give
-/// the gain's predictions.
+/// A recogniser that also scores where to touch next: the model's posterior (Eq. 16, fed with
+/// images, [`ModelPosterior`]) and the [`InformationGain`] state fed with the same readings. A
+/// fused model (several descriptors, their likelihoods multiplied, `recognize::fusion`) gives the
+/// belief; its first model's clusters give the gain's predictions.
 pub struct ActiveRecognition<'a> {
     bag: &'a BagOfFeatures,
-    descriptors: Vec<&'a dyn Descriptor>,
-    posterior: Posterior<'a>,
+    posterior: ModelPosterior<'a>,
     gain: InformationGain<'a>,
 }
 
-/// The belief of one model or of a fused one.
-enum Posterior<'a> {
-    Single(OnlinePosterior<'a>),
-    Fused(FusedPosterior<'a>),
-}
-
 impl<'a> ActiveRecognition<'a> {
-    pub fn new(bag: &'a BagOfFeatures, descriptor: &'a dyn Descriptor, neighbourhood_m: f64) -> Self {
-        Self {
-            bag,
-            descriptors: vec![descriptor],
-            posterior: Posterior::Single(bag.posterior()),
-            gain: InformationGain::new(bag.models(), neighbourhood_m),
-        }
+    /// The recogniser of one model, describing images with the model's descriptor.
+    pub fn new(model: &'a TrainedModel, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+        Ok(Self::with(&model.bag, model.posterior()?, neighbourhood_m))
     }
 
-    /// The recogniser of a fused model; `descriptors[m]` describes readings for `model.fused[m]`.
-    pub fn fused(
-        model: &'a FusedModel,
-        descriptors: Vec<&'a dyn Descriptor>,
-        neighbourhood_m: f64,
-    ) -> Result<Self, RecognizeError> {
-        let kinds: Vec<_> = model.fused.iter().map(|m| m.descriptor.kind()).collect();
-        if descriptors.iter().map(|d| d.kind()).ne(kinds.iter().copied()) {
-            return Err(RecognizeError::InvalidParameter {
-                name: "fused recogniser",
-                what: format!("descriptors do not match the fused model's {kinds:?}"),
-            });
-        }
-        let bag = &model.fused[0].bag;
-        Ok(Self {
+    /// The recogniser of a fused model, describing images with each model's descriptor.
+    pub fn fused(model: &'a FusedModel, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+        Ok(Self::with(
+            &model.fused[0].bag,
+            model.image_posterior()?,
+            neighbourhood_m,
+        ))
+    }
+
+    fn with(bag: &'a BagOfFeatures, posterior: ModelPosterior<'a>, neighbourhood_m: f64) -> Self {
+        Self {
             bag,
-            descriptors,
-            posterior: Posterior::Fused(model.posterior()),
+            posterior,
             gain: InformationGain::new(bag.models(), neighbourhood_m),
-        })
+        }
     }
 
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
-        let features: Vec<_> = self.descriptors.iter().map(|d| d.describe(image)).collect();
-        let belief = match &mut self.posterior {
-            Posterior::Single(p) => p.observe(&features[0])?,
-            Posterior::Fused(p) => p.observe(&features)?,
-        };
+        let features = self.posterior.describe(image);
+        let belief = self.posterior.observe_features(&features)?;
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
         self.gain
@@ -228,14 +214,91 @@ impl<'a> ActiveRecognition<'a> {
     }
 
     pub fn belief(&self) -> Belief {
-        match &self.posterior {
-            Posterior::Single(p) => p.belief(),
-            Posterior::Fused(p) => p.belief(),
-        }
+        self.posterior.belief()
     }
 
     pub fn scorer(&self) -> &InformationGain<'a> {
         &self.gain
+    }
+}
+
+/// How the demo trains a recogniser on what the arm's pad feels (the README's "Training that
+/// matches the arm"; docs/measurements.md has the measurements behind each choice): sampler
+/// readings restricted to the starts the arm can take from any heading of the object, pressed by
+/// the same controllers as the arm's pad; MNTI and SIFT fused ([`Self::DESCRIPTORS`]: SIFT's
+/// gradient orientations with MNTI's moments gained on the arm's own touches as on sampler data)
+/// over the neighbour codebook, one restart (the neighbour codebook draws nothing at random), the
+/// `k` grid sized to the converged readings left after the hold-out
+/// ([`TrainConfig::with_grid_for_dataset`]). Library users get the model `taction demo` gets.
+///
+/// ```
+/// use taction::active_touch::ArmTrainingRecipe;
+///
+/// let recipe = ArmTrainingRecipe { readings_per_object: 3000, seed: 1 };
+/// assert_eq!(recipe.descriptors()?.name(), "mnti+sift");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArmTrainingRecipe {
+    /// Converged sampler readings per object.
+    pub readings_per_object: usize,
+    /// Seeds the training data and the model selection.
+    pub seed: u64,
+}
+
+impl ArmTrainingRecipe {
+    /// The fused descriptors.
+    pub const DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
+    /// The codebook every descriptor's model uses.
+    pub const CODEBOOK: CodebookKind = CodebookKind::Knn;
+
+    /// [`Self::DESCRIPTORS`], fused.
+    pub fn descriptors(&self) -> Result<DescriptorChoice, DescriptorChoiceError> {
+        DescriptorChoice::fused(Self::DESCRIPTORS.to_vec())
+    }
+
+    /// The training data's collection: the sampler from starts the arm can reach, the default
+    /// controllers, the object unperturbed.
+    pub fn collect_plan(&self, sensor: SensorConfig) -> Result<CollectPlan, RangeError> {
+        Ok(CollectPlan {
+            mode: CollectMode::Sampler(Valid::new(SamplerConfig {
+                reachable_by_arm: true,
+                ..SamplerConfig::default()
+            })?),
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+            readings_per_object: self.readings_per_object,
+            seed: self.seed,
+        })
+    }
+
+    /// Model selection for `training` (validation held out of it).
+    pub fn train_config(&self, training: &Dataset) -> Result<Valid<TrainConfig>, RecognizeError> {
+        let codebook = Self::CODEBOOK;
+        let config = TrainConfig {
+            codebook,
+            restarts: 1,
+            seed: self.seed,
+            variance_kept: codebook.default_variance_kept(),
+            ..TrainConfig::default()
+        };
+        Valid::new(config.with_grid_for_dataset(training, false))
+    }
+
+    /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan)).
+    pub fn fit(&self, training: &Dataset) -> Result<FusedModel, RecognizeError> {
+        let choice = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
+            name: "descriptors",
+            what: e.to_string(),
+        })?;
+        FusedModel::fit(
+            &self.train_config(training)?,
+            training,
+            None,
+            &choice,
+            &mut |_| {},
+        )
     }
 }
 

@@ -19,8 +19,7 @@ use taction::experiment::{
 };
 use taction::paper::sim_to_real::square_root;
 use taction::paper::{GaussianBlur, SimToRealPreprocess, SplitSizes, split_per_label};
-use taction::recognize::AccuracyPoint;
-use taction::recognize::evaluate::TrialOutcome;
+use taction::recognize::{AccuracyPoint, TrialOutcome};
 use taction::tactile::TactileImage;
 
 // ---------------------------------------------------------------------------------------------

@@ -11,20 +11,22 @@ use taction::recognize::{
     DescriptorChoice, FusedModel, LabelledFeatures, ReadingRange, Recognizer, TrainConfig, TrainedModel,
     make_trials,
 };
+use taction::valid::Valid;
 
-fn config() -> TrainConfig {
-    TrainConfig {
+fn config() -> Valid<TrainConfig> {
+    Valid::new(TrainConfig {
         ks: vec![4],
         restarts: 1,
         seed: 5,
         ..TrainConfig::default()
-    }
+    })
+    .unwrap()
 }
 
 fn fused() -> FusedModel {
     let training = recognize_toy::dataset(30, 8);
     let choice = DescriptorChoice::parse("mnti+mn").unwrap();
-    FusedModel::fit(&training, None, &choice, config(), &mut |_| {}).unwrap()
+    FusedModel::fit(&config(), &training, None, &choice, &mut |_| {}).unwrap()
 }
 
 #[test]
@@ -141,10 +143,10 @@ fn fused_models_save_load_and_are_checked() {
     let other = recognize_toy::dataset(30, 8);
     let mut renamed = other.clone();
     let relabelled = TrainedModel::fit(
+        &config(),
         &renamed_objects(&mut renamed),
         None,
         DescriptorKind::Mnti.build().as_ref(),
-        config(),
         &mut |_| {},
     )
     .unwrap();

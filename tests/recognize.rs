@@ -7,12 +7,16 @@ mod recognize_toy;
 use rand::RngExt;
 use recognize_toy::{OBJECTS, normal};
 use taction::describe::{DescriptorKind, Feature};
+use taction::recognize::pipeline::{
+    ClusterHistogram, CodebookModel, FeatureMatrix, GaussianMixture, GmmConfig, KMeans, KMeansConfig,
+    ObjectModels, kmeans_plus_plus,
+};
 use taction::recognize::{
-    ClusterHistogram, CodebookKind, CodebookModel, FeatureMatrix, GaussianMixture, GmmConfig, KMeans,
-    KMeansConfig, LabelledFeatures, ObjectModels, PseudoCount, ReadingRange, TrainConfig, TrainProgress,
-    cross_entropy, evaluate, kmeans_plus_plus, make_trials, train,
+    CodebookKind, LabelledFeatures, PseudoCount, ReadingRange, TrainConfig, TrainProgress, cross_entropy,
+    evaluate, make_trials, train,
 };
 use taction::rng::stream;
+use taction::valid::Valid;
 
 /// Three Gaussian clusters in 3-D with different covariances and weights.
 const MEANS: [[f64; 3]; 3] = [[0.0, 0.0, 0.0], [6.0, 1.0, -2.0], [-3.0, 7.0, 4.0]];
@@ -237,22 +241,23 @@ fn toy_features(per_object: usize, seed: u64) -> LabelledFeatures {
     LabelledFeatures::from_dataset(&recognize_toy::dataset(per_object, seed), descriptor.as_ref())
 }
 
-fn toy_config(codebook: CodebookKind) -> TrainConfig {
-    TrainConfig {
+fn toy_config(codebook: CodebookKind) -> Valid<TrainConfig> {
+    Valid::new(TrainConfig {
         codebook,
         ks: vec![3, 6],
         restarts: 2,
         seed: 17,
         ..TrainConfig::default()
-    }
+    })
+    .unwrap()
 }
 
 #[test]
 fn the_posterior_sharpens_as_consistent_readings_arrive() {
     let trained = train(
+        &toy_config(CodebookKind::Gmm),
         &toy_features(40, 1),
         None,
-        &toy_config(CodebookKind::Gmm),
         &mut |_| {},
     )
     .unwrap();
@@ -292,7 +297,7 @@ fn toy_objects_are_recognised_at_100_percent_with_10_readings() {
     let validation = toy_features(20, 2);
     let test = toy_features(30, 3);
     for kind in CodebookKind::ALL {
-        let trained = train(&training, Some(&validation), &toy_config(kind), &mut |_| {}).unwrap();
+        let trained = train(&toy_config(kind), &training, Some(&validation), &mut |_| {}).unwrap();
         let chosen = trained.selection.chosen().unwrap();
         assert!([3, 6].contains(&trained.selection.chosen_k));
         // The neighbour codebook draws nothing at random: one candidate per k, not per restart.
@@ -325,9 +330,9 @@ fn toy_objects_are_recognised_at_100_percent_with_10_readings() {
 #[test]
 fn accuracy_counts_every_object_an_unread_one_as_a_miss() {
     let trained = train(
+        &toy_config(CodebookKind::Gmm),
         &toy_features(60, 1),
         None,
-        &toy_config(CodebookKind::Gmm),
         &mut |_| {},
     )
     .unwrap();
@@ -376,8 +381,8 @@ fn accuracy_counts_every_object_an_unread_one_as_a_miss() {
 #[test]
 fn training_is_seeded_and_deterministic() {
     let training = toy_features(30, 4);
-    let a = train(&training, None, &toy_config(CodebookKind::Gmm), &mut |_| {}).unwrap();
-    let b = train(&training, None, &toy_config(CodebookKind::Gmm), &mut |_| {}).unwrap();
+    let a = train(&toy_config(CodebookKind::Gmm), &training, None, &mut |_| {}).unwrap();
+    let b = train(&toy_config(CodebookKind::Gmm), &training, None, &mut |_| {}).unwrap();
     assert_eq!(a, b);
     let json = |t: &taction::recognize::Trained| serde_json::to_string(&t.bag).unwrap();
     assert_eq!(json(&a), json(&b));
@@ -390,16 +395,17 @@ fn training_is_seeded_and_deterministic() {
 #[test]
 fn the_neighbour_codebook_is_deterministic_and_holds_the_training_features() {
     let training = toy_features(30, 4);
-    let config = TrainConfig {
+    let config = Valid::new(TrainConfig {
         ks: vec![5],
-        ..toy_config(CodebookKind::Knn)
-    };
+        ..toy_config(CodebookKind::Knn).into_inner()
+    })
+    .unwrap();
     let train_on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| train(&training, None, &config, &mut |_| {}).unwrap())
+        pool.install(|| train(&config, &training, None, &mut |_| {}).unwrap())
     };
     let one = train_on(1);
     assert_eq!(one, train_on(3));
@@ -427,7 +433,7 @@ fn candidates_fitted_in_parallel_give_the_model_of_one_thread_and_report_each_on
             .unwrap();
         let mut events = Vec::new();
         let trained = pool.install(|| {
-            train(&training, None, &toy_config(CodebookKind::Gmm), &mut |e| {
+            train(&toy_config(CodebookKind::Gmm), &training, None, &mut |e| {
                 events.push(e)
             })
             .unwrap()
@@ -461,9 +467,9 @@ fn candidates_fitted_in_parallel_give_the_model_of_one_thread_and_report_each_on
 #[test]
 fn bad_inputs_get_named_errors() {
     let trained = train(
+        &toy_config(CodebookKind::Kmeans),
         &toy_features(20, 5),
         None,
-        &toy_config(CodebookKind::Kmeans),
         &mut |_| {},
     )
     .unwrap();
@@ -487,9 +493,9 @@ fn bad_inputs_get_named_errors() {
     assert!(e.contains("'teapot'"), "{e}");
     let config = TrainConfig {
         ks: vec![],
-        ..toy_config(CodebookKind::Gmm)
+        ..toy_config(CodebookKind::Gmm).into_inner()
     };
-    assert!(train(&toy_features(5, 5), None, &config, &mut |_| {}).is_err());
+    assert!(Valid::new(config).is_err());
     assert!("0..5".parse::<ReadingRange>().is_err());
     assert_eq!(
         "3..=7".parse::<ReadingRange>().unwrap(),

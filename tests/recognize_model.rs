@@ -8,6 +8,7 @@ use taction::recognize::{
     CodebookKind, LabelledFeatures, ReadingRange, RecognizeError, TrainConfig, TrainedModel,
     TrainingProvenance, evaluate, make_trials, train,
 };
+use taction::valid::Valid;
 
 fn model(kind: CodebookKind) -> TrainedModel {
     let descriptor = DescriptorKind::PolarFourier.build();
@@ -20,7 +21,7 @@ fn model(kind: CodebookKind) -> TrainedModel {
         seed: 3,
         ..TrainConfig::default()
     };
-    let trained = train(&features, None, &config, &mut |_| {}).unwrap();
+    let trained = train(&Valid::new(config.clone()).unwrap(), &features, None, &mut |_| {}).unwrap();
     TrainedModel::new(
         descriptor.params(),
         data.header().sensor,

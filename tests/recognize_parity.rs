@@ -11,9 +11,8 @@ use std::process::Command;
 use serde_json::{Value, json};
 use taction::dataset::format_f64;
 use taction::describe::{DescriptorKind, Feature};
-use taction::recognize::{
-    FeatureMatrix, GaussianMixture, GmmConfig, LabelledFeatures, Pca, VarianceFraction,
-};
+use taction::recognize::pipeline::{FeatureMatrix, GaussianMixture, GmmConfig, Pca};
+use taction::recognize::{LabelledFeatures, VarianceFraction};
 use taction::rng::stream;
 
 /// The venv's python, creating the venv on first use; `Err` says why it cannot be had.

@@ -16,23 +16,21 @@ use std::path::PathBuf;
 
 use clap::Args;
 use rand::RngExt;
-use taction::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
+use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, TouchRun, explore_recognizing};
 use taction::dataset::describe_shortfalls;
-use taction::describe::DescriptorKind;
 use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
 use taction::experiment::progress::CollectionProgress;
 use taction::explore::Probability;
-use taction::explore::SamplerConfig;
 use taction::explore::active::DEFAULT_CANDIDATES;
-use taction::explore::collect::{CollectMode, CollectPlan, sensor_reader};
+use taction::explore::collect::sensor_reader;
 use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::figure1::{Placement, write_exploration_png};
-use taction::recognize::selection::{TrainConfig, codebook_sizes};
-use taction::recognize::{CodebookKind, DescriptorChoice, FusedModel, Recognizer};
+use taction::recognize::Belief;
+use taction::recognize::{FusedModel, Recognizer};
 use taction::rng;
 use taction::sim::arm::PAD_SITE;
-use taction::sim::{Perturbation, PerturbationBounds, SceneBuilder};
+use taction::sim::{ObjectSpec, Perturbation, PerturbationBounds, Scene, SceneBuilder};
 use taction::tactile::image::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
@@ -48,11 +46,6 @@ const PLANNER_STREAM: u64 = 0xE7;
 /// The seed of the training data and the model: the model is the product's, trained once and
 /// cached, whatever `--seed` draws (the unknown object, its pose, the exploration).
 const TRAINING_SEED: u64 = 1;
-
-/// The demo's descriptors, fused: fusing SIFT's gradient orientations with MNTI's moments gained
-/// on the arm's own touches as on sampler data ("Training that matches the arm" in docs/measurements.md has
-/// the measurements).
-const DEMO_DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
 
 #[derive(Debug, Args)]
 pub struct DemoArgs {
@@ -94,6 +87,23 @@ pub enum DemoStrategy {
 }
 
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
+    check_args(args)?;
+    let _lock = OutputLock::acquire(&args.out, "out")?;
+    let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
+    let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, args.object_size.m)?;
+    let objects = build_objects(&set, "demo", Carrier::Arm)?;
+    // 1. The model: cached per (object set, readings, training seed, descriptors), else trained now.
+    let model = load_or_train(args, &set, &objects, sensor)?;
+    // 2. The unknown object, at a pose the planner is not told.
+    let mut unknown = place_unknown(args, &objects, model.objects(), sensor)?;
+    // 3. The exploration, recognising after every converged touch.
+    let explored = explore_unknown(args, &objects, &model, &mut unknown, sensor)?;
+    // 4. Outputs.
+    write_outputs(args, &model, &unknown, &explored, sensor)
+}
+
+/// The flags `clap` cannot check.
+fn check_args(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.touches == 0 {
         return Err(flag_error("touches", 0, "want 1 or more").into());
     }
@@ -105,14 +115,22 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         )
         .into());
     }
-    let _lock = OutputLock::acquire(&args.out, "out")?;
-    let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
-    let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, args.object_size.m)?;
-    let objects = build_objects(&set, "demo", Carrier::Arm)?;
-    let choice = DescriptorChoice::fused(DEMO_DESCRIPTORS.to_vec())?;
-    let descriptors: Vec<_> = choice.kinds().iter().map(|k| k.build()).collect();
+    Ok(())
+}
 
-    // 1. The model: cached per (object set, readings, training seed, descriptors), else trained now.
+/// The model the demo recognises with: the one cached in `--out` by an earlier run with the same
+/// objects, readings and sensor, else one trained now by the library's [`ArmTrainingRecipe`].
+fn load_or_train(
+    args: &DemoArgs,
+    set: &ObjectSet,
+    objects: &[ObjectSpec],
+    sensor: SensorConfig,
+) -> Result<FusedModel, Box<dyn std::error::Error>> {
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: args.training_readings,
+        seed: TRAINING_SEED,
+    };
+    let choice = recipe.descriptors()?;
     let model_path = args.out.join(format!(
         "model-{}-{}-{}-{}-reachable-knn.json",
         set.id(),
@@ -120,66 +138,72 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         TRAINING_SEED,
         choice.name()
     ));
-    let model = match Recognizer::load(&model_path) {
-        Ok(Recognizer::Fused(model)) if model.fused.iter().all(|m| m.check_sensor(&sensor).is_ok()) => {
-            println!("using the model trained before: {}", model_path.display());
-            model
-        }
-        _ => {
-            println!(
-                "training: {} sampler readings of each of {} objects from starts the arm can reach ({})",
-                args.training_readings,
-                objects.len(),
-                objects
-                    .iter()
-                    .map(|o| o.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-            let plan = CollectPlan {
-                mode: CollectMode::Sampler(Valid::new(SamplerConfig {
-                    reachable_by_arm: true,
-                    ..SamplerConfig::default()
-                })?),
-                sensor,
-                control: Valid::default(),
-                perturbation: PerturbationBounds::NONE,
-                readings_per_object: args.training_readings,
-                seed: TRAINING_SEED,
-            };
-            let progress = CollectionProgress::new("training data", objects.len(), args.training_readings);
-            let dataset = plan.collect_dataset(&set.id(), &objects, 0, &|| progress.converged())?;
-            progress.finish(dataset.converged_only().len());
-            let short = dataset.shortfalls(args.training_readings);
-            if !short.is_empty() {
-                eprintln!("warning: training: {}", describe_shortfalls(&short));
-            }
-            let codebook = CodebookKind::Knn;
-            let mut config = TrainConfig {
-                codebook,
-                restarts: 1,
-                seed: TRAINING_SEED,
-                variance_kept: codebook.default_variance_kept(),
-                ..TrainConfig::default()
-            };
-            // The hold-out keeps about `holdout` of each object's readings for validation; one
-            // feature per converged reading under the descriptor that gives the fewest.
-            let converged = dataset.converged_only().len();
-            let training_features = (converged as f64 * (1.0 - config.holdout)).floor() as usize;
-            config.ks = codebook_sizes(config.codebook, dataset.header().objects.len(), training_features);
-            println!(
-                "training {}: {training_features} training readings; trying k = {:?}",
-                choice.name(),
-                config.ks
-            );
-            let model = FusedModel::fit(&dataset, None, &choice, config, &mut |_| {})?;
-            model.save(&model_path)?;
-            model
-        }
-    };
-    let names = model.objects().to_vec();
+    if let Ok(Recognizer::Fused(model)) = Recognizer::load(&model_path)
+        && model.fused.iter().all(|m| m.check_sensor(&sensor).is_ok())
+    {
+        println!("using the model trained before: {}", model_path.display());
+        return Ok(model);
+    }
+    let model = train_model(&recipe, set, objects, sensor)?;
+    model.save(&model_path)?;
+    Ok(model)
+}
 
-    // 2. The unknown object, at a pose the planner is not told.
+/// Collects the recipe's training data, with a progress bar, and trains the fused model on it.
+fn train_model(
+    recipe: &ArmTrainingRecipe,
+    set: &ObjectSet,
+    objects: &[ObjectSpec],
+    sensor: SensorConfig,
+) -> Result<FusedModel, Box<dyn std::error::Error>> {
+    let readings = recipe.readings_per_object;
+    println!(
+        "training: {readings} sampler readings of each of {} objects from starts the arm can reach ({})",
+        objects.len(),
+        objects
+            .iter()
+            .map(|o| o.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let progress = CollectionProgress::new("training data", objects.len(), readings);
+    let dataset = recipe
+        .collect_plan(sensor)?
+        .collect_dataset(&set.id(), objects, 0, &|| progress.converged())?;
+    let converged = dataset.converged_only().len();
+    progress.finish(converged);
+    let short = dataset.shortfalls(readings);
+    if !short.is_empty() {
+        eprintln!("warning: training: {}", describe_shortfalls(&short));
+    }
+    let config = recipe.train_config(&dataset)?;
+    println!(
+        "training {}: {} training readings; trying k = {:?}",
+        recipe.descriptors()?.name(),
+        config.grid_training_features(converged, false),
+        config.ks
+    );
+    Ok(recipe.fit(&dataset)?)
+}
+
+/// The object to explore and its scene.
+struct Unknown {
+    /// Its index in the object set.
+    index: usize,
+    spec: ObjectSpec,
+    scene: Scene,
+}
+
+/// Draws the unknown object (or takes `--object`) and places it on the table: any heading about
+/// the vertical, then the perturbation of Sec. V-B4 (a tilt of up to 10 degrees about a random
+/// axis, a shift of up to 10% of the width), so that it stands as objects do, in a pose the
+/// planner is not told.
+fn place_unknown(
+    args: &DemoArgs,
+    objects: &[ObjectSpec],
+    names: &[String],
+    sensor: SensorConfig,
+) -> Result<Unknown, Box<dyn std::error::Error>> {
     let mut r = rng::stream(args.seed.seed, UNKNOWN_OBJECT_STREAM);
     let index = match &args.object {
         Some(name) => objects
@@ -188,17 +212,14 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
             .ok_or_else(|| format!("--object: '{name}' is not in the set ({})", names.join(", ")))?,
         None => r.random_range(0..objects.len()),
     };
-    let unknown = objects[index].clone();
+    let spec = objects[index].clone();
     let mut scene = add_sensor(
-        SceneBuilder::with_arm_and_table().object(unknown.clone()),
+        SceneBuilder::with_arm_and_table().object(spec.clone()),
         &Valid::new(sensor)?,
         "covering",
         PAD_SITE,
     )
     .build()?;
-    // Any heading about the vertical, then the perturbation of Sec. V-B4 (a tilt of up to 10
-    // degrees about a random axis, a shift of up to 10% of the width): the object stands on the
-    // table as objects do, in a pose the planner is not told.
     let width = scene.object_width_m().unwrap_or(0.1);
     let heading = Perturbation {
         axis: glam::DVec3::Z,
@@ -210,23 +231,35 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     scene.perturb_object(&shuffle)?;
     println!(
         "exploring an unknown object with the arm (it is '{}'; the planner is not told)",
-        unknown.name
+        spec.name
     );
+    Ok(Unknown { index, spec, scene })
+}
 
-    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
-    let planner_config = Valid::new(
-        PlannerConfig {
-            local_probability: match args.strategy {
-                DemoStrategy::Blind => 0.5,
-                // Candidates half local, half global: the scorer picks among both kinds.
-                DemoStrategy::Active => 0.5,
-            },
-            ..PlannerConfig::default()
-        }
-        .fitted_to(&objects),
-    )?;
+/// What the exploration felt and believed.
+struct Explored {
+    run: TouchRun,
+    /// `touches.csv`.
+    csv: String,
+    /// `(touch, p(true object))` after every touch.
+    p_true: Vec<(f64, f64)>,
+    /// The belief after the last touch.
+    belief: Belief,
+}
+
+/// The arm explores `unknown` with the planner (blind or active), the posterior updated and
+/// printed after every converged touch.
+fn explore_unknown(
+    args: &DemoArgs,
+    objects: &[ObjectSpec],
+    model: &FusedModel,
+    unknown: &mut Unknown,
+    sensor: SensorConfig,
+) -> Result<Explored, Box<dyn std::error::Error>> {
+    let planner_config = arm_planner_config(args, objects)?;
+    let reader = sensor_reader(CoveringSensor::on_site(unknown.scene.model(), PAD_SITE)?);
     let mut planner = Planner::new(
-        &scene,
+        &unknown.scene,
         planner_config,
         taction::explore::TouchSetup {
             sensor,
@@ -236,102 +269,140 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
         rng::stream(args.seed.seed, PLANNER_STREAM),
         reader,
     )?;
-    let mut recognition = ActiveRecognition::fused(
-        &model,
-        descriptors.iter().map(|d| d.as_ref()).collect(),
-        planner_config.grid_cell_m,
-    )?;
-    let mut csv = String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n");
-    let mut p_true_series = Vec::new();
-    println!(
-        "{:>5}  {:<12} {:>8} {:>8} {:>9}",
-        "touch", "best guess", "p(guess)", "p(true)", "entropy"
-    );
+    let mut recognition = ActiveRecognition::fused(model, planner_config.grid_cell_m)?;
+    let mut shown = TouchTable::new(model.objects(), &unknown.spec.name, unknown.index);
     let run = explore_recognizing(
         &mut planner,
-        &mut scene,
-        &unknown.name,
+        &mut unknown.scene,
+        &unknown.spec.name,
         &mut recognition,
         TouchPlan {
             budget: args.touches,
             active_candidates: (args.strategy == DemoStrategy::Active).then_some(DEFAULT_CANDIDATES),
             stop_at_confidence: args.stop_at_confidence,
         },
-        &mut |touch| {
-            let belief = &touch.belief;
-            let guess = belief.guess();
-            let p = belief.probabilities();
-            let n = belief.readings;
-            println!(
-                "{n:>5}  {:<12} {:>8.3} {:>8.3} {:>9.3}",
-                names[guess],
-                p[guess],
-                p[index],
-                belief.entropy_nats()
-            );
-            csv.push_str(&format!(
-                "{n},{},{},{},{},{}\n",
-                unknown.name,
-                names[guess],
-                p[guess],
-                p[index],
-                belief.entropy_nats()
-            ));
-            p_true_series.push((n as f64, p[index]));
-        },
+        &mut |touch| shown.add(&touch.belief),
     )?;
-    let attempts = run.attempts;
     if run.touches.is_empty() {
         return Err(format!(
-            "the planner found no converged reading of '{}' after {attempts} attempts; \
+            "the planner found no converged reading of '{}' after {} attempts; \
              `taction collect --objects {} --mode planner` prints why its attempts fail, per object; \
              try another --seed or --object",
-            unknown.name,
+            unknown.spec.name,
+            run.attempts,
             args.objects.display()
         )
         .into());
     }
-    let images: Vec<_> = run.touches.iter().map(|t| t.reading.image.clone()).collect();
     std::io::stdout().flush()?;
+    Ok(Explored {
+        run,
+        csv: shown.csv,
+        p_true: shown.p_true,
+        belief: recognition.belief(),
+    })
+}
 
-    // 3. Outputs.
-    let csv_path = args.out.join("touches.csv");
-    taction::atomic::write_atomic(&csv_path, csv.as_bytes())?;
-    let figure = Figure {
-        title: format!("Posterior of the true object ({}) over touches", unknown.name),
-        panels: vec![Panel {
-            title: String::new(),
-            x_label: "touches (converged readings)".into(),
-            y_label: "p(true object)".into(),
-            x_range: (1.0, images.len().max(2) as f64),
-            y_range: (0.0, 1.0),
-            series: vec![Series {
-                label: unknown.name.clone(),
-                points: p_true_series,
-                band: Vec::new(),
-            }],
-            markers: true,
-            legend: true,
-            integer_x: true,
-            reference: Some(ReferenceLine {
-                y: 1.0 / names.len() as f64,
-                label: format!("chance (1/{})", names.len()),
-            }),
-        }],
-    };
+/// The paper's planner settings, fitted to the objects: the local strategy with probability 0.5,
+/// the setting the recipe was measured at.
+fn arm_planner_config(
+    args: &DemoArgs,
+    objects: &[ObjectSpec],
+) -> Result<Valid<PlannerConfig>, Box<dyn std::error::Error>> {
+    Ok(Valid::new(
+        PlannerConfig {
+            local_probability: match args.strategy {
+                DemoStrategy::Blind => 0.5,
+                // Candidates half local, half global: the scorer picks among both kinds.
+                DemoStrategy::Active => 0.5,
+            },
+            ..PlannerConfig::default()
+        }
+        .fitted_to(objects),
+    )?)
+}
+
+/// The belief after every touch, printed as a table and kept as `touches.csv` and the series of
+/// p(true object).
+struct TouchTable<'a> {
+    names: &'a [String],
+    truth: &'a str,
+    truth_index: usize,
+    csv: String,
+    p_true: Vec<(f64, f64)>,
+}
+
+impl<'a> TouchTable<'a> {
+    /// Prints the table's header.
+    fn new(names: &'a [String], truth: &'a str, truth_index: usize) -> Self {
+        println!(
+            "{:>5}  {:<12} {:>8} {:>8} {:>9}",
+            "touch", "best guess", "p(guess)", "p(true)", "entropy"
+        );
+        Self {
+            names,
+            truth,
+            truth_index,
+            csv: String::from("touch,object_true,object_guess,p_guess,p_true,entropy_nats\n"),
+            p_true: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, belief: &Belief) {
+        let guess = belief.guess();
+        let p = belief.probabilities();
+        let n = belief.readings;
+        let index = self.truth_index;
+        println!(
+            "{n:>5}  {:<12} {:>8.3} {:>8.3} {:>9.3}",
+            self.names[guess],
+            p[guess],
+            p[index],
+            belief.entropy_nats()
+        );
+        self.csv.push_str(&format!(
+            "{n},{},{},{},{},{}\n",
+            self.truth,
+            self.names[guess],
+            p[guess],
+            p[index],
+            belief.entropy_nats()
+        ));
+        self.p_true.push((n as f64, p[index]));
+    }
+}
+
+/// Writes `touches.csv`, the posterior plot, the contact sheet and Fig. 1, and prints the outcome.
+fn write_outputs(
+    args: &DemoArgs,
+    model: &FusedModel,
+    unknown: &Unknown,
+    explored: &Explored,
+    sensor: SensorConfig,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let names = model.objects();
+    let run = &explored.run;
+    let images: Vec<_> = run.touches.iter().map(|t| t.reading.image.clone()).collect();
+    taction::atomic::write_atomic(&args.out.join("touches.csv"), explored.csv.as_bytes())?;
+    let figure = posterior_figure(
+        &unknown.spec.name,
+        explored.p_true.clone(),
+        images.len(),
+        names.len(),
+    );
     figure.write_svg(&args.out.join("posterior.svg"))?;
     figure.write_png(&args.out.join("posterior.png"))?;
     write_contact_sheet(&images, 10, 12, &args.out.join("contact_sheet.png"))?;
     let placements = Placement::from_readings(run.touches.iter().map(|t| &t.reading));
-    let shown_pose = scene.object_pose().unwrap_or(unknown.pose);
+    let shown_pose = unknown.scene.object_pose().unwrap_or(unknown.spec.pose);
     write_exploration_png(
         &args.out.join("exploration.png"),
-        &unknown.mesh,
+        &unknown.spec.mesh,
         &shown_pose,
         &placements,
         &sensor,
     )?;
-    let belief = recognition.belief();
+    let belief = &explored.belief;
     let ending = if run.stopped_confident {
         "stopped: confident"
     } else {
@@ -340,11 +411,37 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png, exploration.png}}",
         images.len(),
-        attempts,
+        run.attempts,
         names[belief.guess()],
         belief.probabilities()[belief.guess()],
-        unknown.name,
+        unknown.spec.name,
         args.out.display()
     );
     Ok(())
+}
+
+/// The posterior of the true object over `touches` touches, chance at 1 / `objects`.
+fn posterior_figure(truth: &str, p_true: Vec<(f64, f64)>, touches: usize, objects: usize) -> Figure {
+    Figure {
+        title: format!("Posterior of the true object ({truth}) over touches"),
+        panels: vec![Panel {
+            title: String::new(),
+            x_label: "touches (converged readings)".into(),
+            y_label: "p(true object)".into(),
+            x_range: (1.0, touches.max(2) as f64),
+            y_range: (0.0, 1.0),
+            series: vec![Series {
+                label: truth.to_string(),
+                points: p_true,
+                band: Vec::new(),
+            }],
+            markers: true,
+            legend: true,
+            integer_x: true,
+            reference: Some(ReferenceLine {
+                y: 1.0 / objects as f64,
+                label: format!("chance (1/{objects})"),
+            }),
+        }],
+    }
 }

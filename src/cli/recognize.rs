@@ -51,23 +51,7 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     })?;
     let used = evaluation.confusion.n_readings();
     if used < args.readings.last() {
-        let accuracy = if used < args.readings.first() {
-            format!(
-                "accuracy.csv is empty (no trial reaches {} readings)",
-                args.readings.first()
-            )
-        } else {
-            format!("accuracy.csv ends at {used}")
-        };
-        spinner.suspend(|| {
-            eprintln!(
-                "warning: --readings {} asks for up to {} readings per trial, but no object of {} has more \
-                 than {used} converged readings: {accuracy}, confusion.csv decides after {used}",
-                args.readings,
-                args.readings.last(),
-                args.dataset.display()
-            )
-        });
+        spinner.suspend(|| warn_short_trials(args, used));
     }
     let rows = trial_rows(&model, &test, args.readings, &evaluation);
     spinner.finish_and_clear();
@@ -99,6 +83,26 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     println!("wrote {}", names.join(", "));
     Ok(())
+}
+
+/// Warns that `--readings` asks for more readings per trial than the test data's longest trial,
+/// `used`, and what that leaves in the files.
+fn warn_short_trials(args: &RecognizeArgs, used: usize) {
+    let accuracy = if used < args.readings.first() {
+        format!(
+            "accuracy.csv is empty (no trial reaches {} readings)",
+            args.readings.first()
+        )
+    } else {
+        format!("accuracy.csv ends at {used}")
+    };
+    eprintln!(
+        "warning: --readings {} asks for up to {} readings per trial, but no object of {} has more \
+         than {used} converged readings: {accuracy}, confusion.csv decides after {used}",
+        args.readings,
+        args.readings.last(),
+        args.dataset.display()
+    );
 }
 
 /// The accuracy rows of the plot, as an experiment's: trial `k` is the `k`-th trial of every object

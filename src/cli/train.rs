@@ -1,7 +1,6 @@
 //! `taction train`: fit a bag-of-features model (Sec. IV-A) on a dataset, choosing the number of
 //! clusters on validation data (Sec. V-B1), and save it.
 
-use std::collections::BTreeSet;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -10,8 +9,9 @@ use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
     CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, TrainConfig, TrainProgress,
-    TrainedModel, VarianceFraction, codebook_sizes,
+    TrainedModel, VarianceFraction,
 };
+use taction::valid::Valid;
 
 use crate::cli::common::{SeedArg, parse_codebook};
 use crate::cli::dataset::read_dataset;
@@ -63,18 +63,8 @@ pub struct TrainArgs {
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     let training = read_dataset(&args.dataset)?;
-    let ks = match &args.ks {
-        Some(ks) => ks.clone(),
-        None => {
-            // One feature per converged reading: the fewest any descriptor gives.
-            let converged: Vec<_> = training.readings().iter().filter(|r| r.is_converged()).collect();
-            let objects: BTreeSet<&str> = converged.iter().map(|r| r.object.as_str()).collect();
-            codebook_sizes(args.codebook, objects.len(), converged.len())
-        }
-    };
     let config = TrainConfig {
         codebook: args.codebook,
-        ks,
         restarts: args.restarts,
         seed: args.seed.seed,
         variance_kept: match args.variance_kept {
@@ -85,10 +75,18 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         trial_readings: args.trial_readings,
         ..TrainConfig::default()
     };
+    let config = match &args.ks {
+        Some(ks) => TrainConfig {
+            ks: ks.clone(),
+            ..config
+        },
+        None => config.with_grid_for_dataset(&training, args.validation.is_some()),
+    };
     let validation = args.validation.as_deref().map(read_dataset).transpose()?;
+    let config = Valid::new(config)?;
     let mut models = Vec::new();
     for &kind in args.descriptor.kinds() {
-        let model = fit_one(args, kind, &training, validation.as_ref(), config.clone())?;
+        let model = fit_one(args, kind, &config, &training, validation.as_ref())?;
         print_selection(&model);
         models.push(model);
     }
@@ -110,9 +108,9 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
 fn fit_one(
     args: &TrainArgs,
     kind: DescriptorKind,
+    config: &Valid<TrainConfig>,
     training: &Dataset,
     validation: Option<&Dataset>,
-    config: TrainConfig,
 ) -> Result<TrainedModel, Box<dyn std::error::Error>> {
     let descriptor = kind.build();
     let bar = ProgressBar::new(0);
@@ -129,10 +127,10 @@ fn fit_one(
         TrainProgress::Scored(_) => bar.inc(1),
     };
     let model = TrainedModel::fit(
+        config,
         training,
         validation,
         descriptor.as_ref(),
-        config,
         &mut on_progress,
     )
     .map_err(|e| match (&e, &args.validation) {

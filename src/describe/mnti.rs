@@ -23,6 +23,7 @@ use super::moment_normalized::{MomentNormalized, MomentNormalizedParams};
 use super::plane::Plane;
 use super::{Descriptor, DescriptorKind, DescriptorParams, Feature, ParamsError};
 use crate::tactile::TactileImage;
+use crate::valid::{Check, Valid};
 
 /// Parameters of [`Mnti`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -43,9 +44,14 @@ impl Default for MntiParams {
     }
 }
 
-impl MntiParams {
-    pub fn validate(&self) -> Result<(), ParamsError> {
-        let r = self.padded_size_ratio;
+impl Check for MntiParams {
+    type Error = ParamsError;
+
+    fn check(&self) -> Result<(), ParamsError> {
+        let Self {
+            normalize_intensity: _,
+            padded_size_ratio: r,
+        } = *self;
         if !(r.is_finite() && (1.0..=4.0).contains(&r)) {
             return Err(ParamsError::OutOfRange {
                 field: "mnti.padded_size_ratio",
@@ -66,16 +72,17 @@ pub struct Mnti {
 }
 
 impl Mnti {
-    pub fn new(params: MntiParams) -> Result<Self, ParamsError> {
-        params.validate()?;
+    /// The descriptor of checked parameters (`Valid::new(MntiParams { .. })?`).
+    pub fn new(params: Valid<MntiParams>) -> Self {
+        let params = params.into_inner();
         let moment = MomentNormalizedParams {
             normalize_intensity: params.normalize_intensity,
         };
-        Ok(Self {
+        Self {
             params,
             moment_normalized: MomentNormalized::new(moment),
             plans: FftPlans::new(),
-        })
+        }
     }
 
     /// The padded size of a side of `n` pixels: `round(ratio n)`, at least `n`.
@@ -165,7 +172,7 @@ mod tests {
             assert_eq!(mnti.describe(&image)[0].len(), len, "{n}x{n}");
         }
         assert!(
-            Mnti::new(MntiParams {
+            Valid::new(MntiParams {
                 padded_size_ratio: 0.5,
                 ..Default::default()
             })

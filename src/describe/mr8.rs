@@ -46,6 +46,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Descriptor, DescriptorKind, DescriptorParams, Feature, ParamsError};
 use crate::tactile::TactileImage;
+use crate::valid::{Check, Valid};
 
 const ORIENTATIONS: usize = 6;
 /// Across-sigmas of the RFS oriented filters, before scaling; along is 3 times as wide.
@@ -80,9 +81,16 @@ impl Default for Mr8Params {
     }
 }
 
-impl Mr8Params {
-    pub fn validate(&self) -> Result<(), ParamsError> {
-        let floor = self.sigma_floor_px;
+impl Check for Mr8Params {
+    type Error = ParamsError;
+
+    fn check(&self) -> Result<(), ParamsError> {
+        // Any half-width is valid: it is capped to what fits in the image (`half_support_for`).
+        let Self {
+            half_support_px: _,
+            sigma_floor_px: floor,
+            stride_px,
+        } = *self;
         if !(floor.is_finite() && floor > 0.0 && floor <= 10.0) {
             return Err(ParamsError::OutOfRange {
                 field: "mr8.sigma_floor_px",
@@ -90,7 +98,7 @@ impl Mr8Params {
                 expected: "in (0, 10]",
             });
         }
-        if self.stride_px == 0 {
+        if stride_px == 0 {
             return Err(ParamsError::OutOfRange {
                 field: "mr8.stride_px",
                 value: 0.0,
@@ -99,7 +107,9 @@ impl Mr8Params {
         }
         Ok(())
     }
+}
 
+impl Mr8Params {
     /// `h` for an image whose smaller side is `n`.
     pub fn half_support_for(&self, n: usize) -> usize {
         let fits = n.saturating_sub(1) / 2;
@@ -192,12 +202,12 @@ pub struct Mr8 {
 }
 
 impl Mr8 {
-    pub fn new(params: Mr8Params) -> Result<Self, ParamsError> {
-        params.validate()?;
-        Ok(Self {
-            params,
+    /// The descriptor of checked parameters (`Valid::new(Mr8Params { .. })?`).
+    pub fn new(params: Valid<Mr8Params>) -> Self {
+        Self {
+            params: params.into_inner(),
             banks: RwLock::default(),
-        })
+        }
     }
 
     fn bank(&self, half: usize) -> Arc<FilterBank> {
@@ -356,11 +366,13 @@ mod tests {
                 .collect(),
         )
         .unwrap();
-        let one_section = Mr8::new(Mr8Params {
-            half_support_px: Some(5),
-            ..Default::default()
-        })
-        .unwrap();
+        let one_section = Mr8::new(
+            Valid::new(Mr8Params {
+                half_support_px: Some(5),
+                ..Default::default()
+            })
+            .unwrap(),
+        );
         let features = one_section.describe(&image);
         assert_eq!(features.len(), 1);
         let f = &features[0];
@@ -402,7 +414,7 @@ mod tests {
                 assert_eq!(f, vec![0.0; 8]);
             }
         }
-        let e = Mr8::new(Mr8Params {
+        let e = Valid::new(Mr8Params {
             stride_px: 0,
             ..Default::default()
         })

@@ -10,6 +10,7 @@ use super::polar_fourier::{PolarFourier, PolarFourierParams};
 use super::sift::{Sift, SiftParams};
 use super::vectorize::Vectorize;
 use super::{Descriptor, DescriptorKind};
+use crate::valid::Valid;
 
 /// A descriptor kind with its parameters. In JSON: `{"descriptor": "mr8", "sigma_floor_px": 0.5, ...}`;
 /// omitted parameters take their defaults.
@@ -24,7 +25,8 @@ pub enum DescriptorParams {
     Mnti(MntiParams),
 }
 
-/// Parameters that cannot describe anything; names the field and what it accepts.
+/// Parameters that cannot describe anything; names the field and what it accepts. The error of the
+/// descriptors' [`Check`](crate::valid::Check) impls ([`SiftParams`], [`Mr8Params`], [`MntiParams`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamsError {
     #[error("descriptor parameter {field} = {value}: expected {expected}")]
@@ -63,11 +65,11 @@ impl DescriptorParams {
     pub fn build(&self) -> Result<Box<dyn Descriptor>, ParamsError> {
         Ok(match *self {
             Self::Vectorize => Box::new(Vectorize),
-            Self::Sift(p) => Box::new(Sift::new(p)?),
-            Self::Mr8(p) => Box::new(Mr8::new(p)?),
+            Self::Sift(p) => Box::new(Sift::new(Valid::new(p)?)),
+            Self::Mr8(p) => Box::new(Mr8::new(Valid::new(p)?)),
             Self::MomentNormalized(p) => Box::new(MomentNormalized::new(p)),
             Self::PolarFourier(p) => Box::new(PolarFourier::new(p)),
-            Self::Mnti(p) => Box::new(Mnti::new(p)?),
+            Self::Mnti(p) => Box::new(Mnti::new(Valid::new(p)?)),
         })
     }
 }

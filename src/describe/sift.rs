@@ -31,6 +31,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Descriptor, DescriptorKind, DescriptorParams, Feature, ParamsError};
 use crate::tactile::TactileImage;
+use crate::valid::{Check, Valid};
 
 const ORIENTATION_BINS: usize = 36;
 const ANGLE_BINS: usize = 8;
@@ -56,12 +57,19 @@ impl Default for SiftParams {
     }
 }
 
-impl SiftParams {
-    pub fn validate(&self) -> Result<(), ParamsError> {
-        if !(self.clamp.is_finite() && self.clamp > 0.0 && self.clamp <= 1.0) {
+impl Check for SiftParams {
+    type Error = ParamsError;
+
+    fn check(&self) -> Result<(), ParamsError> {
+        // Any grid threshold is a valid choice of where the 4x4 grid starts.
+        let Self {
+            full_grid_min_px: _,
+            clamp,
+        } = *self;
+        if !(clamp.is_finite() && clamp > 0.0 && clamp <= 1.0) {
             return Err(ParamsError::OutOfRange {
                 field: "sift.clamp",
-                value: self.clamp,
+                value: clamp,
                 expected: "in (0, 1]",
             });
         }
@@ -111,9 +119,11 @@ impl Gradients {
 }
 
 impl Sift {
-    pub fn new(params: SiftParams) -> Result<Self, ParamsError> {
-        params.validate()?;
-        Ok(Self { params })
+    /// The descriptor of checked parameters (`Valid::new(SiftParams { .. })?`).
+    pub fn new(params: Valid<SiftParams>) -> Self {
+        Self {
+            params: params.into_inner(),
+        }
     }
 
     /// Spatial bins per side for a `rows x cols` image.
@@ -300,7 +310,7 @@ mod tests {
             assert!((x - y).abs() < 1e-12);
         }
         assert!(
-            Sift::new(SiftParams {
+            Valid::new(SiftParams {
                 clamp: 0.0,
                 ..Default::default()
             })

@@ -26,7 +26,7 @@ use super::context::Family;
 use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::default_sensor;
-use super::recognition::{Curve, RecognitionSweep, Setting, TestData, training_config};
+use super::recognition::{Curve, RecognitionSweep, Setting, SettingData, TestData, training_config};
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};
@@ -175,9 +175,10 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     let key = SafeName::builder(DESCRIPTOR.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
-        context
-            .store
-            .prepare(&sweep.requests(context, &objects, 0, counts)?, dir.root())?;
+        context.store.prepare(
+            &SettingData::new(context, &objects, &sweep.settings[0], counts).requests()?,
+            dir.root(),
+        )?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -238,19 +239,24 @@ struct ActiveUnit<'a> {
 type Rows = (Vec<ActiveRow>, Vec<PerObjectRow>);
 
 impl ActiveUnit<'_> {
+    /// The data of the sweep's one setting.
+    fn data(&self) -> SettingData<'_> {
+        SettingData::new(self.context, &self.objects, &self.sweep.settings[0], self.counts)
+    }
+
     /// One model, then the planner's L curves (Figs. 8 and 10's datasets), then the active
     /// curve for the object fixed and perturbed.
     fn rows(&self) -> Result<Rows, BoxError> {
         let descriptor = DESCRIPTOR.build();
-        let (context, sweep, objects, counts) = (self.context, self.sweep, &self.objects, self.counts);
-        let model = context.store.model(
-            &sweep.training_request(context, objects, 0, counts)?,
-            &sweep.validation_request(context, objects, 0, counts)?,
+        let data = self.data();
+        let model = self.context.store.model(
+            &data.training_request()?,
+            &data.validation_request()?,
             descriptor.as_ref(),
             &self.training,
         )?;
         let (mut rows, mut per_object) = (Vec::new(), Vec::new());
-        for curve in &sweep.settings[0].curves {
+        for curve in &self.sweep.settings[0].curves {
             let (curve_rows, curve_objects) = self.planner_curve(curve, &model, descriptor.as_ref())?;
             rows.extend(curve_rows);
             per_object.extend(curve_objects);
@@ -271,16 +277,9 @@ impl ActiveUnit<'_> {
         model: &TrainedModel,
         descriptor: &dyn Descriptor,
     ) -> Result<Rows, BoxError> {
-        let trials = self.sweep.dataset_trials(
-            self.context,
-            &self.objects,
-            0,
-            curve.test,
-            self.counts,
-            model,
-            descriptor,
-            &curve.factors,
-        )?;
+        let trials = self
+            .data()
+            .dataset_trials(curve.test, model, descriptor, &curve.factors)?;
         curve_rows(
             self.sweep,
             model,
@@ -302,16 +301,10 @@ impl ActiveUnit<'_> {
     ) -> Result<Rows, BoxError> {
         let objects = &self.objects;
         // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
-        let base = self.sweep.test_requests(
-            self.context,
-            objects,
-            0,
-            TestData::Planner {
-                local_probability: ACTIVE_LOCAL_PROBABILITY,
-                perturbation,
-            },
-            self.counts,
-        )?;
+        let base = self.data().test_requests(TestData::Planner {
+            local_probability: ACTIVE_LOCAL_PROBABILITY,
+            perturbation,
+        })?;
         let jobs: Vec<(usize, usize)> = (0..base.len())
             .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
             .collect();
@@ -367,7 +360,7 @@ fn active_trial(
         .object_index(&spec.name)
         .ok_or_else(|| format!("object '{}' is not in the trained model", spec.name))?;
     let (mut scene, mut planner) = plan.planner_for(spec, index, config)?;
-    let mut recognition = ActiveRecognition::new(&model.bag, descriptor, neighbourhood_m);
+    let mut recognition = ActiveRecognition::new(model, neighbourhood_m)?;
     let run = explore_recognizing(
         &mut planner,
         &mut scene,

@@ -33,6 +33,7 @@ use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
 use crate::recognize::{TrainConfig, TrainedModel};
 use crate::sim::ObjectSpec;
+use crate::valid::Valid;
 
 /// An object set with its meshes built and placed, ready for collection.
 pub struct Objects {
@@ -314,10 +315,10 @@ impl DataStore {
         let training_data = self.dataset(training)?;
         let validation_data = self.dataset(validation)?;
         let model = TrainedModel::fit(
+            &Valid::new(config.clone())?,
             &training_data,
             Some(&validation_data),
             descriptor,
-            config.clone(),
             &mut |_| {},
         )?;
         crate::experiment::files::create_dir_all(&self.root.join("models"))?;

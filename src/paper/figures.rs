@@ -471,16 +471,16 @@ mod tests {
             trials: 3,
         };
         let trained: Vec<usize> = (0..sweep.settings.len())
-            .map(|s| sweep.setting_counts(s, paper).training_per_object)
+            .map(|s| sweep.settings[s].counts(paper).training_per_object)
             .collect();
         assert_eq!(trained, TRAINING_SIZES);
         // Everything but the training readings is the scale's; a tiny scale still trains on one.
-        assert_eq!(sweep.setting_counts(0, paper).test_per_object, 100);
+        assert_eq!(sweep.settings[0].counts(paper).test_per_object, 100);
         let tiny = DataCounts {
             training_per_object: 2,
             ..paper
         };
-        assert_eq!(sweep.setting_counts(0, tiny).training_per_object, 1);
+        assert_eq!(sweep.settings[0].counts(tiny).training_per_object, 1);
         let labels: Vec<&str> = sweep.settings.iter().map(|s| s.label.as_str()).collect();
         assert_eq!(labels, ["100", "300", "1000", "3000", "10000"]);
     }

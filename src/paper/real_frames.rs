@@ -40,7 +40,7 @@ use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{Evaluation, LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
 use crate::rng;
 use crate::tactile::TactileImage;
-use crate::valid::Check;
+use crate::valid::{Check, Valid};
 
 /// The command-line name.
 pub const EXPERIMENT_NAME: &str = "real-frames";
@@ -341,9 +341,9 @@ impl TrialPlan<'_> {
             ..self.training.clone()
         };
         let trained = train(
+            &Valid::new(trial_training)?,
             &self.describe(descriptor, &split.train)?,
             Some(&self.describe(descriptor, &split.validation)?),
-            &trial_training,
             &mut |_| {},
         )?;
         let test = self.describe(descriptor, &split.test)?;

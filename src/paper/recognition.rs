@@ -31,8 +31,7 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
-    CodebookKind, LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, codebook_sizes, evaluate,
-    make_trials,
+    CodebookKind, LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -147,10 +146,29 @@ struct SweepConfig<'a> {
 }
 
 /// One unit's work, before it is wrapped in a closure.
-struct UnitPlan {
+struct UnitPlan<'a> {
     key: SafeName,
-    setting: usize,
+    setting: &'a Setting,
     descriptor: DescriptorKind,
+}
+
+/// Prepares the datasets of the units of `plans` that this shard runs and that have no rows yet.
+fn prepare_pending(
+    context: &PaperContext,
+    objects: &Arc<Objects>,
+    counts: DataCounts,
+    plans: &[UnitPlan],
+    dir: &ExperimentDir,
+) -> Result<(), BoxError> {
+    let mut requests = Vec::new();
+    for (i, plan) in plans.iter().enumerate() {
+        if context.options.shard.contains(i) && !dir.unit_csv(&plan.key).exists() {
+            let setting_counts = plan.setting.counts(counts);
+            requests.extend(SettingData::new(context, objects, plan.setting, setting_counts).requests()?);
+        }
+    }
+    context.store.prepare(&requests, dir.root())?;
+    Ok(())
 }
 
 impl RecognitionSweep {
@@ -168,10 +186,7 @@ impl RecognitionSweep {
     pub fn run(&self, context: &PaperContext) -> Result<RunReport, BoxError> {
         let objects = context.objects(self.family)?;
         let counts = context.scale.counts();
-        let training = training_config(context, counts, objects.specs.len());
         let plans = self.unit_plans()?;
-        let setting_counts = |setting: usize| self.setting_counts(setting, counts);
-
         let name = SafeName::new(self.name)?;
         let config = SweepConfig {
             sweep: self,
@@ -183,48 +198,15 @@ impl RecognitionSweep {
             objects: objects.names(),
             control: ControlConfig::default(),
             planner: PlannerConfig::default(),
-            training,
+            training: training_config(context, counts, objects.specs.len()),
         };
         check_resumable(&context.options, &name, &config)?;
         let dir = ExperimentDir::new(&context.options.out, &name);
-        let pending: Vec<&UnitPlan> = plans
-            .iter()
-            .enumerate()
-            .filter(|(i, p)| context.options.shard.contains(*i) && !dir.unit_csv(&p.key).exists())
-            .map(|(_, p)| p)
-            .collect();
-        let mut requests = Vec::new();
-        for plan in &pending {
-            requests.extend(self.requests(context, &objects, plan.setting, setting_counts(plan.setting))?);
-        }
-        context.store.prepare(&requests, dir.root())?;
-
+        prepare_pending(context, &objects, counts, &plans, &dir)?;
         let real = match self.family {
             Family::RealLabels => Some(context.real_data()?),
             _ => None,
         };
-        let units = plans
-            .iter()
-            .map(|plan| {
-                let objects = Arc::clone(&objects);
-                let counts = setting_counts(plan.setting);
-                let training = training_config(context, counts, objects.specs.len());
-                let real = real.clone();
-                let setting = plan.setting;
-                let descriptor = plan.descriptor;
-                Unit::with_detail(plan.key.clone(), move || {
-                    self.unit_rows(
-                        context,
-                        &objects,
-                        setting,
-                        descriptor,
-                        counts,
-                        &training,
-                        real.as_deref(),
-                    )
-                })
-            })
-            .collect();
         let experiment = Experiment {
             spec: ExperimentSpec {
                 name: name.clone(),
@@ -232,9 +214,34 @@ impl RecognitionSweep {
                 plots: vec![self.plot(name, &self.plot_title(real.as_deref()), objects.specs.len())],
             },
             config,
-            units,
+            units: self.units(context, &objects, counts, &plans, real),
         };
         Ok(run(&experiment, &context.options)?)
+    }
+
+    /// One unit per plan: its setting's model for its descriptor, evaluated on the setting's curves.
+    fn units<'a>(
+        &'a self,
+        context: &'a PaperContext,
+        objects: &Arc<Objects>,
+        counts: DataCounts,
+        plans: &[UnitPlan<'a>],
+        real: Option<Arc<RealData>>,
+    ) -> Vec<Unit<'a, AccuracyRow, PerObjectRow>> {
+        plans
+            .iter()
+            .map(|plan| {
+                let objects = Arc::clone(objects);
+                let setting_counts = plan.setting.counts(counts);
+                let training = training_config(context, setting_counts, objects.specs.len());
+                let real = real.clone();
+                let (setting, descriptor) = (plan.setting, plan.descriptor);
+                Unit::with_detail(plan.key.clone(), move || {
+                    let data = SettingData::new(context, &objects, setting, setting_counts);
+                    self.unit_rows(&data, descriptor, &training, real.as_deref())
+                })
+            })
+            .collect()
     }
 
     /// The accuracy plot of the sweep's rows, chance level at 1 / `objects`.
@@ -269,14 +276,14 @@ impl RecognitionSweep {
         Ok(())
     }
 
-    fn unit_plans(&self) -> Result<Vec<UnitPlan>, BoxError> {
+    fn unit_plans(&self) -> Result<Vec<UnitPlan<'_>>, BoxError> {
         self.check_factors()?;
         let mut plans = Vec::new();
-        for (setting, s) in self.settings.iter().enumerate() {
+        for setting in &self.settings {
             for &descriptor in &self.descriptors {
                 let mut key = SafeName::builder(descriptor.name());
                 if !self.key_parameter.is_empty() {
-                    key = key.param(self.key_parameter, &s.label);
+                    key = key.param(self.key_parameter, &setting.label);
                 }
                 let key = key.build()?;
                 plans.push(UnitPlan {
@@ -289,110 +296,180 @@ impl RecognitionSweep {
         Ok(plans)
     }
 
-    /// The scale's data counts with `setting`'s multiple of the training readings (at least one).
-    pub(crate) fn setting_counts(&self, setting: usize, counts: DataCounts) -> DataCounts {
-        let fraction = self.settings[setting].training_fraction;
+    /// The rows of one unit: the model of `data`'s setting for descriptor `kind` (trained, or
+    /// loaded from the store), evaluated on every curve of the setting over all trials.
+    fn unit_rows(
+        &self,
+        data: &SettingData,
+        kind: DescriptorKind,
+        training: &TrainConfig,
+        real: Option<&RealData>,
+    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+        let descriptor = kind.build();
+        let model = data.context.store.model(
+            &data.training_request()?,
+            &data.validation_request()?,
+            descriptor.as_ref(),
+            training,
+        )?;
+        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        for curve in &data.setting.curves {
+            let trials = match curve.test {
+                TestData::Real => {
+                    let real = real.ok_or("internal: the real recording was not loaded")?;
+                    real_trials(
+                        real,
+                        descriptor.as_ref(),
+                        &model,
+                        data.context.seed,
+                        data.counts.trials,
+                    )?
+                }
+                test => data.dataset_trials(test, &model, descriptor.as_ref(), &curve.factors)?,
+            };
+            for (trial, (seed, object_trials)) in trials.iter().enumerate() {
+                let meta = AccuracyCurve {
+                    experiment: self.name.to_string(),
+                    descriptor: kind.name().to_string(),
+                    factors: curve.factors.clone(),
+                    trial: trial as u32,
+                    seed: data.context.seed,
+                    stream_seed: *seed,
+                };
+                let (curve_rows, curve_objects) =
+                    trial_rows(&meta, &model, object_trials, &curve.factors, trial)?;
+                rows.extend(curve_rows);
+                per_object.extend(curve_objects);
+            }
+        }
+        Ok((rows, per_object))
+    }
+}
+
+/// The rows of one trial of a curve: accuracy and reliability after every reading count up to the
+/// longest object trial. One definition of accuracy (`recognize::AccuracyPoint`): every object
+/// counts, an unread one as a miss; the per-object rows are the outcomes it counts.
+fn trial_rows(
+    meta: &AccuracyCurve,
+    model: &TrainedModel,
+    object_trials: &[Trial],
+    curve: &Factors,
+    trial: usize,
+) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+    let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
+    if longest == 0 {
+        return Err(
+            format!("curve '{curve}', trial {trial}: no converged test reading of any object").into(),
+        );
+    }
+    let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
+    Ok((meta.rows(&evaluation.accuracy), meta.object_rows(&evaluation)?))
+}
+
+impl Setting {
+    /// The scale's data counts with this setting's multiple of the training readings (at least
+    /// one).
+    pub(crate) fn counts(&self, counts: DataCounts) -> DataCounts {
         DataCounts {
-            training_per_object: ((counts.training_per_object as f64 * fraction).round() as usize).max(1),
+            training_per_object: ((counts.training_per_object as f64 * self.training_fraction).round()
+                as usize)
+                .max(1),
             ..counts
         }
     }
 
-    /// The sensor of a setting with the run's noise stream.
-    pub(super) fn sensor(&self, context: &PaperContext, setting: usize) -> SensorConfig {
+    /// The sensor with the run's noise stream.
+    pub(super) fn sensor_of_run(&self, context: &PaperContext) -> SensorConfig {
         SensorConfig {
             noise_seed: rng::substream(context.seed, NOISE_STREAM),
-            ..self.settings[setting].sensor
+            ..self.sensor
         }
     }
 
     /// The controllers, told the sensor's noise width as a real controller knows its sensor's
     /// noise floor (see [`ControlConfig::expected_noise_fraction`]).
-    pub(super) fn control(&self, setting: usize) -> Result<Valid<ControlConfig>, RangeError> {
+    pub(super) fn control(&self) -> Result<Valid<ControlConfig>, RangeError> {
         Valid::new(ControlConfig {
-            expected_noise_fraction: self.settings[setting].sensor.noise_fraction,
+            expected_noise_fraction: self.sensor.noise_fraction,
             ..ControlConfig::default()
         })
     }
+}
 
-    fn sampler_request(
-        &self,
-        context: &PaperContext,
-        objects: &Arc<Objects>,
-        setting: usize,
-        readings: usize,
-        stream: u64,
-    ) -> Result<DataRequest, RangeError> {
-        Ok(DataRequest::new(
+/// One setting of a sweep in one run: the data its units read, with the run's objects and the
+/// setting's data counts.
+pub(super) struct SettingData<'a> {
+    pub context: &'a PaperContext,
+    pub objects: &'a Arc<Objects>,
+    pub setting: &'a Setting,
+    /// The data counts of the setting (the scale's, with its training readings: [`Setting::counts`]).
+    pub counts: DataCounts,
+}
+
+impl<'a> SettingData<'a> {
+    /// `setting` in `context` over `objects`, with the setting's data `counts`.
+    pub(super) fn new(
+        context: &'a PaperContext,
+        objects: &'a Arc<Objects>,
+        setting: &'a Setting,
+        counts: DataCounts,
+    ) -> Self {
+        Self {
+            context,
             objects,
+            setting,
+            counts,
+        }
+    }
+
+    fn sampler_request(&self, readings: usize, stream: u64) -> Result<DataRequest, RangeError> {
+        Ok(DataRequest::new(
+            self.objects,
             CollectPlan {
-                mode: CollectMode::Sampler(Valid::new(self.settings[setting].sampler)?),
-                sensor: self.sensor(context, setting),
-                control: self.control(setting)?,
+                mode: CollectMode::Sampler(Valid::new(self.setting.sampler)?),
+                sensor: self.setting.sensor_of_run(self.context),
+                control: self.setting.control()?,
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: readings,
-                seed: rng::substream(context.seed, stream),
+                seed: rng::substream(self.context.seed, stream),
             },
         ))
     }
 
-    pub(super) fn training_request(
-        &self,
-        c: &PaperContext,
-        o: &Arc<Objects>,
-        s: usize,
-        n: DataCounts,
-    ) -> Result<DataRequest, RangeError> {
-        self.sampler_request(c, o, s, n.training_per_object, TRAINING_STREAM)
+    pub(super) fn training_request(&self) -> Result<DataRequest, RangeError> {
+        self.sampler_request(self.counts.training_per_object, TRAINING_STREAM)
     }
 
-    pub(super) fn validation_request(
-        &self,
-        c: &PaperContext,
-        o: &Arc<Objects>,
-        s: usize,
-        n: DataCounts,
-    ) -> Result<DataRequest, RangeError> {
-        self.sampler_request(c, o, s, n.validation_per_object, VALIDATION_STREAM)
+    pub(super) fn validation_request(&self) -> Result<DataRequest, RangeError> {
+        self.sampler_request(self.counts.validation_per_object, VALIDATION_STREAM)
     }
 
-    /// The datasets of curve `test` of `setting`, one per trial (none for real frames).
-    pub(super) fn test_requests(
-        &self,
-        context: &PaperContext,
-        objects: &Arc<Objects>,
-        setting: usize,
-        test: TestData,
-        counts: DataCounts,
-    ) -> Result<Vec<DataRequest>, RangeError> {
+    /// The datasets of curve `test`, one per trial (none for real frames).
+    pub(super) fn test_requests(&self, test: TestData) -> Result<Vec<DataRequest>, RangeError> {
         let trial_stream = |t: usize| TEST_STREAM + t as u64;
         match test {
-            TestData::Validation => Ok(vec![self.validation_request(context, objects, setting, counts)?]),
-            TestData::Sampler => (0..counts.trials)
-                .map(|t| {
-                    self.sampler_request(context, objects, setting, counts.test_per_object, trial_stream(t))
-                })
+            TestData::Validation => Ok(vec![self.validation_request()?]),
+            TestData::Sampler => (0..self.counts.trials)
+                .map(|t| self.sampler_request(self.counts.test_per_object, trial_stream(t)))
                 .collect(),
             TestData::Planner {
                 local_probability,
                 perturbation,
-            } => (0..counts.trials)
+            } => (0..self.counts.trials)
                 .map(|t| {
+                    let config = PlannerConfig {
+                        local_probability,
+                        ..PlannerConfig::default()
+                    };
                     Ok(DataRequest::new(
-                        objects,
+                        self.objects,
                         CollectPlan {
-                            mode: CollectMode::Planner(Valid::new(
-                                PlannerConfig {
-                                    local_probability,
-                                    ..PlannerConfig::default()
-                                }
-                                .fitted_to(&objects.specs),
-                            )?),
-                            sensor: self.sensor(context, setting),
-                            control: self.control(setting)?,
+                            mode: CollectMode::Planner(Valid::new(config.fitted_to(&self.objects.specs))?),
+                            sensor: self.setting.sensor_of_run(self.context),
+                            control: self.setting.control()?,
                             perturbation,
-                            readings_per_object: counts.test_per_object,
-                            seed: rng::substream(context.seed, trial_stream(t)),
+                            readings_per_object: self.counts.test_per_object,
+                            seed: rng::substream(self.context.seed, trial_stream(t)),
                         },
                     ))
                 })
@@ -401,112 +478,33 @@ impl RecognitionSweep {
         }
     }
 
-    /// Every dataset a unit of `setting` reads.
-    pub(super) fn requests(
-        &self,
-        context: &PaperContext,
-        objects: &Arc<Objects>,
-        setting: usize,
-        counts: DataCounts,
-    ) -> Result<Vec<DataRequest>, RangeError> {
-        let mut requests = vec![
-            self.training_request(context, objects, setting, counts)?,
-            self.validation_request(context, objects, setting, counts)?,
-        ];
-        for curve in &self.settings[setting].curves {
-            requests.extend(self.test_requests(context, objects, setting, curve.test, counts)?);
+    /// Every dataset a unit of the setting reads.
+    pub(super) fn requests(&self) -> Result<Vec<DataRequest>, RangeError> {
+        let mut requests = vec![self.training_request()?, self.validation_request()?];
+        for curve in &self.setting.curves {
+            requests.extend(self.test_requests(curve.test)?);
         }
         Ok(requests)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn unit_rows(
-        &self,
-        context: &PaperContext,
-        objects: &Arc<Objects>,
-        setting: usize,
-        kind: DescriptorKind,
-        counts: DataCounts,
-        training: &TrainConfig,
-        real: Option<&RealData>,
-    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
-        let descriptor = kind.build();
-        let model = context.store.model(
-            &self.training_request(context, objects, setting, counts)?,
-            &self.validation_request(context, objects, setting, counts)?,
-            descriptor.as_ref(),
-            training,
-        )?;
-        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
-        for curve in &self.settings[setting].curves {
-            let trials = match curve.test {
-                TestData::Real => {
-                    let real = real.ok_or("internal: the real recording was not loaded")?;
-                    real_trials(real, descriptor.as_ref(), &model, context.seed, counts.trials)?
-                }
-                test => self.dataset_trials(
-                    context,
-                    objects,
-                    setting,
-                    test,
-                    counts,
-                    &model,
-                    descriptor.as_ref(),
-                    &curve.factors,
-                )?,
-            };
-            for (trial, (seed, object_trials)) in trials.iter().enumerate() {
-                let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
-                if longest == 0 {
-                    return Err(format!(
-                        "curve '{}', trial {trial}: no converged test reading of any object",
-                        curve.factors
-                    )
-                    .into());
-                }
-                let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
-                let meta = AccuracyCurve {
-                    experiment: self.name.to_string(),
-                    descriptor: kind.name().to_string(),
-                    factors: curve.factors.clone(),
-                    trial: trial as u32,
-                    seed: context.seed,
-                    stream_seed: *seed,
-                };
-                // One definition of accuracy (`recognize::AccuracyPoint`): every object counts, an unread one as
-                // a miss; the per-object rows are the outcomes it counts.
-                rows.extend(meta.rows(&evaluation.accuracy));
-                per_object.extend(meta.object_rows(&evaluation)?);
-            }
-        }
-        Ok((rows, per_object))
-    }
-}
-
-impl RecognitionSweep {
     /// The trials of a curve read from datasets (every kind but real frames): per trial its seed
     /// and one [`Trial`] per object, the features of its converged readings in order.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn dataset_trials(
         &self,
-        context: &PaperContext,
-        objects: &Arc<Objects>,
-        setting: usize,
         test: TestData,
-        counts: DataCounts,
         model: &TrainedModel,
         descriptor: &dyn Descriptor,
         curve: &Factors,
     ) -> Result<Vec<(u64, Vec<Trial>)>, BoxError> {
-        self.test_requests(context, objects, setting, test, counts)?
+        let readings = self.counts.test_per_object.max(self.counts.validation_per_object);
+        self.test_requests(test)?
             .iter()
             .map(|request| {
-                let data = context.store.dataset(request)?;
+                let data = self.context.store.dataset(request)?;
                 model
                     .check_sensor(&data.header().sensor)
                     .map_err(|e| format!("test data of '{curve}': {e}"))?;
                 let features = LabelledFeatures::from_dataset(&data, descriptor);
-                let readings = counts.test_per_object.max(counts.validation_per_object);
                 Ok((
                     request.plan.seed,
                     make_trials(&features, model.bag.objects(), readings)?,
@@ -517,7 +515,8 @@ impl RecognitionSweep {
 }
 
 /// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
-/// problem ([`codebook_sizes`], counting one feature per training reading), with the run's codebook.
+/// problem ([`TrainConfig::with_grid_for`]: the planned training readings, since the grid is part of
+/// the run's `config.json`, written before any data is collected), with the run's codebook.
 pub(super) fn training_config(context: &PaperContext, counts: DataCounts, objects: usize) -> TrainConfig {
     selection_config(
         context.codebook,
@@ -538,15 +537,16 @@ pub(super) fn selection_config(
     validation_per_object: usize,
     objects: usize,
 ) -> TrainConfig {
+    // The validation readings are a dataset of their own: none is held out of the training ones.
     TrainConfig {
         codebook,
-        ks: codebook_sizes(codebook, objects, training_per_object * objects),
         restarts: 3,
         seed: model_seed,
         variance_kept: codebook.default_variance_kept(),
         trial_readings: validation_per_object.min(10),
         ..TrainConfig::default()
     }
+    .with_grid_for(objects, training_per_object * objects, true)
 }
 
 /// The recorded frames as trials of the model's objects: each label's frames, preprocessed as in

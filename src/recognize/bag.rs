@@ -5,12 +5,13 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::describe::Feature;
+use crate::recognize::RecognizeError;
 use crate::recognize::codebook::{Codebook, CodebookModel};
 use crate::recognize::decision::Decision;
+use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::check_feature;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::pca::Pca;
-use crate::recognize::{FeatureMatrix, RecognizeError};
 
 /// A trained PCA, codebook and object models whose dimensions agree (checked on construction).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

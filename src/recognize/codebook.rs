@@ -105,8 +105,8 @@ impl CodebookKind {
 
     /// The fraction of the training variance the PCA keeps by default: the paper's 90% for the
     /// clustering codebooks; 99% for the neighbour codebook, whose neighbourhoods use the detail
-    /// (a 50-nearest vote on the letters, MNTI: accuracy at 20 readings 85.0% at 90%, 91.2% at
-    /// 99%).
+    /// the last components keep (docs/measurements.md, "A neighbour codebook", has the
+    /// measurement).
     pub fn default_variance_kept(self) -> VarianceFraction {
         match self {
             Self::Gmm | Self::Kmeans => VarianceFraction::PAPER,

@@ -240,7 +240,29 @@ where
     R: Sync,
     P: FnMut(&R) -> Result<Belief, RecognizeError>,
 {
-    // Every trial's belief after 1, 2, ... readings (up to the range's end).
+    let per_trial = trial_beliefs(trials, range, start)?;
+    let longest = per_trial.iter().map(Vec::len).max().unwrap_or(0);
+    let accuracy = accuracy_points(objects.len(), trials, &per_trial, range, longest);
+    let (touches, confusion) = touches_and_confusion(objects, trials, per_trial, range, longest);
+    Ok(Evaluation {
+        objects: objects.to_vec(),
+        touches,
+        accuracy,
+        confusion,
+    })
+}
+
+/// Every trial's belief after 1, 2, ... readings (up to the range's end), trials in parallel, in
+/// trial order.
+fn trial_beliefs<R, P>(
+    trials: &[Trial<R>],
+    range: ReadingRange,
+    start: impl Fn() -> P + Sync,
+) -> Result<Vec<Vec<TouchRow>>, RecognizeError>
+where
+    R: Sync,
+    P: FnMut(&R) -> Result<Belief, RecognizeError>,
+{
     let per_trial: Vec<Result<Vec<TouchRow>, RecognizeError>> = trials
         .par_iter()
         .enumerate()
@@ -261,14 +283,25 @@ where
             Ok(beliefs)
         })
         .collect();
-    let per_trial: Vec<Vec<TouchRow>> = per_trial.into_iter().collect::<Result<_, _>>()?;
-    let longest = per_trial.iter().map(Vec::len).max().unwrap_or(0);
-    let prior = 1.0 / objects.len().max(1) as f64;
+    per_trial.into_iter().collect()
+}
+
+/// One [`AccuracyPoint`] per reading count of `range` up to the `longest` trial: each trial's
+/// outcome after `n` readings, or after its last, or (no reading at all) the uniform prior over
+/// `objects` objects.
+fn accuracy_points<R>(
+    objects: usize,
+    trials: &[Trial<R>],
+    per_trial: &[Vec<TouchRow>],
+    range: ReadingRange,
+    longest: usize,
+) -> Vec<AccuracyPoint> {
+    let prior = 1.0 / objects.max(1) as f64;
     let mut accuracy: Vec<AccuracyPoint> = Vec::new();
     for n in range.first..=range.last.min(longest) {
         let outcomes = trials
             .iter()
-            .zip(&per_trial)
+            .zip(per_trial)
             .map(|(trial, beliefs)| {
                 // The belief after n readings, or after the trial's last; none before any reading.
                 match n.min(beliefs.len()).checked_sub(1).map(|i| &beliefs[i]) {
@@ -287,6 +320,18 @@ where
             .collect();
         accuracy.push(AccuracyPoint::new(n, outcomes));
     }
+    accuracy
+}
+
+/// The rows of `range` of every trial, and the confusion matrix of each trial's last decision in
+/// the range.
+fn touches_and_confusion<R>(
+    objects: &[String],
+    trials: &[Trial<R>],
+    per_trial: Vec<Vec<TouchRow>>,
+    range: ReadingRange,
+    longest: usize,
+) -> (Vec<TouchRow>, ConfusionMatrix) {
     let mut touches = Vec::new();
     // The decisions are taken after the range's end or the longest trial's last reading, whichever
     // comes first: a range beyond the data labels no decision with readings it never had.
@@ -301,12 +346,7 @@ where
         }
         touches.extend(in_range);
     }
-    Ok(Evaluation {
-        objects: objects.to_vec(),
-        touches,
-        accuracy,
-        confusion,
-    })
+    (touches, confusion)
 }
 
 impl Evaluation {

@@ -8,27 +8,24 @@
 //! models' `ln p(U | O_j)` (Eq. 15-16), i.e. the product of their likelihoods, as if the descriptors
 //! were independent given the object, and the posterior is its softmax under a uniform prior. Two
 //! descriptors that err on different objects then correct each other, and the more differently
-//! they describe a patch the more they do: SIFT's gradient orientations (Sec. IV-B2) with MNTI's
-//! normalised moments (Sec. IV-B6) gained 3.0 / 1.1 points over MNTI alone at 10 / 20 readings on
-//! the 12 shapes (6x6, neighbour codebook, 1000 training readings per object) and 3.3 / 2.0 at
-//! 26x26, where MNTI with Moment-Normalized, both moments, gained 1.1 / -1.0 and -0.5 / -0.5
-//! (docs/measurements.md, "What resolution and a second descriptor buy").
+//! they describe a patch the more they do: SIFT's gradient orientations (Sec. IV-B2) beside MNTI's
+//! normalised moments (Sec. IV-B6) gain more than two descriptors built on the same moments. The
+//! measurements are in docs/measurements.md, "What resolution and a second descriptor buy".
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::Dataset;
-use crate::describe::{Descriptor, DescriptorKind, Feature};
+use crate::describe::{DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
-use crate::recognize::decision::Decision;
-use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
-use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
 use crate::recognize::model::{
     MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, read_model_file, save_json,
 };
-use crate::recognize::posterior::{Belief, OnlinePosterior};
+use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
+use crate::valid::Valid;
 
 /// A descriptor name that names no descriptor, or a fusion that names one twice or none.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -156,24 +153,16 @@ impl FusedModel {
     /// Trains one model per descriptor of `choice` on the same datasets ([`TrainedModel::fit`]),
     /// each choosing its own codebook size.
     pub fn fit(
+        config: &Valid<TrainConfig>,
         training: &Dataset,
         validation: Option<&Dataset>,
         choice: &DescriptorChoice,
-        config: TrainConfig,
         progress: &mut (dyn FnMut(TrainProgress) + Send),
     ) -> Result<Self, RecognizeError> {
         let models = choice
             .kinds()
             .iter()
-            .map(|kind| {
-                TrainedModel::fit(
-                    training,
-                    validation,
-                    kind.build().as_ref(),
-                    config.clone(),
-                    progress,
-                )
-            })
+            .map(|kind| TrainedModel::fit(config, training, validation, kind.build().as_ref(), progress))
             .collect::<Result<Vec<_>, _>>()?;
         Self::new(models)
     }
@@ -195,6 +184,17 @@ impl FusedModel {
         FusedPosterior {
             parts: self.fused.iter().map(|m| m.bag.posterior()).collect(),
         }
+    }
+
+    /// A posterior that takes tactile images, describing each with every model's descriptor
+    /// ([`ModelPosterior`]).
+    pub fn image_posterior(&self) -> Result<ModelPosterior<'_>, RecognizeError> {
+        let descriptors = self
+            .fused
+            .iter()
+            .map(TrainedModel::build_descriptor)
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(ModelPosterior::fused(self.posterior(), descriptors))
     }
 
     /// Writes the model as JSON, atomically.
@@ -230,19 +230,17 @@ impl FusedModel {
     }
 
     /// Each reading of `dataset` described by every model's descriptor, as trials of up to
-    /// `readings_per_trial` readings ([`make_trials`]).
+    /// `readings_per_trial` readings ([`TrainedModel::trials`]).
     pub fn trials(
         &self,
         dataset: &Dataset,
         readings_per_trial: usize,
     ) -> Result<Vec<Trial<Vec<Vec<Feature>>>>, RecognizeError> {
-        let mut per_model = Vec::with_capacity(self.fused.len());
-        for model in &self.fused {
-            model.check_sensor(&dataset.header().sensor)?;
-            let descriptor: Box<dyn Descriptor> = model.build_descriptor()?;
-            let features = LabelledFeatures::from_dataset(dataset, descriptor.as_ref());
-            per_model.push(make_trials(&features, self.objects(), readings_per_trial)?);
-        }
+        let per_model = self
+            .fused
+            .iter()
+            .map(|model| model.trials(dataset, readings_per_trial))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(zip_trials(per_model))
     }
 
@@ -281,57 +279,6 @@ fn zip_trials(per_model: Vec<Vec<Trial>>) -> Vec<Trial<Vec<Vec<Feature>>>> {
         }
     }
     zipped
-}
-
-/// The fused belief after each reading (the module docs).
-#[derive(Debug, Clone)]
-pub struct FusedPosterior<'a> {
-    parts: Vec<OnlinePosterior<'a>>,
-}
-
-impl FusedPosterior<'_> {
-    /// Adds one reading, `features[m]` being its features under model `m`'s descriptor. On error
-    /// (a count or length that does not match) the state is unchanged.
-    pub fn observe(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
-        if features.len() != self.parts.len() {
-            return Err(RecognizeError::InvalidParameter {
-                name: "fused reading",
-                what: format!(
-                    "{} feature lists for {} fused models",
-                    features.len(),
-                    self.parts.len()
-                ),
-            });
-        }
-        let mut updated = self.parts.clone();
-        for (part, f) in updated.iter_mut().zip(features) {
-            part.observe(f)?;
-        }
-        self.parts = updated;
-        Ok(self.belief())
-    }
-
-    /// The fused belief now: the softmax of the summed log-likelihoods.
-    pub fn belief(&self) -> Belief {
-        let mut log_likelihood: Vec<f64> = Vec::new();
-        let mut features = 0;
-        for part in &self.parts {
-            let models = part.bag().models();
-            let l = models.log_likelihoods(part.histogram());
-            if log_likelihood.is_empty() {
-                log_likelihood = l;
-            } else {
-                for (sum, x) in log_likelihood.iter_mut().zip(l) {
-                    *sum += x;
-                }
-            }
-            features += part.histogram().features();
-        }
-        Belief {
-            readings: self.parts.first().map_or(0, OnlinePosterior::readings),
-            decision: Decision::from_log_likelihoods(log_likelihood, features),
-        }
-    }
 }
 
 /// A model file of either kind, as `taction recognize` takes it.
@@ -380,24 +327,23 @@ impl Recognizer {
         }
     }
 
-    /// Recognises `dataset` in trials of `range.last()` readings per object; also returns the number
-    /// of trials.
+    /// A posterior that takes tactile images ([`ModelPosterior`]), of either kind of model.
+    pub fn posterior(&self) -> Result<ModelPosterior<'_>, RecognizeError> {
+        match self {
+            Self::Single(m) => m.posterior(),
+            Self::Fused(f) => f.image_posterior(),
+        }
+    }
+
+    /// Recognises `dataset` in trials of `range.last()` readings per object
+    /// ([`TrainedModel::evaluate`]); also returns the number of trials.
     pub fn evaluate(
         &self,
         dataset: &Dataset,
         range: ReadingRange,
     ) -> Result<(Evaluation, usize), RecognizeError> {
         match self {
-            Self::Single(model) => {
-                model.check_sensor(&dataset.header().sensor)?;
-                let descriptor = model.build_descriptor()?;
-                let features = LabelledFeatures::from_dataset(dataset, descriptor.as_ref());
-                let trials = make_trials(&features, model.bag.objects(), range.last())?;
-                Ok((
-                    crate::recognize::evaluate(&model.bag, &trials, range)?,
-                    trials.len(),
-                ))
-            }
+            Self::Single(model) => model.evaluate_counted(dataset, range),
             Self::Fused(fused) => {
                 let trials = fused.trials(dataset, range.last())?;
                 Ok((fused.evaluate(&trials, range)?, trials.len()))

@@ -15,8 +15,9 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::recognize::RecognizeError;
+use crate::recognize::features::FeatureMatrix;
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
-use crate::recognize::{FeatureMatrix, RecognizeError};
 use crate::rng::Rng;
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;

@@ -5,7 +5,8 @@ use rand::RngExt;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::recognize::{FeatureMatrix, RecognizeError};
+use crate::recognize::RecognizeError;
+use crate::recognize::features::FeatureMatrix;
 use crate::rng::Rng;
 
 /// How Lloyd's iterations stop.

@@ -1,15 +1,17 @@
 //! Bag-of-features recognition (Sec. IV-A, V-B1; Fig. 4).
 //!
-//! Training: descriptor features of every training image -> [`Pca`] keeping 90% of the variance ->
-//! a [`Codebook`] (k-means, hard membership, or a Gaussian mixture, soft membership; beyond the
-//! paper, [`NearestNeighbours`], the objects' shares of a feature's nearest training features) -> per object
-//! the smoothed histogram `p(c_i | O_j)` ([`ObjectModels`]); [`train`] repeats the codebook step
+//! Training: descriptor features of every training image -> [`Pca`](pipeline::Pca) keeping 90% of the variance ->
+//! a [`Codebook`](pipeline::Codebook) (k-means, hard membership, or a Gaussian mixture, soft membership; beyond the
+//! paper, [`NearestNeighbours`](pipeline::NearestNeighbours), the objects' shares of a feature's nearest training features) -> per object
+//! the smoothed histogram `p(c_i | O_j)` ([`ObjectModels`](pipeline::ObjectModels)); [`train`] repeats the codebook step
 //! over a grid of `k` and seeded restarts and keeps the best on validation data.
 //!
 //! Testing: the features of the unknown object's readings go through the same PCA and codebook
 //! into a histogram `p(c_i | U)`; the guess minimises the cross-entropy of Eq. 4, and the
 //! distribution over objects is the softmax of `n_U` times the average log-likelihood (Eq. 16).
-//! [`OnlinePosterior`] does this after every reading; [`evaluate()`] over a whole test set.
+//! [`OnlinePosterior`] does this after every reading ([`ModelPosterior`], from
+//! [`TrainedModel::posterior`], takes tactile images); [`evaluate()`] (and
+//! [`TrainedModel::evaluate`]) over a whole test set.
 //!
 //! Everything here works on features (`Vec<Feature>` per reading), so it knows nothing of MuJoCo:
 //! recorded data from a real sensor can be fed in. A [`TrainedModel`] adds the descriptor, the
@@ -20,38 +22,56 @@ pub(crate) mod codebook;
 pub(crate) mod confusion;
 pub(crate) mod decision;
 pub(crate) mod error;
-pub mod evaluate;
+pub(crate) mod evaluate;
 pub(crate) mod features;
 pub(crate) mod fusion;
 pub(crate) mod gmm;
 pub(crate) mod kmeans;
 pub(crate) mod labelled;
-pub mod model;
+pub(crate) mod model;
 pub(crate) mod neighbours;
 pub(crate) mod object_model;
 pub(crate) mod pca;
 pub(crate) mod posterior;
-pub mod selection;
+pub(crate) mod selection;
 
+// The model: trained, saved and loaded, one descriptor or several fused.
 pub use bag::BagOfFeatures;
-pub use codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
-pub use confusion::ConfusionMatrix;
-pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use error::RecognizeError;
-pub use evaluate::{
-    AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, evaluate, evaluate_with, make_trials,
-};
-pub use features::{FeatureMatrix, TrainingFeatures};
-pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, FusedPosterior, Recognizer};
-pub use gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
-pub use kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
+pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, Recognizer};
 pub use labelled::LabelledFeatures;
 pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
-pub use neighbours::{LeaveOneReadingOut, NearestNeighbours};
-pub use object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels, PseudoCount};
-pub use pca::{Pca, VarianceFraction};
-pub use posterior::{Belief, OnlinePosterior};
+
+// Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
+pub use codebook::{CodebookConfig, CodebookKind};
+pub use object_model::PseudoCount;
+pub use pca::VarianceFraction;
 pub use selection::{
-    CandidateScore, SelectionReport, TrainConfig, TrainProgress, Trained, codebook_sizes,
-    supported_codebook_sizes, train,
+    CandidateScore, MIN_FEATURES_PER_CLUSTER, SelectionReport, TrainConfig, TrainProgress, Trained,
+    codebook_sizes, supported_codebook_sizes, train,
 };
+
+// The posterior over objects, touch by touch (Eq. 15-16).
+pub use decision::{Decision, cross_entropy, entropy_nats};
+pub use posterior::{Belief, FusedPosterior, ModelPosterior, OnlinePosterior};
+
+// Evaluation over a test set (Sec. V-B2).
+pub use confusion::ConfusionMatrix;
+pub use evaluate::{
+    AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, TrialOutcome, evaluate, evaluate_with,
+    make_trials,
+};
+
+/// The stages of Fig. 4 one by one, for code that fits or inspects them on their own (the tests,
+/// the benchmarks, the parity checks against scikit-learn): features as a matrix, the PCA, the
+/// codebooks (k-means, Gaussian mixture, nearest neighbours) and the object histograms.
+/// [`train`] and [`TrainedModel::fit`] run them all.
+pub mod pipeline {
+    pub use super::codebook::{Codebook, CodebookModel};
+    pub use super::features::{FeatureMatrix, TrainingFeatures};
+    pub use super::gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
+    pub use super::kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
+    pub use super::neighbours::{LeaveOneReadingOut, NearestNeighbours};
+    pub use super::object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels};
+    pub use super::pca::Pca;
+}

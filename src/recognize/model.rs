@@ -17,9 +17,12 @@ use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
+use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
+use crate::recognize::posterior::ModelPosterior;
 use crate::recognize::selection::{SelectionReport, TrainConfig, TrainProgress, train};
 use crate::tactile::{SensorConfig, TactileImage};
+use crate::valid::Valid;
 
 /// The model file format version this build writes and reads.
 pub const MODEL_FORMAT_VERSION: u32 = 1;
@@ -66,14 +69,71 @@ impl TrainedModel {
     }
 
     /// Trains a model on the converged readings of `training` (Fig. 4), choosing among the
-    /// candidates of `config` on `validation` (or on readings held out of `training`), and records
-    /// the sensor and provenance of the data. The one training path of the CLI, the demo and the
-    /// experiments.
+    /// candidates of the checked `config` on `validation` (or on readings held out of `training`),
+    /// and records the sensor and provenance of the data: linfa's params -> check -> fit, and the
+    /// one training path of the CLI, the demo and the experiments.
+    ///
+    /// # Example
+    ///
+    /// Two objects read by a 4x4 pad: an edge (the left half pressed harder) and a flat face, with
+    /// a little texture. The model trained on them recognises new readings, image by image
+    /// ([`posterior`](Self::posterior)) or a whole test set ([`evaluate`](Self::evaluate)).
+    ///
+    /// ```
+    /// use taction::dataset::{ContactStatus, Dataset, DatasetHeader, Reading, Strategy};
+    /// use taction::describe::DescriptorKind;
+    /// use taction::pose::Pose;
+    /// use taction::recognize::{ReadingRange, TrainConfig, TrainedModel};
+    /// use taction::tactile::{SensorConfig, TactileImage};
+    /// use taction::valid::Valid;
+    ///
+    /// let image = |object: usize, i: usize| {
+    ///     let value = |t: usize| {
+    ///         let texture = 0.05 * ((i * 7 + t * 3) % 5) as f64;
+    ///         if object == 0 && t % 4 < 2 { 0.8 + texture } else { 0.3 + texture }
+    ///     };
+    ///     TactileImage::new(4, 4, (0..16).map(value).collect())
+    /// };
+    /// let objects = ["edge".to_string(), "face".to_string()];
+    /// let dataset = |first: usize, per_object: usize| -> Result<Dataset, Box<dyn std::error::Error>> {
+    ///     let sensor = SensorConfig::square(4, 4, 0.012, 0.0012);
+    ///     let header = DatasetHeader::new(sensor, "toy", objects.to_vec(), "by hand", 0);
+    ///     let mut readings = Vec::new();
+    ///     for i in first..first + per_object {
+    ///         for (j, object) in objects.iter().enumerate() {
+    ///             readings.push(Reading {
+    ///                 image: image(j, i)?,
+    ///                 object: object.clone(),
+    ///                 object_pose: Pose::IDENTITY,
+    ///                 status: ContactStatus::Converged,
+    ///                 iterations: 1,
+    ///                 strategy: Strategy::Sampler,
+    ///                 cause: None,
+    ///             });
+    ///         }
+    ///     }
+    ///     Ok(Dataset::new(header, readings)?)
+    /// };
+    ///
+    /// let config = Valid::new(TrainConfig { ks: vec![2], restarts: 1, ..TrainConfig::default() })?;
+    /// let descriptor = DescriptorKind::Vectorize.build();
+    /// let model = TrainedModel::fit(&config, &dataset(0, 22)?, None, descriptor.as_ref(), &mut |_| {})?;
+    ///
+    /// let mut posterior = model.posterior()?;
+    /// posterior.observe(&image(0, 100)?)?;
+    /// let belief = posterior.observe(&image(0, 101)?)?;
+    /// assert_eq!(model.bag.objects()[belief.guess()], "edge");
+    /// assert_eq!(posterior.probabilities().len(), 2);
+    ///
+    /// let evaluation = model.evaluate(&dataset(50, 5)?, ReadingRange::new(1, 5)?)?;
+    /// assert_eq!(evaluation.accuracy_at(5), Some(1.0));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn fit(
+        config: &Valid<TrainConfig>,
         training: &Dataset,
         validation: Option<&Dataset>,
         descriptor: &dyn Descriptor,
-        config: TrainConfig,
         progress: &mut (dyn FnMut(TrainProgress) + Send),
     ) -> Result<Self, RecognizeError> {
         let header = training.header();
@@ -82,7 +142,7 @@ impl TrainedModel {
         }
         let train_features = LabelledFeatures::from_dataset(training, descriptor);
         let validation_features = validation.map(|v| LabelledFeatures::from_dataset(v, descriptor));
-        let trained = train(&train_features, validation_features.as_ref(), &config, progress)?;
+        let trained = train(config, &train_features, validation_features.as_ref(), progress)?;
         Ok(Self::new(
             descriptor.params(),
             header.sensor,
@@ -92,9 +152,45 @@ impl TrainedModel {
                 object_set: header.object_set.clone(),
                 generator: header.generator.clone(),
                 dataset_seed: header.seed,
-                config,
+                config: TrainConfig::clone(config),
             },
         ))
+    }
+
+    /// A posterior over the model's objects (Eq. 15-16) that takes tactile images one at a time,
+    /// describing each with the model's descriptor ([`ModelPosterior::observe`]), or readings
+    /// already described ([`ModelPosterior::observe_features`]). The example of
+    /// [`fit`](Self::fit) uses it.
+    pub fn posterior(&self) -> Result<ModelPosterior<'_>, RecognizeError> {
+        Ok(ModelPosterior::single(&self.bag, self.build_descriptor()?))
+    }
+
+    /// Recognition touch by touch over the converged readings of `test` (Sec. V-B2): each object's
+    /// readings, in order, in trials of `readings.last()` readings, the belief recorded at every
+    /// reading count of `readings`; accuracy as [`AccuracyPoint`](crate::recognize::AccuracyPoint)
+    /// defines it. `test` must come from the model's sensor and name only its objects. The example
+    /// of [`fit`](Self::fit) uses it.
+    pub fn evaluate(&self, test: &Dataset, readings: ReadingRange) -> Result<Evaluation, RecognizeError> {
+        Ok(self.evaluate_counted(test, readings)?.0)
+    }
+
+    /// [`evaluate`](Self::evaluate), and the number of trials.
+    pub(crate) fn evaluate_counted(
+        &self,
+        test: &Dataset,
+        readings: ReadingRange,
+    ) -> Result<(Evaluation, usize), RecognizeError> {
+        let trials = self.trials(test, readings.last())?;
+        Ok((evaluate(&self.bag, &trials, readings)?, trials.len()))
+    }
+
+    /// The converged readings of `test`, described by the model's descriptor, as trials of up to
+    /// `readings_per_trial` readings ([`make_trials`]).
+    pub fn trials(&self, test: &Dataset, readings_per_trial: usize) -> Result<Vec<Trial>, RecognizeError> {
+        self.check_sensor(&test.header().sensor)?;
+        let descriptor = self.build_descriptor()?;
+        let features = LabelledFeatures::from_dataset(test, descriptor.as_ref());
+        make_trials(&features, self.bag.objects(), readings_per_trial)
     }
 
     /// Builds the descriptor the model was trained with.
@@ -125,82 +221,84 @@ impl TrainedModel {
 
     /// Parses the bytes of a model file; `origin` names it in errors.
     pub fn from_json(bytes: &[u8], origin: &str) -> Result<Self, RecognizeError> {
-        let path = || origin.to_string();
-        let value: serde_json::Value = serde_json::from_slice(bytes).map_err(|e| {
-            if e.is_eof() {
-                RecognizeError::Truncated {
-                    path: path(),
-                    what: format!("the JSON ends early: {e}"),
-                }
-            } else {
-                RecognizeError::NotAModel {
-                    path: path(),
-                    what: format!("not JSON: {e}"),
-                }
-            }
-        })?;
-        let version = value
-            .get("format_version")
-            .ok_or_else(|| RecognizeError::NotAModel {
-                path: path(),
-                what: "no 'format_version' field".into(),
-            })?;
-        match version.as_u64() {
-            Some(v) if v == u64::from(MODEL_FORMAT_VERSION) => {}
-            Some(found) => {
-                return Err(RecognizeError::Version {
-                    path: path(),
-                    found,
-                    expected: MODEL_FORMAT_VERSION,
-                });
-            }
-            None => {
-                return Err(RecognizeError::NotAModel {
-                    path: path(),
-                    what: format!("'format_version' is {version}, not an unsigned integer"),
-                });
-            }
-        }
+        let value = parse_model_json(bytes, origin)?;
+        check_format_version(&value, origin)?;
         let model: TrainedModel =
             serde_json::from_value(value).map_err(|e| RecognizeError::Inconsistent {
-                path: path(),
+                path: origin.to_string(),
                 what: e.to_string(),
             })?;
         model
-            .bag
-            .check()
-            .map_err(|what| RecognizeError::Inconsistent { path: path(), what })?;
-        let descriptor = model
+            .check_parts_agree()
+            .map_err(|what| RecognizeError::Inconsistent {
+                path: origin.to_string(),
+                what,
+            })?;
+        Ok(model)
+    }
+
+    /// The parts of a loaded model agree: the bag's own dimensions, the descriptor parameters, and
+    /// what the descriptor gives for an image of the model's sensor is what the PCA takes.
+    fn check_parts_agree(&self) -> Result<(), String> {
+        self.bag.check()?;
+        let descriptor = self
             .descriptor
             .build()
-            .map_err(|e| RecognizeError::Inconsistent {
-                path: path(),
-                what: format!(
-                    "the descriptor parameters {:?} are invalid: {e}",
-                    model.descriptor
-                ),
-            })?;
-        // What the descriptor gives for an image of the model's sensor must be what the PCA takes.
-        let blank = TactileImage::zeros(model.sensor.rows, model.sensor.cols).map_err(|e| {
-            RecognizeError::Inconsistent {
-                path: path(),
-                what: format!("sensor: {e}"),
-            }
-        })?;
+            .map_err(|e| format!("the descriptor parameters {:?} are invalid: {e}", self.descriptor))?;
+        let blank =
+            TactileImage::zeros(self.sensor.rows, self.sensor.cols).map_err(|e| format!("sensor: {e}"))?;
         let produced = descriptor.describe(&blank).first().map_or(0, Vec::len);
-        if produced != model.bag.input_dim() {
-            return Err(RecognizeError::Inconsistent {
-                path: path(),
-                what: format!(
-                    "{} gives {produced} values for a {}x{} image, but the PCA takes {}",
-                    model.descriptor.kind().name(),
-                    model.sensor.rows,
-                    model.sensor.cols,
-                    model.bag.input_dim()
-                ),
-            });
+        if produced != self.bag.input_dim() {
+            return Err(format!(
+                "{} gives {produced} values for a {}x{} image, but the PCA takes {}",
+                self.descriptor.kind().name(),
+                self.sensor.rows,
+                self.sensor.cols,
+                self.bag.input_dim()
+            ));
         }
-        Ok(model)
+        Ok(())
+    }
+}
+
+/// The JSON of a model file: a file cut short is [`Truncated`](RecognizeError::Truncated), anything
+/// else that is not JSON [`NotAModel`](RecognizeError::NotAModel).
+fn parse_model_json(bytes: &[u8], origin: &str) -> Result<serde_json::Value, RecognizeError> {
+    serde_json::from_slice(bytes).map_err(|e| {
+        if e.is_eof() {
+            RecognizeError::Truncated {
+                path: origin.to_string(),
+                what: format!("the JSON ends early: {e}"),
+            }
+        } else {
+            RecognizeError::NotAModel {
+                path: origin.to_string(),
+                what: format!("not JSON: {e}"),
+            }
+        }
+    })
+}
+
+/// The file's `format_version` is this build's [`MODEL_FORMAT_VERSION`].
+fn check_format_version(value: &serde_json::Value, origin: &str) -> Result<(), RecognizeError> {
+    let path = || origin.to_string();
+    let version = value
+        .get("format_version")
+        .ok_or_else(|| RecognizeError::NotAModel {
+            path: path(),
+            what: "no 'format_version' field".into(),
+        })?;
+    match version.as_u64() {
+        Some(v) if v == u64::from(MODEL_FORMAT_VERSION) => Ok(()),
+        Some(found) => Err(RecognizeError::Version {
+            path: path(),
+            found,
+            expected: MODEL_FORMAT_VERSION,
+        }),
+        None => Err(RecognizeError::NotAModel {
+            path: path(),
+            what: format!("'format_version' is {version}, not an unsigned integer"),
+        }),
     }
 }
 

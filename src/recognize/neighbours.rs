@@ -14,10 +14,9 @@
 //!
 //! Why: a GMM codebook of a few hundred components cuts the 52 letters' feature space into cells
 //! too coarse to keep what tells letters apart (validation accuracy still rose at k = 400). The
-//! neighbourhood of a feature adapts to the data's density instead. On the raised letters (6x6,
-//! MNTI, 1000 training and 100 validation sampler readings per letter, 5 test trials of 60
-//! readings per letter) accuracy at 10 / 20 / 60 readings went from 54.2 / 76.5 / 97.3% (GMM, k
-//! chosen from 50-400) to 77.3 / 90.4 / 98.8% (PCA keeping 99%).
+//! neighbourhood of a feature adapts to the data's density instead, and on the raised letters it
+//! recognises with fewer readings than the GMM; docs/measurements.md, "A neighbour codebook",
+//! holds the measurements.
 //!
 //! Cost: the model keeps every training feature, and a membership scans them all (at most `n d`
 //! flops; `cargo bench --bench recognize`, `per_touch`, times it against the GMM). Training scans
@@ -27,9 +26,10 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::recognize::RecognizeError;
+use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::TrainingFeatures;
 use crate::recognize::object_model::ClusterHistogram;
-use crate::recognize::{FeatureMatrix, RecognizeError};
 
 /// The training features (PCA-reduced), their objects, and the neighbour count `k`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

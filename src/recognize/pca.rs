@@ -4,7 +4,8 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::{Deserialize, Serialize};
 
-use crate::recognize::{FeatureMatrix, RecognizeError};
+use crate::recognize::RecognizeError;
+use crate::recognize::features::FeatureMatrix;
 
 /// The fraction of the training variance the kept components must explain, in (0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]

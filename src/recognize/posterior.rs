@@ -1,11 +1,13 @@
 //! The belief over object identity after every touch: the histogram of all features so far, and
-//! the distribution of Eq. 16 it implies.
+//! the distribution of Eq. 16 it implies. [`OnlinePosterior`] takes described readings;
+//! [`ModelPosterior`] takes tactile images and describes them as the model's training did.
 
-use crate::describe::Feature;
+use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::Decision;
 use crate::recognize::object_model::ClusterHistogram;
+use crate::tactile::TactileImage;
 
 impl BagOfFeatures {
     /// A posterior over the objects that takes readings one at a time. (Defined here, beside the
@@ -90,5 +92,145 @@ impl<'a> OnlinePosterior<'a> {
     /// The summed cluster memberships of every feature so far.
     pub fn histogram(&self) -> &ClusterHistogram {
         &self.histogram
+    }
+}
+
+/// The fused belief after each reading of a fused model (`recognize::fusion`): the softmax of the
+/// models' summed log-likelihoods.
+#[derive(Debug, Clone)]
+pub struct FusedPosterior<'a> {
+    pub(crate) parts: Vec<OnlinePosterior<'a>>,
+}
+
+impl FusedPosterior<'_> {
+    /// Adds one reading, `features[m]` being its features under model `m`'s descriptor. On error
+    /// (a count or length that does not match) the state is unchanged.
+    pub fn observe(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
+        if features.len() != self.parts.len() {
+            return Err(RecognizeError::InvalidParameter {
+                name: "fused reading",
+                what: format!(
+                    "{} feature lists for {} fused models",
+                    features.len(),
+                    self.parts.len()
+                ),
+            });
+        }
+        let mut updated = self.parts.clone();
+        for (part, f) in updated.iter_mut().zip(features) {
+            part.observe(f)?;
+        }
+        self.parts = updated;
+        Ok(self.belief())
+    }
+
+    /// Readings observed so far.
+    pub fn readings(&self) -> usize {
+        self.parts.first().map_or(0, OnlinePosterior::readings)
+    }
+
+    /// The fused belief now: the softmax of the summed log-likelihoods.
+    pub fn belief(&self) -> Belief {
+        let mut log_likelihood: Vec<f64> = Vec::new();
+        let mut features = 0;
+        for part in &self.parts {
+            let models = part.bag().models();
+            let l = models.log_likelihoods(part.histogram());
+            if log_likelihood.is_empty() {
+                log_likelihood = l;
+            } else {
+                for (sum, x) in log_likelihood.iter_mut().zip(l) {
+                    *sum += x;
+                }
+            }
+            features += part.histogram().features();
+        }
+        Belief {
+            readings: self.readings(),
+            decision: Decision::from_log_likelihoods(log_likelihood, features),
+        }
+    }
+}
+
+/// The posterior of a trained model (one descriptor or several fused), fed with tactile images:
+/// each image is described by the model's own descriptors, so that test images are described as
+/// the training images were. What [`TrainedModel::posterior`](crate::recognize::TrainedModel::posterior)
+/// and [`Recognizer::posterior`](crate::recognize::Recognizer::posterior) give.
+pub struct ModelPosterior<'a> {
+    descriptors: Vec<Box<dyn Descriptor>>,
+    beliefs: Beliefs<'a>,
+}
+
+/// The belief of one model, or of several fused (their likelihoods multiplied).
+#[derive(Clone)]
+enum Beliefs<'a> {
+    Single(OnlinePosterior<'a>),
+    Fused(FusedPosterior<'a>),
+}
+
+impl<'a> ModelPosterior<'a> {
+    /// The posterior of one model whose images `descriptor` describes.
+    pub(crate) fn single(bag: &'a BagOfFeatures, descriptor: Box<dyn Descriptor>) -> Self {
+        Self {
+            descriptors: vec![descriptor],
+            beliefs: Beliefs::Single(bag.posterior()),
+        }
+    }
+
+    /// The posterior of a fused model; `descriptors[m]` describes images for its model `m`.
+    pub(crate) fn fused(posterior: FusedPosterior<'a>, descriptors: Vec<Box<dyn Descriptor>>) -> Self {
+        Self {
+            descriptors,
+            beliefs: Beliefs::Fused(posterior),
+        }
+    }
+
+    /// The features of `image` under each of the model's descriptors, in the model's order.
+    pub fn describe(&self, image: &TactileImage) -> Vec<Vec<Feature>> {
+        self.descriptors.iter().map(|d| d.describe(image)).collect()
+    }
+
+    /// Describes one reading's image, adds it and returns the belief after it.
+    pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
+        let features = self.describe(image);
+        self.observe_features(&features)
+    }
+
+    /// Adds one reading already described: `features[m]` its features under descriptor `m` (one
+    /// list for a model of one descriptor). On error (a count or a length that does not match) the
+    /// state is unchanged.
+    pub fn observe_features(&mut self, features: &[Vec<Feature>]) -> Result<Belief, RecognizeError> {
+        match &mut self.beliefs {
+            Beliefs::Single(p) => match features {
+                [one] => p.observe(one),
+                _ => Err(RecognizeError::InvalidParameter {
+                    name: "reading",
+                    what: format!("{} feature lists for a model of one descriptor", features.len()),
+                }),
+            },
+            Beliefs::Fused(p) => p.observe(features),
+        }
+    }
+
+    /// The belief now.
+    pub fn belief(&self) -> Belief {
+        match &self.beliefs {
+            Beliefs::Single(p) => p.belief(),
+            Beliefs::Fused(p) => p.belief(),
+        }
+    }
+
+    /// `p(O_j | readings so far)` for every object of the model; sums to 1 (uniform before any
+    /// reading).
+    pub fn probabilities(&self) -> Vec<f64> {
+        self.belief().decision.probabilities
+    }
+
+    /// Readings observed so far.
+    pub fn readings(&self) -> usize {
+        match &self.beliefs {
+            Beliefs::Single(p) => p.readings(),
+            Beliefs::Fused(p) => p.readings(),
+        }
     }
 }

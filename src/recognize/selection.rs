@@ -2,21 +2,25 @@
 //! restarts, keep the model with the best validation accuracy, ties broken by reliability (the
 //! probability the posterior puts on the correct object).
 
+use std::borrow::Cow;
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::dataset::{ContactStatus, Dataset};
+use crate::recognize::RecognizeError;
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
 use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 use crate::recognize::evaluate::{Trial, make_trials};
+use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::TrainingFeatures;
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::neighbours::LeaveOneReadingOut;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 use crate::recognize::pca::{Pca, VarianceFraction};
-use crate::recognize::{FeatureMatrix, RecognizeError};
 use crate::rng::{stream, substream};
+use crate::valid::{Check, Valid};
 
 /// Everything that determines a trained model besides the data.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -58,25 +62,39 @@ impl Default for TrainConfig {
     }
 }
 
-impl TrainConfig {
-    fn validate(&self) -> Result<(), RecognizeError> {
-        let bad = |name, what: &str| {
-            Err(RecognizeError::InvalidParameter {
-                name,
-                what: what.to_string(),
-            })
-        };
-        if self.ks.is_empty() {
-            return bad("k", "give at least one cluster count");
+impl Check for TrainConfig {
+    type Error = RecognizeError;
+
+    /// The grid and the trial length; the hold-out fraction, which [`LabelledFeatures::split_validation`]
+    /// needs in `(0, 1)`. The PCA share and the pseudo-count are checked by their types, a codebook
+    /// kind and a seed are any, and the codebook's fitting settings are checked by the fits.
+    fn check(&self) -> Result<(), RecognizeError> {
+        let Self {
+            codebook: _,
+            ks,
+            restarts,
+            seed: _,
+            variance_kept: _,
+            pseudo_count: _,
+            fitting: _,
+            trial_readings,
+            holdout,
+        } = self;
+        let bad = |name, what: String| Err(RecognizeError::InvalidParameter { name, what });
+        if ks.is_empty() {
+            return bad("k", "give at least one cluster count".into());
         }
-        if self.ks.contains(&0) {
-            return bad("k", "cluster counts must be at least 1");
+        if ks.contains(&0) {
+            return bad("k", "cluster counts must be at least 1".into());
         }
-        if self.restarts == 0 {
-            return bad("restarts", "must be at least 1");
+        if *restarts == 0 {
+            return bad("restarts", "must be at least 1".into());
         }
-        if self.trial_readings == 0 {
-            return bad("trial_readings", "must be at least 1");
+        if *trial_readings == 0 {
+            return bad("trial_readings", "must be at least 1".into());
+        }
+        if !(*holdout > 0.0 && *holdout < 1.0) {
+            return bad("holdout", format!("{holdout} is not a fraction in (0, 1)"));
         }
         Ok(())
     }
@@ -129,6 +147,47 @@ pub fn codebook_sizes(kind: CodebookKind, objects: usize, training_features: usi
     let first = CODEBOOK_LADDER.iter().rposition(|&k| k <= objects).unwrap_or(0);
     let last = (first + CODEBOOK_STEPS).min(CODEBOOK_LADDER.len());
     supported_codebook_sizes(&CODEBOOK_LADDER[first..last], training_features)
+}
+
+impl TrainConfig {
+    /// The training features that size the `k` grid ([`codebook_sizes`]) when `training_readings`
+    /// converged readings train the model: one feature per reading, the fewest any descriptor gives
+    /// (MR-8 gives one per image section, the others one), so that the grid holds for every
+    /// descriptor of a fused model; less the share [`holdout`](Self::holdout) keeps for validation
+    /// when there is no separate validation set, since those readings never reach the codebook.
+    /// The one count the CLI's `train`, the demo and the experiments size their grids by (the CLI
+    /// used to count the held-out readings too, and so could try a `k` the features left after the
+    /// hold-out do not support).
+    pub fn grid_training_features(&self, training_readings: usize, separate_validation: bool) -> usize {
+        if separate_validation {
+            training_readings
+        } else {
+            (training_readings as f64 * (1.0 - self.holdout)).floor() as usize
+        }
+    }
+
+    /// This configuration with the `k` grid of [`codebook_sizes`] for its codebook, `objects`
+    /// objects and the [`grid_training_features`](Self::grid_training_features) of
+    /// `training_readings` converged training readings.
+    pub fn with_grid_for(self, objects: usize, training_readings: usize, separate_validation: bool) -> Self {
+        let features = self.grid_training_features(training_readings, separate_validation);
+        Self {
+            ks: codebook_sizes(self.codebook, objects, features),
+            ..self
+        }
+    }
+
+    /// [`with_grid_for`](Self::with_grid_for) the converged readings of `training`, over its
+    /// header's objects (the objects a model trained on it knows).
+    pub fn with_grid_for_dataset(self, training: &Dataset, separate_validation: bool) -> Self {
+        let objects = training.header().objects.len();
+        let converged = training
+            .readings()
+            .iter()
+            .filter(|r| r.status == ContactStatus::Converged)
+            .count();
+        self.with_grid_for(objects, converged, separate_validation)
+    }
 }
 
 /// One candidate's validation result.
@@ -223,7 +282,8 @@ pub struct Trained {
 /// Trains on `training` (Fig. 4): PCA on all training features, then for every `k` and restart a
 /// codebook and the objects' histograms, scored on validation trials; keeps the best candidate.
 /// `validation` must name only training objects; without it, part of `training` is held out
-/// ([`TrainConfig::holdout`]).
+/// ([`TrainConfig::holdout`]). The configuration comes checked (`Valid::new(TrainConfig { .. })?`),
+/// linfa's params -> check -> fit.
 ///
 /// # Example
 ///
@@ -233,6 +293,7 @@ pub struct Trained {
 ///
 /// ```
 /// use taction::recognize::{LabelledFeatures, TrainConfig, train};
+/// use taction::valid::Valid;
 ///
 /// // Reading `i` of object `j`: one feature, near (5 j, 5 j).
 /// let reading = |j: usize, i: usize| {
@@ -241,8 +302,8 @@ pub struct Trained {
 /// };
 /// let readings = (0..2).map(|j| (0..110).map(|i| reading(j, i)).collect()).collect();
 /// let training = LabelledFeatures::new(vec!["cube".into(), "sphere".into()], readings)?;
-/// let config = TrainConfig { ks: vec![2], restarts: 1, ..TrainConfig::default() };
-/// let trained = train(&training, None, &config, &mut |_| {})?;
+/// let config = Valid::new(TrainConfig { ks: vec![2], restarts: 1, ..TrainConfig::default() })?;
+/// let trained = train(&config, &training, None, &mut |_| {})?;
 ///
 /// let mut posterior = trained.bag.posterior();
 /// for i in 0..2 {
@@ -253,89 +314,175 @@ pub struct Trained {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn train(
+    config: &Valid<TrainConfig>,
     training: &LabelledFeatures,
     validation: Option<&LabelledFeatures>,
-    config: &TrainConfig,
     progress: &mut (dyn FnMut(TrainProgress) + Send),
 ) -> Result<Trained, RecognizeError> {
-    config.validate()?;
-    let held_out;
-    let (training, validation, validation_origin) = match validation {
-        Some(v) => (training, v, "a separate validation set".to_string()),
-        None => {
-            held_out = training.split_validation(config.holdout)?;
-            (
-                &held_out.0,
-                &held_out.1,
-                format!(
-                    "the last {:.3} of each object's training readings",
-                    config.holdout
-                ),
-            )
-        }
+    let split = ValidationSplit::new(training, validation, config.holdout)?;
+    let (training, validation) = (&*split.training, &*split.validation);
+    check_every_object_read(training)?;
+    let reduced = ReducedTraining::fit(training, config.variance_kept)?;
+    let trials = make_trials(validation, training.objects(), config.trial_readings)?;
+    let trials = reduce_trials(&reduced.pca, &trials)?;
+    let fitted = fit_candidates(config, &reduced, training.objects(), &trials, progress);
+    let chosen = choose_candidate(fitted)?;
+    let selection = SelectionReport {
+        chosen_k: chosen.score.k,
+        chosen_restart: chosen.score.restart,
+        candidates: chosen.candidates,
+        validation: split.origin,
+        training_readings: training.reading_count(),
+        training_features: reduced.reduced.rows(),
+        pca_components: reduced.pca.output_dim(),
+        pca_variance_ratio: reduced.pca.kept_variance_ratio(),
     };
-    let objects = training.objects().to_vec();
-    if let Some(j) = (0..objects.len()).find(|&j| training.readings(j).iter().all(Vec::is_empty)) {
-        return Err(RecognizeError::EmptyObject {
+    Ok(Trained {
+        bag: BagOfFeatures::new(reduced.pca, chosen.codebook, chosen.models)?,
+        selection,
+    })
+}
+
+/// The readings a model is fitted on and those it is chosen on (Sec. V-B1), and where the latter
+/// came from.
+struct ValidationSplit<'a> {
+    training: Cow<'a, LabelledFeatures>,
+    validation: Cow<'a, LabelledFeatures>,
+    origin: String,
+}
+
+impl<'a> ValidationSplit<'a> {
+    /// `validation` when given, else the last `holdout` of each object's training readings.
+    fn new(
+        training: &'a LabelledFeatures,
+        validation: Option<&'a LabelledFeatures>,
+        holdout: f64,
+    ) -> Result<Self, RecognizeError> {
+        Ok(match validation {
+            Some(v) => Self {
+                training: Cow::Borrowed(training),
+                validation: Cow::Borrowed(v),
+                origin: "a separate validation set".to_string(),
+            },
+            None => {
+                let (training, validation) = training.split_validation(holdout)?;
+                Self {
+                    training: Cow::Owned(training),
+                    validation: Cow::Owned(validation),
+                    origin: format!("the last {holdout:.3} of each object's training readings"),
+                }
+            }
+        })
+    }
+}
+
+/// Every object needs a training reading: an object without one has no histogram `p(c | O_j)`.
+fn check_every_object_read(training: &LabelledFeatures) -> Result<(), RecognizeError> {
+    let objects = training.objects();
+    match (0..objects.len()).find(|&j| training.readings(j).iter().all(Vec::is_empty)) {
+        Some(j) => Err(RecognizeError::EmptyObject {
             object: objects[j].clone(),
-        });
+        }),
+        None => Ok(()),
     }
-    let raw = FeatureMatrix::from_features(training.features(), "the training set")?;
-    let pca = Pca::fit(&raw, config.variance_kept)?;
-    let reduced = pca.transform(&raw);
-    drop(raw);
-    // Rows of `reduced` are object by object; each object's block gives its histogram.
-    let mut blocks = Vec::with_capacity(objects.len());
-    let (mut row_objects, mut row_readings) = (Vec::new(), Vec::new());
-    let mut reading_id = 0u32;
-    let mut start = 0;
-    for j in 0..objects.len() {
-        for reading in training.readings(j) {
-            row_objects.extend(std::iter::repeat_n(j as u32, reading.len()));
-            row_readings.extend(std::iter::repeat_n(reading_id, reading.len()));
-            reading_id += 1;
+}
+
+/// The training features after PCA (Fig. 4's first step): all rows, each row's object and reading,
+/// and the rows object by object (each object's block gives its histogram).
+struct ReducedTraining {
+    pca: Pca,
+    reduced: FeatureMatrix,
+    blocks: Vec<FeatureMatrix>,
+    row_objects: Vec<u32>,
+    row_readings: Vec<u32>,
+    object_count: usize,
+}
+
+impl ReducedTraining {
+    /// Fits the PCA keeping `variance_kept` on every training feature and reduces them.
+    fn fit(training: &LabelledFeatures, variance_kept: VarianceFraction) -> Result<Self, RecognizeError> {
+        let raw = FeatureMatrix::from_features(training.features(), "the training set")?;
+        let pca = Pca::fit(&raw, variance_kept)?;
+        let reduced = pca.transform(&raw);
+        drop(raw);
+        // Rows of `reduced` are object by object; each object's block gives its histogram.
+        let object_count = training.objects().len();
+        let mut blocks = Vec::with_capacity(object_count);
+        let (mut row_objects, mut row_readings) = (Vec::new(), Vec::new());
+        let mut reading_id = 0u32;
+        let mut start = 0;
+        for j in 0..object_count {
+            for reading in training.readings(j) {
+                row_objects.extend(std::iter::repeat_n(j as u32, reading.len()));
+                row_readings.extend(std::iter::repeat_n(reading_id, reading.len()));
+                reading_id += 1;
+            }
+            let n: usize = training.readings(j).iter().map(Vec::len).sum();
+            blocks.push(FeatureMatrix::from_trusted(
+                n,
+                reduced.dim(),
+                reduced.as_slice()[start * reduced.dim()..(start + n) * reduced.dim()].to_vec(),
+            ));
+            start += n;
         }
-        let n: usize = training.readings(j).iter().map(Vec::len).sum();
-        blocks.push(FeatureMatrix::from_trusted(
-            n,
-            reduced.dim(),
-            reduced.as_slice()[start * reduced.dim()..(start + n) * reduced.dim()].to_vec(),
-        ));
-        start += n;
+        Ok(Self {
+            pca,
+            reduced,
+            blocks,
+            row_objects,
+            row_readings,
+            object_count,
+        })
     }
-    let trials = make_trials(validation, &objects, config.trial_readings)?;
-    let trials = reduce_trials(&pca, &trials)?;
-    let features = TrainingFeatures {
-        data: &reduced,
-        objects: &row_objects,
-        object_count: objects.len(),
-        readings: &row_readings,
-    };
+
+    fn features(&self) -> TrainingFeatures<'_> {
+        TrainingFeatures {
+            data: &self.reduced,
+            objects: &self.row_objects,
+            object_count: self.object_count,
+            readings: &self.row_readings,
+        }
+    }
+}
+
+/// Every (k, restart) candidate of the grid, `k` in the given order, restarts within: one restart
+/// for a codebook that draws nothing at random.
+fn candidate_grid(config: &TrainConfig) -> Vec<(usize, usize)> {
     let restarts = if config.codebook.is_random() {
         config.restarts
     } else {
         1
     };
-    let total = config.ks.len() * restarts;
-    progress(TrainProgress::PcaFitted {
-        components: pca.output_dim(),
-        variance_ratio: pca.kept_variance_ratio(),
-        total,
-    });
-
-    // Every (k, restart) candidate is fitted and scored on its own random stream, in parallel;
-    // the choice then walks them in grid order, so the model is the same for any thread count.
-    let jobs: Vec<(usize, usize)> = config
+    config
         .ks
         .iter()
         .flat_map(|&k| (0..restarts).map(move |restart| (k, restart)))
-        .collect();
+        .collect()
+}
+
+/// Fits and scores every candidate of the grid. Each is fitted on its own random stream, in
+/// parallel; the result is in grid order, so the model is the same for any thread count.
+fn fit_candidates(
+    config: &TrainConfig,
+    reduced: &ReducedTraining,
+    objects: &[String],
+    trials: &[ReducedTrial],
+    progress: &mut (dyn FnMut(TrainProgress) + Send),
+) -> Vec<Candidate> {
+    let jobs = candidate_grid(config);
+    let total = jobs.len();
+    progress(TrainProgress::PcaFitted {
+        components: reduced.pca.output_dim(),
+        variance_ratio: reduced.pca.kept_variance_ratio(),
+        total,
+    });
+    let features = reduced.features();
     // The neighbour codebook's training histograms, for every candidate k, from one scan.
     let neighbours = (config.codebook == CodebookKind::Knn)
         .then(|| LeaveOneReadingOut::scan(features, config.ks.iter().copied().max().unwrap_or(1)));
     let candidate_training = CandidateTraining {
         features,
-        blocks: &blocks,
+        blocks: &reduced.blocks,
         neighbours: neighbours.as_ref(),
     };
     let progress = Mutex::new(progress);
@@ -343,8 +490,7 @@ pub fn train(
         let mut progress = progress.lock().unwrap_or_else(PoisonError::into_inner);
         (*progress)(event);
     };
-    let fitted: Vec<Candidate> = jobs
-        .par_iter()
+    jobs.par_iter()
         .enumerate()
         .map(|(index, &(k, restart))| {
             report(TrainProgress::Fitting {
@@ -353,14 +499,26 @@ pub fn train(
                 k,
                 restart,
             });
-            let candidate = fit_candidate(config, &candidate_training, &objects, &trials, k, restart);
+            let candidate = fit_candidate(config, &candidate_training, objects, trials, k, restart);
             report(TrainProgress::Scored(candidate.score.clone()));
             candidate
         })
-        .collect();
+        .collect()
+}
 
+/// The candidate model selection keeps, and every candidate's score in grid order.
+struct Chosen {
+    score: CandidateScore,
+    codebook: CodebookModel,
+    models: ObjectModels,
+    candidates: Vec<CandidateScore>,
+}
+
+/// Walks the candidates in grid order and keeps the best ([`CandidateScore::is_better_than`]: the
+/// first of equals); when none was fitted, the first failure.
+fn choose_candidate(fitted: Vec<Candidate>) -> Result<Chosen, RecognizeError> {
     let mut best: Option<(CandidateScore, CodebookModel, ObjectModels)> = None;
-    let mut candidates = Vec::with_capacity(total);
+    let mut candidates = Vec::with_capacity(fitted.len());
     let mut first_error = None;
     for candidate in fitted {
         match candidate.fitted {
@@ -378,24 +536,16 @@ pub fn train(
         }
         candidates.push(candidate.score);
     }
-    let Some((chosen, codebook, models)) = best else {
+    let Some((score, codebook, models)) = best else {
         return Err(
             first_error.unwrap_or_else(|| RecognizeError::NoFeatures("no candidate was fitted".into()))
         );
     };
-    let selection = SelectionReport {
-        chosen_k: chosen.k,
-        chosen_restart: chosen.restart,
+    Ok(Chosen {
+        score,
+        codebook,
+        models,
         candidates,
-        validation: validation_origin,
-        training_readings: training.reading_count(),
-        training_features: reduced.rows(),
-        pca_components: pca.output_dim(),
-        pca_variance_ratio: pca.kept_variance_ratio(),
-    };
-    Ok(Trained {
-        bag: BagOfFeatures::new(pca, codebook, models)?,
-        selection,
     })
 }
 
@@ -556,6 +706,17 @@ mod tests {
         assert_eq!(codebook_sizes(CodebookKind::Knn, 12, 12 * 60), vec![10, 20]);
         assert_eq!(codebook_sizes(CodebookKind::Knn, 12, 12 * 10), vec![5]);
         assert_eq!(codebook_sizes(CodebookKind::Knn, 3, 0), vec![1]);
+    }
+
+    /// The grid counts the readings that reach the codebook: without a separate validation set
+    /// the held-out 1/11 does not (105 readings of 2 objects support k = 20 only with all of them).
+    #[test]
+    fn the_grid_counts_the_training_readings_left_after_the_hold_out() {
+        let config = TrainConfig::default();
+        assert_eq!(config.grid_training_features(105, true), 105);
+        assert_eq!(config.grid_training_features(105, false), 95);
+        assert_eq!(config.clone().with_grid_for(2, 105, true).ks, vec![10, 20]);
+        assert_eq!(config.with_grid_for(2, 105, false).ks, vec![10]);
     }
 
     fn score(correct: usize, reliability: f64, failure: bool) -> CandidateScore {
