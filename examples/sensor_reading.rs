@@ -24,8 +24,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let image = pad.read_at(&pressed)?;
     println!(
-        "the pawn's top, pressed {} m deep:\n{image}",
-        0.5 * config.thickness_m
+        "the pawn's top, pressed {:.1} mm deep:\n{image}",
+        0.5e3 * config.thickness_m
     );
 
     let peak = image.values().iter().copied().fold(0.0, f64::max);

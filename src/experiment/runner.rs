@@ -162,7 +162,7 @@ where
     prepare_folders(options, &dir, detail.as_ref())?;
     let manifest = record_experiment(experiment, &dir, detail.clone())?;
 
-    let (in_shard, pending) = pending_in_shard::<R, D>(units, options, &dir)?;
+    let ShardUnits { in_shard, pending } = pending_in_shard::<R, D>(units, options, &dir)?;
     let reused = in_shard - pending.len();
     let ran = run_pending(&pending, options, &dir, detail.as_ref(), &spec.name.to_string())?;
 
@@ -252,7 +252,7 @@ fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
     units: &'u [Unit<'a, R, D>],
     options: &RunOptions,
     dir: &ExperimentDir,
-) -> Result<(usize, Vec<&'u Unit<'a, R, D>>), ExperimentError> {
+) -> Result<ShardUnits<'u, 'a, R, D>, ExperimentError> {
     let mut in_shard = 0;
     let mut pending = Vec::new();
     for (_, unit) in units
@@ -268,7 +268,13 @@ fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
             pending.push(unit);
         }
     }
-    Ok((in_shard, pending))
+    Ok(ShardUnits { in_shard, pending })
+}
+
+/// This shard's share of the units: how many it has, and those of them not yet saved.
+struct ShardUnits<'u, 'a, R, D> {
+    in_shard: usize,
+    pending: Vec<&'u Unit<'a, R, D>>,
 }
 
 /// Step 3: the pending units on a pool of `--threads` workers; no unit starts after one failed.
