@@ -6,9 +6,8 @@
 
 use glam::DVec3;
 use taction::control::arm_pad::ArmPad;
-use taction::control::{ControlConfig, settle};
+use taction::control::{ControlConfig, sensor_reader, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::collect::sensor_reader;
 use taction::explore::planner::precise_motion;
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::arm::PAD_SITE;
@@ -21,9 +20,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let top_m = pawn.mesh.vertices.iter().map(|v| v.z).fold(f64::MIN, f64::max);
 
     // The world: the arm, the table, the pawn at the origin, the sensor on the arm's pad site.
-    let sensor = SensorConfig::default();
+    let sensor = Valid::new(SensorConfig::paper())?;
     let builder = SceneBuilder::with_arm_and_table().object(ObjectSpec::from(pawn));
-    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE)?.build()?;
+    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
     let arm = scene.arm().cloned().ok_or(SimError::NoArm)?;
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
 
@@ -39,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Algorithm 1 on the arm.
     let control = Valid::new(ControlConfig::default())?;
-    let mut pad = ArmPad::new(&mut scene, &mut ik, sensor, reader, motion)?;
+    let mut pad = ArmPad::new(&mut scene, &mut ik, *sensor, reader, motion)?;
     let outcome = settle(&mut pad, &control)?;
     println!(
         "{:?} after {} Press/Orient iterations; pad centre {:.4} m, normal {:.3}\n{}",

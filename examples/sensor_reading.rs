@@ -7,7 +7,9 @@
 use glam::DVec3;
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::ObjectSpec;
-use taction::tactile::{FreeFloatingSensor, PadPose, SensorConfig};
+use taction::control::FreePad;
+use taction::tactile::{PadPose, SensorConfig};
+use taction::valid::Valid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // A built-in object: generated, checked and plausible (`Object::from_file` loads your own).
@@ -15,8 +17,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let top_m = pawn.mesh.vertices.iter().map(|v| v.z).fold(f64::MIN, f64::max);
 
     // The paper's letters sensor: 6x6 taxels on a 12 mm pad, a 1.2 mm covering.
-    let config = SensorConfig::default();
-    let mut pad = FreeFloatingSensor::new(ObjectSpec::from(pawn), &config)?;
+    let config = Valid::new(SensorConfig::paper())?;
+    let mut pad = FreePad::new(ObjectSpec::from(pawn), &config)?;
     let pressed = PadPose {
         center_m: DVec3::new(0.0, 0.0, top_m - 0.5 * config.thickness_m),
         normal: -DVec3::Z,
