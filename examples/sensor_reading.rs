@@ -5,9 +5,9 @@
 //! `cargo run --release --example sensor_reading`
 
 use glam::DVec3;
+use taction::control::FreePad;
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::ObjectSpec;
-use taction::control::FreePad;
 use taction::tactile::{PadPose, SensorConfig};
 use taction::valid::Valid;
 

@@ -17,8 +17,8 @@ use crate::explore::setup::TouchSetup;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
-use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::tactile::SensorConfig;
+use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::valid::{RangeError, Valid};
 
 /// Which procedure collects the readings.

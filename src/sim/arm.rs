@@ -394,18 +394,31 @@ impl Arm {
                 }
             });
         }
+        self.move_servo(scene, target, options, observer)
+    }
+
+    /// The servo execution of [`move_to`](Self::move_to): the position servos driven in
+    /// `max_step_rad` interpolated steps while MuJoCo steps, then up to `settle_intervals` more
+    /// control intervals for the joints to settle within `tolerance_rad`.
+    fn move_servo<F>(
+        &self,
+        scene: &mut Scene,
+        target: &[f64],
+        options: &MoveOptions,
+        mut observer: F,
+    ) -> Result<MoveOutcome, SimError>
+    where
+        F: FnMut(&mut Scene) -> bool,
+    {
         let target = self.checked_target(target)?;
         let start: Vec<f64> = self
             .joints
             .iter()
             .map(|j| scene.data().ctrl()[j.actuator])
             .collect();
-        let span = start
-            .iter()
-            .zip(&target)
-            .map(|(a, b)| (b - a).abs())
-            .fold(0.0, f64::max);
-        let intervals = (span / options.max_step_rad).ceil().max(1.0) as usize;
+        let intervals = (largest_difference(&start, &target) / options.max_step_rad)
+            .ceil()
+            .max(1.0) as usize;
         let mut command = start.clone();
         for k in 1..=intervals + options.settle_intervals {
             if k <= intervals {
@@ -415,25 +428,14 @@ impl Arm {
                 }
                 self.command(scene.data_mut(), &command);
             }
-            for _ in 0..options.steps_per_interval {
-                scene.step_without_sensors()?;
-                if let Some(c) = self.collision(scene) {
-                    return Ok(MoveOutcome::Collided(c));
-                }
+            if let Some(c) = self.step_interval(scene, options)? {
+                return Ok(MoveOutcome::Collided(c));
             }
             if observer(scene) {
                 return Ok(MoveOutcome::Stopped);
             }
-            if k >= intervals {
-                let q = self.q(scene.data());
-                let error = q
-                    .iter()
-                    .zip(&target)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max);
-                if error <= options.tolerance_rad {
-                    return Ok(MoveOutcome::Reached);
-                }
+            if k >= intervals && largest_difference(&self.q(scene.data()), &target) <= options.tolerance_rad {
+                return Ok(MoveOutcome::Reached);
             }
         }
         Err(SimError::Physics {
@@ -442,6 +444,18 @@ impl Arm {
                 options.settle_intervals
             ),
         })
+    }
+
+    /// One control interval of `steps_per_interval` MuJoCo steps; the first contact of the arm
+    /// with anything ends it.
+    fn step_interval(&self, scene: &mut Scene, options: &MoveOptions) -> Result<Option<Collision>, SimError> {
+        for _ in 0..options.steps_per_interval {
+            scene.step_without_sensors()?;
+            if let Some(c) = self.collision(scene) {
+                return Ok(Some(c));
+            }
+        }
+        Ok(None)
     }
 
     /// `target` validated and clamped into the joint limits.
@@ -475,43 +489,23 @@ impl Arm {
     {
         let target = self.checked_target(target)?;
         let start = self.q(scene.data());
-        let span = start
-            .iter()
-            .zip(&target)
-            .map(|(a, b)| (b - a).abs())
-            .fold(0.0, f64::max);
-        let reach_m = self.back_geom.map_or(0.0, |g| scene.model().geom_rbound()[g]);
-        let max_step_rad = options.max_step_rad.max(1e-6);
+        let path = JointPath {
+            span: largest_difference(&start, &target),
+            reach_m: self.back_geom.map_or(0.0, |g| scene.model().geom_rbound()[g]),
+            max_step_rad: options.max_step_rad.max(1e-6),
+            start: &start,
+            target: &target,
+        };
         let mut limit_m = options.max_pad_step_m;
-        let mut q = start.clone();
         let mut last_free = start.clone();
         scene.data_mut().kinematics();
-        let mut previous = self.site_pose(scene.data());
-        let mut s = 0.0_f64;
-        while s < 1.0 {
-            let mut ds = (1.0 - s).min(max_step_rad / span.max(1e-12));
-            // Shrink the increment until the pad travels at most `limit_m` (kinematics are cheap).
-            loop {
-                let next = (s + ds).min(1.0);
-                if next >= 1.0 {
-                    q.copy_from_slice(&target);
-                } else {
-                    for (v, (a, b)) in q.iter_mut().zip(start.iter().zip(&target)) {
-                        *v = a + (b - a) * next;
-                    }
-                }
-                self.set_q(scene.data_mut(), &q);
-                scene.data_mut().kinematics();
-                let pose = self.site_pose(scene.data());
-                let travel = (pose.position_m - previous.position_m).length()
-                    + pose.rotation.angle_between(previous.rotation) * reach_m;
-                if travel <= limit_m || ds * span <= 1e-7 {
-                    previous = pose;
-                    s = next;
-                    break;
-                }
-                ds *= (0.9 * limit_m / travel).clamp(0.1, 0.5);
-            }
+        let mut sample = PathSample {
+            s: 0.0,
+            q: start.clone(),
+            pad: self.site_pose(scene.data()),
+        };
+        while sample.s < 1.0 {
+            self.next_sample(scene, &path, &mut sample, limit_m);
             scene.data_mut().collision();
             scene.check_state()?;
             if let Some(c) = self.collision(scene) {
@@ -521,7 +515,7 @@ impl Arm {
             // The observer may have computed sensors; kinematics and contacts stay those of `q`.
             match observer(scene)? {
                 Watch::Stop => {
-                    self.rest_at(scene, &q);
+                    self.rest_at(scene, &sample.q);
                     return Ok(MoveOutcome::Stopped);
                 }
                 Watch::Blocked(c) => {
@@ -532,12 +526,75 @@ impl Arm {
                     limit_m = max_pad_step_m.min(options.max_pad_step_m).max(1e-6);
                 }
             }
-            last_free.copy_from_slice(&q);
+            last_free.copy_from_slice(&sample.q);
         }
         // The last sample was `target` itself: its kinematics and contacts are current.
         self.rest_at(scene, &target);
         Ok(MoveOutcome::Reached)
     }
+
+    /// Advances `sample` along `path` by at most `max_step_rad` on any joint and at most
+    /// `limit_m` of pad travel (the increment shrinks until it does: kinematics are cheap, and
+    /// the rigid back's bounding radius turns the pad's rotation into travel); the scene's
+    /// kinematics are left at the new sample.
+    fn next_sample(&self, scene: &mut Scene, path: &JointPath<'_>, sample: &mut PathSample, limit_m: f64) {
+        let mut ds = (1.0 - sample.s).min(path.max_step_rad / path.span.max(1e-12));
+        loop {
+            let next = (sample.s + ds).min(1.0);
+            path.at(next, &mut sample.q);
+            self.set_q(scene.data_mut(), &sample.q);
+            scene.data_mut().kinematics();
+            let pad = self.site_pose(scene.data());
+            let travel = (pad.position_m - sample.pad.position_m).length()
+                + pad.rotation.angle_between(sample.pad.rotation) * path.reach_m;
+            if travel <= limit_m || ds * path.span <= 1e-7 {
+                sample.pad = pad;
+                sample.s = next;
+                return;
+            }
+            ds *= (0.9 * limit_m / travel).clamp(0.1, 0.5);
+        }
+    }
+}
+
+/// A straight joint-space motion of [`Arm::move_kinematic`], from `start` (s = 0) to `target`
+/// (s = 1).
+struct JointPath<'a> {
+    start: &'a [f64],
+    target: &'a [f64],
+    /// The largest joint change along the path, radians.
+    span: f64,
+    /// The rigid back's bounding radius: how far its rim moves per radian the pad turns.
+    reach_m: f64,
+    max_step_rad: f64,
+}
+
+impl JointPath<'_> {
+    /// The configuration at `s` into `q`; `target` itself from s = 1 on.
+    fn at(&self, s: f64, q: &mut [f64]) {
+        if s >= 1.0 {
+            q.copy_from_slice(self.target);
+        } else {
+            for (v, (a, b)) in q.iter_mut().zip(self.start.iter().zip(self.target)) {
+                *v = a + (b - a) * s;
+            }
+        }
+    }
+}
+
+/// Where a kinematic motion is: its path parameter, the configuration and the pad site's pose.
+struct PathSample {
+    s: f64,
+    q: Vec<f64>,
+    pad: Pose,
+}
+
+/// The largest change of any joint from `from` to `to`, radians.
+fn largest_difference(from: &[f64], to: &[f64]) -> f64 {
+    from.iter()
+        .zip(to)
+        .map(|(a, b)| (b - a).abs())
+        .fold(0.0, f64::max)
 }
 
 /// The world pose of site `site`.

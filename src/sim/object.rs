@@ -95,42 +95,8 @@ impl ObjectSpec {
                 message: "the mesh has no triangles".into(),
             });
         }
-        let asset = match mesh_file {
-            Some(file) => format!(
-                "<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>",
-                escape_attr(file)
-            ),
-            None => {
-                let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
-                let face = self
-                    .mesh
-                    .triangles
-                    .iter()
-                    .flatten()
-                    .map(|i| i.to_string())
-                    .collect::<Vec<_>>()
-                    .join(" ");
-                format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
-            }
-        };
-        doc.add(Section::Asset, asset);
-
-        // Contacts go through the shell (see `collision_shell`), the sensor reads the exact mesh.
-        let mut shell = String::new();
-        for (i, piece) in collision_shell(&self.mesh, &ShellOptions::default())
-            .iter()
-            .enumerate()
-        {
-            let vertex = numbers(piece.iter().flat_map(|v| v.to_array()));
-            doc.add(
-                Section::Asset,
-                format!("<mesh name=\"{OBJECT_GEOM}_shell_{i}\" inertia=\"shell\" vertex=\"{vertex}\"/>"),
-            );
-            shell.push_str(&format!(
-                "<geom name=\"{OBJECT_GEOM}_shell_{i}\" type=\"mesh\" mesh=\"{OBJECT_GEOM}_shell_{i}\" \
-                 group=\"{COLLISION_GROUP}\" contype=\"2\" conaffinity=\"2\" rgba=\"0.8 0.5 0.3 0.3\" friction=\"0.6\"/>\n"
-            ));
-        }
+        doc.add(Section::Asset, self.mesh_asset(mesh_file));
+        let shell = self.add_collision_shell(doc);
 
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);
@@ -155,5 +121,50 @@ impl ObjectSpec {
             ),
         );
         Ok(())
+    }
+
+    /// The `<mesh>` asset of the exact surface the sensor reads: `mesh_file` when given, else the
+    /// vertices and faces inline.
+    fn mesh_asset(&self, mesh_file: Option<&str>) -> String {
+        match mesh_file {
+            Some(file) => format!(
+                "<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>",
+                escape_attr(file)
+            ),
+            None => {
+                let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
+                let face = self
+                    .mesh
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .map(|i| i.to_string())
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
+            }
+        }
+    }
+
+    /// Adds the convex pieces of the collision shell as assets and returns their geoms for the
+    /// object's body: contacts go through the shell (see `collision_shell`), the sensor reads the
+    /// exact mesh.
+    fn add_collision_shell(&self, doc: &mut Document) -> String {
+        let mut shell = String::new();
+        for (i, piece) in collision_shell(&self.mesh, &ShellOptions::default())
+            .iter()
+            .enumerate()
+        {
+            let vertex = numbers(piece.iter().flat_map(|v| v.to_array()));
+            doc.add(
+                Section::Asset,
+                format!("<mesh name=\"{OBJECT_GEOM}_shell_{i}\" inertia=\"shell\" vertex=\"{vertex}\"/>"),
+            );
+            shell.push_str(&format!(
+                "<geom name=\"{OBJECT_GEOM}_shell_{i}\" type=\"mesh\" mesh=\"{OBJECT_GEOM}_shell_{i}\" \
+                 group=\"{COLLISION_GROUP}\" contype=\"2\" conaffinity=\"2\" rgba=\"0.8 0.5 0.3 0.3\" friction=\"0.6\"/>\n"
+            ));
+        }
+        shell
     }
 }
