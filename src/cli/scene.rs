@@ -149,24 +149,15 @@ fn touch_from_above(
     Ok(in_contact)
 }
 
-/// Writes the scene and its mesh; returns the scene file's path.
-pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
-    let config = args.sensor.config(args.seed)?;
-    let built = resolve_object(&args.object, args.object_size.m)?;
-    check_mesh(&format!("--object: {}", args.object), &built.mesh, Carrier::Arm)?;
-    if !built.warnings.is_clean() {
-        eprintln!(
-            "taction scene export: warning: {}: {}",
-            args.object, built.warnings
-        );
-    }
-    // Named as `taction objects export` names its files.
-    let mesh_file = format!("{}.obj", built.name);
-    let spec = ObjectSpec::from(built);
-    let mut builder = SceneBuilder::with_arm_and_table()
-        .object(spec.clone())
-        .object_mesh_file(mesh_file.clone());
-    let keyframe = match touch_from_above(&spec, &config)? {
+/// `builder` with the keyframe "touch" where the arm, pressing from above, settled on `spec`
+/// (none, with a warning, when it could not), and the sentence the scene's header gives it.
+fn with_touch_keyframe(
+    mut builder: SceneBuilder,
+    spec: &ObjectSpec,
+    config: &Valid<SensorConfig>,
+    object: &str,
+) -> Result<(SceneBuilder, String), Box<dyn std::error::Error>> {
+    let keyframe = match touch_from_above(spec, config)? {
         Some(touch) => {
             builder = builder.add(
                 Section::Keyframe,
@@ -187,11 +178,32 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
         None => {
             eprintln!(
                 "taction scene export: warning: {}: the arm could not press the pad onto the object from above; the scene has no keyframe \"touch\"",
-                args.object
+                object
             );
             "No keyframe: the arm could not press the pad onto the object from above.".to_string()
         }
     };
+    Ok((builder, keyframe))
+}
+
+/// Writes the scene and its mesh; returns the scene file's path.
+pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
+    let config = args.sensor.config(args.seed)?;
+    let built = resolve_object(&args.object, args.object_size.m)?;
+    check_mesh(&format!("--object: {}", args.object), &built.mesh, Carrier::Arm)?;
+    if !built.warnings.is_clean() {
+        eprintln!(
+            "taction scene export: warning: {}: {}",
+            args.object, built.warnings
+        );
+    }
+    // Named as `taction objects export` names its files.
+    let mesh_file = format!("{}.obj", built.name);
+    let spec = ObjectSpec::from(built);
+    let builder = SceneBuilder::with_arm_and_table()
+        .object(spec.clone())
+        .object_mesh_file(mesh_file.clone());
+    let (builder, keyframe) = with_touch_keyframe(builder, &spec, &config, &args.object)?;
     let xml = add_sensor(builder, &config, "tactile", PAD_SITE).to_xml()?;
     let header = comment(&format!(
         "  Written by taction scene export for the object {}: the arm, the table, the object (mesh in {mesh_file},\n  \
