@@ -13,7 +13,7 @@
 //! # Ok::<(), taction::valid::RangeError>(())
 //! ```
 //!
-//! Everything else stays at its module's root (`taction::recognize::GaussianMixture`, ...); the
+//! Everything else stays at its module's root (`taction::recognize::OnlinePosterior`, `taction::recognize::pipeline::GaussianMixture`, ...); the
 //! modules' own files are not part of the interface.
 
 pub use crate::control::{ContactOutcome, ControlConfig, FreePad, PadCarrier, settle};

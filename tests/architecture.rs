@@ -329,7 +329,8 @@ fn tests_benches_and_the_command_line_use_module_roots() {
         rust_files(&root.join(dir), &mut files);
     }
     let mut deep = Vec::new();
-    for file in &files {
+    // This file's own samples of what the scan looks for are not uses.
+    for file in files.iter().filter(|f| !f.ends_with("tests/architecture.rs")) {
         let text = std::fs::read_to_string(file).expect("source is readable");
         for path in deep_paths(&text, &modules) {
             let relative = file.strip_prefix(root).expect("under the root");

@@ -9,22 +9,28 @@
 //! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
 //! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
 //! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
-//! alike. The file format is in [`format`]; the counts `dataset show` prints in `summary.rs`; the
+//! alike. The file format is in `format.rs`; the counts `dataset show` prints in `summary.rs`; the
 //! recorded frames of a real sensor, and their import as a dataset (`dataset import`), in
-//! [`recorded`].
+//! `recorded.rs` ([`import_real_csv`]).
 
 mod format;
 mod reading;
-pub mod recorded;
+pub(crate) mod recorded;
 mod status;
 mod strategy;
 mod summary;
 
-pub use format::{FORMAT_VERSION, column_names, format_f64};
+// A reading and how its contact ended.
 pub use reading::{AttemptCause, CauseKind, Reading};
 pub use status::ContactStatus;
 pub use strategy::Strategy;
+
+// The file: its columns and numbers, and the counts `dataset show` prints.
+pub use format::{FORMAT_VERSION, column_names, format_f64};
 pub use summary::DatasetSummary;
+
+// A real sensor's recorded frames, and their import as a dataset.
+pub use recorded::{Calibration, Normalisation, RealImport, RealReading, import_real_csv, parse_real_csv};
 
 use std::fmt;
 

@@ -17,8 +17,8 @@ use crate::explore::setup::TouchSetup;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
-use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::tactile::SensorConfig;
+use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::valid::{RangeError, Valid};
 
 /// Which procedure collects the readings.
@@ -73,7 +73,7 @@ pub struct CollectPlan {
 }
 
 /// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
-pub use crate::control::sensor_reader;
+use crate::control::sensor_reader;
 
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.

@@ -7,8 +7,8 @@ use glam::DVec3;
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
 use taction::sim::SceneBuilder;
-use taction::sim::mjcf::Section;
-use taction::tactile::free_floating::free_pad_body_xml;
+use taction::sim::Section;
+use taction::tactile::free_pad_body_xml;
 use taction::tactile::{PadPose, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
