@@ -36,12 +36,13 @@ use taction::explore::TouchScorer;
 use taction::explore::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
+use taction::pose::PadPose;
 use taction::recognize::PseudoCount;
 use taction::recognize::pipeline::{ClusterHistogram, ObjectModels};
 use taction::sim::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
+use taction::tactile::SensorConfig;
 use taction::tactile::{CoveringSensor, add_sensor};
-use taction::tactile::{PadPose, SensorConfig};
 use taction::valid::Valid;
 
 /// Converged readings per timed run.

@@ -39,6 +39,7 @@ use obvhs::triangle::Triangle;
 use sensor_support::{geodesic_sphere, icosphere, taxel_centre};
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
+use taction::pose::PadPose;
 use taction::sim::COLLISION_GROUP;
 use taction::sim::numbers;
 use taction::sim::{ObjectSpec, SceneBuilder};
@@ -46,7 +47,7 @@ use taction::tactile::pipeline::DepthBuffer;
 use taction::tactile::pipeline::ImageFormation;
 use taction::tactile::pipeline::MeshBvh;
 use taction::tactile::pipeline::SampleGrid;
-use taction::tactile::{PadPose, SensorConfig, query_region};
+use taction::tactile::{SensorConfig, query_region};
 use taction::tactile::{free_floating_builder, free_pad_body_xml};
 use taction::valid::Valid;
 

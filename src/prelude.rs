@@ -22,9 +22,10 @@ pub use crate::describe::{Descriptor, DescriptorKind};
 pub use crate::explore::{Collect, CollectMode, CollectPlan};
 pub use crate::explore::{PlannerConfig, SamplerConfig};
 pub use crate::mesh::{ObjectSet, TriMesh};
+pub use crate::pose::PadPose;
 pub use crate::recognize::{
     DescriptorChoice, OnlinePosterior, ReadingRange, Recognizer, TrainConfig, TrainedModel, evaluate, train,
 };
 pub use crate::sim::{ObjectSpec, PerturbationBounds};
-pub use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
+pub use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 pub use crate::valid::{Check, Valid};

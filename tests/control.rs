@@ -7,10 +7,11 @@ use rand::RngExt;
 use taction::control::{ControlConfig, FreePad, settle};
 use taction::dataset::ContactStatus;
 use taction::mesh::TriMesh;
+use taction::pose::PadPose;
 use taction::pose::Pose;
 use taction::rng;
 use taction::sim::ObjectSpec;
-use taction::tactile::{PadPose, SensorConfig};
+use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
 fn sensor() -> SensorConfig {

@@ -84,10 +84,11 @@ fn bad_config_fails_compilation_naming_the_key_and_range() {
 
 use glam::DQuat;
 use taction::control::FreePad;
+use taction::pose::PadPose;
 use taction::pose::Pose;
 use taction::sim::COLLISION_GROUP;
 use taction::sim::{ObjectMount, ObjectSpec};
-use taction::tactile::{PadPose, TactileImage};
+use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
 /// The analytic depth of the ray through pad point (x, y) to the plane z = 0 (pad above it).

@@ -17,10 +17,11 @@ use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::mesh::BUILTIN_SETS;
 use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
+use taction::pose::PadPose;
 use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::sim::{Section, comment, numbers};
-use taction::tactile::{PadPose, SensorConfig, add_sensor};
+use taction::tactile::{SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::ObjectSizeArg;

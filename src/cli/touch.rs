@@ -21,9 +21,10 @@ use taction::control::{
     ArmPad, ContactOutcome, ContactReport, ControlConfig, FreePad, sensor_reader, settle,
 };
 use taction::explore::precise_motion;
+use taction::pose::PadPose;
 use taction::sim::{ARM_JOINTS, PAD_SITE};
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::{CoveringSensor, PadPose, SensorConfig, add_sensor};
+use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ControlArg, ControlFileError, SeedArg};

@@ -26,7 +26,7 @@ pub use status::ContactStatus;
 pub use strategy::Strategy;
 
 // The file: its columns and numbers, and the counts `dataset show` prints.
-pub use format::{FORMAT_VERSION, column_names, format_f64};
+pub use format::{FORMAT_VERSION, column_names};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.
@@ -317,9 +317,11 @@ pub fn describe_shortfalls(shortfalls: &[Shortfall]) -> String {
 mod tests {
     use glam::{DQuat, DVec3};
 
+    use super::format::format_f64;
     use super::*;
+    use crate::pose::PadPose;
     use crate::pose::Pose;
-    use crate::tactile::{PadPose, TactileImage};
+    use crate::tactile::TactileImage;
 
     #[test]
     fn the_column_layout_lists_every_column_once_in_file_order() {

@@ -246,13 +246,16 @@ fn record_experiment<R, C: Serialize, D: DetailRow>(
     Ok(manifest)
 }
 
+/// A shard's unit count, and those of its units not yet saved.
+type Pending<'u, 'a, R, D> = (usize, Vec<&'u Unit<'a, R, D>>);
+
 /// Step 2: this shard's unit count, and those of its units not yet saved (a saved one must read
 /// back as rows of `R`).
 fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
     units: &'u [Unit<'a, R, D>],
     options: &RunOptions,
     dir: &ExperimentDir,
-) -> Result<(usize, Vec<&'u Unit<'a, R, D>>), ExperimentError> {
+) -> Result<Pending<'u, 'a, R, D>, ExperimentError> {
     let mut in_shard = 0;
     let mut pending = Vec::new();
     for (_, unit) in units

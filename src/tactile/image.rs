@@ -11,7 +11,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::{FileError, write_atomic};
-pub use crate::pose::PadPose;
+use crate::pose::PadPose;
 
 /// Errors from building or reading a tactile image; each names the offending place.
 #[derive(Debug, thiserror::Error)]

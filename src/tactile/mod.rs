@@ -32,7 +32,7 @@ pub(crate) mod sensor;
 
 // The sensor: its configuration, its image, and the handle that reads it from `sensordata`.
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
-pub use image::{ImageError, PadPose, TactileImage, write_contact_sheet};
+pub use image::{ImageError, TactileImage, write_contact_sheet};
 pub use sensor::{CoveringSensor, TactileError, add_sensor, extension_xml, sensor_xml};
 
 // The pad on a mocap body, no arm (Sec. V-A3).

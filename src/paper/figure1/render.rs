@@ -16,9 +16,10 @@ use glam::DVec3;
 
 use crate::dataset::Reading;
 use crate::mesh::TriMesh;
+use crate::pose::PadPose;
 use crate::pose::Pose;
 use crate::tactile::image::{CONTACT_SHEET_GUTTER_PX, GrayPicture, contact_sheet, write_rgb_png};
-use crate::tactile::{ImageError, PadPose, SensorConfig, TactileImage};
+use crate::tactile::{ImageError, SensorConfig, TactileImage};
 
 /// The paper's figure shows the first 50 tactile images of a 100-reading exploration.
 pub const PAPER_IMAGES_SHOWN: usize = 50;
