@@ -30,7 +30,10 @@ pub use format::{FORMAT_VERSION, column_names};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.
-pub use recorded::{Calibration, Normalisation, RealImport, RealReading, import_real_csv, parse_real_csv};
+pub use recorded::{
+    Calibration, Normalisation, RealData, RealImport, RealReading, SYNTHETIC_MARK, import_real_csv,
+    parse_real_csv,
+};
 
 use std::fmt;
 

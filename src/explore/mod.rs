@@ -21,7 +21,10 @@ pub use sampler::{SamplerConfig, TrainingSampler};
 pub use surface_sampling::{SurfacePoint, SurfaceSampler};
 
 // The planner (Sec. III-A): its tree, how the arm reaches, and its report.
-pub use planner::{Planner, PlannerConfig, precise_kinematic_motion, precise_motion};
+pub use planner::{
+    ITERATIONS_PER_READING, Planner, PlannerConfig, WORKSPACE_MARGIN_M, precise_kinematic_motion,
+    precise_motion,
+};
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;
 pub use tree::{ExplorationTree, Vertex};

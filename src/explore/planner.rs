@@ -407,7 +407,7 @@ where
     }
 
     /// [`explore_reporting`](Self::explore_reporting) with the active strategy when `guidance` is
-    /// given ([`crate::explore::active`]): each iteration draws `guidance.candidates` targets by the
+    /// given (`explore/active.rs`): each iteration draws `guidance.candidates` targets by the
     /// local/global rule and expands toward the one the scorer rates highest; the readings are
     /// tagged [`Strategy::Active`].
     pub fn explore_guided(

@@ -47,9 +47,11 @@ pub use object_set::{BUILTIN_SETS, BuildOptions, NamedObject, ObjectSet, ObjectS
 
 // The paper's objects: the CGAL meshes fetched from Debian, chess pieces as surfaces of
 // revolution, raised letters from a font.
-pub use cgal::{CGAL_MESHES, CgalMesh, DEB_FILE, ObjectCache, cache_root_from, cgal_mesh, ensure_fetched};
+pub use cgal::{
+    CGAL_MESHES, CgalMesh, DEB_FILE, ObjectCache, cache_root, cache_root_from, cgal_mesh, ensure_fetched,
+};
 pub use chess::ChessPiece;
-pub use glyph::Font;
+pub use glyph::{BUILTIN_FONT_PREFIX, CAPITAL_I_FONT, DEFAULT_FONT, Font};
 pub use glyph_overlap::{LetterPair, letter_pairs};
 pub use letters::{LetterStyle, alphabet, letter_from_name, letter_name, letter_outline, raised_letter};
-pub use revolution::Profile;
+pub use revolution::{Profile, ProfileBuilder};

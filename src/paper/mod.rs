@@ -45,8 +45,8 @@ use std::path::PathBuf;
 // under `<out>/data`; the time it will take; the headline table `reproduce` prints.
 pub use context::{EXAMPLE_REAL_CSV, Family, PaperContext, RealRecording};
 pub use data::{SHORTFALLS_FILE, read_shortfalls};
-pub use estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
-pub use headline::headline_table;
+pub use estimate::{PACE_AFTER_S, REFERENCE_THREADS, RunEstimate, human_duration};
+pub use headline::{HEADLINE_READINGS, headline_table};
 pub use scale::{DataCounts, Scale, ScaleError};
 
 // The recognition figures: a sweep of settings, each a curve over the readings.
@@ -61,7 +61,7 @@ pub use figure1::{
 // Fig. 14: controller convergence against noise.
 pub use convergence::{
     ConvergencePlan, ConvergenceRow, MIN_CONVERGENCES, PAPER_NOISE_FRACTIONS, convergence_experiment,
-    paper_object,
+    convergences_at, paper_object,
 };
 
 // Fig. 16b and 17: recorded frames of a real sensor, pruned and split; the simulation made to look

@@ -14,7 +14,9 @@ pub use object::{ObjectMount, ObjectSpec};
 pub use scene::{Scene, SceneBuilder, SceneObject, SceneState};
 
 // The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.
-pub use arm::{ARM_JOINTS, Arm, Collision, Execution, MoveOptions, MoveOutcome, PAD_SITE};
+pub use arm::{
+    ARM_JOINTS, Arm, Collision, Execution, MoveOptions, MoveOutcome, PAD_BACK_GEOM, PAD_SITE, Watch,
+};
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 
 // The object perturbed between readings (Sec. V-B4).

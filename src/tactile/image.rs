@@ -269,7 +269,7 @@ pub fn contact_sheet(
     })
 }
 
-/// Writes the [`contact_sheet`] of `images` as PNG.
+/// Writes the `contact_sheet` of `images` as PNG.
 pub fn write_contact_sheet(
     images: &[TactileImage],
     columns: usize,

@@ -167,7 +167,7 @@ impl Camera {
     }
 }
 
-/// Renders the object at `object_pose` with every placement's patch, and the [`contact_sheet`] of
+/// Renders the object at `object_pose` with every placement's patch, and the `contact_sheet` of
 /// the first `view.images_shown` tactile images to its right, scaled to the panel's height. Fails
 /// only when the images differ in shape.
 pub fn render_exploration(
