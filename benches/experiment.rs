@@ -7,10 +7,10 @@ use std::path::Path;
 
 use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
-use taction::dataset::recorded::{RealImport, import_real_csv};
-use taction::experiment::figure::{Figure, Panel, ReferenceLine, Series};
-use taction::experiment::plot::ACCURACY_LABEL;
+use taction::dataset::{RealImport, import_real_csv};
+use taction::experiment::ACCURACY_LABEL;
 use taction::experiment::{Experiment, ExperimentSpec, RunOptions, SafeName, Unit, run};
+use taction::experiment::{Figure, Panel, ReferenceLine, Series};
 use taction::paper::SimToRealPreprocess;
 use taction::tactile::TactileImage;
 

@@ -33,15 +33,16 @@ use rand::RngExt;
 use taction::active_touch::InformationGain;
 use taction::control::{FreePad, sensor_reader};
 use taction::explore::TouchScorer;
-use taction::explore::collect::{CollectMode, CollectPlan};
+use taction::explore::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig};
 use taction::mesh::{BuildOptions, ObjectSet};
+use taction::pose::PadPose;
 use taction::recognize::PseudoCount;
 use taction::recognize::pipeline::{ClusterHistogram, ObjectModels};
-use taction::sim::arm::{Execution, PAD_SITE};
+use taction::sim::{Execution, PAD_SITE};
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
-use taction::tactile::sensor::{CoveringSensor, add_sensor};
-use taction::tactile::{PadPose, SensorConfig};
+use taction::tactile::SensorConfig;
+use taction::tactile::{CoveringSensor, add_sensor};
 use taction::valid::Valid;
 
 /// Converged readings per timed run.

@@ -5,12 +5,12 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use taction::mesh::chess::ChessPiece;
-use taction::mesh::glyph::Font;
-use taction::mesh::letters::{LetterStyle, alphabet, raised_letter};
+use taction::mesh::ChessPiece;
+use taction::mesh::Font;
 use taction::mesh::{
     CGAL_MESHES, MeshFormat, ValidationReport, ensure_fetched, normalise_to_diagonal, parse,
 };
+use taction::mesh::{LetterStyle, alphabet, raised_letter};
 
 fn bench_mesh(c: &mut Criterion) {
     let cache = ensure_fetched().expect("the CGAL meshes can be fetched");

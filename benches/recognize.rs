@@ -21,13 +21,13 @@ use std::path::{Path, PathBuf};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use rand::RngExt;
-use taction::dataset::format_f64;
 use taction::describe::Feature;
 use taction::recognize::pipeline::{
     FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LeaveOneReadingOut, TrainingFeatures,
 };
 use taction::recognize::{CodebookConfig, CodebookKind, LabelledFeatures, TrainConfig, train};
 use taction::rng::{Rng, stream};
+use taction::units::round_trip;
 use taction::valid::Valid;
 
 const OBJECTS: usize = 10;
@@ -78,7 +78,7 @@ fn bench_data_dir() -> PathBuf {
 fn export(path: &Path, data: &FeatureMatrix) {
     let mut text = String::new();
     for row in data.iter_rows() {
-        let line: Vec<String> = row.iter().map(|&v| format_f64(v)).collect();
+        let line: Vec<String> = row.iter().map(|&v| round_trip(v)).collect();
         text.push_str(&line.join(","));
         text.push('\n');
     }

@@ -39,15 +39,16 @@ use obvhs::triangle::Triangle;
 use sensor_support::{geodesic_sphere, icosphere, taxel_centre};
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
-use taction::sim::mjcf::COLLISION_GROUP;
-use taction::sim::mjcf::numbers;
+use taction::pose::PadPose;
+use taction::sim::COLLISION_GROUP;
+use taction::sim::numbers;
 use taction::sim::{ObjectSpec, SceneBuilder};
-use taction::tactile::formation::ImageFormation;
-use taction::tactile::free_floating::{free_floating_builder, free_pad_body_xml};
-use taction::tactile::grid::SampleGrid;
-use taction::tactile::mesh_bvh::MeshBvh;
-use taction::tactile::raster::DepthBuffer;
-use taction::tactile::{PadPose, SensorConfig, query_region};
+use taction::tactile::pipeline::DepthBuffer;
+use taction::tactile::pipeline::ImageFormation;
+use taction::tactile::pipeline::MeshBvh;
+use taction::tactile::pipeline::SampleGrid;
+use taction::tactile::{SensorConfig, query_region};
+use taction::tactile::{free_floating_builder, free_pad_body_xml};
 use taction::valid::Valid;
 
 const RADIUS_M: f64 = 0.05;
@@ -165,7 +166,7 @@ impl RawScene {
 }
 
 /// MuJoCo's rays see the geom groups the covering senses: every group but the objects' collision
-/// shells (`taction::sim::mjcf::COLLISION_GROUP`), which would only add geoms for MuJoCo to test.
+/// shells (`taction::sim::COLLISION_GROUP`), which would only add geoms for MuJoCo to test.
 const SENSED_GROUPS: [u8; 6] = {
     let mut groups = [1; 6];
     groups[COLLISION_GROUP as usize] = 0;
@@ -349,7 +350,7 @@ fn sensor(c: &mut Criterion) {
             let mut bare = SceneBuilder::new()
                 .table(false)
                 .object(ObjectSpec::new("sphere", mesh.clone()))
-                .add(taction::sim::mjcf::Section::Worldbody, free_pad_body_xml(&config))
+                .add(taction::sim::Section::Worldbody, free_pad_body_xml(&config))
                 .build()
                 .unwrap();
             {

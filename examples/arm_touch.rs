@@ -5,13 +5,13 @@
 //! `cargo run --release --example arm_touch`
 
 use glam::DVec3;
-use taction::control::arm_pad::ArmPad;
-use taction::control::{ControlConfig, sensor_reader, settle};
+
+use taction::control::{ArmPad, ControlConfig, sensor_reader, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::planner::precise_motion;
+use taction::explore::precise_motion;
 use taction::mesh::{BuildOptions, ObjectSet};
-use taction::sim::arm::PAD_SITE;
-use taction::sim::{InverseKinematics, ObjectSpec, PadTarget, SceneBuilder, SimError};
+
+use taction::sim::{InverseKinematics, ObjectSpec, PAD_SITE, PadTarget, SceneBuilder, SimError};
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 

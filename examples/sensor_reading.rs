@@ -7,8 +7,9 @@
 use glam::DVec3;
 use taction::control::FreePad;
 use taction::mesh::{BuildOptions, ObjectSet};
+use taction::pose::PadPose;
 use taction::sim::ObjectSpec;
-use taction::tactile::{PadPose, SensorConfig};
+use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -13,7 +13,7 @@
 //! # Ok::<(), taction::valid::RangeError>(())
 //! ```
 //!
-//! Everything else stays at its module's root (`taction::recognize::GaussianMixture`, ...); the
+//! Everything else stays at its module's root (`taction::recognize::OnlinePosterior`, `taction::recognize::pipeline::GaussianMixture`, ...); the
 //! modules' own files are not part of the interface.
 
 pub use crate::control::{ContactOutcome, ControlConfig, FreePad, PadCarrier, settle};
@@ -22,9 +22,10 @@ pub use crate::describe::{Descriptor, DescriptorKind};
 pub use crate::explore::{Collect, CollectMode, CollectPlan};
 pub use crate::explore::{PlannerConfig, SamplerConfig};
 pub use crate::mesh::{ObjectSet, TriMesh};
+pub use crate::pose::PadPose;
 pub use crate::recognize::{
     DescriptorChoice, OnlinePosterior, ReadingRange, Recognizer, TrainConfig, TrainedModel, evaluate, train,
 };
 pub use crate::sim::{ObjectSpec, PerturbationBounds};
-pub use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
+pub use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 pub use crate::valid::{Check, Valid};

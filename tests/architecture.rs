@@ -209,3 +209,154 @@ fn no_two_files_of_a_module_use_each_other() {
         "{found:?}"
     );
 }
+
+/// The crate's top-level modules that have files of their own (a folder under `src/`), each with
+/// the names of those files (`arm` for `sim/arm.rs`, `figure1` for `paper/figure1/mod.rs`). The
+/// command line (`cli`) is the binary, not the library.
+fn file_modules() -> BTreeMap<String, BTreeSet<String>> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut modules = BTreeMap::new();
+    for entry in std::fs::read_dir(&src).expect("src is readable") {
+        let dir = entry.expect("directory entry").path();
+        let Some(module) = dir.file_name().and_then(|n| n.to_str()).map(str::to_string) else {
+            continue;
+        };
+        if !dir.is_dir() || module == "cli" {
+            continue;
+        }
+        let mut files = BTreeSet::new();
+        for file in std::fs::read_dir(&dir).expect("module folder is readable") {
+            let path = file.expect("directory entry").path();
+            let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            if path.is_dir() || (path.extension().is_some_and(|e| e == "rs") && stem != "mod") {
+                files.insert(stem.to_string());
+            }
+        }
+        modules.insert(module, files);
+    }
+    modules
+}
+
+/// The `pub mod name;` declarations of a module root: each makes a file part of the interface.
+/// An inline grouping module (`pub mod pipeline { pub use super::...; }`) is allowed.
+fn public_file_modules(root: &str) -> Vec<String> {
+    root.lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with("//"))
+        .filter_map(|l| l.strip_prefix("pub mod "))
+        .filter(|rest| !rest.trim_end().ends_with('{'))
+        .map(|rest| rest.trim_end_matches(';').trim().to_string())
+        .collect()
+}
+
+#[test]
+fn module_roots_keep_their_files_private() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut public = Vec::new();
+    for module in file_modules().keys() {
+        let root = std::fs::read_to_string(src.join(module).join("mod.rs")).expect("a module root");
+        for file in public_file_modules(&root) {
+            public.push(format!("src/{module}/mod.rs: pub mod {file};"));
+        }
+    }
+    assert!(
+        public.is_empty(),
+        "a module's files are private (`pub(crate) mod`); re-export what users need from its root:\n{}",
+        public.join("\n")
+    );
+}
+
+/// The paths `taction::<module>::<file>::...` in `text`'s code lines that go through one of the
+/// module's files instead of its root, also inside a group (`taction::paper::{data::X, Scale}`).
+fn deep_paths(text: &str, modules: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    let code: String = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut found = Vec::new();
+    for (at, _) in code.match_indices("taction::") {
+        let rest = &code[at + "taction::".len()..];
+        let module = ident(rest);
+        let Some(files) = modules.get(&module) else {
+            continue;
+        };
+        let Some(after) = rest[module.len()..].strip_prefix("::") else {
+            continue;
+        };
+        // The first segment after the module, or each first segment of a `{...}` group.
+        let mut firsts = Vec::new();
+        if let Some(group) = after.strip_prefix('{') {
+            let mut depth = 1;
+            let mut start = true;
+            for (i, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 1 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 1 => start = true,
+                    c if start && !c.is_whitespace() => {
+                        start = false;
+                        firsts.push(&group[i..]);
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            firsts.push(after);
+        }
+        for first in firsts {
+            let name = ident(first);
+            if files.contains(&name) && first[name.len()..].starts_with("::") {
+                found.push(format!("taction::{module}::{name}::"));
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn tests_benches_and_the_command_line_use_module_roots() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let modules = file_modules();
+    let mut files = vec![root.join("src/main.rs")];
+    for dir in ["tests", "benches", "examples", "src/cli"] {
+        rust_files(&root.join(dir), &mut files);
+    }
+    let mut deep = Vec::new();
+    // This file's own samples of what the scan looks for are not uses.
+    for file in files.iter().filter(|f| !f.ends_with("tests/architecture.rs")) {
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        for path in deep_paths(&text, &modules) {
+            let relative = file.strip_prefix(root).expect("under the root");
+            deep.push(format!("{}: {path}", relative.display()));
+        }
+    }
+    assert!(
+        deep.is_empty(),
+        "{} paths through a module's files; use the module's root:\n{}",
+        deep.len(),
+        deep.join("\n")
+    );
+}
+
+#[test]
+fn the_scans_see_a_public_file_and_a_deep_path() {
+    let modules = BTreeMap::from([(
+        "sim".to_string(),
+        BTreeSet::from(["arm".to_string(), "mjcf".to_string()]),
+    )]);
+    let text = "// taction::sim::arm::PAD_SITE in a comment\nuse taction::sim::arm::PAD_SITE;\n\
+                use taction::sim::{Scene, mjcf::{Section, numbers}};\nuse taction::sim::Arm;\n";
+    assert_eq!(
+        deep_paths(text, &modules),
+        ["taction::sim::arm::", "taction::sim::mjcf::"]
+    );
+    let root = "pub(crate) mod arm;\npub mod mjcf;\n/// Grouped.\npub mod pipeline {\n";
+    assert_eq!(public_file_modules(root), ["mjcf"]);
+}

@@ -11,10 +11,10 @@
 
 use taction::control::{ArmPad, ContactOutcome, ControlConfig, FreePad, sensor_reader, settle};
 use taction::dataset::ContactStatus;
-use taction::explore::planner::precise_kinematic_motion;
+use taction::explore::precise_kinematic_motion;
 use taction::explore::{SurfaceSampler, carried};
 use taction::mesh::ObjectSet;
-use taction::sim::arm::PAD_SITE;
+use taction::sim::PAD_SITE;
 use taction::sim::{InverseKinematics, ObjectSpec, PadTarget, Scene, SceneBuilder};
 use taction::tactile::{CoveringSensor, SensorConfig, TactileImage, add_sensor};
 use taction::valid::Valid;

@@ -7,10 +7,11 @@ use rand::RngExt;
 use taction::control::{ControlConfig, FreePad, settle};
 use taction::dataset::ContactStatus;
 use taction::mesh::TriMesh;
+use taction::pose::PadPose;
 use taction::pose::Pose;
 use taction::rng;
 use taction::sim::ObjectSpec;
-use taction::tactile::{PadPose, SensorConfig};
+use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
 fn sensor() -> SensorConfig {
@@ -145,7 +146,7 @@ fn sphere_converges_and_box_edge_reading_shows_the_edge() {
     for r in 0..6 {
         for c in 0..6 {
             let v = image.get(r, c);
-            let (x, y) = taction::control::orient::taxel_position_m(&sensor(), r, c);
+            let (x, y) = taction::control::taxel_position_m(&sensor(), r, c);
             wx += v * x;
             wy += v * y;
             w += v;

@@ -5,7 +5,7 @@ use std::num::NonZeroUsize;
 use std::path::Path;
 
 use taction::experiment::{RunOptions, Shard, run};
-use taction::paper::convergence::{
+use taction::paper::{
     ConvergencePlan, ConvergenceRow, MIN_CONVERGENCES, PAPER_NOISE_FRACTIONS, convergence_experiment,
     paper_object,
 };

@@ -10,14 +10,14 @@ use std::time::{Duration, Instant};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
-use taction::dataset::recorded::parse_real_csv;
-use taction::dataset::recorded::{Normalisation, RealImport, import_real_csv};
-use taction::experiment::plot::build_figure;
+use taction::dataset::parse_real_csv;
+use taction::dataset::{Normalisation, RealImport, import_real_csv};
+use taction::experiment::build_figure;
 use taction::experiment::{
     AccuracyCurve, AccuracyRow, Axis, DetailRow, Experiment, ExperimentError, ExperimentSpec, Factor,
     Factors, PlotSpec, RunOptions, SafeName, Shard, Unit, merge, run,
 };
-use taction::paper::sim_to_real::square_root;
+use taction::paper::square_root;
 use taction::paper::{GaussianBlur, SimToRealPreprocess, SplitSizes, split_per_label};
 use taction::recognize::{AccuracyPoint, TrialOutcome};
 use taction::tactile::TactileImage;

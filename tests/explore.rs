@@ -7,7 +7,7 @@ use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::dataset::Strategy;
 use taction::explore::PlannerConfig;
-use taction::explore::collect::{CollectMode, CollectPlan};
+use taction::explore::{CollectMode, CollectPlan};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
@@ -290,11 +290,11 @@ fn datasets_are_identical_for_one_and_two_threads() {
 /// leaves the tree near the arm's start, outside most octants.
 #[test]
 fn global_strategy_covers_the_workspace() {
+    use taction::control::sensor_reader;
     use taction::explore::Planner;
-    use taction::explore::collect::sensor_reader;
+    use taction::sim::PAD_SITE;
     use taction::sim::SceneBuilder;
-    use taction::sim::arm::PAD_SITE;
-    use taction::tactile::sensor::{CoveringSensor, add_sensor};
+    use taction::tactile::{CoveringSensor, add_sensor};
 
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     // No object: nothing stops the expansion, so the tree shows the strategy alone.
@@ -603,11 +603,11 @@ fn faulted_sampler(faults: &'static [usize]) -> taction::explore::ExplorationRep
 /// The arm's planner on the box for 8 converged readings, the arm's velocities made NaN (an
 /// unstable step's) at reads `faults`.
 fn faulted_planner(faults: &'static [usize]) -> taction::explore::ExplorationReport {
+    use taction::control::sensor_reader;
     use taction::explore::Planner;
-    use taction::explore::collect::sensor_reader;
+    use taction::sim::PAD_SITE;
     use taction::sim::SceneBuilder;
-    use taction::sim::arm::PAD_SITE;
-    use taction::tactile::sensor::{CoveringSensor, add_sensor};
+    use taction::tactile::{CoveringSensor, add_sensor};
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let builder = SceneBuilder::with_arm_and_table().object(box_object());
     let mut scene = add_sensor(builder, &Valid::new(sensor).unwrap(), "covering", PAD_SITE)

@@ -12,7 +12,7 @@ use std::process::Command;
 use glam::DVec3;
 use taction::dataset::{ContactStatus, Dataset, Reading};
 use taction::explore::PlannerConfig;
-use taction::explore::collect::{CollectMode, CollectPlan};
+use taction::explore::{CollectMode, CollectPlan};
 use taction::mesh::{ObjectSet, TriMesh, write_obj};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;

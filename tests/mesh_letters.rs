@@ -6,12 +6,10 @@ use std::collections::BTreeMap;
 
 use std::path::Path;
 
-use taction::mesh::glyph::Font;
-use taction::mesh::glyph_overlap::{LetterPair, letter_pairs};
-use taction::mesh::letters::{
-    LetterStyle, alphabet, letter_from_name, letter_name, letter_outline, raised_letter,
-};
+use taction::mesh::Font;
 use taction::mesh::{EdgeTopology, MeshError, ObjectSet, TriMesh, ValidationReport, connected_components};
+use taction::mesh::{LetterPair, letter_pairs};
+use taction::mesh::{LetterStyle, alphabet, letter_from_name, letter_name, letter_outline, raised_letter};
 
 /// The font the built-in set draws `ch` in.
 fn built_in_font(ch: char) -> Font {

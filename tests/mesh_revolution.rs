@@ -4,8 +4,8 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use glam::DVec2;
-use taction::mesh::chess::ChessPiece;
-use taction::mesh::revolution::Profile;
+use taction::mesh::ChessPiece;
+use taction::mesh::Profile;
 use taction::mesh::{EdgeTopology, MeshError, TriMesh, ValidationReport};
 
 fn assert_closed_outward(mesh: &TriMesh, what: &str) {

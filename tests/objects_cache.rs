@@ -6,7 +6,7 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use taction::mesh::cgal::{DEB_FILE, ObjectCache, cache_root_from};
+use taction::mesh::{DEB_FILE, ObjectCache, cache_root_from};
 
 fn fetch_in(cwd: &Path, env: &[(&str, &Path)], extra: &[&str]) -> Output {
     let mut command = Command::new(env!("CARGO_BIN_EXE_taction"));

@@ -1,8 +1,8 @@
 //! The ten CGAL meshes: fetched once (shared by concurrent test processes), they load, validate,
 //! and normalise to the stated size; a corrupted cache file is caught by its checksum.
 
-use taction::mesh::cgal::{CGAL_MESHES, DEB_FILE, ObjectCache, ensure_fetched};
 use taction::mesh::{BuildOptions, EdgeTopology, MeshError, ObjectSet, ObjectSource};
+use taction::mesh::{CGAL_MESHES, DEB_FILE, ObjectCache, ensure_fetched};
 
 #[test]
 fn fetched_meshes_load_validate_and_normalise() {

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::DVec3;
-use taction::mesh::glyph::Font;
-use taction::mesh::letters::LetterStyle;
+use taction::mesh::Font;
+use taction::mesh::LetterStyle;
 use taction::mesh::{BuildOptions, MeshError, ObjectSet, ObjectSource, load, write_obj};
 
 mod common;

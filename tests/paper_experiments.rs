@@ -8,9 +8,9 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use taction::experiment::{AccuracyRow, Factor, PerObjectRow};
+use taction::mesh::Font;
+use taction::mesh::LetterStyle;
 use taction::mesh::ObjectSet;
-use taction::mesh::glyph::Font;
-use taction::mesh::letters::LetterStyle;
 use taction::paper::PaperExperiment;
 
 /// The factor columns of each recognition experiment: one per thing it varies besides the

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use rand::RngExt;
 use taction::dataset::Dataset;
-use taction::dataset::recorded::{Calibration, RealImport, parse_real_csv};
+use taction::dataset::{Calibration, RealImport, parse_real_csv};
 use taction::mesh::{MeshFormat, parse};
 use taction::rng::{Rng, stream};
 use taction::tactile::TactileImage;

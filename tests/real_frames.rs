@@ -6,11 +6,11 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use taction::dataset::recorded::{Calibration, RealImport, parse_real_csv};
+use taction::dataset::{Calibration, RealImport, parse_real_csv};
 use taction::dataset::{ContactStatus, Dataset, Strategy};
 use taction::experiment::{AccuracyRow, PerObjectRow};
-use taction::paper::context::EXAMPLE_REAL_CSV;
-use taction::paper::real_frames::{prune, scaled_split_sizes, trial_split};
+use taction::paper::EXAMPLE_REAL_CSV;
+use taction::paper::{prune, scaled_split_sizes, trial_split};
 
 /// The figure varies only the descriptor: no factor column.
 const ACCURACY_HEADER: &str = "experiment,descriptor,trial,n_readings,accuracy,reliability,seed,stream_seed";
@@ -210,9 +210,8 @@ fn splits_are_disjoint_seeded_and_differ_across_trials() {
     assert!(counts.values().all(|c| (c.kept, c.dropped) == (8, 0)));
     let kept: Vec<_> = kept.into_iter().cloned().collect();
     let sizes = scaled_split_sizes(8, 1.0).unwrap();
-    let lines = |part: &[&taction::dataset::recorded::RealReading]| -> Vec<u64> {
-        part.iter().map(|r| r.line).collect()
-    };
+    let lines =
+        |part: &[&taction::dataset::RealReading]| -> Vec<u64> { part.iter().map(|r| r.line).collect() };
     let mut trials = Vec::new();
     for trial in 0..7 {
         let split = trial_split(&kept, sizes, 1, trial).unwrap();

@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::{Value, json};
-use taction::dataset::format_f64;
 use taction::describe::{DescriptorKind, Feature};
 use taction::recognize::pipeline::{FeatureMatrix, GaussianMixture, GmmConfig, Pca};
 use taction::recognize::{LabelledFeatures, VarianceFraction};
 use taction::rng::stream;
+use taction::units::round_trip;
 
 /// The venv's python, creating the venv on first use; `Err` says why it cannot be had.
 fn reference_python() -> Result<PathBuf, String> {
@@ -51,7 +51,7 @@ fn reference_python() -> Result<PathBuf, String> {
 fn write_features(path: &Path, rows: impl IntoIterator<Item = impl AsRef<[f64]>>) {
     let mut text = String::new();
     for row in rows {
-        let line: Vec<String> = row.as_ref().iter().map(|&v| format_f64(v)).collect();
+        let line: Vec<String> = row.as_ref().iter().map(|&v| round_trip(v)).collect();
         text.push_str(&line.join(","));
         text.push('\n');
     }

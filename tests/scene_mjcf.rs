@@ -12,8 +12,8 @@ use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtCatBit, mjtGeom, mjtObj};
 use mujoco_rs::prelude::*;
 use sensor_support::shipped_scene_at_touch;
-use taction::tactile::plugin::{taxel_rgba, taxel_tiles};
 use taction::tactile::{CoveringSensor, SensorConfig, ensure_registered};
+use taction::tactile::{taxel_rgba, taxel_tiles};
 
 #[test]
 fn scene_xml_carries_the_paper_sensor_and_its_touch_keyframe_reads_the_cylinder_rim() {
@@ -271,12 +271,9 @@ fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
             .unwrap();
         strictly_parsed(&xml, &format!("the arm's scene ({mount:?} object)"));
     }
-    let free = taction::tactile::free_floating::free_floating_builder(
-        named(taction::sim::ObjectMount::Mocap),
-        &config,
-    )
-    .to_xml()
-    .unwrap();
+    let free = taction::tactile::free_floating_builder(named(taction::sim::ObjectMount::Mocap), &config)
+        .to_xml()
+        .unwrap();
     strictly_parsed(&free, "the free-floating pad's scene");
 
     // `taction scene export` for a mesh file (its name with `--` in it) and a built-in object.

@@ -15,9 +15,10 @@ use glam::DVec3;
 use sensor_support::{box_between, icosphere};
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
-use taction::mesh::cgal::{cgal_mesh, ensure_fetched};
+use taction::mesh::{cgal_mesh, ensure_fetched};
+use taction::pose::PadPose;
 use taction::sim::ObjectSpec;
-use taction::tactile::{PadPose, SensorConfig, psf_sigma_for_thickness};
+use taction::tactile::{SensorConfig, psf_sigma_for_thickness};
 use taction::valid::Valid;
 
 const TOLERANCE: f64 = 1e-6;

@@ -39,7 +39,7 @@ fn plane_parallel_at_distance_reads_uniform_fraction() {
 /// Compiles a scene whose sensor has the raw `<config>` pairs given, returning MuJoCo's error text.
 fn compile_error(pairs: &[(&str, &str)]) -> Option<String> {
     use taction::sim::SceneBuilder;
-    use taction::sim::mjcf::Section;
+    use taction::sim::Section;
     taction::tactile::ensure_registered();
     let config: String = pairs
         .iter()
@@ -84,10 +84,11 @@ fn bad_config_fails_compilation_naming_the_key_and_range() {
 
 use glam::DQuat;
 use taction::control::FreePad;
+use taction::pose::PadPose;
 use taction::pose::Pose;
-use taction::sim::mjcf::COLLISION_GROUP;
+use taction::sim::COLLISION_GROUP;
 use taction::sim::{ObjectMount, ObjectSpec};
-use taction::tactile::{PadPose, TactileImage};
+use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
 /// The analytic depth of the ray through pad point (x, y) to the plane z = 0 (pad above it).
@@ -379,7 +380,7 @@ fn the_pads_own_tree_is_not_sensed() {
     for (other, want) in [(false, 0.0), (true, 1.0)] {
         let builder = taction::sim::SceneBuilder::new()
             .table(false)
-            .add(taction::sim::mjcf::Section::Worldbody, tree(other));
+            .add(taction::sim::Section::Worldbody, tree(other));
         let builder = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad");
         let scene = builder.build().unwrap();
         let sensor = taction::tactile::CoveringSensor::on_site(scene.model(), "pad").unwrap();
@@ -398,7 +399,7 @@ fn the_pads_own_tree_is_not_sensed() {
             geom
         };
         let builder = taction::sim::SceneBuilder::new().table(false).add(
-            taction::sim::mjcf::Section::Worldbody,
+            taction::sim::Section::Worldbody,
             format!("<site name=\"pad\"/>{world}"),
         );
         let scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad")

@@ -15,10 +15,11 @@ use std::process::Command;
 use glam::DVec3;
 use sensor_support::{icosphere, pad_looking_down, shipped_scene_at_touch};
 use taction::control::FreePad;
-use taction::sim::arm::PAD_SITE;
+use taction::pose::PadPose;
+use taction::sim::PAD_SITE;
 use taction::sim::{IkOptions, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::free_floating::free_floating_builder;
-use taction::tactile::{CoveringSensor, PadPose, SensorConfig};
+use taction::tactile::free_floating_builder;
+use taction::tactile::{CoveringSensor, SensorConfig};
 use taction::valid::Valid;
 
 fn target_dir() -> PathBuf {

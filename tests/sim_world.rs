@@ -33,7 +33,7 @@ fn world_files_load_in_mujoco_unchanged() {
 fn malformed_mjcf_is_a_named_error() {
     let e = SceneBuilder::new()
         .add(
-            taction::sim::mjcf::Section::Worldbody,
+            taction::sim::Section::Worldbody,
             "<body name=\"x\"><geom type=\"sphere\" size=\"-1\"/></body>",
         )
         .build()

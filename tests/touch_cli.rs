@@ -147,7 +147,7 @@ fn an_arm_touch_reports_its_joint_angles_and_replays_in_the_exported_scene() {
     ]));
     assert_eq!(r["status"], "converged", "{r}");
     let joints: Vec<String> = serde_json::from_value(r["arm_joints"].clone()).unwrap();
-    assert_eq!(joints, taction::sim::arm::ARM_JOINTS);
+    assert_eq!(joints, taction::sim::ARM_JOINTS);
     let q: Vec<f64> = serde_json::from_value(r["arm_q_rad"].clone()).unwrap();
     let image: Vec<f64> = serde_json::from_value::<Vec<Vec<f64>>>(r["image"].clone())
         .unwrap()

@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use taction::dataset::{Dataset, describe_shortfalls};
-use taction::experiment::progress::CollectionProgress;
+use taction::experiment::CollectionProgress;
 use taction::explore::{Collect, ExplorationReport, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
-use taction::tactile::image::write_contact_sheet;
+use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
 use crate::cli::common::{ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, flag_error};

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use taction::control::ControlConfig;
-use taction::paper::real_frames_options::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
+use taction::paper::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
 use taction::recognize::CodebookKind;
 use taction::valid::{Check, Valid};
 

@@ -5,10 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use taction::dataset::recorded::{Calibration, RealImport, import_real_csv};
+use taction::dataset::{Calibration, RealImport, import_real_csv};
 use taction::dataset::{Dataset, DatasetError};
-use taction::paper::real_frames::recorded_dataset;
-use taction::paper::real_frames_options::RealFramesOptions;
+use taction::paper::RealFramesOptions;
+use taction::paper::recorded_dataset;
 
 use crate::cli::common::{PreprocessArgs, UsageError};
 

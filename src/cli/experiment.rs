@@ -4,15 +4,15 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use taction::dataset::recorded::Calibration;
+use taction::dataset::Calibration;
 use taction::experiment::RunOptions;
+use taction::mesh::BUILTIN_SETS;
 use taction::mesh::ObjectSet;
-use taction::mesh::object_set::BUILTIN_SETS;
-use taction::paper::data::{SHORTFALLS_FILE, read_shortfalls};
-use taction::paper::estimate::{REFERENCE_THREADS, RunEstimate, human_duration};
-use taction::paper::headline::headline_table;
-use taction::paper::real_frames_options::PAPER_TRIALS;
+use taction::paper::PAPER_TRIALS;
+use taction::paper::headline_table;
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
+use taction::paper::{REFERENCE_THREADS, RunEstimate, human_duration};
+use taction::paper::{SHORTFALLS_FILE, read_shortfalls};
 
 use crate::cli::common::{ObjectSizeArg, OutputLock, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook};
 use crate::cli::plausible::{Carrier, build_objects};

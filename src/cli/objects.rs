@@ -4,12 +4,12 @@ use std::path::{Path, PathBuf};
 
 use crate::cli::common::ObjectSizeArg;
 use clap::{Args, Subcommand};
-use taction::mesh::cgal::{CGAL_MESHES, ObjectCache};
-use taction::mesh::glyph::Font;
-use taction::mesh::glyph_overlap::letter_pairs;
-use taction::mesh::letters::LetterStyle;
-use taction::mesh::object_set::BUILTIN_SETS;
+use taction::mesh::BUILTIN_SETS;
+use taction::mesh::Font;
+use taction::mesh::LetterStyle;
+use taction::mesh::letter_pairs;
 use taction::mesh::{BuildOptions, MeshError, ObjectSet, ObjectSource, write_obj};
+use taction::mesh::{CGAL_MESHES, ObjectCache};
 
 #[derive(Debug, Args)]
 pub struct ObjectsArgs {

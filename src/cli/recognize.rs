@@ -8,7 +8,7 @@ use clap::Args;
 use indicatif::ProgressBar;
 use taction::atomic::write_atomic;
 use taction::dataset::Dataset;
-use taction::experiment::plot::build_figure;
+use taction::experiment::build_figure;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer};
 

@@ -15,12 +15,13 @@ use clap::{Args, Subcommand};
 use glam::DVec3;
 use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
-use taction::mesh::object_set::BUILTIN_SETS;
+use taction::mesh::BUILTIN_SETS;
 use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
-use taction::sim::arm::PAD_SITE;
-use taction::sim::mjcf::{Section, comment, numbers};
+use taction::pose::PadPose;
+use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, SceneBuilder};
-use taction::tactile::{PadPose, SensorConfig, add_sensor};
+use taction::sim::{Section, comment, numbers};
+use taction::tactile::{SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::ObjectSizeArg;

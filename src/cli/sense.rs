@@ -11,7 +11,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use taction::control::{ControlError, FreePad};
-use taction::tactile::{PadPose, SensorConfig};
+use taction::pose::PadPose;
+use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
 use crate::cli::common::SeedArg;

@@ -6,8 +6,9 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::DVec3;
 use taction::mesh::Object;
+use taction::pose::PadPose;
 use taction::sim::ObjectSpec;
-use taction::tactile::{ConfigKey, PadPose, SensorConfig, psf_sigma_for_thickness};
+use taction::tactile::{ConfigKey, SensorConfig, psf_sigma_for_thickness};
 
 use crate::cli::plausible::{Carrier, check_mesh};
 use taction::valid::Valid;

@@ -20,10 +20,11 @@ use serde::Serialize;
 use taction::control::{
     ArmPad, ContactOutcome, ContactReport, ControlConfig, FreePad, sensor_reader, settle,
 };
-use taction::explore::planner::precise_motion;
-use taction::sim::arm::{ARM_JOINTS, PAD_SITE};
+use taction::explore::precise_motion;
+use taction::pose::PadPose;
+use taction::sim::{ARM_JOINTS, PAD_SITE};
 use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::{CoveringSensor, PadPose, SensorConfig, add_sensor};
+use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ControlArg, ControlFileError, SeedArg};

@@ -24,9 +24,10 @@
 //! through both (`InverseKinematics::solve_with_up`).
 
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, backed_off};
+use crate::pose::PadPose;
 use crate::sim::arm::Execution;
 use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::tactile::{SensorConfig, TactileImage};
 
 /// The arm-mounted pad: a scene with an arm, an IK solver, and a way to read the sensor.
 pub struct ArmPad<'s, R> {

@@ -3,8 +3,9 @@
 //! One controller implementation drives both the free-floating pad (a mocap body, Sec. V-A3) and the
 //! arm-mounted pad (pose commands through inverse kinematics, executed by MuJoCo stepping).
 
+use crate::pose::PadPose;
 use crate::sim::{Collision, Scene, SimError};
-use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
+use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 
 /// How a pose command went.
 #[derive(Debug, Clone, PartialEq)]

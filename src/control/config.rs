@@ -53,7 +53,7 @@ pub struct ControlConfig {
     pub orient_max_step_rad: f64,
     /// Press/Orient alternations before `MaxIterations`.
     pub max_iterations: usize,
-    /// Keep Orient from tilting over an edge ([`surface_normal`](crate::control::orient::surface_normal)):
+    /// Keep Orient from tilting over an edge (`orient.rs`, `surface_normal`):
     /// fit the plane to the taxels inside the contact patch, whose coverage is whole, and issue no
     /// tilt when the fitted plane says the surface comes well into the covering where a taxel reads
     /// no contact. Off by default, because it costs recognition: a pad tipped over a stroke's edge

@@ -31,7 +31,8 @@ use crate::valid::Valid;
 /// use taction::control::FreePad;
 /// use taction::mesh::TriMesh;
 /// use taction::sim::ObjectSpec;
-/// use taction::tactile::{PadPose, SensorConfig};
+/// use taction::pose::PadPose;
+/// use taction::tactile::SensorConfig;
 /// use taction::valid::Valid;
 ///
 /// let sensor = Valid::new(SensorConfig::paper())?;

@@ -13,7 +13,8 @@ use glam::{DQuat, DVec3};
 use nalgebra::{Matrix3xX, SVD};
 
 use crate::control::config::ControlConfig;
-use crate::tactile::{PadPose, SensorConfig, TactileImage};
+use crate::pose::PadPose;
+use crate::tactile::{SensorConfig, TactileImage};
 
 /// The outcome of a plane fit.
 #[derive(Debug, Clone, Copy, PartialEq)]

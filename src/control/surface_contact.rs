@@ -11,8 +11,9 @@ use crate::control::orient::orient_command;
 use crate::control::press::{PressOutcome, is_clipped, press, pressed_peak};
 use crate::control::trace::{Command, Trace};
 use crate::dataset::ContactStatus;
+use crate::pose::PadPose;
 use crate::sim::Collision;
-use crate::tactile::{PadPose, TactileImage};
+use crate::tactile::TactileImage;
 use crate::valid::Valid;
 
 /// The result of one settling run.
@@ -41,7 +42,8 @@ pub struct ContactOutcome {
 /// use taction::dataset::ContactStatus;
 /// use taction::mesh::TriMesh;
 /// use taction::sim::ObjectSpec;
-/// use taction::tactile::{PadPose, SensorConfig};
+/// use taction::pose::PadPose;
+/// use taction::tactile::SensorConfig;
 /// use taction::valid::Valid;
 ///
 /// let object = ObjectSpec::new("box", TriMesh::cuboid(DVec3::new(0.03, 0.03, 0.02)));

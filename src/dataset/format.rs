@@ -50,8 +50,9 @@ use crate::atomic::write_atomic;
 use crate::dataset::{
     AttemptCause, CauseKind, ContactStatus, Dataset, DatasetError, DatasetHeader, Reading, Strategy,
 };
+use crate::pose::PadPose;
 use crate::pose::Pose;
-use crate::tactile::{PadPose, TactileImage};
+use crate::tactile::TactileImage;
 use crate::valid::Check;
 
 /// The file format version this build writes; it reads this one and every earlier one.
@@ -485,7 +486,7 @@ fn columns_of(metas: &[Meta], rows: usize, cols: usize) -> Vec<String> {
     names
 }
 
-pub use crate::units::round_trip as format_f64;
+pub(crate) use crate::units::round_trip as format_f64;
 
 fn reading_row(r: &Reading, row: &mut Vec<String>) {
     row.clear();

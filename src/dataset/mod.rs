@@ -9,22 +9,31 @@
 //! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
 //! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
 //! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
-//! alike. The file format is in [`format`]; the counts `dataset show` prints in `summary.rs`; the
+//! alike. The file format is in `format.rs`; the counts `dataset show` prints in `summary.rs`; the
 //! recorded frames of a real sensor, and their import as a dataset (`dataset import`), in
-//! [`recorded`].
+//! `recorded.rs` ([`import_real_csv`]).
 
 mod format;
 mod reading;
-pub mod recorded;
+pub(crate) mod recorded;
 mod status;
 mod strategy;
 mod summary;
 
-pub use format::{FORMAT_VERSION, column_names, format_f64};
+// A reading and how its contact ended.
 pub use reading::{AttemptCause, CauseKind, Reading};
 pub use status::ContactStatus;
 pub use strategy::Strategy;
+
+// The file: its columns and numbers, and the counts `dataset show` prints.
+pub use format::{FORMAT_VERSION, column_names};
 pub use summary::DatasetSummary;
+
+// A real sensor's recorded frames, and their import as a dataset.
+pub use recorded::{
+    Calibration, Normalisation, RealData, RealImport, RealReading, SYNTHETIC_MARK, import_real_csv,
+    parse_real_csv,
+};
 
 use std::fmt;
 
@@ -311,9 +320,11 @@ pub fn describe_shortfalls(shortfalls: &[Shortfall]) -> String {
 mod tests {
     use glam::{DQuat, DVec3};
 
+    use super::format::format_f64;
     use super::*;
+    use crate::pose::PadPose;
     use crate::pose::Pose;
-    use crate::tactile::{PadPose, TactileImage};
+    use crate::tactile::TactileImage;
 
     #[test]
     fn the_column_layout_lists_every_column_once_in_file_order() {

@@ -19,30 +19,41 @@ pub(crate) mod accuracy;
 pub(crate) mod assemble;
 pub(crate) mod error;
 pub(crate) mod factor;
-pub mod figure;
+pub(crate) mod figure;
 pub(crate) mod files;
 pub(crate) mod font;
 pub(crate) mod index;
 pub(crate) mod layout;
-pub mod merge;
+pub(crate) mod merge;
 pub(crate) mod name;
-pub mod plot;
-pub mod progress;
+pub(crate) mod plot;
+pub(crate) mod progress;
 pub(crate) mod runner;
 pub(crate) mod shard;
 pub(crate) mod spec;
 pub(crate) mod unit;
 
-pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, RepeatedObject};
-pub use assemble::Finished;
+// An experiment: named units producing rows, run on a shard, resumed, merged.
 pub use error::{ExperimentError, UnitFailure};
 pub use factor::{Factor, FactorError, Factors};
-pub use index::write_index;
-pub use layout::ExperimentDir;
 pub use merge::{MergeReport, merge};
 pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
-pub use plot::{Axis, PlotKind, PlotSpec};
 pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};
 pub use unit::{BoxError, DetailRow, NoDetail, Unit};
+
+// Its rows: recognition curves and per-object detail.
+pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, RepeatedObject};
+
+// Its outputs on disk: the layout, the assembled tables, the index.
+pub use assemble::Finished;
+pub use index::write_index;
+pub use layout::ExperimentDir;
+
+// Plots: the spec of a plot, the figure it builds, its panels and series.
+pub use figure::{Figure, Panel, ReferenceLine, Series};
+pub use plot::{ACCURACY_LABEL, Axis, PlotKind, PlotSpec, build_figure};
+
+// Progress of a long collection, on the terminal.
+pub use progress::CollectionProgress;

@@ -73,7 +73,7 @@ pub struct CollectPlan {
 }
 
 /// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
-pub use crate::control::sensor_reader;
+use crate::control::sensor_reader;
 
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.

@@ -1,9 +1,9 @@
 //! Exploration (Sec. III-A) and training-data collection (Sec. V-A3).
 
-pub mod active;
-pub mod collect;
+pub(crate) mod active;
+pub(crate) mod collect;
 pub(crate) mod grid;
-pub mod planner;
+pub(crate) mod planner;
 pub(crate) mod reach;
 pub(crate) mod report;
 pub(crate) mod sampler;
@@ -11,13 +11,23 @@ pub(crate) mod setup;
 pub(crate) mod surface_sampling;
 pub(crate) mod tree;
 
-pub use active::{ActiveGuidance, Probability, TouchScorer};
-pub use collect::{Collect, CollectError, CollectMode, CollectPlan, sensor_reader};
+// Collecting a dataset: the sampler or the exploring arm, over a set of objects.
+pub use collect::{Collect, CollectError, CollectMode, CollectPlan};
 pub use grid::ReadingGrid;
-pub use planner::{Planner, PlannerConfig};
+pub use setup::TouchSetup;
+
+// The training sampler (Sec. V-A3) and the points it draws on the surface.
+pub use sampler::{SamplerConfig, TrainingSampler};
+pub use surface_sampling::{SurfacePoint, SurfaceSampler};
+
+// The planner (Sec. III-A): its tree, how the arm reaches, and its report.
+pub use planner::{
+    ITERATIONS_PER_READING, Planner, PlannerConfig, WORKSPACE_MARGIN_M, precise_kinematic_motion,
+    precise_motion,
+};
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;
-pub use sampler::{SamplerConfig, TrainingSampler};
-pub use setup::TouchSetup;
-pub use surface_sampling::{SurfacePoint, SurfaceSampler};
 pub use tree::{ExplorationTree, Vertex};
+
+// Active touch: the next touch chosen by the posterior.
+pub use active::{ActiveGuidance, DEFAULT_CANDIDATES, Probability, TouchScorer};

@@ -51,6 +51,7 @@ use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading
 use crate::explore::setup::TouchSetup;
 use crate::explore::tree::ExplorationTree;
 use crate::mesh::SizeLimit;
+use crate::pose::PadPose;
 use crate::rng::Rng;
 use crate::sim::arm::{Execution, PAD_SITE, Watch};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
@@ -58,7 +59,7 @@ use crate::sim::{
     Arm, Collision, IkOptions, InverseKinematics, MoveOptions, MoveOutcome, ObjectSpec, PadTarget, Scene,
     SceneState,
 };
-use crate::tactile::{CoveringSensor, PadPose, SensorConfig, TactileImage};
+use crate::tactile::{CoveringSensor, SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The planner's parameters.
@@ -406,7 +407,7 @@ where
     }
 
     /// [`explore_reporting`](Self::explore_reporting) with the active strategy when `guidance` is
-    /// given ([`crate::explore::active`]): each iteration draws `guidance.candidates` targets by the
+    /// given (`explore/active.rs`): each iteration draws `guidance.candidates` targets by the
     /// local/global rule and expands toward the one the scorer rates highest; the readings are
     /// tagged [`Strategy::Active`].
     pub fn explore_guided(

@@ -11,9 +11,9 @@
 //! included, which the arm's controllers then hold (`InverseKinematics::solve_with_up`).
 
 use crate::explore::planner::precise_motion;
+use crate::pose::PadPose;
 use crate::pose::Pose;
 use crate::sim::{Arm, InverseKinematics, ObjectSpec, PadTarget, Scene, SceneBuilder, SimError};
-use crate::tactile::PadPose;
 
 /// The arm, the table and the object at rest on it: the scene the planner explores.
 pub struct ArmReach {

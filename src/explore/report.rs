@@ -5,9 +5,10 @@ use std::collections::BTreeMap;
 use crate::bodies::ARM_BODIES;
 use crate::control::ContactOutcome;
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
+use crate::pose::PadPose;
 use crate::pose::Pose;
 use crate::sim::Collision;
-use crate::tactile::{PadPose, SensorConfig, TactileError, TactileImage};
+use crate::tactile::{SensorConfig, TactileError, TactileImage};
 
 /// The collision that stopped a motion, as a reading's cause: the arm's body first.
 impl From<&Collision> for AttemptCause {

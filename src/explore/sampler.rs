@@ -22,10 +22,10 @@ use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading
 use crate::explore::setup::TouchSetup;
 use crate::explore::surface_sampling::SurfaceSampler;
 use crate::mesh::TriMesh;
+use crate::pose::PadPose;
 use crate::pose::Pose;
 use crate::rng::Rng;
 use crate::sim::{ObjectSpec, Scene, SimError};
-use crate::tactile::PadPose;
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
 /// The sampler's parameters.

@@ -3,40 +3,55 @@
 //! - loading OBJ, OFF and STL with validation ([`load()`], [`ValidationReport`]), writing OBJ;
 //! - geometry: bounds, area, signed volume, normalisation to a common size ([`normalise_to_diagonal`]),
 //!   and the edge topology behind watertightness and orientation checks ([`EdgeTopology`]);
-//! - the objects: ten real meshes fetched from Debian ([`cgal`]), chess pieces as surfaces of
-//!   revolution ([`chess`], [`revolution`]), raised letters from a font ([`letters`], [`glyph`]);
+//! - the objects: ten real meshes fetched from Debian ([`CgalMesh`]), chess pieces as surfaces of
+//!   revolution ([`ChessPiece`], [`Profile`]), raised letters from a font ([`raised_letter`], [`Font`]);
 //! - one object, loaded, checked and plausible ([`Object::from_file`]);
 //! - object sets: named, versioned manifests that datasets and models refer to ([`ObjectSet`]).
 
-pub mod cgal;
+pub(crate) mod cgal;
 pub(crate) mod checksum;
-pub mod chess;
+pub(crate) mod chess;
 pub(crate) mod error;
-pub mod glyph;
-pub mod glyph_overlap;
-pub mod letters;
-pub mod load;
+pub(crate) mod glyph;
+pub(crate) mod glyph_overlap;
+pub(crate) mod letters;
+pub(crate) mod load;
 pub(crate) mod normalise;
 pub(crate) mod obj;
 mod object;
-pub mod object_set;
+pub(crate) mod object_set;
 mod off;
 mod plausible;
-pub mod revolution;
+pub(crate) mod revolution;
 mod stl;
 pub(crate) mod topology;
 pub(crate) mod triangulate;
 pub(crate) mod trimesh;
 pub(crate) mod validate;
 
-pub use cgal::{CGAL_MESHES, CgalMesh, ObjectCache, ensure_fetched};
+// One object: a mesh file loaded, validated, and checked for a plausible size.
 pub use error::{Location, MeshError};
 pub use load::{LoadedMesh, MeshFormat, load, parse};
+pub use object::Object;
+pub use plausible::{Implausible, SizeLimit, check_plausible};
+pub use validate::ValidationReport;
+
+// The mesh and its geometry: normalisation, orientation, topology, writing OBJ.
 pub use normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
 pub use obj::{to_obj_string, write_obj};
-pub use object::Object;
-pub use object_set::{BuildOptions, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
-pub use plausible::{Implausible, SizeLimit, check_plausible};
 pub use topology::{EdgeTopology, connected_components};
 pub use trimesh::TriMesh;
-pub use validate::ValidationReport;
+
+// Object sets: named, versioned manifests that datasets and models refer to.
+pub use object_set::{BUILTIN_SETS, BuildOptions, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
+
+// The paper's objects: the CGAL meshes fetched from Debian, chess pieces as surfaces of
+// revolution, raised letters from a font.
+pub use cgal::{
+    CGAL_MESHES, CgalMesh, DEB_FILE, ObjectCache, cache_root, cache_root_from, cgal_mesh, ensure_fetched,
+};
+pub use chess::ChessPiece;
+pub use glyph::{BUILTIN_FONT_PREFIX, CAPITAL_I_FONT, DEFAULT_FONT, Font};
+pub use glyph_overlap::{LetterPair, letter_pairs};
+pub use letters::{LetterStyle, alphabet, letter_from_name, letter_name, letter_outline, raised_letter};
+pub use revolution::{Profile, ProfileBuilder};

@@ -72,7 +72,7 @@ pub struct PaperContext {
     /// The raised letters (Fig. 16a) and the source of the sim-to-real letters.
     pub letters: ObjectSet,
     pub real: RealRecording,
-    /// Fig. 16b's settings ([`super::real_frames`]).
+    /// Fig. 16b's settings ([`RealFramesOptions`](super::RealFramesOptions)).
     pub real_frames: RealFramesOptions,
     /// The codebook every model is trained with: the paper's GMM unless `--codebook` says otherwise.
     pub codebook: CodebookKind,

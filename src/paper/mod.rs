@@ -12,40 +12,63 @@
 //! | `thickness` | 11 | covering thickness |
 //! | `resolution` | 12 | taxels per side |
 //! | `noise` | 13 | additive noise |
-//! | `convergence` | 14 | controller convergence against noise ([`crate::paper::convergence`]) |
+//! | `convergence` | 14 | controller convergence against noise ([`convergence_experiment`]) |
 //! | `letters` | 16a | - (52 raised letters, sampler from above) |
-//! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`real_frames`]) |
+//! | `real-frames` | 16b | - (trained and tested on recorded frames, 7 random splits; [`RealFramesOptions`]) |
 //! | `sim-to-real` | 17 | - (trained in simulation, tested on recorded frames) |
 //! | `training-size` | beyond | training readings per object (100, 300, 1000, 3000, 10,000) |
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //! | `end-to-end` | beyond | the arm's blind touches recognised by the paper's training and ours (L, fixed/perturbed) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
-//! `<out>/models` ([`data`]).
+//! `<out>/models` (`data.rs`, [`read_shortfalls`]).
 
 pub(crate) mod active;
-pub mod context;
-pub mod convergence;
-pub mod data;
-pub mod estimate;
-pub mod figure1;
+pub(crate) mod context;
+pub(crate) mod convergence;
+pub(crate) mod data;
+pub(crate) mod estimate;
+pub(crate) mod figure1;
 pub(crate) mod figures;
-pub mod headline;
-pub mod real_frames;
-pub mod real_frames_options;
+pub(crate) mod headline;
+pub(crate) mod real_frames;
+pub(crate) mod real_frames_options;
 pub(crate) mod recognition;
 pub(crate) mod scale;
-pub mod sim_to_real;
+pub(crate) mod sim_to_real;
 pub(crate) mod split;
 
 use std::fmt;
 use std::path::PathBuf;
 
-pub use context::{Family, PaperContext, RealRecording};
-pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
+// A run of the paper's experiments: its context (objects, recordings, scale) and the shared data
+// under `<out>/data`; the time it will take; the headline table `reproduce` prints.
+pub use context::{EXAMPLE_REAL_CSV, Family, PaperContext, RealRecording};
+pub use data::{SHORTFALLS_FILE, read_shortfalls};
+pub use estimate::{PACE_AFTER_S, REFERENCE_THREADS, RunEstimate, human_duration};
+pub use headline::{HEADLINE_READINGS, headline_table};
 pub use scale::{DataCounts, Scale, ScaleError};
-pub use sim_to_real::{GaussianBlur, SimToRealPreprocess};
+
+// The recognition figures: a sweep of settings, each a curve over the readings.
+pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
 pub use split::{Split, SplitError, SplitSizes, split_per_label};
+
+// Fig. 1: the exploration drawn.
+pub use figure1::{
+    ExplorationView, PAPER_IMAGES_SHOWN, Placement, RgbPicture, render_exploration, write_exploration_png,
+};
+
+// Fig. 14: controller convergence against noise.
+pub use convergence::{
+    ConvergencePlan, ConvergenceRow, MIN_CONVERGENCES, PAPER_NOISE_FRACTIONS, convergence_experiment,
+    convergences_at, paper_object,
+};
+
+// Fig. 16b and 17: recorded frames of a real sensor, pruned and split; the simulation made to look
+// like them.
+pub use real_frames::{prune, recorded_dataset, scaled_split_sizes, trial_split};
+pub use real_frames_options::{DEFAULT_CONTACT_THRESHOLD, PAPER_TRIALS, RealFramesOptions};
+pub use sim_to_real::{GaussianBlur, SimToRealPreprocess, square_root};
 
 use crate::experiment::runner::{RunReport, run};
 use crate::experiment::unit::BoxError;

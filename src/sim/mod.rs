@@ -1,19 +1,29 @@
 //! The MuJoCo world (Sec. V-A1): the articulated arm with the sensor pad on its end, a table, and
 //! the object under exploration, free to be perturbed between readings (Sec. V-B4).
 
-pub mod arm;
+pub(crate) mod arm;
 pub(crate) mod collision_shell;
 pub(crate) mod ik;
-pub mod mjcf;
+pub(crate) mod mjcf;
 pub(crate) mod object;
 pub(crate) mod perturb;
 pub(crate) mod scene;
 
-pub use arm::{Arm, Collision, MoveOptions, MoveOutcome};
-pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
+// The world: built from objects and the arm, stepped, saved and restored.
 pub use object::{ObjectMount, ObjectSpec};
-pub use perturb::{Perturbation, PerturbationBounds};
 pub use scene::{Scene, SceneBuilder, SceneObject, SceneState};
+
+// The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.
+pub use arm::{
+    ARM_JOINTS, Arm, Collision, Execution, MoveOptions, MoveOutcome, PAD_BACK_GEOM, PAD_SITE, Watch,
+};
+pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
+
+// The object perturbed between readings (Sec. V-B4).
+pub use perturb::{Perturbation, PerturbationBounds};
+
+// MJCF text for code that adds bodies to the world: its sections, the collision group, numbers.
+pub use mjcf::{COLLISION_GROUP, Section, comment, numbers};
 
 /// Errors of the simulated world; each says which part and what is wrong.
 #[derive(Debug, thiserror::Error)]

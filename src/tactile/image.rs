@@ -11,7 +11,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::{FileError, write_atomic};
-pub use crate::pose::PadPose;
+use crate::pose::PadPose;
 
 /// Errors from building or reading a tactile image; each names the offending place.
 #[derive(Debug, thiserror::Error)]
@@ -269,7 +269,7 @@ pub fn contact_sheet(
     })
 }
 
-/// Writes the [`contact_sheet`] of `images` as PNG.
+/// Writes the `contact_sheet` of `images` as PNG.
 pub fn write_contact_sheet(
     images: &[TactileImage],
     columns: usize,

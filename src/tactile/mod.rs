@@ -19,21 +19,38 @@
 pub(crate) mod back_contact;
 pub(crate) mod config;
 pub(crate) mod covering;
-pub mod formation;
-pub mod free_floating;
-pub mod grid;
-pub mod image;
-pub mod mesh_bvh;
+pub(crate) mod formation;
+pub(crate) mod free_floating;
+pub(crate) mod grid;
+pub(crate) mod image;
+pub(crate) mod mesh_bvh;
 pub(crate) mod model_view;
-pub mod plugin;
+pub(crate) mod plugin;
 pub(crate) mod primitive;
-pub mod raster;
-pub mod sensor;
+pub(crate) mod raster;
+pub(crate) mod sensor;
 
+// The sensor: its configuration, its image, and the handle that reads it from `sensordata`.
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
-pub use covering::{Covering, CoveringError, CoveringStats, query_region};
-pub use free_floating::free_floating_builder;
-pub use image::{ImageError, PadPose, TactileImage};
-pub use model_view::{ModelView, PoseView};
-pub use plugin::{PLUGIN_NAME, ensure_registered, register};
+pub use image::{ImageError, TactileImage, write_contact_sheet};
 pub use sensor::{CoveringSensor, TactileError, add_sensor, extension_xml, sensor_xml};
+
+// The pad on a mocap body, no arm (Sec. V-A3).
+pub use free_floating::{free_floating_builder, free_pad_body_xml};
+
+// The MuJoCo plugin: registration, and the taxel colours of the viewer.
+pub use plugin::{PLUGIN_NAME, ensure_registered, register, taxel_rgba, taxel_tiles};
+
+// One instance's state and the model it reads.
+pub use covering::{Covering, CoveringError, CoveringStats, query_region};
+pub use model_view::{ModelView, PoseView};
+
+/// The stages of one reading one by one, for code that runs or times them on their own (the
+/// benchmarks): where the rays pierce the pad, the mesh BVH, the depth buffer, and the image
+/// formation from penetration to taxels. [`CoveringSensor`] runs them all.
+pub mod pipeline {
+    pub use super::formation::ImageFormation;
+    pub use super::grid::SampleGrid;
+    pub use super::mesh_bvh::MeshBvh;
+    pub use super::raster::{DepthBuffer, rasterise_triangle};
+}

@@ -5,11 +5,12 @@ use mujoco_rs::mujoco_c::mjtObj;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 
+use crate::pose::PadPose;
 use crate::sim::SceneBuilder;
 use crate::sim::mjcf::{Section, escape_attr};
 use crate::tactile::config::{ConfigError, ConfigKey, SensorConfig};
 use crate::tactile::covering::CoveringStats;
-use crate::tactile::image::{ImageError, PadPose, TactileImage};
+use crate::tactile::image::{ImageError, TactileImage};
 use crate::tactile::model_view::ModelView;
 use crate::tactile::plugin::{
     PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state, is_covering_instance,

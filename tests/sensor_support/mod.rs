@@ -6,10 +6,11 @@ use std::collections::HashMap;
 use glam::DVec3;
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
+use taction::pose::PadPose;
 use taction::sim::SceneBuilder;
-use taction::sim::mjcf::Section;
-use taction::tactile::free_floating::free_pad_body_xml;
-use taction::tactile::{PadPose, SensorConfig, add_sensor};
+use taction::sim::Section;
+use taction::tactile::free_pad_body_xml;
+use taction::tactile::{SensorConfig, add_sensor};
 use taction::valid::Valid;
 
 /// The unit icosahedron: 12 vertices, 20 outward faces.

@@ -16,9 +16,10 @@ use glam::DVec3;
 
 use crate::dataset::Reading;
 use crate::mesh::TriMesh;
+use crate::pose::PadPose;
 use crate::pose::Pose;
 use crate::tactile::image::{CONTACT_SHEET_GUTTER_PX, GrayPicture, contact_sheet, write_rgb_png};
-use crate::tactile::{ImageError, PadPose, SensorConfig, TactileImage};
+use crate::tactile::{ImageError, SensorConfig, TactileImage};
 
 /// The paper's figure shows the first 50 tactile images of a 100-reading exploration.
 pub const PAPER_IMAGES_SHOWN: usize = 50;
@@ -166,7 +167,7 @@ impl Camera {
     }
 }
 
-/// Renders the object at `object_pose` with every placement's patch, and the [`contact_sheet`] of
+/// Renders the object at `object_pose` with every placement's patch, and the `contact_sheet` of
 /// the first `view.images_shown` tactile images to its right, scaled to the panel's height. Fails
 /// only when the images differ in shape.
 pub fn render_exploration(
