@@ -133,19 +133,29 @@ const COMPILE_ATTEMPTS: usize = 4;
 /// the call's `errno` when the sandbox refuses it, so heap trimming is switched off once
 /// (memory stays with the process, as it would after the first large scene anyway), and each
 /// retry holds a ballast allocation that moves the heap's top.
+///
+/// Seen a third time late in a whole `reproduce --scale 0.02` (twice in two runs, every attempt
+/// failing): on a heap grown large, the main arena's `sbrk` is refused, glibc falls back to
+/// `mmap` and the allocation succeeds with `errno` left at `ENOMEM`, however the top moves. A
+/// thread other than the main one allocates from its own `mmap`ed arena and never calls `sbrk`,
+/// so each retry compiles on a fresh thread.
 fn compile_xml(xml: &str) -> Result<MjModel, MjModelError> {
     keep_heap_top();
     let mut attempt = 1;
     let mut ballast: Vec<Vec<u8>> = Vec::new();
-    loop {
-        match MjModel::from_xml_string(xml) {
-            Err(e) if attempt < COMPILE_ATTEMPTS && mujoco_message(&e).starts_with(STRAY_ERRNO_MESSAGE) => {
-                ballast.push(vec![1u8; 4096 << attempt]);
-                attempt += 1;
-            }
-            result => return result,
-        }
+    let mut result = MjModel::from_xml_string(xml);
+    while attempt < COMPILE_ATTEMPTS
+        && matches!(&result, Err(e) if mujoco_message(e).starts_with(STRAY_ERRNO_MESSAGE))
+    {
+        ballast.push(vec![1u8; 4096 << attempt]);
+        attempt += 1;
+        result = std::thread::scope(|s| {
+            s.spawn(|| MjModel::from_xml_string(xml))
+                .join()
+                .unwrap_or_else(|_| Err(MjModelError::LoadFailed("MuJoCo's compiler panicked".into())))
+        });
     }
+    result
 }
 
 /// Switches glibc's heap trimming off, once per process (see [`compile_xml`]).
