@@ -9,5 +9,5 @@
 static REGISTER_ON_LOAD: extern "C" fn() = register_on_load;
 
 extern "C" fn register_on_load() {
-    taction::tactile::plugin::register();
+    taction::tactile::register();
 }
