@@ -325,7 +325,14 @@ fn tests_benches_and_the_command_line_use_module_roots() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let modules = file_modules();
     let mut files = vec![root.join("src/main.rs")];
-    for dir in ["tests", "benches", "examples", "src/cli", "plugin/src", "xtask/src"] {
+    for dir in [
+        "tests",
+        "benches",
+        "examples",
+        "src/cli",
+        "plugin/src",
+        "xtask/src",
+    ] {
         rust_files(&root.join(dir), &mut files);
     }
     let mut deep = Vec::new();
