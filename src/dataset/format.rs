@@ -216,9 +216,15 @@ impl Dataset {
     /// Writes the file format of the module docs atomically: a temporary file beside `path`,
     /// flushed to disk, then renamed over `path`.
     pub fn write(&self, path: &Path) -> Result<(), DatasetError> {
-        let name = path.display().to_string();
+        let text = self.to_file_bytes(&path.display().to_string())?;
+        Ok(write_atomic(path, &text)?)
+    }
+
+    /// The bytes [`write`](Self::write) puts in a file (what `Dataset.to_pandas` in Python parses
+    /// as `pandas.read_csv(..., comment="#")` would); `name` names the destination in errors.
+    pub fn to_file_bytes(&self, name: &str) -> Result<Vec<u8>, DatasetError> {
         let io = |source| DatasetError::Io {
-            path: name.clone(),
+            path: name.to_string(),
             source,
         };
         let file_header = FileHeader {
@@ -234,7 +240,7 @@ impl Dataset {
                 .terminator(csv::Terminator::Any(b'\n'))
                 .from_writer(&mut text);
             let csv_err = |e: csv::Error| DatasetError::Csv {
-                path: name.clone(),
+                path: name.to_string(),
                 line: 0,
                 what: e.to_string(),
             };
@@ -248,7 +254,7 @@ impl Dataset {
             csv.flush().map_err(io)?;
         }
         writeln!(text, "{END_PREFIX}{}", self.readings.len()).map_err(io)?;
-        Ok(write_atomic(path, &text)?)
+        Ok(text)
     }
 
     /// Reads a file written by [`write`](Self::write); errors name the file, line and field.

@@ -26,11 +26,14 @@ usage: cargo xtask <task> [args...]
 
 tasks:
   setup          fetch and check the MuJoCo runtime if missing, build the MuJoCo plugin library
-                 (target/release/libtaction_covering.so, for Python and MuJoCo's viewer); object meshes
-                 are fetched on first use
+                 (target/release/libtaction_covering.so, for Python and MuJoCo's viewer), and make the
+                 project venv .venv/ with the Python package `taction` built from this checkout;
+                 object meshes are fetched on first use
+  runtime        only fetch and check the MuJoCo runtime (what `pip install .` runs first)
   demo [args]    setup, then `cargo run --release -- demo [args]`
   test [args]    setup, then run the whole test suite (`cargo test --workspace [args]`), then each
-                 example (`cargo run --release --example NAME`, see examples/)
+                 example (`cargo run --release --example NAME`, see examples/), then the Python
+                 package's tests (`.venv/bin/python -m pytest python/tests`)
   bench [args]   setup, then `cargo bench [args]`
   run [args]     setup, then `cargo run --release -- [args]` (any taction subcommand)";
 
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
     let rest: Vec<OsString> = args.collect();
     let result = match task.as_deref() {
         Some("setup") => setup(),
+        Some("runtime") => ensure_mujoco_runtime(&project_root().join(".runtime")),
         Some("demo") => setup().and_then(|()| {
             let mut a = os(&[
                 "run",
@@ -62,7 +66,8 @@ fn main() -> ExitCode {
             let mut a = os(&["test", "--workspace"]);
             a.extend(rest);
             cargo(&a)?;
-            run_examples()
+            run_examples()?;
+            run_python_tests()
         }),
         Some("bench") => setup().and_then(|()| {
             let mut a = os(&["bench", "--package", "taction"]);
@@ -122,7 +127,64 @@ fn project_root() -> PathBuf {
 
 fn setup() -> Result<(), String> {
     ensure_mujoco_runtime(&project_root().join(".runtime"))?;
-    build_plugin_library()
+    build_plugin_library()?;
+    install_python_package()
+}
+
+/// The project venv `.venv/` with the Python package built from this checkout (`pip install .`,
+/// through maturin; cargo does no work when nothing changed) and its runtime and development
+/// dependencies (`pyproject.toml`'s `dev` extra: maturin, pytest, pandas, pyarrow). The MuJoCo
+/// wheel `setup` fetched is offered to pip first, so it is not downloaded twice.
+fn install_python_package() -> Result<(), String> {
+    let root = project_root();
+    let python = root.join(".venv").join("bin").join("python");
+    if !python.exists() {
+        eprintln!("xtask: making the project venv .venv/ (python3 -m venv)");
+        run(Command::new("python3").args(["-m", "venv"]).arg(root.join(".venv")))?;
+    }
+    // As in an activated venv: maturin's backend runs the `maturin` program it installed there.
+    let path = std::env::join_paths(
+        std::iter::once(root.join(".venv").join("bin"))
+            .chain(std::env::var_os("PATH").iter().flat_map(std::env::split_paths)),
+    )
+    .map_err(|e| format!("PATH: {e}"))?;
+    let pip = |args: &[&str]| {
+        run(Command::new(&python)
+            .env("PATH", &path)
+            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+            .arg("--find-links")
+            .arg(root.join(".runtime").join("download"))
+            .args(args)
+            .current_dir(&root))
+    };
+    let has_maturin = Command::new(&python)
+        .args(["-c", "import maturin"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_maturin {
+        pip(&["maturin>=1.5,<2"])?;
+    }
+    pip(&["--no-build-isolation", ".[dev]"])
+}
+
+/// Runs the Python package's tests in the project venv.
+fn run_python_tests() -> Result<(), String> {
+    let root = project_root();
+    run(Command::new(root.join(".venv").join("bin").join("python"))
+        .args(["-m", "pytest", "-q", "python/tests"])
+        .current_dir(&root))
+}
+
+fn run(command: &mut Command) -> Result<(), String> {
+    let shown = format!("{command:?}");
+    let status = command
+        .status()
+        .map_err(|e| format!("cannot start {shown}: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{shown} failed ({status})"))
+    }
 }
 
 /// Builds the `taction.covering` plugin library in release, so that the README's Python recipe

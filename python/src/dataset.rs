@@ -1,0 +1,262 @@
+//! Datasets: collected from Python (the training sampler or the planner, Sec. III-A, V-A3), read
+//! from and written to the CLI's file, and handed to numpy and pandas column by column.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use taction::dataset::{ExportFormat, Reading};
+use taction::explore::{Collect, PlannerConfig};
+use taction::sim::{ObjectSpec, PerturbationBounds};
+
+use crate::array;
+use crate::error::{bad_argument, refused};
+use crate::object::Object;
+use crate::sensor::Sensor;
+
+/// Readings of a set of objects, with the header saying how they were made. Columns come out as
+/// numpy arrays in file order: `images (N, rows, cols)` float32, `pad_pose (N, 9)` float64 (NaN
+/// where a reading has no pose), `object`, `status`, `strategy`, `cause`, `touched_bodies`
+/// (strings), `iterations` (int64).
+#[pyclass(module = "taction", frozen)]
+pub struct Dataset {
+    pub inner: Arc<taction::dataset::Dataset>,
+}
+
+impl Dataset {
+    fn strings(&self, py: Python<'_>, column: impl Fn(&Reading) -> String) -> PyResult<Py<PyAny>> {
+        let items = self.inner.readings().iter().map(column).collect();
+        Ok(array::strings(py, items)?.unbind())
+    }
+}
+
+/// A JSON value as the Python value `json.loads` makes of it.
+pub fn json_to_python(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    Ok(py
+        .import("json")?
+        .call_method1("loads", (value.to_string(),))?
+        .unbind())
+}
+
+#[pymethods]
+impl Dataset {
+    /// Reads a dataset file (`taction collect`'s CSV, any format version).
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let dataset = py
+            .detach(|| taction::dataset::Dataset::read(&path))
+            .map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(dataset),
+        })
+    }
+
+    /// Writes the dataset file `taction train` reads.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| self.inner.write(&path)).map_err(refused)
+    }
+
+    /// Writes the dataset for the ML toolchain, as `taction dataset export` does: `format="npz"`
+    /// (numpy's `np.load`, no pickles: `images`, `pad_pose`, `object`, `status`, `cause`, ...) or
+    /// `"parquet"` (`pandas.read_parquet`: the file's columns).
+    #[pyo3(signature = (path, format="npz"))]
+    fn export(&self, py: Python<'_>, path: PathBuf, format: &str) -> PyResult<()> {
+        let format: ExportFormat = format.parse().map_err(|e| bad_argument("format", e))?;
+        py.detach(|| self.inner.export(&path, format)).map_err(refused)
+    }
+
+    /// The converged readings only (what training and recognition use).
+    fn converged(&self) -> Self {
+        Self {
+            inner: Arc::new(self.inner.converged_only()),
+        }
+    }
+
+    /// The dataset as a pandas DataFrame with the file's columns (`object`, `status`, ..., the pad
+    /// pose's nine, `t_{row}_{col}` per taxel): what `pandas.read_csv(path, comment="#")` gives
+    /// for its file.
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = self.inner.to_file_bytes("to_pandas").map_err(refused)?;
+        let buffer = py
+            .import("io")?
+            .call_method1("BytesIO", (pyo3::types::PyBytes::new(py, &text),))?;
+        let kwargs = pyo3::types::PyDict::new(py);
+        kwargs.set_item("comment", "#")?;
+        py.import("pandas")?
+            .call_method("read_csv", (buffer,), Some(&kwargs))
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// The object names the header lists, in index order.
+    #[getter]
+    fn objects(&self) -> Vec<String> {
+        self.inner.header().objects.clone()
+    }
+
+    /// The header (sensor, object set, objects, generator, seed) as a dict.
+    #[getter]
+    fn header(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        json_to_python(py, &serde_json::to_value(self.inner.header()).map_err(refused)?)
+    }
+
+    #[getter]
+    fn images<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let sensor = &self.inner.header().sensor;
+        let values: Vec<f64> = self
+            .inner
+            .readings()
+            .iter()
+            .flat_map(|r| r.image.values().iter().copied())
+            .collect();
+        array::from_f64(
+            py,
+            &values,
+            &[self.inner.len(), sensor.rows, sensor.cols],
+            "float32",
+        )
+    }
+
+    #[getter]
+    fn pad_pose<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let values: Vec<f64> = self
+            .inner
+            .readings()
+            .iter()
+            .flat_map(|r| match r.image.pose() {
+                Some(p) => [p.center_m, p.normal, p.up].map(|v| v.to_array()).concat(),
+                None => vec![f64::NAN; 9],
+            })
+            .collect();
+        array::from_f64(py, &values, &[self.inner.len(), 9], "float64")
+    }
+
+    #[getter]
+    fn object(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.strings(py, |r| r.object.clone())
+    }
+
+    #[getter]
+    fn status(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.strings(py, |r| r.status.name().to_string())
+    }
+
+    #[getter]
+    fn strategy(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.strings(py, |r| r.strategy.name().to_string())
+    }
+
+    #[getter]
+    fn cause(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.strings(py, |r| r.cause.as_ref().map_or("", |c| c.name()).to_string())
+    }
+
+    #[getter]
+    fn touched_bodies(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.strings(py, |r| {
+            r.cause
+                .as_ref()
+                .and_then(|c| c.touched_bodies())
+                .unwrap_or_default()
+        })
+    }
+
+    #[getter]
+    fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let values = self.inner.readings().iter().map(|r| i64::from(r.iterations)).collect();
+        array::from_i64(py, values)
+    }
+
+    fn __repr__(&self) -> String {
+        let h = self.inner.header();
+        format!(
+            "Dataset({} readings of {} objects, {}x{}, generator {:?})",
+            self.inner.len(),
+            h.objects.len(),
+            h.sensor.rows,
+            h.sensor.cols,
+            h.generator
+        )
+    }
+}
+
+/// Touches `objects` and gathers the readings into a `Dataset`, objects in parallel (`threads`, 0:
+/// one per core; the readings do not depend on it), as `taction collect` does:
+/// - `mode="sampler"`: the training sampler (Sec. V-A3) on area-weighted random surface points,
+///   `readings` converged readings per object (`from_above`: approach only from above;
+///   `reachable_by_arm`: only from starts the arm can take);
+/// - `mode="planner"`: the arm explores with the paper's planner (Sec. III-A), local with
+///   probability `local_probability`.
+///
+/// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3). Same seed, same
+/// dataset, bit for bit.
+#[pyfunction]
+#[pyo3(signature = (objects, mode="sampler", readings=100, seed=1, sensor=None, threads=0, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
+pub fn collect(
+    py: Python<'_>,
+    objects: Vec<PyRef<'_, Object>>,
+    mode: &str,
+    readings: usize,
+    seed: u64,
+    sensor: Option<PyRef<'_, Sensor>>,
+    threads: usize,
+    local_probability: f64,
+    perturb_deg: f64,
+    perturb_frac: f64,
+    from_above: bool,
+    reachable_by_arm: bool,
+    object_set: &str,
+) -> PyResult<Dataset> {
+    let sensor = match sensor {
+        Some(s) => s.config.clone(),
+        None => Sensor::paper_config()?,
+    }
+    .into_inner();
+    let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
+    let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
+    let collect = match mode {
+        "sampler" => {
+            let c = Collect::sampler(sensor);
+            let c = if from_above { c.from_above() } else { c };
+            if reachable_by_arm { c.reachable_by_arm() } else { c }
+        }
+        "planner" => Collect::planner(
+            sensor,
+            PlannerConfig {
+                local_probability,
+                max_iterations: PlannerConfig::iterations_for(readings),
+                ..PlannerConfig::default()
+            }
+            .fitted_to(&specs),
+        ),
+        other => {
+            return Err(bad_argument(
+                "mode",
+                format!("'{other}' is not 'sampler' or 'planner'"),
+            ));
+        }
+    }
+    .per_object(readings)
+    .seed(seed)
+    .threads(threads)
+    .perturbation(perturbation);
+    let dataset = py
+        .detach(|| collect.dataset(object_set, &specs))
+        .map_err(refused)?;
+    // A run that gathered fewer readings than asked says so (the planner may run out of
+    // iterations on an object it cannot reach well).
+    let shortfalls = dataset.shortfalls(readings);
+    if !shortfalls.is_empty() {
+        let message = format!(
+            "taction.collect: fewer readings than asked: {}",
+            taction::dataset::describe_shortfalls(&shortfalls)
+        );
+        py.import("warnings")?.call_method1("warn", (message,))?;
+    }
+    Ok(Dataset {
+        inner: Arc::new(dataset),
+    })
+}

@@ -1,0 +1,254 @@
+//! Recognition (Sec. IV-A): a bag-of-features model trained on a dataset, and its posterior over
+//! the objects' identity, updated after every touch (Eq. 15-16).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use taction::active_touch::ArmTrainingRecipe;
+use taction::describe::Feature;
+use taction::recognize::{
+    Belief, CodebookKind, DescriptorChoice, FusedModel, PseudoCount, Recognizer, TrainConfig, TrainedModel,
+    VarianceFraction,
+};
+use taction::tactile::TactileImage;
+use taction::valid::Valid;
+
+use crate::array;
+use crate::dataset::Dataset;
+use crate::error::{bad_argument, refused};
+
+/// A trained recogniser: one descriptor's model, or several fused (`"mnti+sift"`). Files are the
+/// ones `taction train` writes and `taction recognize` reads.
+#[pyclass(module = "taction", frozen)]
+pub struct Model {
+    pub inner: Arc<Recognizer>,
+}
+
+#[pymethods]
+impl Model {
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let model = py.detach(|| Recognizer::load(&path)).map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(model),
+        })
+    }
+
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| match self.inner.as_ref() {
+            Recognizer::Single(m) => m.save(&path),
+            Recognizer::Fused(f) => f.save(&path),
+        })
+        .map_err(refused)
+    }
+
+    /// The objects it tells apart, in the order of the posterior's probabilities.
+    #[getter]
+    fn objects(&self) -> Vec<String> {
+        self.inner.objects().to_vec()
+    }
+
+    /// The descriptor name (`mnti`, `mnti+sift`).
+    #[getter]
+    fn descriptor(&self) -> String {
+        self.inner.choice().name()
+    }
+
+    /// The sensor's `(rows, cols)`: the shape of the images it recognises.
+    #[getter]
+    fn sensor_shape(&self) -> (usize, usize) {
+        let sensor = self.inner.sensor();
+        (sensor.rows, sensor.cols)
+    }
+
+    /// Each model's chosen codebook size.
+    #[getter]
+    fn k(&self) -> Vec<usize> {
+        self.inner.chosen_ks()
+    }
+
+    /// A fresh posterior: uniform over the objects until it observes a reading.
+    fn posterior(&self) -> PyResult<Posterior> {
+        let _ = self.inner.posterior().map_err(refused)?;
+        Ok(Posterior {
+            model: self.inner.clone(),
+            observed: Vec::new(),
+            probabilities: vec![1.0 / self.inner.objects().len() as f64; self.inner.objects().len()],
+            belief: None,
+        })
+    }
+
+    /// Recognition accuracy on `dataset` in trials of `readings` consecutive converged readings per
+    /// object, as `taction recognize` scores it: `{"accuracy": [after 1, ..., after readings],
+    /// "trials": n}`.
+    #[pyo3(signature = (dataset, readings=30))]
+    fn evaluate(&self, py: Python<'_>, dataset: &Dataset, readings: usize) -> PyResult<Py<PyAny>> {
+        let range = taction::recognize::ReadingRange::new(1, readings).map_err(refused)?;
+        let (evaluation, trials) = py
+            .detach(|| self.inner.evaluate(&dataset.inner, range))
+            .map_err(refused)?;
+        let accuracy: Vec<Option<f64>> = (1..=readings).map(|n| evaluation.accuracy_at(n)).collect();
+        let result = serde_json::json!({ "accuracy": accuracy, "trials": trials });
+        crate::dataset::json_to_python(py, &result)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model({}, k={:?}, objects={:?})",
+            self.inner.choice().name(),
+            self.inner.chosen_ks(),
+            self.inner.objects()
+        )
+    }
+}
+
+/// The probability over the model's objects after the readings observed so far (Eq. 15-16).
+#[pyclass(module = "taction")]
+pub struct Posterior {
+    model: Arc<Recognizer>,
+    /// Every observed reading's features under each of the model's descriptors.
+    observed: Vec<Vec<Vec<Feature>>>,
+    probabilities: Vec<f64>,
+    belief: Option<Belief>,
+}
+
+#[pymethods]
+impl Posterior {
+    /// Adds one tactile image (an array `(rows, cols)` of the model's sensor) and returns the
+    /// probabilities after it.
+    fn observe<'py>(&mut self, py: Python<'py>, image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let (shape, values) = array::to_f64(image, "image")?;
+        let [rows, cols] = shape[..] else {
+            return Err(bad_argument("image", format!("want a 2-D array, got shape {shape:?}")));
+        };
+        let image = TactileImage::new(rows, cols, values).map_err(refused)?;
+        // The posterior borrows the model, so it is rebuilt from the observed features: adding a
+        // reading's features is cheap next to describing its image, which happens once.
+        let mut posterior = self.model.posterior().map_err(refused)?;
+        let features = posterior.describe(&image);
+        for earlier in &self.observed {
+            posterior.observe_features(earlier).map_err(refused)?;
+        }
+        let belief = posterior.observe_features(&features).map_err(refused)?;
+        self.observed.push(features);
+        self.probabilities = belief.probabilities().to_vec();
+        self.belief = Some(belief);
+        self.probabilities(py)
+    }
+
+    /// P(object | readings so far), in the order of `Model.objects`.
+    #[getter]
+    fn probabilities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array::from_f64(py, &self.probabilities, &[self.probabilities.len()], "float64")
+    }
+
+    /// The most probable object (the first of equal ones).
+    #[getter]
+    fn guess(&self) -> String {
+        // Before any reading the posterior is uniform and the first object is the guess.
+        let best = self.belief.as_ref().map_or(0, Belief::guess);
+        self.model.objects()[best].clone()
+    }
+
+    /// Readings observed.
+    #[getter]
+    fn readings(&self) -> usize {
+        self.observed.len()
+    }
+
+    #[getter]
+    fn objects(&self) -> Vec<String> {
+        self.model.objects().to_vec()
+    }
+}
+
+/// Trains a recogniser on `dataset` as `taction train` does: `descriptor` one of `vectorize`,
+/// `sift`, `mr8`, `mn`, `pf`, `mnti` or several joined by `+` (fused), `codebook` `gmm`, `kmeans`
+/// or `knn`; the codebook size chosen among `ks` (default: a grid sized to the data) on
+/// `validation` (default: the last 1/11 of each object's readings).
+#[pyfunction]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
+pub fn train(
+    py: Python<'_>,
+    dataset: &Dataset,
+    descriptor: &str,
+    codebook: &str,
+    validation: Option<PyRef<'_, Dataset>>,
+    ks: Option<Vec<usize>>,
+    restarts: usize,
+    seed: u64,
+    variance_kept: Option<f64>,
+    pseudo_count: f64,
+    trial_readings: usize,
+) -> PyResult<Model> {
+    let choice = DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?;
+    let codebook = CodebookKind::from_name(codebook).ok_or_else(|| {
+        let names: Vec<&str> = CodebookKind::ALL.iter().map(|k| k.name()).collect();
+        bad_argument(
+            "codebook",
+            format!("unknown codebook '{codebook}'; expected {}", names.join(", ")),
+        )
+    })?;
+    let config = TrainConfig {
+        codebook,
+        restarts,
+        seed,
+        variance_kept: match variance_kept {
+            Some(f) => VarianceFraction::new(f).map_err(refused)?,
+            None => codebook.default_variance_kept(),
+        },
+        pseudo_count: PseudoCount::new(pseudo_count).map_err(refused)?,
+        trial_readings,
+        ..TrainConfig::default()
+    };
+    let config = match ks {
+        Some(ks) => TrainConfig { ks, ..config },
+        None => config.with_grid_for_dataset(&dataset.inner, validation.is_some()),
+    };
+    let config = Valid::new(config).map_err(refused)?;
+    let validation = validation.map(|v| v.inner.clone());
+    let training = dataset.inner.clone();
+    let model = py
+        .detach(|| fit(&config, &training, validation.as_deref(), &choice))
+        .map_err(refused)?;
+    Ok(Model {
+        inner: Arc::new(model),
+    })
+}
+
+fn fit(
+    config: &Valid<TrainConfig>,
+    training: &taction::dataset::Dataset,
+    validation: Option<&taction::dataset::Dataset>,
+    choice: &DescriptorChoice,
+) -> Result<Recognizer, taction::recognize::RecognizeError> {
+    Ok(match choice.kinds() {
+        [kind] => Recognizer::Single(Box::new(TrainedModel::fit(
+            config,
+            training,
+            validation,
+            kind.build().as_ref(),
+            &mut |_| {},
+        )?)),
+        _ => Recognizer::Fused(FusedModel::fit(config, training, validation, choice, &mut |_| {})?),
+    })
+}
+
+/// The recogniser `taction demo` trains for the arm's own touches (`ArmTrainingRecipe`): sampler
+/// readings from starts the arm can reach, MNTI and SIFT fused over the neighbour codebook.
+/// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`.
+#[pyfunction]
+#[pyo3(signature = (training, seed=1))]
+pub fn train_for_arm(py: Python<'_>, training: &Dataset, seed: u64) -> PyResult<Model> {
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: training.inner.len(),
+        seed,
+    };
+    let data = training.inner.clone();
+    let model = py.detach(|| recipe.fit(&data)).map_err(refused)?;
+    Ok(Model {
+        inner: Arc::new(Recognizer::Fused(model)),
+    })
+}

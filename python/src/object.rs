@@ -1,0 +1,119 @@
+//! Objects: a mesh file of the user's, or the pieces of a built-in set, checked as the CLI checks
+//! them (faced outward, sized, a plausible table-top solid).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use taction::mesh::{BuildOptions, ObjectSet};
+use taction::sim::{ObjectSpec, PAD_SITE, SceneBuilder};
+use taction::tactile::add_sensor;
+
+use crate::error::refused;
+use crate::sensor::Sensor;
+
+/// One object the sensor can touch: a name and a checked triangle mesh in metres.
+#[pyclass(module = "taction", frozen)]
+pub struct Object {
+    pub inner: Arc<taction::mesh::Object>,
+}
+
+impl Object {
+    pub fn spec(&self) -> ObjectSpec {
+        ObjectSpec::from(self.inner.as_ref().clone())
+    }
+}
+
+#[pymethods]
+impl Object {
+    /// The mesh in `path` (OBJ, OFF or STL), named after the file's stem. Coordinates are metres
+    /// unless `size_m` is given: then the mesh is rescaled to that bounding diagonal, centred and
+    /// resting on z = 0. A broken or implausible mesh raises `TactionError` naming the file.
+    #[staticmethod]
+    #[pyo3(signature = (path, size_m=None))]
+    fn from_file(py: Python<'_>, path: PathBuf, size_m: Option<f64>) -> PyResult<Self> {
+        let object = py
+            .detach(|| match size_m {
+                Some(d) => taction::mesh::Object::from_file_with_size(&path, d),
+                None => taction::mesh::Object::from_file(&path),
+            })
+            .map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(object),
+        })
+    }
+
+    #[getter]
+    fn name(&self) -> &str {
+        &self.inner.name
+    }
+
+    /// Triangles of the mesh.
+    #[getter]
+    fn triangles(&self) -> usize {
+        self.inner.mesh.triangles.len()
+    }
+
+    /// The bounding box's diagonal, metres.
+    #[getter]
+    fn size_m(&self) -> Option<f64> {
+        self.inner.mesh.bounding_diagonal_m()
+    }
+
+    /// The axis-aligned bounding box, metres: `[[min x, y, z], [max x, y, z]]`.
+    #[getter]
+    fn bounds_m<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let vertices = &self.inner.mesh.vertices;
+        let min = vertices.iter().fold(glam::DVec3::INFINITY, |a, v| a.min(*v));
+        let max = vertices.iter().fold(glam::DVec3::NEG_INFINITY, |a, v| a.max(*v));
+        let values = [min.to_array(), max.to_array()].concat();
+        crate::array::from_f64(py, &values, &[2, 3], "float64")
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Object({:?}, {} triangles, {:.4} m across)",
+            self.inner.name,
+            self.inner.mesh.triangles.len(),
+            self.inner.mesh.bounding_diagonal_m().unwrap_or(0.0)
+        )
+    }
+}
+
+/// The objects of a set: a built-in set's name (`shapes`, `chess`, `letters`), a folder of meshes or
+/// a set manifest (`.json`), as `taction objects list` takes it. The `shapes` meshes are fetched into
+/// the user's cache on first use.
+#[pyfunction]
+#[pyo3(signature = (set, size_m=None))]
+pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Vec<Object>> {
+    let built = py
+        .detach(|| {
+            let set = ObjectSet::resolve(&[set], None, size_m)?;
+            set.build(&BuildOptions {
+                fetch: true,
+                ..BuildOptions::default()
+            })
+        })
+        .map_err(refused)?;
+    Ok(built
+        .into_iter()
+        .map(|o| Object { inner: Arc::new(o) })
+        .collect())
+}
+
+/// The MJCF world the arm explores, for stock `mujoco`: the arm, the table, `object` (its mesh
+/// inline) and the `taction.covering` sensor named `tactile` on the pad (the paper's 6x6 sensor
+/// unless `sensor` is given). `import taction` registers the plugin, so
+/// `mujoco.MjModel.from_xml_string(taction.scene(obj))` compiles.
+#[pyfunction]
+#[pyo3(signature = (object, sensor=None))]
+pub fn scene(object: &Object, sensor: Option<PyRef<'_, Sensor>>) -> PyResult<String> {
+    let config = match sensor {
+        Some(s) => s.config.clone(),
+        None => Sensor::paper_config()?,
+    };
+    let builder = SceneBuilder::with_arm_and_table().object(object.spec());
+    add_sensor(builder, &config, "tactile", PAD_SITE)
+        .to_xml()
+        .map_err(refused)
+}

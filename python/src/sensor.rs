@@ -1,0 +1,144 @@
+//! The covering sensor (Sec. V-A2) on the free-floating pad: one reading of an object at a pad pose,
+//! no controllers, exactly what `taction sense` reads.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use pyo3::prelude::*;
+use taction::control::FreePad;
+use taction::pose::PadPose;
+use taction::tactile::{SensorConfig, psf_sigma_for_thickness};
+use taction::valid::Valid;
+
+use crate::array;
+use crate::error::{bad_argument, refused};
+use crate::object::Object;
+
+/// The tactile sensor: `rows x cols` taxels over a square pad `pad_m` wide under a covering
+/// `thickness_m` thick (default 10% of the pad), blurred by a Gaussian point-spread (default
+/// sigma 0.48 t), each taxel averaging `rays_per_taxel` rays, with additive noise `noise` (a
+/// fraction of the range) drawn from `seed`. The defaults are `taction sense`'s (the paper's
+/// 6x6 sensor).
+#[pyclass(module = "taction", unsendable)]
+pub struct Sensor {
+    pub config: Valid<SensorConfig>,
+    /// One free pad per object read so far (building its MuJoCo scene is the expensive part).
+    pads: Vec<(Arc<taction::mesh::Object>, FreePad)>,
+}
+
+impl Sensor {
+    /// The paper's sensor, checked.
+    pub fn paper_config() -> PyResult<Valid<SensorConfig>> {
+        Valid::new(SensorConfig::paper()).map_err(refused)
+    }
+
+    fn pad_for(&mut self, object: &Object) -> PyResult<&mut FreePad> {
+        let index = match self.pads.iter().position(|(o, _)| Arc::ptr_eq(o, &object.inner)) {
+            Some(i) => i,
+            None => {
+                let pad = FreePad::new(object.spec(), &self.config).map_err(refused)?;
+                self.pads.push((object.inner.clone(), pad));
+                self.pads.len() - 1
+            }
+        };
+        Ok(&mut self.pads[index].1)
+    }
+}
+
+/// The nine numbers of a pad pose, as a dataset's `pad_*` columns: the centre (metres), the normal
+/// (from the pad into the covering, toward the object) and the up direction (row 0's edge).
+pub fn pad_pose(value: &Bound<'_, PyAny>) -> PyResult<PadPose> {
+    let (_, v) = array::to_f64(value, "pad_pose")?;
+    if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
+        return Err(bad_argument(
+            "pad_pose",
+            format!("want 9 finite numbers (centre xyz in metres, normal xyz, up xyz), got {v:?}"),
+        ));
+    }
+    let vec = |i: usize| DVec3::new(v[i], v[i + 1], v[i + 2]);
+    PadPose::new(vec(0), vec(3), vec(6)).ok_or_else(|| {
+        bad_argument(
+            "pad_pose",
+            "the normal and up must be non-zero and not parallel",
+        )
+    })
+}
+
+#[pymethods]
+impl Sensor {
+    #[new]
+    #[pyo3(signature = (rows=6, cols=6, pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=4, noise=0.0, seed=1))]
+    #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a sensor parameter
+    fn new(
+        rows: usize,
+        cols: usize,
+        pad_m: f64,
+        thickness_m: Option<f64>,
+        psf_sigma_m: Option<f64>,
+        rays_per_taxel: usize,
+        noise: f64,
+        seed: u64,
+    ) -> PyResult<Self> {
+        let thickness_m = thickness_m.unwrap_or(0.1 * pad_m);
+        let config = SensorConfig {
+            rows,
+            cols,
+            pad_width_m: pad_m,
+            pad_height_m: pad_m,
+            thickness_m,
+            psf_sigma_m: psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
+            rays_per_taxel,
+            noise_fraction: noise,
+            noise_seed: seed,
+        };
+        Ok(Self {
+            config: Valid::new(config).map_err(refused)?,
+            pads: Vec::new(),
+        })
+    }
+
+    /// One reading of `object` with the pad at `pad_pose` (9 numbers: centre xyz in metres,
+    /// normal xyz, up xyz): an array `(rows, cols)` of values in [0, 1], row 0 the pad's up edge.
+    #[pyo3(signature = (object, pad_pose, dtype="float32"))]
+    fn read<'py>(
+        &mut self,
+        py: Python<'py>,
+        object: PyRef<'py, Object>,
+        pad_pose: &Bound<'py, PyAny>,
+        dtype: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let pose = self::pad_pose(pad_pose)?;
+        let image = self.pad_for(&object)?.read_at(&pose).map_err(refused)?;
+        array::from_f64(py, image.values(), &[image.rows(), image.cols()], dtype)
+    }
+
+    #[getter]
+    fn rows(&self) -> usize {
+        self.config.rows
+    }
+
+    #[getter]
+    fn cols(&self) -> usize {
+        self.config.cols
+    }
+
+    /// The configuration as a dataset's header writes it.
+    fn config(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        crate::dataset::json_to_python(py, &serde_json::to_value(&*self.config).map_err(refused)?)
+    }
+
+    fn __repr__(&self) -> String {
+        let c = &*self.config;
+        format!(
+            "Sensor(rows={}, cols={}, pad_m={}, thickness_m={}, psf_sigma_m={}, rays_per_taxel={}, noise={}, seed={})",
+            c.rows,
+            c.cols,
+            c.pad_width_m,
+            c.thickness_m,
+            c.psf_sigma_m,
+            c.rays_per_taxel,
+            c.noise_fraction,
+            c.noise_seed
+        )
+    }
+}

@@ -1,0 +1,70 @@
+"""taction: a simulated robot arm that recognises objects by touch.
+
+A Python face of the Rust library (Pezzementi et al., *Tactile Object Recognition From Appearance
+Information*, IEEE T-RO 2011): objects, the covering sensor, datasets, recognisers and their
+posterior, all speaking numpy; and the Gymnasium environment ``taction/ActiveTouch-v0``, registered on
+import. Importing the package also registers the ``taction.covering`` sensor plugin with stock
+``mujoco``, so ``mujoco.MjModel.from_xml_string(taction.scene(obj))`` compiles.
+
+    import taction
+    pawn = taction.objects("chess")[0]
+    sensor = taction.Sensor(rows=6, cols=6)
+    image = sensor.read(pawn, [0, 0, 0.06, 0, 0, -1, 0, 1, 0])   # numpy (6, 6) float32
+"""
+
+# The MuJoCo library the extension links is the one the `mujoco` package ships (the extension's
+# rpath is `$ORIGIN/../mujoco`); importing `mujoco` first loads it once for both.
+import mujoco as _mujoco  # noqa: F401
+
+from taction._taction import (  # noqa: F401
+    Dataset,
+    Model,
+    Object,
+    Posterior,
+    Sensor,
+    TactionError,
+    TouchEpisode,
+    __version__,
+    collect,
+    objects,
+    scene,
+    train,
+    train_for_arm,
+)
+from taction import _taction
+
+
+def plugin_path() -> str:
+    """The library that holds the ``taction.covering`` MuJoCo sensor plugin: this package's compiled
+    module. ``import taction`` has already registered the plugin; ``mujoco.mj_loadPluginLibrary``
+    on this path is harmless (the library is loaded once)."""
+    return _taction.__file__
+
+
+def _register_environments() -> None:
+    import gymnasium
+
+    if "taction/ActiveTouch-v0" not in gymnasium.registry:
+        gymnasium.register(
+            id="taction/ActiveTouch-v0",
+            entry_point="taction.env:ActiveTouchEnv",
+        )
+
+
+_register_environments()
+
+__all__ = [
+    "Dataset",
+    "Model",
+    "Object",
+    "Posterior",
+    "Sensor",
+    "TactionError",
+    "TouchEpisode",
+    "collect",
+    "objects",
+    "plugin_path",
+    "scene",
+    "train",
+    "train_for_arm",
+]

@@ -1,0 +1,198 @@
+"""``taction/ActiveTouch-v0``: learn where to touch to recognise an unknown object.
+
+Each episode places one object of a set (drawn from the episode's seed, optionally perturbed after
+every reading) before the arm. The agent does not see the object; after every action it sees the
+last tactile image, where the pad is, how many touches it has made, the recogniser's belief over the
+objects, and the K targets the exploration planner (Sec. III-A of the paper) offers for the next
+touch. An action either touches toward one of those targets (one planner iteration: the arm moves
+toward it and, if the sensor meets the surface, the controllers of Algorithm 1 settle it and the
+reading updates the belief) or declares which object it is, which ends the episode. A right
+declaration pays ``right_reward``, a wrong one ``wrong_reward``, every touch costs ``touch_cost``; the
+episode is truncated after ``budget`` touches.
+
+The recogniser is ``model`` (a ``taction.Model`` or a model file), or by default the one
+``taction demo`` trains for the arm's touches (``taction.train_for_arm`` on ``training_readings``
+sampler readings per object from starts the arm can reach), trained once per process and set.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Sequence, Union
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+import taction
+
+#: Models trained by default, per (set, readings, seed): one training per process serves every
+#: environment of a vector env.
+_DEFAULT_MODELS: dict = {}
+
+
+def _objects_of(objects: Union[str, Sequence["taction.Object"]]) -> list:
+    if isinstance(objects, (str, os.PathLike)):
+        return taction.objects(objects)
+    return list(objects)
+
+
+def default_model(objects, training_readings: int = 300, seed: int = 1) -> "taction.Model":
+    """The recogniser ``taction demo`` trains for the arm (``taction.train_for_arm``) on ``objects``
+    (a set name or a list of objects); trained once per process for a set name."""
+    key = (objects, training_readings, seed) if isinstance(objects, str) else None
+    if key is not None and key in _DEFAULT_MODELS:
+        return _DEFAULT_MODELS[key]
+    training = taction.collect(
+        _objects_of(objects),
+        mode="sampler",
+        readings=training_readings,
+        seed=seed,
+        reachable_by_arm=True,
+    )
+    model = taction.train_for_arm(training.converged(), seed=seed)
+    if key is not None:
+        _DEFAULT_MODELS[key] = model
+    return model
+
+
+class ActiveTouchEnv(gymnasium.Env):
+    """Active tactile recognition as a Gymnasium environment (see the module docs).
+
+    Observation (a Dict):
+      - ``image``: Box(0, 1, (rows, cols), float32), the last converged reading (zeros before one);
+      - ``pad_pose``: Box((9,), float32), the pad's centre (m), normal and up now;
+      - ``touches``: Discrete(budget + 1), touches made;
+      - ``belief``: Box(0, 1, (objects,), float32), P(object | readings so far);
+      - ``candidates``: Box((K, 3), float32), the targets the next touch may go toward (m).
+    Action: Discrete(K + objects): ``a < K`` touches toward candidate ``a``; ``a >= K`` declares
+    object ``a - K`` (``env.unwrapped.objects`` names them).
+    ``info`` holds ``converged`` (whether the touch gave a reading), ``attempts``, ``readings`` and,
+    when the episode ends, ``object`` (the truth) and ``declared``.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self,
+        objects: Union[str, Sequence["taction.Object"]] = "chess",
+        model: Union[None, str, os.PathLike, "taction.Model"] = None,
+        budget: int = 30,
+        candidates: int = 12,
+        local_probability: float = 0.5,
+        perturb_deg: float = 0.0,
+        perturb_frac: float = 0.0,
+        touch_cost: float = 0.01,
+        right_reward: float = 1.0,
+        wrong_reward: float = -1.0,
+        training_readings: int = 300,
+        training_seed: int = 1,
+    ):
+        if budget < 1:
+            raise taction.TactionError(f"budget: {budget} is not 1 or more")
+        if candidates < 1:
+            raise taction.TactionError(f"candidates: {candidates} is not 1 or more")
+        self._objects = _objects_of(objects)
+        if isinstance(model, (str, os.PathLike)):
+            model = taction.Model.load(model)
+        elif model is None:
+            model = default_model(objects if isinstance(objects, str) else self._objects,
+                                  training_readings, training_seed)
+        self.model = model
+        by_name = {o.name: o for o in self._objects}
+        missing = [name for name in model.objects if name not in by_name]
+        if missing:
+            raise taction.TactionError(f"model: knows objects not in the set: {missing}")
+        self.objects = list(model.objects)
+        self._episode_objects = [by_name[name] for name in self.objects]
+        self.budget = budget
+        self.k = candidates
+        self._settings = dict(
+            candidates=candidates,
+            local_probability=local_probability,
+            perturb_deg=perturb_deg,
+            perturb_frac=perturb_frac,
+        )
+        self.touch_cost = touch_cost
+        self.right_reward = right_reward
+        self.wrong_reward = wrong_reward
+        rows, cols = model.sensor_shape
+        self.observation_space = spaces.Dict(
+            {
+                "image": spaces.Box(0.0, 1.0, (rows, cols), np.float32),
+                "pad_pose": spaces.Box(-np.inf, np.inf, (9,), np.float32),
+                "touches": spaces.Discrete(budget + 1),
+                "belief": spaces.Box(0.0, 1.0, (len(self.objects),), np.float32),
+                "candidates": spaces.Box(-np.inf, np.inf, (candidates, 3), np.float32),
+            }
+        )
+        self.action_space = spaces.Discrete(candidates + len(self.objects))
+        self._episode: Optional[taction.TouchEpisode] = None
+        self._touches = 0
+
+    # The episode's candidates, repeated in order when the planner offered fewer than K.
+    def _candidates(self) -> np.ndarray:
+        offered = self._episode.candidates
+        return offered[np.arange(self.k) % len(offered)]
+
+    def _observation(self) -> dict:
+        e = self._episode
+        return {
+            "image": e.image.astype(np.float32),
+            "pad_pose": e.pad_pose.astype(np.float32),
+            "touches": self._touches,
+            "belief": np.clip(e.probabilities, 0.0, 1.0).astype(np.float32),
+            "candidates": self._candidates().astype(np.float32),
+        }
+
+    def gains(self) -> np.ndarray:
+        """The expected information gain (nats) of a touch toward each of the K candidates: what
+        the information-gain policy maximises (``taction.active_touch``)."""
+        offered = self._episode.gains()
+        return offered[np.arange(self.k) % len(offered)]
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        super().reset(seed=seed)
+        options = options or {}
+        index = options.get("object")
+        if index is None:
+            index = int(self.np_random.integers(len(self.objects)))
+        elif isinstance(index, str):
+            index = self.objects.index(index)
+        episode_seed = int(self.np_random.integers(2**63 - 1))
+        self._episode = taction.TouchEpisode(
+            self.model,
+            self._episode_objects[index],
+            seed=episode_seed,
+            workspace=self._episode_objects,
+            **self._settings,
+        )
+        self._touches = 0
+        return self._observation(), {"attempts": 0, "readings": 0}
+
+    def step(self, action):
+        if self._episode is None:
+            raise taction.TactionError("step: call reset() first")
+        action = int(action)
+        if not 0 <= action < self.action_space.n:
+            raise taction.TactionError(f"action: {action} is outside 0..{self.action_space.n - 1}")
+        e = self._episode
+        info: dict[str, Any] = {}
+        terminated = truncated = False
+        if action >= self.k:
+            declared = action - self.k
+            right = declared == e.object_index
+            reward = self.right_reward if right else self.wrong_reward
+            terminated = True
+            info["declared"] = self.objects[declared]
+            info["converged"] = False
+        else:
+            info["converged"] = e.touch(action % len(e.candidates))
+            self._touches += 1
+            reward = -self.touch_cost
+            truncated = self._touches >= self.budget
+        info["attempts"] = e.attempts
+        info["readings"] = e.touches
+        if terminated or truncated:
+            info["object"] = e.object
+        return self._observation(), float(reward), terminated, truncated, info

@@ -1,0 +1,83 @@
+"""Datasets from Python: the collected arrays, determinism, and the round trips through the CLI's
+file, pandas, npz and Parquet."""
+
+import numpy as np
+import pytest
+
+import taction
+
+
+def test_collected_arrays_have_the_documented_shapes(small_dataset):
+    n = len(small_dataset)
+    assert n >= 80  # 40 converged readings of each piece, plus the attempts that did not converge
+    assert small_dataset.images.shape == (n, 6, 6)
+    assert small_dataset.images.dtype == np.float32
+    assert small_dataset.pad_pose.shape == (n, 9)
+    assert set(small_dataset.object) == {"pawn", "rook"}
+    converged = small_dataset.status == "converged"
+    assert converged.sum() == 80
+    assert np.all(small_dataset.cause[converged] == "")
+    assert small_dataset.images[converged].max() <= 1.0
+    assert small_dataset.images[converged].max(axis=(1, 2)).min() > 0.0
+    # The normal and up of every pose are unit vectors.
+    poses = small_dataset.pad_pose[converged]
+    assert np.allclose(np.linalg.norm(poses[:, 3:6], axis=1), 1.0)
+    assert np.allclose(np.linalg.norm(poses[:, 6:9], axis=1), 1.0)
+    assert small_dataset.header["sensor"]["rows"] == 6
+    assert len(small_dataset.converged()) == 80
+
+
+def test_same_seed_same_dataset(chess):
+    a = taction.collect(chess[:1], readings=5, seed=11)
+    b = taction.collect(chess[:1], readings=5, seed=11)
+    c = taction.collect(chess[:1], readings=5, seed=12)
+    assert np.array_equal(a.images, b.images)
+    assert np.array_equal(a.pad_pose, b.pad_pose)
+    assert not np.array_equal(a.pad_pose[: len(c)], c.pad_pose[: len(a)])
+
+
+def test_the_csv_reads_back_and_pandas_reads_it_with_comment(small_dataset, tmp_path):
+    import pandas as pd
+
+    path = tmp_path / "data.csv"
+    small_dataset.save(path)
+    again = taction.Dataset.load(path)
+    assert np.array_equal(again.images, small_dataset.images)
+    assert np.array_equal(again.pad_pose, small_dataset.pad_pose, equal_nan=True)
+    frame = pd.read_csv(path, comment="#")
+    assert len(frame) == len(small_dataset)
+    assert list(frame["object"]) == list(small_dataset.object)
+    taxels = frame[[f"t_{r}_{c}" for r in range(6) for c in range(6)]].to_numpy()
+    assert np.array_equal(taxels.reshape(-1, 6, 6), again.images.astype(np.float64))
+    assert np.allclose(frame["pad_x_m"], small_dataset.pad_pose[:, 0], equal_nan=True)
+
+
+def test_npz_round_trip(small_dataset, tmp_path):
+    path = tmp_path / "data.npz"
+    small_dataset.export(path, format="npz")
+    with np.load(path) as npz:  # no pickles: plain numeric and unicode arrays
+        assert np.array_equal(npz["images"], small_dataset.images)
+        assert np.array_equal(npz["pad_pose"], small_dataset.pad_pose, equal_nan=True)
+        assert list(npz["object"]) == list(small_dataset.object)
+        assert list(npz["status"]) == list(small_dataset.status)
+        assert list(npz["cause"]) == list(small_dataset.cause)
+
+
+def test_parquet_round_trip(small_dataset, tmp_path):
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("pyarrow")
+    path = tmp_path / "data.parquet"
+    small_dataset.export(path, format="parquet")
+    frame = pd.read_parquet(path)
+    assert len(frame) == len(small_dataset)
+    assert list(frame["object"]) == list(small_dataset.object)
+    assert list(frame["status"]) == list(small_dataset.status)
+    frame_pandas = small_dataset.to_pandas()
+    assert list(frame_pandas["object"]) == list(small_dataset.object)
+
+
+def test_a_corrupt_dataset_file_names_the_file(tmp_path):
+    path = tmp_path / "cut.csv"
+    path.write_text("# taction dataset\n# {not json\n")
+    with pytest.raises(taction.TactionError, match="cut.csv"):
+        taction.Dataset.load(path)

@@ -1,0 +1,114 @@
+"""taction/ActiveTouch-v0: Gymnasium's own checks, vector envs, seeded determinism, rewards."""
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import taction
+
+ENV = "taction/ActiveTouch-v0"
+
+
+@pytest.fixture
+def make(small_model):
+    def make(**kwargs):
+        return gymnasium.make(ENV, objects="chess", model=small_model, budget=4, **kwargs)
+
+    return make
+
+
+def test_the_environment_is_registered_on_import():
+    assert ENV in gymnasium.registry
+
+
+def test_check_env_passes(make):
+    env = make()
+    check_env(env.unwrapped, skip_render_check=True)
+    env.close()
+
+
+def test_make_vec_steps_two_environments(small_model):
+    envs = gymnasium.make_vec(
+        ENV, num_envs=2, vectorization_mode="sync", objects="chess", model=small_model, budget=3
+    )
+    obs, info = envs.reset(seed=3)
+    assert obs["image"].shape == (2, 6, 6)
+    assert obs["belief"].shape == (2, 2)
+    obs, reward, terminated, truncated, info = envs.step(np.array([0, 1]))
+    assert reward.shape == (2,)
+    assert np.allclose(reward, -0.01)
+    envs.close()
+
+
+def trace(env, seed, actions):
+    obs, _ = env.reset(seed=seed)
+    out = [obs]
+    for a in actions:
+        obs, reward, terminated, truncated, info = env.step(a)
+        out.append((obs, reward, terminated, truncated, info))
+        if terminated or truncated:
+            break
+    return out
+
+
+def same(a, b):
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if isinstance(a, (tuple, list)):
+        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray):
+        return np.array_equal(a, b)
+    return a == b
+
+
+def test_same_seed_same_episode(make):
+    env = make()
+    actions = [0, 3, 1, 2]
+    first = trace(env, 11, actions)
+    again = trace(env, 11, actions)
+    assert same(first, again)
+    other = trace(env, 12, actions)
+    assert not same(first, other)
+    env.close()
+
+
+def test_a_declaration_ends_the_episode_and_pays_when_right(make):
+    env = make()
+    obs, _ = env.reset(seed=0, options={"object": "rook"})
+    k = env.unwrapped.k
+    rook = env.unwrapped.objects.index("rook")
+    _, reward, terminated, truncated, info = env.step(k + rook)
+    assert terminated and not truncated
+    assert reward == 1.0 and info["object"] == "rook" and info["declared"] == "rook"
+    env.reset(seed=0, options={"object": "rook"})
+    _, reward, terminated, _, _ = env.step(k + (1 - rook))
+    assert terminated and reward == -1.0
+
+
+def test_the_budget_truncates_and_touches_read_the_object(make):
+    env = make()
+    obs, _ = env.reset(seed=5)
+    gains = env.unwrapped.gains()
+    assert gains.shape == (env.unwrapped.k,) and np.all(np.isfinite(gains))
+    steps = 0
+    readings = 0
+    while True:
+        obs, reward, terminated, truncated, info = env.step(int(np.argmax(env.unwrapped.gains())))
+        steps += 1
+        readings = info["readings"]
+        if terminated or truncated:
+            break
+    assert truncated and steps == 4 and obs["touches"] == 4
+    assert abs(obs["belief"].sum() - 1.0) < 1e-5
+    if readings:
+        assert obs["image"].max() > 0
+
+
+def test_bad_arguments_raise(make, small_model):
+    with pytest.raises(taction.TactionError, match="budget"):
+        gymnasium.make(ENV, objects="chess", model=small_model, budget=0)
+    env = make()
+    env.reset(seed=0)
+    with pytest.raises(taction.TactionError, match="action"):
+        env.unwrapped.step(99)

@@ -1,0 +1,53 @@
+"""Training and recognising from Python: the posterior after each reading, files, errors."""
+
+import numpy as np
+import pytest
+
+import taction
+
+
+def test_the_posterior_moves_toward_the_touched_object(small_model, small_dataset):
+    assert small_model.objects == ["pawn", "rook"]
+    assert small_model.descriptor == "mnti"
+    converged = small_dataset.status == "converged"
+    images = small_dataset.images[converged]
+    names = small_dataset.object[converged]
+    right = 0
+    for target in ("pawn", "rook"):
+        posterior = small_model.posterior()
+        assert np.allclose(posterior.probabilities, [0.5, 0.5])
+        for image in images[names == target][:10]:
+            p = posterior.observe(image)
+        assert p.shape == (2,)
+        assert abs(p.sum() - 1.0) < 1e-9
+        assert posterior.readings == 10
+        right += posterior.guess == target
+    assert right == 2
+
+
+def test_a_model_file_round_trips(small_model, small_dataset, tmp_path):
+    path = tmp_path / "model.json"
+    small_model.save(path)
+    again = taction.Model.load(path)
+    image = small_dataset.images[small_dataset.status == "converged"][0]
+    a = small_model.posterior().observe(image)
+    b = again.posterior().observe(image)
+    assert np.array_equal(a, b)
+    scores = again.evaluate(small_dataset, readings=5)
+    assert scores["trials"] > 0 and len(scores["accuracy"]) == 5
+
+
+def test_training_is_seeded(small_dataset):
+    a = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)
+    b = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)
+    image = small_dataset.images[0]
+    assert np.array_equal(a.posterior().observe(image), b.posterior().observe(image))
+
+
+def test_bad_training_arguments_name_the_argument(small_dataset, small_model):
+    with pytest.raises(taction.TactionError, match="descriptor"):
+        taction.train(small_dataset, descriptor="nope")
+    with pytest.raises(taction.TactionError, match="codebook"):
+        taction.train(small_dataset, codebook="nope")
+    with pytest.raises(taction.TactionError, match="image"):
+        small_model.posterior().observe(np.zeros(6))

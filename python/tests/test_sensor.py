@@ -1,0 +1,74 @@
+"""The sensor from Python reads what the CLI reads, bit for bit; bad input raises TactionError."""
+
+import numpy as np
+import pytest
+
+import taction
+from conftest import ROOT, taction_cli
+
+# The pad 0.6 mm into the top of the 3 cm sphere (its apex at z = 6 cm): the covering is 1.2 mm.
+TOUCH = [0.001, -0.002, 0.0606, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0]
+
+
+def test_a_reading_equals_taction_sense_bit_for_bit(sphere_path, tmp_path):
+    out = tmp_path / "sense.csv"
+    taction_cli(
+        "sense",
+        "--mesh", str(sphere_path),
+        "--pad-center", "0.001,-0.002,0.0606",
+        "--pad-normal", "0,0,-1",
+        "--pad-up", "0,1,0",
+        "--out", str(out),
+    )
+    cli = np.loadtxt(out, delimiter=",", ndmin=2)
+    sphere = taction.Object.from_file(sphere_path)
+    sensor = taction.Sensor()
+    exact = sensor.read(sphere, TOUCH, dtype="float64")
+    assert exact.shape == (6, 6)
+    assert exact.max() > 0.3, exact  # the apex is felt, off-centre as the pad is
+    assert np.array_equal(exact, cli)
+    # The default dtype is float32: the same values, rounded once.
+    image = sensor.read(sphere, TOUCH)
+    assert image.dtype == np.float32
+    assert np.array_equal(image, cli.astype(np.float32))
+
+
+def test_the_sensor_parameters_shape_the_image(sphere_path):
+    sphere = taction.Object.from_file(sphere_path)
+    big = taction.Sensor(rows=14, cols=10).read(sphere, TOUCH)
+    assert big.shape == (14, 10)
+    # Lifted clear of the covering, nothing is felt.
+    lifted = list(TOUCH)
+    lifted[2] += 0.01
+    assert taction.Sensor().read(sphere, lifted).max() == 0.0
+
+
+def test_noise_is_seeded(sphere_path):
+    sphere = taction.Object.from_file(sphere_path)
+    a = taction.Sensor(noise=0.4, seed=3).read(sphere, TOUCH)
+    b = taction.Sensor(noise=0.4, seed=3).read(sphere, TOUCH)
+    c = taction.Sensor(noise=0.4, seed=4).read(sphere, TOUCH)
+    assert np.array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_a_broken_mesh_raises_an_error_naming_the_file(tmp_path):
+    broken = tmp_path / "broken_cup.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+    with pytest.raises(taction.TactionError, match="broken_cup.obj"):
+        taction.Object.from_file(broken)
+    missing = tmp_path / "nowhere.stl"
+    with pytest.raises(taction.TactionError, match="nowhere.stl"):
+        taction.Object.from_file(missing)
+
+
+def test_out_of_range_parameters_name_the_field(sphere_path):
+    with pytest.raises(taction.TactionError, match="rows"):
+        taction.Sensor(rows=0)
+    with pytest.raises(taction.TactionError, match="noise"):
+        taction.Sensor(noise=-0.1)
+    sphere = taction.Object.from_file(sphere_path)
+    with pytest.raises(taction.TactionError, match="pad_pose"):
+        taction.Sensor().read(sphere, [0, 0, 0.06, 0, 0, -1])
+    with pytest.raises(taction.TactionError, match="pad_pose"):
+        taction.Sensor().read(sphere, [0, 0, 0.06, 0, 0, -1, 0, 0, -1])
