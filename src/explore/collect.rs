@@ -75,6 +75,11 @@ pub struct CollectPlan {
 /// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
 use crate::control::sensor_reader;
 
+/// The reader [`CollectPlan::planner_for`]'s planner reads the arm's pad with: a named type, so
+/// that a caller can keep the planner in a struct (`active_touch::TouchEpisode`) and send it to
+/// another thread.
+pub type SensorReader = Box<dyn ReadTactile + Send>;
+
 impl CollectPlan {
     /// The sensor of object `index`: the noise stream is the object's own.
     pub fn sensor_for(&self, index: usize) -> SensorConfig {
@@ -138,12 +143,12 @@ impl CollectPlan {
         object: &ObjectSpec,
         index: usize,
         config: Valid<PlannerConfig>,
-    ) -> Result<(Scene, Planner<impl ReadTactile + use<>>), ControlError> {
+    ) -> Result<(Scene, Planner<SensorReader>), ControlError> {
         let setup = self.setup_for(index);
         let builder = SceneBuilder::with_arm_and_table().object(object.clone());
         let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
         let scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
-        let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
+        let reader: SensorReader = Box::new(sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?));
         let planner = Planner::new(
             &scene,
             config,

@@ -12,7 +12,7 @@ pub(crate) mod surface_sampling;
 pub(crate) mod tree;
 
 // Collecting a dataset: the sampler or the exploring arm, over a set of objects.
-pub use collect::{Collect, CollectError, CollectMode, CollectPlan};
+pub use collect::{Collect, CollectError, CollectMode, CollectPlan, SensorReader};
 pub use grid::ReadingGrid;
 pub use setup::TouchSetup;
 
@@ -22,12 +22,12 @@ pub use surface_sampling::{SurfacePoint, SurfaceSampler};
 
 // The planner (Sec. III-A): its tree, how the arm reaches, and its report.
 pub use planner::{
-    ITERATIONS_PER_READING, Planner, PlannerConfig, WORKSPACE_MARGIN_M, precise_kinematic_motion,
-    precise_motion,
+    ITERATIONS_PER_READING, PROPOSAL_DRAWS_PER_CANDIDATE, Planner, PlannerConfig, WORKSPACE_MARGIN_M,
+    precise_kinematic_motion, precise_motion,
 };
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;
 pub use tree::{ExplorationTree, Vertex};
 
 // Active touch: the next touch chosen by the posterior.
-pub use active::{ActiveGuidance, DEFAULT_CANDIDATES, Probability, TouchScorer};
+pub use active::{ActiveGuidance, DEFAULT_CANDIDATES, Probability, TouchScorer, best_candidate};

@@ -94,6 +94,11 @@ pub struct PlannerConfig {
     pub execution: Execution,
 }
 
+/// Draws of the paper's rule per candidate asked of [`Planner::propose_candidates`] at most: a
+/// local draw fails only when no grid cell is found, so four draws per candidate leave room for
+/// failures without letting a caller loop forever.
+pub const PROPOSAL_DRAWS_PER_CANDIDATE: usize = 4;
+
 /// Planner iterations allowed per converged reading asked for. The default budget (20,000
 /// iterations) was sized for the paper's 100 test readings per object; a training set from the
 /// arm asks for ten times as many, and a budget that does not grow with it stops short (the
@@ -437,35 +442,89 @@ where
             } else {
                 strategy
             };
-            let vertex = self.tree.nearest(target);
-            if !self.return_to(scene, &arm, vertex) {
-                continue;
-            }
-            // A physics fault anywhere in this iteration puts the world back here (the arm at the
-            // vertex, the object as it lay) and exploration goes on.
-            let checkpoint = scene.checkpoint()?;
-            let expansion = Expansion {
-                vertex,
-                strategy,
-                label,
-                target,
-                object,
-                checkpoint: &checkpoint,
-            };
-            match self.expand(scene, &arm, &expansion, &mut record) {
-                Ok(()) => {}
-                Err(e) if e.is_physics_fault() => {
-                    scene.restore(&checkpoint)?;
-                    *record
-                        .report
-                        .expansion_stops
-                        .entry(CauseKind::PhysicsFault)
-                        .or_insert(0) += 1;
-                }
-                Err(e) => return Err(e),
-            }
+            self.iterate_toward(scene, &arm, object, (strategy, target), label, &mut record)?;
         }
         Ok(record.report)
+    }
+
+    /// `k` targets by the paper's rule (each local with probability L once a reading exists, else
+    /// global: what one iteration of [`explore`](Self::explore) draws), in the order drawn, for a caller that chooses among them
+    /// itself (an active-touch policy). A local draw that finds no cell gives nothing and is drawn
+    /// again, at most [`PROPOSAL_DRAWS_PER_CANDIDATE`]` * k` draws in all, so fewer than `k` come
+    /// back only when the draws keep failing (never while a global draw is possible, L < 1).
+    pub fn propose_candidates(&mut self, k: usize) -> Vec<(Strategy, DVec3)> {
+        let mut proposals = Vec::with_capacity(k);
+        for _ in 0..k.saturating_mul(PROPOSAL_DRAWS_PER_CANDIDATE) {
+            if proposals.len() == k {
+                break;
+            }
+            proposals.extend(self.propose());
+        }
+        proposals
+    }
+
+    /// Exactly one planner iteration (Sec. III-A) toward `candidate` (a proposal of
+    /// [`propose_candidates`](Self::propose_candidates), or any target and the strategy that
+    /// carries the pad toward it): from the nearest tree vertex, the expansion in small steps and,
+    /// where the sensor feels the object, surface contact control; its reading, if any, is tagged
+    /// with `candidate.0`. The same iteration as [`explore_guided`](Self::explore_guided)'s: a
+    /// physics fault restores the world and is counted in the report's `expansion_stops`.
+    pub fn touch_toward(
+        &mut self,
+        scene: &mut Scene,
+        object: &str,
+        candidate: (Strategy, DVec3),
+    ) -> Result<ExplorationReport, ControlError> {
+        let arm = scene.arm().cloned().ok_or(crate::sim::SimError::NoArm)?;
+        let mut record = Record {
+            report: ExplorationReport {
+                iterations: 1,
+                ..ExplorationReport::default()
+            },
+            on_converged: &mut || {},
+        };
+        self.iterate_toward(scene, &arm, object, candidate, candidate.0, &mut record)?;
+        Ok(record.report)
+    }
+
+    /// One iteration toward `target` (its strategy, its point), the reading tagged `label`: return
+    /// to the tree vertex nearest the target, then expand (a physics fault anywhere puts the world
+    /// back at the vertex, the object as it lay, and is counted; exploration goes on).
+    fn iterate_toward(
+        &mut self,
+        scene: &mut Scene,
+        arm: &Arm,
+        object: &str,
+        (strategy, target): (Strategy, DVec3),
+        label: Strategy,
+        record: &mut Record<'_>,
+    ) -> Result<(), ControlError> {
+        let vertex = self.tree.nearest(target);
+        if !self.return_to(scene, arm, vertex) {
+            return Ok(());
+        }
+        let checkpoint = scene.checkpoint()?;
+        let expansion = Expansion {
+            vertex,
+            strategy,
+            label,
+            target,
+            object,
+            checkpoint: &checkpoint,
+        };
+        match self.expand(scene, arm, &expansion, record) {
+            Ok(()) => Ok(()),
+            Err(e) if e.is_physics_fault() => {
+                scene.restore(&checkpoint)?;
+                *record
+                    .report
+                    .expansion_stops
+                    .entry(CauseKind::PhysicsFault)
+                    .or_insert(0) += 1;
+                Ok(())
+            }
+            Err(e) => Err(e),
+        }
     }
 
     /// The iteration's target: one proposal by the paper's rule ([`propose`](Self::propose)), or

@@ -25,6 +25,7 @@ use crate::recognize::model::{
 };
 use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
+use crate::tactile::SensorConfig;
 use crate::valid::Valid;
 
 /// A descriptor name that names no descriptor, or a fusion that names one twice or none.
@@ -316,6 +317,15 @@ impl Recognizer {
         match self {
             Self::Single(m) => m.bag.objects(),
             Self::Fused(f) => f.objects(),
+        }
+    }
+
+    /// The sensor the model was trained on (a fused model's parts share it, [`FusedModel::new`]):
+    /// what data must be taken with to be recognised ([`check_same_sensor`]).
+    pub fn sensor(&self) -> &SensorConfig {
+        match self {
+            Self::Single(m) => &m.sensor,
+            Self::Fused(f) => &f.fused[0].sensor,
         }
     }
 

@@ -36,7 +36,13 @@
 //! `benches/recognize.rs` measures it against a plain planner iteration.
 //!
 //! [`explore_recognizing`] runs the planner one touch at a time, updates the posterior after each
-//! converged reading and applies the confidence stop.
+//! converged reading and applies the confidence stop. [`TouchEpisode`] hands the choice of each
+//! touch to a caller instead (a learned policy, a Gymnasium environment): it owns the scene, the
+//! planner and the belief of one object's exploration, and touches toward the candidate it is told.
+
+mod episode;
+
+pub use episode::{EpisodeConfig, TouchEpisode};
 
 use glam::DVec3;
 
@@ -51,8 +57,8 @@ use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, ModelPosterior};
 use crate::recognize::{
-    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, TrainConfig,
-    TrainedModel,
+    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer,
+    TrainConfig, TrainedModel,
 };
 use crate::sim::{PerturbationBounds, Scene};
 use crate::tactile::{SensorConfig, TactileImage};
@@ -194,6 +200,14 @@ impl<'a> ActiveRecognition<'a> {
         ))
     }
 
+    /// The recogniser of a model of either kind ([`new`](Self::new) or [`fused`](Self::fused)).
+    pub fn of(model: &'a Recognizer, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+        match model {
+            Recognizer::Single(m) => Self::new(m, neighbourhood_m),
+            Recognizer::Fused(f) => Self::fused(f, neighbourhood_m),
+        }
+    }
+
     fn with(bag: &'a BagOfFeatures, posterior: ModelPosterior<'a>, neighbourhood_m: f64) -> Self {
         Self {
             bag,
@@ -316,6 +330,7 @@ pub struct TouchPlan {
 }
 
 /// One converged touch and the belief after it.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Touch {
     pub reading: Reading,
     pub belief: Belief,
@@ -331,13 +346,24 @@ pub struct TouchRun {
     pub stopped_confident: bool,
 }
 
-/// What can end [`explore_recognizing`] early.
+/// What can end [`explore_recognizing`] early, or refuse a [`TouchEpisode`] or one of its touches.
 #[derive(Debug, thiserror::Error)]
 pub enum TouchError {
     #[error(transparent)]
     Explore(#[from] ControlError),
     #[error(transparent)]
     Recognize(#[from] RecognizeError),
+    /// The episode's configuration failed its check.
+    #[error(transparent)]
+    Config(#[from] RangeError),
+    /// A touch toward a candidate the episode did not offer.
+    #[error(
+        "touch toward candidate {index}: the episode offers {candidates} candidates (0 to {candidates} - 1)"
+    )]
+    NoSuchCandidate { index: usize, candidates: usize },
+    /// The object to explore is not one the model recognises.
+    #[error("object '{object}' is not in the model (it knows {known})")]
+    UnknownObject { object: String, known: String },
 }
 
 /// Explores `object` in `scene` one converged touch at a time, recognising as it goes: after each

@@ -1,0 +1,217 @@
+//! Active touch driven from outside (`active_touch::TouchEpisode`, what the Gymnasium environment
+//! steps), and the planner's one-iteration entry point it rests on, on a box and a sphere with a
+//! tiny model.
+
+mod common;
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use taction::active_touch::{EpisodeConfig, Touch, TouchEpisode, TouchError};
+use taction::describe::DescriptorKind;
+use taction::explore::{Collect, CollectMode, CollectPlan, ExplorationReport, PlannerConfig};
+use taction::recognize::{Recognizer, TrainConfig, TrainedModel};
+use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::tactile::SensorConfig;
+use taction::valid::Valid;
+
+fn sensor() -> SensorConfig {
+    SensorConfig::square(6, 6, 0.012, 0.0012)
+}
+
+fn objects() -> Vec<ObjectSpec> {
+    vec![
+        ObjectSpec::new("box", common::box_mesh(DVec3::new(0.08, 0.06, 0.08))),
+        ObjectSpec::new("ball", common::sphere_mesh(0.04, DVec3::new(0.0, 0.0, 0.04), 12)),
+    ]
+}
+
+/// A planner fitted to the two objects, at most `iterations` iterations per run.
+fn planner(iterations: usize) -> Valid<PlannerConfig> {
+    Valid::new(PlannerConfig {
+        max_iterations: iterations,
+        ..PlannerConfig::default().fitted_to(&objects())
+    })
+    .unwrap()
+}
+
+/// MNTI over 4 clusters, trained on a few sampler readings of each object.
+fn model() -> Arc<Recognizer> {
+    let training = Collect::sampler(sensor())
+        .per_object(16)
+        .seed(3)
+        .dataset("test", &objects())
+        .unwrap();
+    let config = Valid::new(TrainConfig {
+        ks: vec![4],
+        restarts: 1,
+        seed: 3,
+        ..TrainConfig::default()
+    })
+    .unwrap();
+    let descriptor = DescriptorKind::Mnti.build();
+    let model = TrainedModel::fit(&config, &training, None, descriptor.as_ref(), &mut |_| {}).unwrap();
+    Arc::new(Recognizer::Single(Box::new(model)))
+}
+
+fn config() -> Valid<EpisodeConfig> {
+    Valid::new(EpisodeConfig {
+        planner: planner(PlannerConfig::default().max_iterations),
+        perturbation: PerturbationBounds::new(10.0, 0.1).unwrap(),
+        candidates: 4,
+        ..EpisodeConfig::new(sensor())
+    })
+    .unwrap()
+}
+
+/// What one step of an episode showed: the candidates offered, their gains, the touch made.
+type Step = (Vec<DVec3>, Vec<f64>, Option<Touch>);
+
+/// Touches of an episode of the ball, alternating the information-gain policy and the last
+/// candidate, until `converged` of them converged (or `steps` touches).
+fn run(model: &Arc<Recognizer>, seed: u64, converged: usize, steps: usize) -> (Vec<Step>, TouchEpisode) {
+    let mut episode = TouchEpisode::new(Arc::clone(model), &objects()[1], &config(), seed).unwrap();
+    let mut shown = Vec::new();
+    for step in 0..steps {
+        if episode.touches() == converged {
+            break;
+        }
+        let candidates = episode.candidates().to_vec();
+        let gains = episode.gains().unwrap();
+        let choice = if step % 2 == 0 {
+            episode.most_informative().unwrap().unwrap()
+        } else {
+            candidates.len() - 1
+        };
+        let touch = episode.touch(choice).unwrap();
+        shown.push((candidates, gains, touch));
+    }
+    (shown, episode)
+}
+
+#[test]
+fn an_episode_is_its_seed_checks_its_choices_and_believes_after_each_touch() {
+    fn send<T: Send>() {}
+    send::<TouchEpisode>();
+    let model = model();
+    let t0 = std::time::Instant::now();
+    let (first, episode) = run(&model, 11, 3, 300);
+    eprintln!(
+        "{} touches: {} attempts, {} converged ({:?})",
+        first.len(),
+        episode.attempts(),
+        episode.touches(),
+        t0.elapsed()
+    );
+    let (second, again) = run(&model, 11, 3, 300);
+    assert_eq!(first, second, "one seed, one episode");
+    assert_eq!(episode.belief(), again.belief());
+    assert_eq!(episode.pad_pose(), again.pad_pose());
+    let (other, _) = run(&model, 12, 1, 1);
+    assert_ne!(first[0].0, other[0].0, "another seed, other candidates");
+    for (candidates, gains, _) in &first {
+        assert_eq!(candidates.len(), 4);
+        assert_eq!(gains.len(), 4);
+        assert!(gains.iter().all(|g| g.is_finite() && *g >= -1e-12), "{gains:?}");
+    }
+
+    // Each converged touch grows the belief by one reading, whose probabilities sum to 1.
+    let converged: Vec<&Touch> = first.iter().filter_map(|s| s.2.as_ref()).collect();
+    assert_eq!(converged.len(), 3, "3 converged touches in {}", first.len());
+    for (n, touch) in converged.iter().enumerate() {
+        assert_eq!(touch.belief.readings, n + 1);
+        let sum: f64 = touch.belief.probabilities().iter().sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{sum}");
+        assert!(touch.reading.is_converged());
+        assert_eq!(touch.reading.object, "ball");
+    }
+    assert_eq!(episode.touches(), converged.len());
+    assert_eq!(episode.belief(), &converged[converged.len() - 1].belief);
+    assert_eq!(
+        episode.last_image(),
+        Some(&converged[converged.len() - 1].reading.image)
+    );
+    assert!(episode.attempts() >= episode.touches());
+    assert_eq!(episode.object_name(), "ball");
+    assert_eq!(episode.object_index(), 1);
+}
+
+#[test]
+fn an_episode_refuses_what_it_cannot_do() {
+    let model = model();
+    let mut episode = TouchEpisode::new(Arc::clone(&model), &objects()[0], &config(), 1).unwrap();
+    let offered = episode.candidates().to_vec();
+    match episode.touch(4) {
+        Err(TouchError::NoSuchCandidate {
+            index: 4,
+            candidates: 4,
+        }) => {}
+        other => panic!("{:?}", other.map(|t| t.is_some())),
+    }
+    assert_eq!(episode.attempts(), 0);
+    assert_eq!(episode.candidates(), offered, "a refused touch draws nothing");
+
+    let cube = ObjectSpec::new("cube", common::box_mesh(DVec3::splat(0.05)));
+    let unknown = TouchEpisode::new(Arc::clone(&model), &cube, &config(), 1).err();
+    assert!(
+        unknown.is_some_and(|e| e.to_string().contains("'cube' is not in the model")),
+        "an object the model does not know"
+    );
+    let other_sensor = Valid::new(EpisodeConfig {
+        sensor: SensorConfig::square(6, 6, 0.014, 0.0012),
+        ..*config()
+    })
+    .unwrap();
+    let mismatch = TouchEpisode::new(model, &objects()[0], &other_sensor, 1).err();
+    assert!(
+        mismatch.is_some_and(|e| e.to_string().contains("pad_width_m")),
+        "a sensor the model was not trained on"
+    );
+}
+
+/// `touch_toward` the planner's own proposal, iteration after iteration, is `explore` (the plain
+/// planner: one proposal per iteration): the same readings, tree and counts.
+#[test]
+fn touching_toward_the_planners_own_proposals_is_exploring() {
+    const ITERATIONS: usize = 80;
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(planner(ITERATIONS)),
+        sensor: sensor(),
+        control: Valid::default(),
+        perturbation: PerturbationBounds::new(10.0, 0.1).unwrap(),
+        readings_per_object: usize::MAX,
+        seed: 5,
+    };
+    let object = &objects()[0];
+    let (mut scene, mut explorer) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
+    let explored = explorer.explore(&mut scene, "box", usize::MAX).unwrap();
+    assert_eq!(explored.iterations, ITERATIONS);
+
+    let (mut scene, mut stepped) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
+    let mut touched = ExplorationReport::default();
+    for _ in 0..ITERATIONS {
+        let proposal = stepped.propose_candidates(1);
+        assert_eq!(proposal.len(), 1);
+        let one = stepped.touch_toward(&mut scene, "box", proposal[0]).unwrap();
+        assert_eq!(one.iterations, 1);
+        assert!(one.readings.len() <= 1, "one iteration, one reading at most");
+        touched.iterations += one.iterations;
+        touched.readings.extend(one.readings);
+        touched.unreachable_steps += one.unreachable_steps;
+        for (cause, n) in one.expansion_stops {
+            *touched.expansion_stops.entry(cause).or_insert(0) += n;
+        }
+    }
+    eprintln!(
+        "{ITERATIONS} iterations: {} readings, {} converged, {} tree vertices, stops {:?}, {} unreachable",
+        explored.readings.len(),
+        explored.converged(),
+        explorer.tree().vertices().len(),
+        explored.expansion_stops,
+        explored.unreachable_steps
+    );
+    assert!(explored.converged() > 0, "a run that reads nothing checks little");
+    assert_eq!(touched, explored);
+    assert_eq!(stepped.tree().vertices().len(), explorer.tree().vertices().len());
+    assert_eq!(stepped.grid().cells(), explorer.grid().cells());
+}
