@@ -331,6 +331,7 @@ fn tests_benches_and_the_command_line_use_module_roots() {
         "examples",
         "src/cli",
         "plugin/src",
+        "python/src",
         "xtask/src",
     ] {
         rust_files(&root.join(dir), &mut files);
