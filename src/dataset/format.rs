@@ -126,7 +126,7 @@ impl Meta {
 
     /// The pad pose's nine columns, `pad_x_m` to `pad_up_z`: all set, or all empty (an image
     /// without a pose).
-    fn pad() -> &'static [Meta] {
+    pub(super) fn pad() -> &'static [Meta] {
         &Self::ALL[Self::PadX.index()..=Self::PadUpZ.index()]
     }
 
@@ -162,33 +162,18 @@ impl Meta {
         }
     }
 
+    /// The object pose's seven columns, `object_x_m` to `object_qz`.
+    pub(super) fn object_pose() -> &'static [Meta] {
+        &Self::ALL[Self::ObjectX.index()..=Self::ObjectQz.index()]
+    }
+
     /// This column of `r`, as written.
-    fn field(self, r: &Reading) -> String {
-        let position = r.object_pose.position_m;
-        let rotation = r.object_pose.rotation;
-        let pad = r.image.pose();
-        let pad_number = |value: fn(&PadPose) -> f64| pad.map(|p| format_f64(value(p))).unwrap_or_default();
+    pub(super) fn field(self, r: &Reading) -> String {
         match self {
             Self::Object => r.object.clone(),
             Self::Status => r.status.name().to_string(),
             Self::Strategy => r.strategy.name().to_string(),
             Self::Iterations => r.iterations.to_string(),
-            Self::ObjectX => format_f64(position.x),
-            Self::ObjectY => format_f64(position.y),
-            Self::ObjectZ => format_f64(position.z),
-            Self::ObjectQw => format_f64(rotation.w),
-            Self::ObjectQx => format_f64(rotation.x),
-            Self::ObjectQy => format_f64(rotation.y),
-            Self::ObjectQz => format_f64(rotation.z),
-            Self::PadX => pad_number(|p| p.center_m.x),
-            Self::PadY => pad_number(|p| p.center_m.y),
-            Self::PadZ => pad_number(|p| p.center_m.z),
-            Self::PadNormalX => pad_number(|p| p.normal.x),
-            Self::PadNormalY => pad_number(|p| p.normal.y),
-            Self::PadNormalZ => pad_number(|p| p.normal.z),
-            Self::PadUpX => pad_number(|p| p.up.x),
-            Self::PadUpY => pad_number(|p| p.up.y),
-            Self::PadUpZ => pad_number(|p| p.up.z),
             Self::Cause => r
                 .cause
                 .as_ref()
@@ -200,6 +185,39 @@ impl Meta {
                 .as_ref()
                 .and_then(AttemptCause::touched_bodies)
                 .unwrap_or_default(),
+            _ => self.number(r).map(format_f64).unwrap_or_default(),
+        }
+    }
+
+    /// This pose column of `r` as a number: `None` for a pad pose column of an image without a
+    /// pose, and for the columns that are not poses.
+    pub(super) fn number(self, r: &Reading) -> Option<f64> {
+        let position = r.object_pose.position_m;
+        let rotation = r.object_pose.rotation;
+        let pad = |value: fn(&PadPose) -> f64| r.image.pose().map(value);
+        match self {
+            Self::ObjectX => Some(position.x),
+            Self::ObjectY => Some(position.y),
+            Self::ObjectZ => Some(position.z),
+            Self::ObjectQw => Some(rotation.w),
+            Self::ObjectQx => Some(rotation.x),
+            Self::ObjectQy => Some(rotation.y),
+            Self::ObjectQz => Some(rotation.z),
+            Self::PadX => pad(|p| p.center_m.x),
+            Self::PadY => pad(|p| p.center_m.y),
+            Self::PadZ => pad(|p| p.center_m.z),
+            Self::PadNormalX => pad(|p| p.normal.x),
+            Self::PadNormalY => pad(|p| p.normal.y),
+            Self::PadNormalZ => pad(|p| p.normal.z),
+            Self::PadUpX => pad(|p| p.up.x),
+            Self::PadUpY => pad(|p| p.up.y),
+            Self::PadUpZ => pad(|p| p.up.z),
+            Self::Object
+            | Self::Status
+            | Self::Strategy
+            | Self::Iterations
+            | Self::Cause
+            | Self::TouchedBodies => None,
         }
     }
 }
@@ -221,12 +239,7 @@ impl Dataset {
             path: name.clone(),
             source,
         };
-        let file_header = FileHeader {
-            header: self.header.clone(),
-            readings: self.readings.len(),
-        };
-        let json = serde_json::to_string(&file_header)
-            .map_err(|e| DatasetError::Invalid(format!("cannot encode the header: {e}")))?;
+        let json = self.header_json()?;
         let mut text = Vec::with_capacity(64 * (self.readings.len() + 1));
         writeln!(text, "{MAGIC}\n# {json}").map_err(io)?;
         {
@@ -249,6 +262,17 @@ impl Dataset {
         }
         writeln!(text, "{END_PREFIX}{}", self.readings.len()).map_err(io)?;
         Ok(write_atomic(path, &text)?)
+    }
+
+    /// The header as line 2 of the file holds it (after `# `): the [`DatasetHeader`] as JSON,
+    /// plus `readings`, the number of readings.
+    pub(super) fn header_json(&self) -> Result<String, DatasetError> {
+        let file_header = FileHeader {
+            header: self.header.clone(),
+            readings: self.readings.len(),
+        };
+        serde_json::to_string(&file_header)
+            .map_err(|e| DatasetError::Invalid(format!("cannot encode the header: {e}")))
     }
 
     /// Reads a file written by [`write`](Self::write); errors name the file, line and field.
