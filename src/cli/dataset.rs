@@ -105,16 +105,7 @@ pub fn read_dataset(path: &Path) -> Result<Dataset, Box<dyn std::error::Error>> 
 }
 
 fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let same_file = std::fs::canonicalize(&args.out)
-        .ok()
-        .is_some_and(|out| std::fs::canonicalize(&args.frames).is_ok_and(|frames| frames == out));
-    if same_file {
-        return Err(UsageError(format!(
-            "--out {} is the frames file itself; write the dataset to another file",
-            args.out.display()
-        ))
-        .into());
-    }
+    refuse_overwriting(&args.out, &args.frames, "frames file", "dataset")?;
     let options = args.preprocess.options(RealFramesOptions::default().trials)?;
     let calibration = args
         .calibration
@@ -140,7 +131,22 @@ fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// `--out` naming the `input` file itself (a `what` file) is refused before it is overwritten.
+fn refuse_overwriting(out: &Path, input: &Path, what: &str, written: &str) -> Result<(), UsageError> {
+    let same_file = std::fs::canonicalize(out)
+        .ok()
+        .is_some_and(|out| std::fs::canonicalize(input).is_ok_and(|input| input == out));
+    if same_file {
+        return Err(UsageError(format!(
+            "--out {} is the {what} itself; write the {written} to another file",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
 fn run_export(args: &ExportArgs) -> Result<(), Box<dyn std::error::Error>> {
+    refuse_overwriting(&args.out, &args.dataset, "dataset", "export")?;
     let data = read_dataset(&args.dataset)?;
     data.export(&args.out, args.format)?;
     let sensor = &data.header().sensor;
