@@ -553,7 +553,9 @@ fn dataset_export_names_a_missing_dataset_and_refuses_to_overwrite_it() {
     let out = dir.path().join("d.npz");
     let out_arg = out.display().to_string();
     let line = fails_with(
-        &taction(&["dataset", "export", &missing, "--format", "npz", "--out", &out_arg]),
+        &taction(&[
+            "dataset", "export", &missing, "--format", "npz", "--out", &out_arg,
+        ]),
         1,
     );
     assert!(line.contains(&missing), "{line}");
@@ -573,12 +575,20 @@ fn dataset_export_names_a_missing_dataset_and_refuses_to_overwrite_it() {
         &taction(&["dataset", "export", &csv, "--format", "csv", "--out", &out_arg]),
         2,
     );
-    assert!(line.contains("'csv' is not an export format (npz or parquet)"), "{line}");
+    assert!(
+        line.contains("'csv' is not an export format (npz or parquet)"),
+        "{line}"
+    );
 
-    let done = taction(&["dataset", "export", &csv, "--format", "parquet", "--out", &out_arg]);
+    let done = taction(&[
+        "dataset", "export", &csv, "--format", "parquet", "--out", &out_arg,
+    ]);
     assert!(done.status.success(), "{}", stderr(&done));
     let text = String::from_utf8_lossy(&done.stdout).into_owned();
-    assert_eq!(text.trim(), format!("wrote 4 readings of 6x4 taxels as parquet to {out_arg}"));
+    assert_eq!(
+        text.trim(),
+        format!("wrote 4 readings of 6x4 taxels as parquet to {out_arg}")
+    );
 }
 
 #[test]

@@ -41,7 +41,11 @@ fn dataset() -> Dataset {
             },
             status,
             iterations: k as u32,
-            strategy: if with_pad { Strategy::Local } else { Strategy::Recorded },
+            strategy: if with_pad {
+                Strategy::Local
+            } else {
+                Strategy::Recorded
+            },
             cause: (status == ContactStatus::Collision).then(|| AttemptCause::Touched {
                 body_a: "link4".into(),
                 body_b: "world".into(),
@@ -61,7 +65,12 @@ fn csv_header_json(dataset: &Dataset, dir: &Path) -> String {
     let path = dir.join("d.csv");
     dataset.write(&path).unwrap();
     let text = std::fs::read_to_string(path).unwrap();
-    text.lines().nth(1).unwrap().strip_prefix("# ").unwrap().to_string()
+    text.lines()
+        .nth(1)
+        .unwrap()
+        .strip_prefix("# ")
+        .unwrap()
+        .to_string()
 }
 
 /// One `.npy` array as read by [`parse_npy`].
@@ -114,24 +123,34 @@ impl Npy {
     fn f4(&self) -> Vec<u32> {
         assert_eq!(self.descr, "<f4");
         let chunks = self.data.chunks_exact(4);
-        chunks.map(|c| f32::from_le_bytes(c.try_into().unwrap()).to_bits()).collect()
+        chunks
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()).to_bits())
+            .collect()
     }
 
     fn f8(&self) -> Vec<u64> {
         assert_eq!(self.descr, "<f8");
         let chunks = self.data.chunks_exact(8);
-        chunks.map(|c| f64::from_le_bytes(c.try_into().unwrap()).to_bits()).collect()
+        chunks
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()).to_bits())
+            .collect()
     }
 
     fn i8(&self) -> Vec<i64> {
         assert_eq!(self.descr, "<i8");
-        self.data.chunks_exact(8).map(|c| i64::from_le_bytes(c.try_into().unwrap())).collect()
+        self.data
+            .chunks_exact(8)
+            .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
     }
 
     /// Fixed-width UTF-32LE texts, NUL-padded.
     fn texts(&self) -> Vec<String> {
         let width: usize = self.descr.strip_prefix("<U").unwrap().parse().unwrap();
-        let chars = self.data.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap()));
+        let chars = self
+            .data
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()));
         let chars: Vec<char> = chars.map(|c| char::from_u32(c).unwrap()).collect();
         chars
             .chunks(width)
@@ -149,8 +168,16 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
     let arrays = read_npz(&path);
     let names: Vec<&str> = arrays.keys().map(String::as_str).collect();
     let expected = [
-        "cause", "header", "images", "iterations", "object", "object_pose", "pad_pose", "status",
-        "strategy", "touched_bodies",
+        "cause",
+        "header",
+        "images",
+        "iterations",
+        "object",
+        "object_pose",
+        "pad_pose",
+        "status",
+        "strategy",
+        "touched_bodies",
     ];
     assert_eq!(names, expected);
     let readings = data.readings();
@@ -173,7 +200,10 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
         .map(f64::to_bits)
         .collect();
     assert_eq!(pad_values[18..], third);
-    assert!(pad_values[9..18].iter().all(|&b| f64::from_bits(b).is_nan()), "no pose: NaN");
+    assert!(
+        pad_values[9..18].iter().all(|&b| f64::from_bits(b).is_nan()),
+        "no pose: NaN"
+    );
     assert_eq!(pad_values[2], (1e-17f64).to_bits());
     assert_eq!(pad_values[1], (-0.0f64).to_bits(), "the sign of zero survives");
 
@@ -201,7 +231,10 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
     assert!(header.shape.is_empty(), "a 0-d array");
     assert_eq!(header.texts(), [csv_header_json(&data, dir.path())]);
 
-    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(left.len(), 2, "only d.npz and d.csv: {left:?}");
 }
 
@@ -213,7 +246,10 @@ fn the_npy_header_is_the_bytes_numpy_save_writes() {
     one.export(&path, ExportFormat::Npz).unwrap();
     let mut zip = zip::ZipArchive::new(File::open(&path).unwrap()).unwrap();
     let mut bytes = Vec::new();
-    zip.by_name("images.npy").unwrap().read_to_end(&mut bytes).unwrap();
+    zip.by_name("images.npy")
+        .unwrap()
+        .read_to_end(&mut bytes)
+        .unwrap();
     // `numpy.save(f, numpy.zeros((1, 2, 3), "<f4"))`: 128 header bytes, then 6 x 4 data bytes.
     let dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (1, 2, 3), }";
     let mut numpy = b"\x93NUMPY\x01\x00\x76\x00".to_vec();
@@ -223,9 +259,19 @@ fn the_npy_header_is_the_bytes_numpy_save_writes() {
     assert_eq!(bytes.len(), 128 + 6 * 4);
     assert_eq!(bytes[..128], numpy[..]);
     let mut status = Vec::new();
-    zip.by_name("status.npy").unwrap().read_to_end(&mut status).unwrap();
-    assert!(status.starts_with(b"\x93NUMPY\x01\x00\x76\x00{'descr': '<U9', 'fortran_order': False, 'shape': (1,), }"));
-    assert_eq!(status[128..], *b"c\0\0\0o\0\0\0n\0\0\0v\0\0\0e\0\0\0r\0\0\0g\0\0\0e\0\0\0d\0\0\0");
+    zip.by_name("status.npy")
+        .unwrap()
+        .read_to_end(&mut status)
+        .unwrap();
+    assert!(
+        status.starts_with(
+            b"\x93NUMPY\x01\x00\x76\x00{'descr': '<U9', 'fortran_order': False, 'shape': (1,), }"
+        )
+    );
+    assert_eq!(
+        status[128..],
+        *b"c\0\0\0o\0\0\0n\0\0\0v\0\0\0e\0\0\0r\0\0\0g\0\0\0e\0\0\0d\0\0\0"
+    );
 }
 
 #[test]
@@ -237,7 +283,12 @@ fn parquet_reads_back_with_the_parquet_reader() {
     let reader = SerializedFileReader::new(File::open(&path).unwrap()).unwrap();
     let meta = reader.metadata().file_metadata();
     assert_eq!(meta.num_rows(), 3);
-    let columns: Vec<String> = meta.schema_descr().columns().iter().map(|c| c.name().to_string()).collect();
+    let columns: Vec<String> = meta
+        .schema_descr()
+        .columns()
+        .iter()
+        .map(|c| c.name().to_string())
+        .collect();
     assert_eq!(columns, taction::dataset::column_names(2, 3));
     let header = meta
         .key_value_metadata()
@@ -273,4 +324,32 @@ fn export_formats_parse_their_names_and_refuse_others() {
     }
     let err = "csv".parse::<ExportFormat>().unwrap_err().to_string();
     assert_eq!(err, "'csv' is not an export format (npz or parquet)");
+}
+
+/// `pandas.read_csv(path, comment="#")` cuts a line at an unquoted `#`: the writer quotes a field
+/// holding one, and reads it back unchanged.
+#[test]
+fn the_csv_quotes_a_name_holding_a_hash_for_readers_that_skip_comments() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = dataset();
+    let mut header = original.header().clone();
+    header.objects[1] = "cup #2".into();
+    let readings = original
+        .readings()
+        .iter()
+        .cloned()
+        .map(|mut r| {
+            if r.object == "c" {
+                r.object = "cup #2".into();
+            }
+            r
+        })
+        .collect();
+    let data = Dataset::new(header, readings).unwrap();
+    let path = dir.path().join("d.csv");
+    data.write(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let body: Vec<&str> = text.lines().skip(3).filter(|l| !l.starts_with('#')).collect();
+    assert!(body[1].starts_with("\"cup #2\",no_contact,"), "{}", body[1]);
+    assert_eq!(Dataset::read(&path).unwrap(), data);
 }

@@ -136,9 +136,18 @@ fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::Zip
     let text = |meta: Meta| Npy::unicode(vec![n], &texts(readings, meta));
     let arrays = [
         ("images", Npy::f4(vec![n, rows, cols], images)),
-        ("pad_pose", Npy::f8(vec![n, 9], pose_values(readings, Meta::pad()))),
-        ("object_pose", Npy::f8(vec![n, 7], pose_values(readings, Meta::object_pose()))),
-        ("iterations", Npy::i8(vec![n], readings.iter().map(|r| i64::from(r.iterations)))),
+        (
+            "pad_pose",
+            Npy::f8(vec![n, 9], pose_values(readings, Meta::pad())),
+        ),
+        (
+            "object_pose",
+            Npy::f8(vec![n, 7], pose_values(readings, Meta::object_pose())),
+        ),
+        (
+            "iterations",
+            Npy::i8(vec![n], readings.iter().map(|r| i64::from(r.iterations))),
+        ),
         ("object", text(Meta::Object)),
         ("status", text(Meta::Status)),
         ("strategy", text(Meta::Strategy)),
@@ -169,17 +178,29 @@ struct Npy {
 impl Npy {
     fn f4(shape: Vec<usize>, values: impl IntoIterator<Item = f32>) -> Self {
         let data = values.into_iter().flat_map(f32::to_le_bytes).collect();
-        Self { descr: "<f4".into(), shape, data }
+        Self {
+            descr: "<f4".into(),
+            shape,
+            data,
+        }
     }
 
     fn f8(shape: Vec<usize>, values: impl IntoIterator<Item = f64>) -> Self {
         let data = values.into_iter().flat_map(f64::to_le_bytes).collect();
-        Self { descr: "<f8".into(), shape, data }
+        Self {
+            descr: "<f8".into(),
+            shape,
+            data,
+        }
     }
 
     fn i8(shape: Vec<usize>, values: impl IntoIterator<Item = i64>) -> Self {
         let data = values.into_iter().flat_map(i64::to_le_bytes).collect();
-        Self { descr: "<i8".into(), shape, data }
+        Self {
+            descr: "<i8".into(),
+            shape,
+            data,
+        }
     }
 
     /// Fixed-width unicode `<U{width}`, the longest text's length in characters (at least 1, as
@@ -254,9 +275,7 @@ impl ParquetColumn {
             Self::Taxel(_) => (PhysicalType::FLOAT, Repetition::REQUIRED),
             Self::Meta(Meta::Iterations) => (PhysicalType::INT64, Repetition::REQUIRED),
             Self::Meta(m) if Meta::pad().contains(&m) => (PhysicalType::DOUBLE, Repetition::OPTIONAL),
-            Self::Meta(m) if Meta::object_pose().contains(&m) => {
-                (PhysicalType::DOUBLE, Repetition::REQUIRED)
-            }
+            Self::Meta(m) if Meta::object_pose().contains(&m) => (PhysicalType::DOUBLE, Repetition::REQUIRED),
             Self::Meta(_) => (PhysicalType::BYTE_ARRAY, Repetition::REQUIRED),
         }
     }
@@ -272,7 +291,11 @@ impl ParquetColumn {
     }
 
     /// This column of every reading.
-    fn write(self, column: &mut SerializedColumnWriter<'_>, readings: &[Reading]) -> Result<(), ParquetError> {
+    fn write(
+        self,
+        column: &mut SerializedColumnWriter<'_>,
+        readings: &[Reading],
+    ) -> Result<(), ParquetError> {
         let meta = match self {
             Self::Taxel(taxel) => {
                 let values: Vec<f32> = readings.iter().map(|r| r.image.values()[taxel] as f32).collect();

@@ -36,6 +36,10 @@
 //! - The last line, `# end N`, repeats the row count, so a file cut anywhere (even inside the
 //!   last number) is reported as truncated rather than read short.
 //! - Numbers are written in shortest round-trip form, so reading back is bit-exact.
+//! - pandas reads it as `pandas.read_csv(path, comment="#")`: the `#` lines are skipped, a field
+//!   holding a `#` (an object's name) is quoted so it is not cut there, and the empty fields
+//!   (`cause`, `touched_bodies`, the pad pose of an image without one) read as NaN. For numpy
+//!   arrays, or Parquet, see [`Dataset::export`].
 //!
 //! Size: about 20 bytes per taxel at worst, i.e. ~150 MB for 10 objects x 1100 readings of 26x26
 //! and ~8 MB at 6x6; reading parses ~100 MB/s.
@@ -245,6 +249,7 @@ impl Dataset {
         {
             let mut csv = csv::WriterBuilder::new()
                 .terminator(csv::Terminator::Any(b'\n'))
+                .comment(Some(b'#'))
                 .from_writer(&mut text);
             let csv_err = |e: csv::Error| DatasetError::Csv {
                 path: name.clone(),
