@@ -513,6 +513,7 @@ fn no_help_text_points_to_rust_code() {
         vec!["objects", "letters"],
         vec!["sense"],
         vec!["dataset", "show"],
+        vec!["dataset", "export"],
         vec!["recognize"],
         vec!["touch"],
         vec!["train"],
@@ -542,6 +543,51 @@ fn dataset_show_prints_lengths_in_millimetres() {
     assert!(
         text.contains("pad 12 mm x 12 mm, covering 1.2 mm, PSF sigma 0.5761 mm"),
         "{text}"
+    );
+}
+
+#[test]
+fn dataset_export_names_a_missing_dataset_and_refuses_to_overwrite_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.csv").display().to_string();
+    let out = dir.path().join("d.npz");
+    let out_arg = out.display().to_string();
+    let line = fails_with(
+        &taction(&[
+            "dataset", "export", &missing, "--format", "npz", "--out", &out_arg,
+        ]),
+        1,
+    );
+    assert!(line.contains(&missing), "{line}");
+    assert!(!out.exists());
+
+    let path = dir.path().join("d.csv");
+    flat_dataset(SensorConfig::square(6, 4, 0.012, 0.0012), &["a", "b"], 2)
+        .write(&path)
+        .unwrap();
+    let csv = path.display().to_string();
+    let line = fails_with(
+        &taction(&["dataset", "export", &csv, "--format", "npz", "--out", &csv]),
+        2,
+    );
+    assert!(line.contains("is the dataset itself"), "{line}");
+    let line = fails_with(
+        &taction(&["dataset", "export", &csv, "--format", "csv", "--out", &out_arg]),
+        2,
+    );
+    assert!(
+        line.contains("'csv' is not an export format (npz or parquet)"),
+        "{line}"
+    );
+
+    let done = taction(&[
+        "dataset", "export", &csv, "--format", "parquet", "--out", &out_arg,
+    ]);
+    assert!(done.status.success(), "{}", stderr(&done));
+    let text = String::from_utf8_lossy(&done.stdout).into_owned();
+    assert_eq!(
+        text.trim(),
+        format!("wrote 4 readings of 6x4 taxels as parquet to {out_arg}")
     );
 }
 

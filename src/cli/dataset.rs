@@ -1,12 +1,13 @@
 //! `taction dataset show DATASET`: what a dataset file holds (see `taction::dataset` for the format).
 //! `taction dataset import FRAMES --out DATASET`: recorded sensor frames as a dataset, so that
 //! `train` and `recognize` take real data.
+//! `taction dataset export DATASET --format npz|parquet --out PATH`: a dataset for numpy and pandas.
 
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
 use taction::dataset::{Calibration, RealImport, import_real_csv};
-use taction::dataset::{Dataset, DatasetError};
+use taction::dataset::{Dataset, DatasetError, ExportFormat};
 use taction::paper::RealFramesOptions;
 use taction::paper::recorded_dataset;
 
@@ -29,6 +30,26 @@ pub enum DatasetCommand {
     /// reading, `converged` when it touched and `no_contact` when the real-frames experiment would
     /// prune it, its image as that experiment describes it.
     Import(ImportArgs),
+    /// A dataset in the formats the ML toolchain reads: `npz` (numpy.load: arrays `images` [N,
+    /// rows, cols] float32, `pad_pose` [N, 9], `object_pose` [N, 7], `iterations`, and `object`,
+    /// `status`, `strategy`, `cause`, `touched_bodies` as strings, `header` the JSON header) or
+    /// `parquet` (pandas.read_parquet: the CSV's columns, taxels `t_{row}_{col}` as float32, the
+    /// JSON header as the metadata `taction_header`).
+    Export(ExportArgs),
+}
+
+/// `dataset export`: which dataset, as what, where.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The dataset file.
+    #[arg(value_name = "DATASET.csv")]
+    pub dataset: PathBuf,
+    /// The format to write: npz or parquet.
+    #[arg(long, value_name = "npz|parquet")]
+    pub format: ExportFormat,
+    /// The file to write.
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
 }
 
 /// `dataset import`: the recording and the settings of the real-frames experiment that shape its
@@ -60,6 +81,7 @@ pub fn run(args: &DatasetArgs) -> Result<(), Box<dyn std::error::Error>> {
             println!("{}", data.summary());
         }
         DatasetCommand::Import(import) => run_import(import)?,
+        DatasetCommand::Export(export) => run_export(export)?,
     }
     Ok(())
 }
@@ -83,16 +105,7 @@ pub fn read_dataset(path: &Path) -> Result<Dataset, Box<dyn std::error::Error>> 
 }
 
 fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let same_file = std::fs::canonicalize(&args.out)
-        .ok()
-        .is_some_and(|out| std::fs::canonicalize(&args.frames).is_ok_and(|frames| frames == out));
-    if same_file {
-        return Err(UsageError(format!(
-            "--out {} is the frames file itself; write the dataset to another file",
-            args.out.display()
-        ))
-        .into());
-    }
+    refuse_overwriting(&args.out, &args.frames, "frames file", "dataset")?;
     let options = args.preprocess.options(RealFramesOptions::default().trials)?;
     let calibration = args
         .calibration
@@ -115,5 +128,35 @@ fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
     dataset.write(&args.out)?;
     println!("wrote {}", args.out.display());
     println!("{}", dataset.summary());
+    Ok(())
+}
+
+/// `--out` naming the `input` file itself (a `what` file) is refused before it is overwritten.
+fn refuse_overwriting(out: &Path, input: &Path, what: &str, written: &str) -> Result<(), UsageError> {
+    let same_file = std::fs::canonicalize(out)
+        .ok()
+        .is_some_and(|out| std::fs::canonicalize(input).is_ok_and(|input| input == out));
+    if same_file {
+        return Err(UsageError(format!(
+            "--out {} is the {what} itself; write the {written} to another file",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
+fn run_export(args: &ExportArgs) -> Result<(), Box<dyn std::error::Error>> {
+    refuse_overwriting(&args.out, &args.dataset, "dataset", "export")?;
+    let data = read_dataset(&args.dataset)?;
+    data.export(&args.out, args.format)?;
+    let sensor = &data.header().sensor;
+    println!(
+        "wrote {} readings of {}x{} taxels as {} to {}",
+        data.len(),
+        sensor.rows,
+        sensor.cols,
+        args.format,
+        args.out.display()
+    );
     Ok(())
 }

@@ -36,6 +36,10 @@
 //! - The last line, `# end N`, repeats the row count, so a file cut anywhere (even inside the
 //!   last number) is reported as truncated rather than read short.
 //! - Numbers are written in shortest round-trip form, so reading back is bit-exact.
+//! - pandas reads it as `pandas.read_csv(path, comment="#")`: the `#` lines are skipped, a field
+//!   holding a `#` (an object's name) is quoted so it is not cut there, and the empty fields
+//!   (`cause`, `touched_bodies`, the pad pose of an image without one) read as NaN. For numpy
+//!   arrays, or Parquet, see [`Dataset::export`].
 //!
 //! Size: about 20 bytes per taxel at worst, i.e. ~150 MB for 10 objects x 1100 readings of 26x26
 //! and ~8 MB at 6x6; reading parses ~100 MB/s.
@@ -126,7 +130,7 @@ impl Meta {
 
     /// The pad pose's nine columns, `pad_x_m` to `pad_up_z`: all set, or all empty (an image
     /// without a pose).
-    fn pad() -> &'static [Meta] {
+    pub(super) fn pad() -> &'static [Meta] {
         &Self::ALL[Self::PadX.index()..=Self::PadUpZ.index()]
     }
 
@@ -162,33 +166,18 @@ impl Meta {
         }
     }
 
+    /// The object pose's seven columns, `object_x_m` to `object_qz`.
+    pub(super) fn object_pose() -> &'static [Meta] {
+        &Self::ALL[Self::ObjectX.index()..=Self::ObjectQz.index()]
+    }
+
     /// This column of `r`, as written.
-    fn field(self, r: &Reading) -> String {
-        let position = r.object_pose.position_m;
-        let rotation = r.object_pose.rotation;
-        let pad = r.image.pose();
-        let pad_number = |value: fn(&PadPose) -> f64| pad.map(|p| format_f64(value(p))).unwrap_or_default();
+    pub(super) fn field(self, r: &Reading) -> String {
         match self {
             Self::Object => r.object.clone(),
             Self::Status => r.status.name().to_string(),
             Self::Strategy => r.strategy.name().to_string(),
             Self::Iterations => r.iterations.to_string(),
-            Self::ObjectX => format_f64(position.x),
-            Self::ObjectY => format_f64(position.y),
-            Self::ObjectZ => format_f64(position.z),
-            Self::ObjectQw => format_f64(rotation.w),
-            Self::ObjectQx => format_f64(rotation.x),
-            Self::ObjectQy => format_f64(rotation.y),
-            Self::ObjectQz => format_f64(rotation.z),
-            Self::PadX => pad_number(|p| p.center_m.x),
-            Self::PadY => pad_number(|p| p.center_m.y),
-            Self::PadZ => pad_number(|p| p.center_m.z),
-            Self::PadNormalX => pad_number(|p| p.normal.x),
-            Self::PadNormalY => pad_number(|p| p.normal.y),
-            Self::PadNormalZ => pad_number(|p| p.normal.z),
-            Self::PadUpX => pad_number(|p| p.up.x),
-            Self::PadUpY => pad_number(|p| p.up.y),
-            Self::PadUpZ => pad_number(|p| p.up.z),
             Self::Cause => r
                 .cause
                 .as_ref()
@@ -200,6 +189,39 @@ impl Meta {
                 .as_ref()
                 .and_then(AttemptCause::touched_bodies)
                 .unwrap_or_default(),
+            _ => self.number(r).map(format_f64).unwrap_or_default(),
+        }
+    }
+
+    /// This pose column of `r` as a number: `None` for a pad pose column of an image without a
+    /// pose, and for the columns that are not poses.
+    pub(super) fn number(self, r: &Reading) -> Option<f64> {
+        let position = r.object_pose.position_m;
+        let rotation = r.object_pose.rotation;
+        let pad = |value: fn(&PadPose) -> f64| r.image.pose().map(value);
+        match self {
+            Self::ObjectX => Some(position.x),
+            Self::ObjectY => Some(position.y),
+            Self::ObjectZ => Some(position.z),
+            Self::ObjectQw => Some(rotation.w),
+            Self::ObjectQx => Some(rotation.x),
+            Self::ObjectQy => Some(rotation.y),
+            Self::ObjectQz => Some(rotation.z),
+            Self::PadX => pad(|p| p.center_m.x),
+            Self::PadY => pad(|p| p.center_m.y),
+            Self::PadZ => pad(|p| p.center_m.z),
+            Self::PadNormalX => pad(|p| p.normal.x),
+            Self::PadNormalY => pad(|p| p.normal.y),
+            Self::PadNormalZ => pad(|p| p.normal.z),
+            Self::PadUpX => pad(|p| p.up.x),
+            Self::PadUpY => pad(|p| p.up.y),
+            Self::PadUpZ => pad(|p| p.up.z),
+            Self::Object
+            | Self::Status
+            | Self::Strategy
+            | Self::Iterations
+            | Self::Cause
+            | Self::TouchedBodies => None,
         }
     }
 }
@@ -227,17 +249,13 @@ impl Dataset {
             path: name.to_string(),
             source,
         };
-        let file_header = FileHeader {
-            header: self.header.clone(),
-            readings: self.readings.len(),
-        };
-        let json = serde_json::to_string(&file_header)
-            .map_err(|e| DatasetError::Invalid(format!("cannot encode the header: {e}")))?;
+        let json = self.header_json()?;
         let mut text = Vec::with_capacity(64 * (self.readings.len() + 1));
         writeln!(text, "{MAGIC}\n# {json}").map_err(io)?;
         {
             let mut csv = csv::WriterBuilder::new()
                 .terminator(csv::Terminator::Any(b'\n'))
+                .comment(Some(b'#'))
                 .from_writer(&mut text);
             let csv_err = |e: csv::Error| DatasetError::Csv {
                 path: name.to_string(),
@@ -255,6 +273,17 @@ impl Dataset {
         }
         writeln!(text, "{END_PREFIX}{}", self.readings.len()).map_err(io)?;
         Ok(text)
+    }
+
+    /// The header as line 2 of the file holds it (after `# `): the [`DatasetHeader`] as JSON,
+    /// plus `readings`, the number of readings.
+    pub(super) fn header_json(&self) -> Result<String, DatasetError> {
+        let file_header = FileHeader {
+            header: self.header.clone(),
+            readings: self.readings.len(),
+        };
+        serde_json::to_string(&file_header)
+            .map_err(|e| DatasetError::Invalid(format!("cannot encode the header: {e}")))
     }
 
     /// Reads a file written by [`write`](Self::write); errors name the file, line and field.

@@ -9,10 +9,12 @@
 //! This module is the vocabulary both sides share, and it knows no MuJoCo: the controllers and the
 //! planner (`control`, `explore`) produce readings and `explore::collect` gathers them into a
 //! dataset; recognition (`recognize`) reads them, from a simulated run or a real sensor's recording
-//! alike. The file format is in `format.rs`; the counts `dataset show` prints in `summary.rs`; the
+//! alike. The file format is in `format.rs`, its export as npz or Parquet in `export.rs`
+//! ([`Dataset::export`]); the counts `dataset show` prints in `summary.rs`; the
 //! recorded frames of a real sensor, and their import as a dataset (`dataset import`), in
 //! `recorded.rs` ([`import_real_csv`]).
 
+mod export;
 mod format;
 mod reading;
 pub(crate) mod recorded;
@@ -27,6 +29,8 @@ pub use strategy::Strategy;
 
 // The file: its columns and numbers, and the counts `dataset show` prints.
 pub use format::{FORMAT_VERSION, column_names};
+// The file for the ML toolchain: numpy's npz, Parquet.
+pub use export::{ExportFormat, ExportFormatError};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.
@@ -80,6 +84,12 @@ pub enum DatasetError {
     Invalid(String),
     #[error("invalid dataset: {0}")]
     InvalidHeader(#[from] HeaderError),
+    #[error("{path}: cannot write {format}: {what}")]
+    Export {
+        path: String,
+        format: ExportFormat,
+        what: String,
+    },
 }
 
 impl From<FileError> for DatasetError {

@@ -1,0 +1,358 @@
+//! A dataset in the formats the ML toolchain reads (issue 37): numpy's `.npz` and Apache Parquet,
+//! one row per reading in file order, written atomically like the CSV (`format.rs`).
+//!
+//! **npz** (`numpy.load(path)`, no `allow_pickle` needed): a zip of `.npy` arrays (NPY format 1.0,
+//! little-endian, strings as fixed-width unicode):
+//!
+//! | array | dtype | shape | what |
+//! | --- | --- | --- | --- |
+//! | `images` | `<f4` | `[N, rows, cols]` | the tactile images, row 0 the pad's `+up` edge as [`TactileImage`](crate::tactile::TactileImage) stores it |
+//! | `pad_pose` | `<f8` | `[N, 9]` | centre xyz (m), normal xyz, up xyz: the CSV's `pad_x_m` ... `pad_up_z`; NaN where a reading has no pose |
+//! | `object_pose` | `<f8` | `[N, 7]` | x, y, z (m), qw, qx, qy, qz: the CSV's `object_x_m` ... `object_qz` |
+//! | `iterations` | `<i8` | `[N]` | the contact controller's iterations |
+//! | `object`, `status`, `strategy`, `cause`, `touched_bodies` | `<U..` | `[N]` | the CSV's names; `cause` and `touched_bodies` empty when none |
+//! | `header` | `<U..` | `[]` | the header JSON of the CSV's line 2 (`json.loads(str(z["header"]))`) |
+//!
+//! **Parquet** (`pandas.read_parquet(path)`): the CSV's columns under the CSV's names and in its
+//! order, one row group: the names as UTF-8 strings, `iterations` int64, the poses float64 (the
+//! nine pad pose columns null where a reading has no pose), then one float32 column per taxel,
+//! `t_{row}_{col}` row-major, so `df.filter(regex="^t_").to_numpy().reshape(-1, rows, cols)` gives
+//! the images. Snappy-compressed; the header JSON is the file's key-value metadata
+//! `taction_header` (`pyarrow.parquet.read_schema(path).metadata[b"taction_header"]`).
+
+use std::fmt;
+use std::io::{Cursor, Write};
+use std::path::Path;
+use std::str::FromStr;
+use std::sync::Arc;
+
+use parquet::basic::{Compression, LogicalType, Repetition, Type as PhysicalType};
+use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, FloatType, Int64Type};
+use parquet::errors::ParquetError;
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterProperties;
+use parquet::file::writer::{SerializedColumnWriter, SerializedFileWriter};
+use parquet::schema::types::{Type as SchemaType, TypePtr};
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, ZipWriter};
+
+use crate::atomic::write_atomic;
+use crate::dataset::format::{Meta, column_names};
+use crate::dataset::{Dataset, DatasetError, Reading};
+
+/// A format [`Dataset::export`] writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ExportFormat {
+    /// numpy's `.npz`: a zip of `.npy` arrays, read by `numpy.load`.
+    Npz,
+    /// Apache Parquet: one column per CSV column, read by `pandas.read_parquet`.
+    Parquet,
+}
+
+impl ExportFormat {
+    pub const ALL: [ExportFormat; 2] = [Self::Npz, Self::Parquet];
+
+    /// The name `--format` takes, also the file extension.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Npz => "npz",
+            Self::Parquet => "parquet",
+        }
+    }
+}
+
+impl fmt::Display for ExportFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A `--format` that names no [`ExportFormat`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{0}' is not an export format (npz or parquet)")]
+pub struct ExportFormatError(pub String);
+
+impl FromStr for ExportFormat {
+    type Err = ExportFormatError;
+
+    /// [`name`](Self::name), e.g. `npz`.
+    fn from_str(s: &str) -> Result<Self, ExportFormatError> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == s.trim())
+            .ok_or_else(|| ExportFormatError(s.to_string()))
+    }
+}
+
+impl Dataset {
+    /// Writes the dataset as `format` (module docs) to `path`, atomically: a temporary file beside
+    /// `path`, then renamed over it.
+    ///
+    /// ```
+    /// # use taction::dataset::{Dataset, DatasetHeader, ExportFormat};
+    /// # use taction::tactile::SensorConfig;
+    /// let header = DatasetHeader::new(SensorConfig::square(6, 6, 0.012, 0.0012), "shapes",
+    ///     vec!["cube".into()], "sampler", 7);
+    /// let dataset = Dataset::new(header, vec![]).unwrap();
+    /// let dir = tempfile::tempdir().unwrap();
+    /// dataset.export(&dir.path().join("d.npz"), ExportFormat::Npz).unwrap();
+    /// ```
+    pub fn export(&self, path: &Path, format: ExportFormat) -> Result<(), DatasetError> {
+        let header_json = self.header_json()?;
+        let bytes = match format {
+            ExportFormat::Npz => npz(self, &header_json).map_err(|e| e.to_string()),
+            ExportFormat::Parquet => parquet(self, header_json).map_err(|e| e.to_string()),
+        }
+        .map_err(|what| DatasetError::Export {
+            path: path.display().to_string(),
+            format,
+            what,
+        })?;
+        Ok(write_atomic(path, &bytes)?)
+    }
+}
+
+/// The values of the pose `columns` (a [`Meta`] range), row-major per reading, NaN where unset.
+fn pose_values(readings: &[Reading], columns: &[Meta]) -> Vec<f64> {
+    readings
+        .iter()
+        .flat_map(|r| columns.iter().map(|m| m.number(r).unwrap_or(f64::NAN)))
+        .collect()
+}
+
+/// The text of column `meta` of every reading, as the CSV writes it.
+fn texts(readings: &[Reading], meta: Meta) -> Vec<String> {
+    readings.iter().map(|r| meta.field(r)).collect()
+}
+
+/// The `.npz` of the module docs, in memory.
+fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::ZipError> {
+    let readings = dataset.readings();
+    let n = readings.len();
+    let (rows, cols) = (dataset.header().sensor.rows, dataset.header().sensor.cols);
+    let images = readings
+        .iter()
+        .flat_map(|r| r.image.values().iter().map(|&v| v as f32));
+    let text = |meta: Meta| Npy::unicode(vec![n], &texts(readings, meta));
+    let arrays = [
+        ("images", Npy::f4(vec![n, rows, cols], images)),
+        (
+            "pad_pose",
+            Npy::f8(vec![n, 9], pose_values(readings, Meta::pad())),
+        ),
+        (
+            "object_pose",
+            Npy::f8(vec![n, 7], pose_values(readings, Meta::object_pose())),
+        ),
+        (
+            "iterations",
+            Npy::i8(vec![n], readings.iter().map(|r| i64::from(r.iterations))),
+        ),
+        ("object", text(Meta::Object)),
+        ("status", text(Meta::Status)),
+        ("strategy", text(Meta::Strategy)),
+        ("cause", text(Meta::Cause)),
+        ("touched_bodies", text(Meta::TouchedBodies)),
+        ("header", Npy::unicode(vec![], &[header_json.to_string()])),
+    ];
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    for (name, array) in arrays {
+        let bytes = array.to_bytes();
+        let options = SimpleFileOptions::default()
+            .compression_method(CompressionMethod::Deflated)
+            .large_file(bytes.len() >= u32::MAX as usize);
+        zip.start_file(format!("{name}.npy"), options)?;
+        zip.write_all(&bytes)?;
+    }
+    Ok(zip.finish()?.into_inner())
+}
+
+/// One array of an `.npz`: its NPY dtype (`descr`), shape (C order), and little-endian data.
+#[derive(Debug, Clone, PartialEq)]
+struct Npy {
+    descr: String,
+    shape: Vec<usize>,
+    data: Vec<u8>,
+}
+
+impl Npy {
+    fn f4(shape: Vec<usize>, values: impl IntoIterator<Item = f32>) -> Self {
+        let data = values.into_iter().flat_map(f32::to_le_bytes).collect();
+        Self {
+            descr: "<f4".into(),
+            shape,
+            data,
+        }
+    }
+
+    fn f8(shape: Vec<usize>, values: impl IntoIterator<Item = f64>) -> Self {
+        let data = values.into_iter().flat_map(f64::to_le_bytes).collect();
+        Self {
+            descr: "<f8".into(),
+            shape,
+            data,
+        }
+    }
+
+    fn i8(shape: Vec<usize>, values: impl IntoIterator<Item = i64>) -> Self {
+        let data = values.into_iter().flat_map(i64::to_le_bytes).collect();
+        Self {
+            descr: "<i8".into(),
+            shape,
+            data,
+        }
+    }
+
+    /// Fixed-width unicode `<U{width}`, the longest text's length in characters (at least 1, as
+    /// numpy makes it): UTF-32LE, each text padded with NULs, so no pickle is needed to load it.
+    fn unicode(shape: Vec<usize>, texts: &[String]) -> Self {
+        let width = texts.iter().map(|t| t.chars().count()).max().unwrap_or(0).max(1);
+        let mut data = Vec::with_capacity(4 * width * texts.len());
+        for text in texts {
+            data.extend(text.chars().flat_map(|c| u32::from(c).to_le_bytes()));
+            data.resize(data.len() + 4 * (width - text.chars().count()), 0);
+        }
+        Self {
+            descr: format!("<U{width}"),
+            shape,
+            data,
+        }
+    }
+
+    /// The NPY 1.0 header: magic `\x93NUMPY`, version 1.0, the dict's length (u16 LE), then the
+    /// dict as numpy writes it, padded with spaces and a newline so the data starts at a multiple
+    /// of 64 bytes (numpy's own padding rule, so the bytes equal `numpy.save`'s).
+    fn header(&self) -> Vec<u8> {
+        let shape = match self.shape.as_slice() {
+            [n] => format!("({n},)"),
+            dims => format!(
+                "({})",
+                dims.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+            ),
+        };
+        let mut dict = format!(
+            "{{'descr': '{}', 'fortran_order': False, 'shape': {shape}, }}",
+            self.descr
+        );
+        const PREFIX: usize = 10;
+        let padding = 64 - (PREFIX + dict.len() + 1) % 64;
+        dict.extend(std::iter::repeat_n(' ', padding));
+        dict.push('\n');
+        let mut header = b"\x93NUMPY\x01\x00".to_vec();
+        // A dict of one dtype and a shape of at most three numbers is far below u16::MAX.
+        header.extend((dict.len() as u16).to_le_bytes());
+        header.extend(dict.as_bytes());
+        header
+    }
+
+    /// The `.npy` file: [`header`](Self::header), then the data.
+    fn to_bytes(&self) -> Vec<u8> {
+        let mut bytes = self.header();
+        bytes.extend(&self.data);
+        bytes
+    }
+}
+
+/// A column of the Parquet file: one of the CSV's columns before the taxels, or a taxel
+/// (row-major index).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ParquetColumn {
+    Meta(Meta),
+    Taxel(usize),
+}
+
+impl ParquetColumn {
+    /// Every column, in the CSV's order.
+    fn all(taxels: usize) -> impl Iterator<Item = Self> {
+        let metas = Meta::ALL.into_iter().map(Self::Meta);
+        metas.chain((0..taxels).map(Self::Taxel))
+    }
+
+    /// How the column is stored: names as UTF-8 strings, `iterations` int64, poses float64 (the
+    /// pad pose optional, for images without one), taxels float32.
+    fn storage(self) -> (PhysicalType, Repetition) {
+        match self {
+            Self::Taxel(_) => (PhysicalType::FLOAT, Repetition::REQUIRED),
+            Self::Meta(Meta::Iterations) => (PhysicalType::INT64, Repetition::REQUIRED),
+            Self::Meta(m) if Meta::pad().contains(&m) => (PhysicalType::DOUBLE, Repetition::OPTIONAL),
+            Self::Meta(m) if Meta::object_pose().contains(&m) => (PhysicalType::DOUBLE, Repetition::REQUIRED),
+            Self::Meta(_) => (PhysicalType::BYTE_ARRAY, Repetition::REQUIRED),
+        }
+    }
+
+    fn schema(self, name: &str) -> Result<TypePtr, ParquetError> {
+        let (physical, repetition) = self.storage();
+        let logical = (physical == PhysicalType::BYTE_ARRAY).then_some(LogicalType::String);
+        let column = SchemaType::primitive_type_builder(name, physical)
+            .with_repetition(repetition)
+            .with_logical_type(logical)
+            .build()?;
+        Ok(Arc::new(column))
+    }
+
+    /// This column of every reading.
+    fn write(
+        self,
+        column: &mut SerializedColumnWriter<'_>,
+        readings: &[Reading],
+    ) -> Result<(), ParquetError> {
+        let meta = match self {
+            Self::Taxel(taxel) => {
+                let values: Vec<f32> = readings.iter().map(|r| r.image.values()[taxel] as f32).collect();
+                column.typed::<FloatType>().write_batch(&values, None, None)?;
+                return Ok(());
+            }
+            Self::Meta(meta) => meta,
+        };
+        match self.storage() {
+            (PhysicalType::INT64, _) => {
+                let values: Vec<i64> = readings.iter().map(|r| i64::from(r.iterations)).collect();
+                column.typed::<Int64Type>().write_batch(&values, None, None)?;
+            }
+            (PhysicalType::DOUBLE, repetition) => {
+                let numbers: Vec<Option<f64>> = readings.iter().map(|r| meta.number(r)).collect();
+                let values: Vec<f64> = numbers.iter().flatten().copied().collect();
+                let defined: Vec<i16> = numbers.iter().map(|n| i16::from(n.is_some())).collect();
+                let levels = (repetition == Repetition::OPTIONAL).then_some(defined.as_slice());
+                column.typed::<DoubleType>().write_batch(&values, levels, None)?;
+            }
+            _ => {
+                let values: Vec<ByteArray> = readings
+                    .iter()
+                    .map(|r| ByteArray::from(meta.field(r).into_bytes()))
+                    .collect();
+                column.typed::<ByteArrayType>().write_batch(&values, None, None)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The `.parquet` of the module docs, in memory.
+fn parquet(dataset: &Dataset, header_json: String) -> Result<Vec<u8>, ParquetError> {
+    let (rows, cols) = (dataset.header().sensor.rows, dataset.header().sensor.cols);
+    let columns: Vec<ParquetColumn> = ParquetColumn::all(rows * cols).collect();
+    let fields = column_names(rows, cols)
+        .iter()
+        .zip(&columns)
+        .map(|(name, column)| column.schema(name))
+        .collect::<Result<Vec<_>, _>>()?;
+    let schema = SchemaType::group_type_builder("taction_dataset")
+        .with_fields(fields)
+        .build()?;
+    let properties = WriterProperties::builder()
+        .set_compression(Compression::SNAPPY)
+        .set_key_value_metadata(Some(vec![KeyValue::new("taction_header".into(), header_json)]))
+        .build();
+    let mut writer = SerializedFileWriter::new(Vec::new(), Arc::new(schema), Arc::new(properties))?;
+    let mut group = writer.next_row_group()?;
+    for column in columns {
+        let mut writer = group
+            .next_column()?
+            .ok_or_else(|| ParquetError::General(format!("{column:?} is not in the schema")))?;
+        column.write(&mut writer, dataset.readings())?;
+        writer.close()?;
+    }
+    group.close()?;
+    writer.into_inner()
+}
