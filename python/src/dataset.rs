@@ -215,6 +215,9 @@ pub fn collect(
         None => Sensor::paper_config()?,
     }
     .into_inner();
+    if objects.is_empty() {
+        return Err(bad_argument("objects", "no object to touch"));
+    }
     let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
     let collect = match mode {

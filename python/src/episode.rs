@@ -2,7 +2,7 @@
 //! touch at a time toward a target the caller picks among the planner's candidates, and the
 //! recogniser's belief follows every converged reading. `taction/ActiveTouch-v0` steps it.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::prelude::*;
 use taction::active_touch::EpisodeConfig;
@@ -20,9 +20,29 @@ use crate::object::Object;
 /// probability `local_probability`, in a workspace fitted to `workspace` (all the objects that
 /// could be there, so that it tells nothing of which one is; default: `object` alone), the object
 /// perturbed after every reading within `perturb_deg` / `perturb_frac`.
-#[pyclass(module = "taction", unsendable)]
+///
+/// Its touches release the GIL; one episode is used by one thread at a time (a lock).
+#[pyclass(module = "taction")]
 pub struct TouchEpisode {
-    inner: taction::active_touch::TouchEpisode,
+    inner: Mutex<taction::active_touch::TouchEpisode>,
+}
+
+impl TouchEpisode {
+    fn episode(&self) -> PyResult<MutexGuard<'_, taction::active_touch::TouchEpisode>> {
+        self.inner
+            .lock()
+            .map_err(|_| refused("the episode was poisoned by an earlier failure"))
+    }
+}
+
+/// The planner's workspace for `objects`: the default one fitted to them
+/// ([`PlannerConfig::fitted_to`]), where every candidate target lies.
+fn planner_for(objects: &[ObjectSpec], local_probability: f64) -> PlannerConfig {
+    PlannerConfig {
+        local_probability,
+        ..PlannerConfig::default()
+    }
+    .fitted_to(objects)
 }
 
 #[pymethods]
@@ -46,11 +66,7 @@ impl TouchEpisode {
             Some(objects) => objects.iter().map(|o| o.spec()).collect(),
             None => vec![spec.clone()],
         };
-        let planner = PlannerConfig {
-            local_probability,
-            ..PlannerConfig::default()
-        }
-        .fitted_to(&fitted_to);
+        let planner = planner_for(&fitted_to, local_probability);
         let config = EpisodeConfig {
             planner: Valid::new(planner).map_err(refused)?,
             perturbation: PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?,
@@ -62,36 +78,57 @@ impl TouchEpisode {
         let inner = py
             .detach(|| taction::active_touch::TouchEpisode::new(recognizer, &spec, &config, seed))
             .map_err(refused)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner: Mutex::new(inner),
+        })
+    }
+
+    /// The box every candidate target of an episode among `objects` lies in, metres: `[[min x, y,
+    /// z], [max x, y, z]]`.
+    #[staticmethod]
+    fn workspace_m<'py>(
+        py: Python<'py>,
+        objects: Vec<PyRef<'py, Object>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
+        let planner = planner_for(&specs, 0.5);
+        let values = [planner.workspace_min_m.to_array(), planner.workspace_max_m.to_array()].concat();
+        array::from_f64(py, &values, &[2, 3], "float64")
     }
 
     /// The targets the next touch may go toward, `(K, 3)` metres (fewer rows only when the
     /// planner's draws keep failing).
     #[getter]
     fn candidates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let targets = self.inner.candidates();
+        let episode = self.episode()?;
+        let targets = episode.candidates();
         let values: Vec<f64> = targets.iter().flat_map(|t| t.to_array()).collect();
         array::from_f64(py, &values, &[targets.len(), 3], "float64")
     }
 
     /// The expected information gain of a touch toward each candidate, nats.
     fn gains<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let gains = self.inner.gains().map_err(refused)?;
+        let mut episode = self.episode()?;
+        let episode = &mut *episode;
+        let gains = py.detach(move || episode.gains()).map_err(refused)?;
         array::from_f64(py, &gains, &[gains.len()], "float64")
     }
 
     /// One planner iteration toward candidate `index`; `True` when it ended in a converged reading
     /// (the belief now includes it). New candidates are drawn either way.
-    fn touch(&mut self, index: usize) -> PyResult<bool> {
-        Ok(self.inner.touch(index).map_err(refused)?.is_some())
+    fn touch(&self, py: Python<'_>, index: usize) -> PyResult<bool> {
+        let mut episode = self.episode()?;
+        let episode = &mut *episode;
+        Ok(py.detach(move || episode.touch(index)).map_err(refused)?.is_some())
     }
 
     /// The last converged reading, `(rows, cols)` float32; zeros before one.
     #[getter]
     fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let sensor = self.inner.model().sensor();
+        let episode = self.episode()?;
+        let sensor = episode.model().sensor();
         let shape = [sensor.rows, sensor.cols];
-        match self.inner.last_image() {
+        match episode.last_image() {
             Some(image) => array::from_f64(py, image.values(), &shape, "float32"),
             None => array::from_f64(py, &vec![0.0; sensor.rows * sensor.cols], &shape, "float32"),
         }
@@ -100,7 +137,7 @@ impl TouchEpisode {
     /// Where the pad is now: centre (m), normal, up.
     #[getter]
     fn pad_pose<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let p = self.inner.pad_pose();
+        let p = self.episode()?.pad_pose();
         let values = [p.center_m, p.normal, p.up].map(|v| v.to_array()).concat();
         array::from_f64(py, &values, &[9], "float64")
     }
@@ -108,31 +145,32 @@ impl TouchEpisode {
     /// P(object | readings so far), in the model's object order.
     #[getter]
     fn probabilities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let p = self.inner.belief().probabilities();
+        let episode = self.episode()?;
+        let p = episode.belief().probabilities();
         array::from_f64(py, p, &[p.len()], "float64")
     }
 
-    /// Converged touches so far.
+    /// Converged readings so far (the belief includes each).
     #[getter]
-    fn touches(&self) -> usize {
-        self.inner.touches()
+    fn readings(&self) -> PyResult<usize> {
+        Ok(self.episode()?.touches())
     }
 
     /// Reading attempts so far, converged or not.
     #[getter]
-    fn attempts(&self) -> usize {
-        self.inner.attempts()
+    fn attempts(&self) -> PyResult<usize> {
+        Ok(self.episode()?.attempts())
     }
 
     /// The explored object's name (the truth).
     #[getter]
-    fn object(&self) -> String {
-        self.inner.object_name().to_string()
+    fn object(&self) -> PyResult<String> {
+        Ok(self.episode()?.object_name().to_string())
     }
 
     /// The explored object's index in the model's objects.
     #[getter]
-    fn object_index(&self) -> usize {
-        self.inner.object_index()
+    fn object_index(&self) -> PyResult<usize> {
+        Ok(self.episode()?.object_index())
     }
 }

@@ -43,6 +43,16 @@ impl Model {
         .map_err(refused)
     }
 
+    /// A model does not change: copies are the model itself (Gymnasium copies an environment's
+    /// arguments).
+    fn __copy__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __deepcopy__<'py>(slf: PyRef<'py, Self>, _memo: &Bound<'py, PyAny>) -> PyRef<'py, Self> {
+        slf
+    }
+
     /// The objects it tells apart, in the order of the posterior's probabilities.
     #[getter]
     fn objects(&self) -> Vec<String> {
@@ -119,10 +129,18 @@ impl Posterior {
     /// probabilities after it.
     fn observe<'py>(&mut self, py: Python<'py>, image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let (shape, values) = array::to_f64(image, "image")?;
-        let [rows, cols] = shape[..] else {
-            return Err(bad_argument("image", format!("want a 2-D array, got shape {shape:?}")));
-        };
-        let image = TactileImage::new(rows, cols, values).map_err(refused)?;
+        let sensor = self.model.sensor();
+        if shape[..] != [sensor.rows, sensor.cols] {
+            return Err(bad_argument(
+                "image",
+                format!(
+                    "want the model's {}x{} taxels, got an array of shape {shape:?}",
+                    sensor.rows, sensor.cols
+                ),
+            ));
+        }
+        let image =
+            TactileImage::new(sensor.rows, sensor.cols, values).map_err(|e| bad_argument("image", e))?;
         // The posterior borrows the model, so it is rebuilt from the observed features: adding a
         // reading's features is cheap next to describing its image, which happens once.
         let mut posterior = self.model.posterior().map_err(refused)?;
@@ -130,7 +148,9 @@ impl Posterior {
         for earlier in &self.observed {
             posterior.observe_features(earlier).map_err(refused)?;
         }
-        let belief = posterior.observe_features(&features).map_err(refused)?;
+        let belief = posterior
+            .observe_features(&features)
+            .map_err(|e| bad_argument("image", e))?;
         self.observed.push(features);
         self.probabilities = belief.probabilities().to_vec();
         self.belief = Some(belief);

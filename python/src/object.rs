@@ -43,6 +43,16 @@ impl Object {
         })
     }
 
+    /// An object does not change: copies are the object itself (Gymnasium copies an environment's
+    /// arguments).
+    fn __copy__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __deepcopy__<'py>(slf: PyRef<'py, Self>, _memo: &Bound<'py, PyAny>) -> PyRef<'py, Self> {
+        slf
+    }
+
     #[getter]
     fn name(&self) -> &str {
         &self.inner.name

@@ -1,13 +1,13 @@
 //! The covering sensor (Sec. V-A2) on the free-floating pad: one reading of an object at a pad pose,
 //! no controllers, exactly what `taction sense` reads.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use glam::DVec3;
 use pyo3::prelude::*;
 use taction::control::FreePad;
 use taction::pose::PadPose;
-use taction::tactile::{SensorConfig, psf_sigma_for_thickness};
+use taction::tactile::{SensorConfig, TactileImage, psf_sigma_for_thickness};
 use taction::valid::Valid;
 
 use crate::array;
@@ -19,11 +19,12 @@ use crate::object::Object;
 /// sigma 0.48 t), each taxel averaging `rays_per_taxel` rays, with additive noise `noise` (a
 /// fraction of the range) drawn from `seed`. The defaults are `taction sense`'s (the paper's
 /// 6x6 sensor).
-#[pyclass(module = "taction", unsendable)]
+#[pyclass(module = "taction")]
 pub struct Sensor {
     pub config: Valid<SensorConfig>,
-    /// One free pad per object read so far (building its MuJoCo scene is the expensive part).
-    pads: Vec<(Arc<taction::mesh::Object>, FreePad)>,
+    /// One free pad per object read so far (building its MuJoCo scene is the expensive part); one
+    /// thread reads at a time.
+    pads: Mutex<Vec<(Arc<taction::mesh::Object>, FreePad)>>,
 }
 
 impl Sensor {
@@ -32,16 +33,21 @@ impl Sensor {
         Valid::new(SensorConfig::paper()).map_err(refused)
     }
 
-    fn pad_for(&mut self, object: &Object) -> PyResult<&mut FreePad> {
-        let index = match self.pads.iter().position(|(o, _)| Arc::ptr_eq(o, &object.inner)) {
+    /// One reading of `object` at `pose` by its pad (made on first use).
+    fn read_at(&self, object: &Object, pose: &PadPose) -> PyResult<TactileImage> {
+        let mut pads = self
+            .pads
+            .lock()
+            .map_err(|_| refused("the sensor was poisoned by an earlier failure"))?;
+        let index = match pads.iter().position(|(o, _)| Arc::ptr_eq(o, &object.inner)) {
             Some(i) => i,
             None => {
                 let pad = FreePad::new(object.spec(), &self.config).map_err(refused)?;
-                self.pads.push((object.inner.clone(), pad));
-                self.pads.len() - 1
+                pads.push((object.inner.clone(), pad));
+                pads.len() - 1
             }
         };
-        Ok(&mut self.pads[index].1)
+        pads[index].1.read_at(pose).map_err(refused)
     }
 }
 
@@ -93,7 +99,7 @@ impl Sensor {
         };
         Ok(Self {
             config: Valid::new(config).map_err(refused)?,
-            pads: Vec::new(),
+            pads: Mutex::new(Vec::new()),
         })
     }
 
@@ -101,14 +107,14 @@ impl Sensor {
     /// normal xyz, up xyz): an array `(rows, cols)` of values in [0, 1], row 0 the pad's up edge.
     #[pyo3(signature = (object, pad_pose, dtype="float32"))]
     fn read<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         object: PyRef<'py, Object>,
         pad_pose: &Bound<'py, PyAny>,
         dtype: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let pose = self::pad_pose(pad_pose)?;
-        let image = self.pad_for(&object)?.read_at(&pose).map_err(refused)?;
+        let image = self.read_at(&object, &pose)?;
         array::from_f64(py, image.values(), &[image.rows(), image.cols()], dtype)
     }
 

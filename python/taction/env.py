@@ -26,6 +26,10 @@ from gymnasium import spaces
 
 import taction
 
+#: How far the pad's centre can be from the world origin, metres: the arm (mjcf/arm.xml) has its
+#: shoulder 0.30 m above a base at x = -0.35 m and reaches 0.69 m from it, so at most 1.04 m.
+PAD_REACH_M = 1.5
+
 #: Models trained by default, per (set, readings, seed): one training per process serves every
 #: environment of a vector env.
 _DEFAULT_MODELS: dict = {}
@@ -62,12 +66,13 @@ class ActiveTouchEnv(gymnasium.Env):
     Observation (a Dict):
       - ``image``: Box(0, 1, (rows, cols), float32), the last converged reading (zeros before one);
       - ``pad_pose``: Box((9,), float32), the pad's centre (m), normal and up now;
-      - ``touches``: Discrete(budget + 1), touches made;
+      - ``touches``: Discrete(budget + 1), touch actions made (converged or not);
       - ``belief``: Box(0, 1, (objects,), float32), P(object | readings so far);
       - ``candidates``: Box((K, 3), float32), the targets the next touch may go toward (m).
     Action: Discrete(K + objects): ``a < K`` touches toward candidate ``a``; ``a >= K`` declares
     object ``a - K`` (``env.unwrapped.objects`` names them).
-    ``info`` holds ``converged`` (whether the touch gave a reading), ``attempts``, ``readings`` and,
+    ``info`` holds ``converged`` (whether the touch gave a reading), ``attempts``, ``readings`` (the
+    converged ones, which the belief includes) and,
     when the episode ends, ``object`` (the truth) and ``declared``.
     """
 
@@ -117,13 +122,20 @@ class ActiveTouchEnv(gymnasium.Env):
         self.right_reward = right_reward
         self.wrong_reward = wrong_reward
         rows, cols = model.sensor_shape
+        reach = np.array([PAD_REACH_M] * 3 + [1.0] * 6, dtype=np.float32)
+        workspace = taction.TouchEpisode.workspace_m(self._episode_objects).astype(np.float32)
         self.observation_space = spaces.Dict(
             {
                 "image": spaces.Box(0.0, 1.0, (rows, cols), np.float32),
-                "pad_pose": spaces.Box(-np.inf, np.inf, (9,), np.float32),
+                "pad_pose": spaces.Box(-reach, reach, (9,), np.float32),
                 "touches": spaces.Discrete(budget + 1),
                 "belief": spaces.Box(0.0, 1.0, (len(self.objects),), np.float32),
-                "candidates": spaces.Box(-np.inf, np.inf, (candidates, 3), np.float32),
+                "candidates": spaces.Box(
+                    np.tile(workspace[0], (candidates, 1)),
+                    np.tile(workspace[1], (candidates, 1)),
+                    (candidates, 3),
+                    np.float32,
+                ),
             }
         )
         self.action_space = spaces.Discrete(candidates + len(self.objects))
@@ -157,8 +169,15 @@ class ActiveTouchEnv(gymnasium.Env):
         index = options.get("object")
         if index is None:
             index = int(self.np_random.integers(len(self.objects)))
-        elif isinstance(index, str):
+        elif isinstance(index, str) and index in self.objects:
             index = self.objects.index(index)
+        elif isinstance(index, (int, np.integer)) and 0 <= index < len(self.objects):
+            index = int(index)
+        else:
+            raise taction.TactionError(
+                f"options['object']: {index!r} is neither one of {self.objects} nor an index below "
+                f"{len(self.objects)}"
+            )
         episode_seed = int(self.np_random.integers(2**63 - 1))
         self._episode = taction.TouchEpisode(
             self.model,
@@ -192,7 +211,7 @@ class ActiveTouchEnv(gymnasium.Env):
             reward = -self.touch_cost
             truncated = self._touches >= self.budget
         info["attempts"] = e.attempts
-        info["readings"] = e.touches
+        info["readings"] = e.readings
         if terminated or truncated:
             info["object"] = e.object
         return self._observation(), float(reward), terminated, truncated, info

@@ -48,7 +48,7 @@ def test_the_csv_reads_back_and_pandas_reads_it_with_comment(small_dataset, tmp_
     assert len(frame) == len(small_dataset)
     assert list(frame["object"]) == list(small_dataset.object)
     taxels = frame[[f"t_{r}_{c}" for r in range(6) for c in range(6)]].to_numpy()
-    assert np.array_equal(taxels.reshape(-1, 6, 6), again.images.astype(np.float64))
+    assert np.array_equal(taxels.reshape(-1, 6, 6).astype(np.float32), again.images)
     assert np.allclose(frame["pad_x_m"], small_dataset.pad_pose[:, 0], equal_nan=True)
 
 

@@ -40,7 +40,7 @@ def test_a_model_file_round_trips(small_model, small_dataset, tmp_path):
 def test_training_is_seeded(small_dataset):
     a = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)
     b = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)
-    image = small_dataset.images[0]
+    image = small_dataset.images[small_dataset.status == "converged"][0]
     assert np.array_equal(a.posterior().observe(image), b.posterior().observe(image))
 
 
@@ -51,3 +51,5 @@ def test_bad_training_arguments_name_the_argument(small_dataset, small_model):
         taction.train(small_dataset, codebook="nope")
     with pytest.raises(taction.TactionError, match="image"):
         small_model.posterior().observe(np.zeros(6))
+    with pytest.raises(taction.TactionError, match="image"):
+        small_model.posterior().observe(np.zeros((14, 14)))

@@ -5,30 +5,50 @@ import re
 
 import mujoco
 import numpy as np
+import pytest
 
 import taction
 from conftest import ROOT
 
 
-def test_stock_mujoco_compiles_and_reads_the_scene(chess):
-    taction.Sensor()  # the package is imported: the plugin is registered
+def test_stock_mujoco_reads_what_the_free_pad_reads(chess):
+    """The object (a mocap body) is put under the arm's pad, its top 0.6 mm into the covering:
+    stock mujoco's sensordata equals taction's free-pad reading at the same relative pose."""
+    pawn = chess[0]
+    sensor = taction.Sensor()
     mujoco.mj_loadPluginLibrary(taction.plugin_path())  # loading it again is harmless
-    model = mujoco.MjModel.from_xml_string(taction.scene(chess[0]))
+    model = mujoco.MjModel.from_xml_string(taction.scene(pawn))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    sensor = model.sensor("tactile")
-    assert sensor.dim[0] == 36
-    image = data.sensordata[sensor.adr[0] : sensor.adr[0] + 36]
-    assert np.all((image >= 0) & (image <= 1))
+    site = data.site("pad")
+    x_s, y_s, n = site.xmat.reshape(3, 3).T  # the site's axes: right, up, normal
+    top = pawn.bounds_m[1, 2]
+    depth = 0.0012 - 0.0006
+    # The object's +z along -normal, +y along the pad's up: its top meets the covering.
+    rotation = np.column_stack([-x_s, y_s, -n])
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, rotation.flatten())
+    mocap = model.body_mocapid[model.body("object").id]
+    assert mocap >= 0
+    data.mocap_pos[mocap] = site.xpos + n * (top + depth)
+    data.mocap_quat[mocap] = quat
+    mujoco.mj_forward(model, data)
+    tactile = model.sensor("tactile")
+    assert tactile.dim[0] == 36
+    image = data.sensordata[tactile.adr[0] : tactile.adr[0] + 36].reshape(6, 6)
+    expected = sensor.read(pawn, [0, 0, top + depth, 0, 0, -1, 0, 1, 0], dtype="float64")
+    assert expected.max() > 0.2
+    assert np.allclose(image, expected, atol=1e-6), (image, expected)
 
 
 def python_blocks(readme):
     return re.findall(r"```python\n(.*?)```", readme.read_text(), flags=re.S)
 
 
-def test_the_readme_python_block_runs_as_written(tmp_path, monkeypatch):
-    blocks = [b for b in python_blocks(ROOT / "README.md") if b.startswith("import taction")]
-    assert blocks, "the README has a Python block beginning with `import taction`"
+@pytest.mark.parametrize("document", ["README.md", "docs/python.md"])
+def test_the_python_blocks_run_as_written(document, tmp_path, monkeypatch):
+    blocks = [b for b in python_blocks(ROOT / document) if b.startswith("import taction")]
+    assert blocks, f"{document} has a Python block beginning with `import taction`"
     monkeypatch.chdir(tmp_path)
     for block in blocks:
-        exec(compile(block, "README.md", "exec"), {})
+        exec(compile(block, document, "exec"), {})

@@ -71,6 +71,10 @@ impl EpisodeConfig {
     }
 }
 
+/// K at most: far beyond any use (each candidate is scored before every touch), small enough that
+/// the candidates' memory is never a concern.
+pub const MAX_CANDIDATES: usize = 4096;
+
 impl Check for EpisodeConfig {
     type Error = RangeError;
 
@@ -85,7 +89,12 @@ impl Check for EpisodeConfig {
             neighbourhood_m,
         } = *self;
         FieldChecks::of("episode config")
-            .count("candidates", candidates, candidates >= 1, "1 or more")
+            .count(
+                "candidates",
+                candidates,
+                (1..=MAX_CANDIDATES).contains(&candidates),
+                "1 to 4096",
+            )
             .real(
                 "neighbourhood_m",
                 neighbourhood_m,

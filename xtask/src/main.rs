@@ -132,19 +132,35 @@ fn setup() -> Result<(), String> {
 }
 
 /// The project venv `.venv/` with the Python package built from this checkout (`pip install .`,
-/// through maturin; cargo does no work when nothing changed) and its runtime and development
-/// dependencies (`pyproject.toml`'s `dev` extra: maturin, pytest, pandas, pyarrow). The MuJoCo
-/// wheel `setup` fetched is offered to pip first, so it is not downloaded twice.
+/// through maturin) and its runtime and development dependencies (`pyproject.toml`'s `dev` extra:
+/// maturin, pytest, pandas, pyarrow). The MuJoCo wheel `setup` fetched is offered to pip first, so
+/// it is not downloaded twice. The package is rebuilt only when a source it is built from changed
+/// since the last install (a stamp in the venv), so a second run does no work.
 fn install_python_package() -> Result<(), String> {
     let root = project_root();
-    let python = root.join(".venv").join("bin").join("python");
-    if !python.exists() {
+    let venv = root.join(".venv");
+    let python = venv.join("bin").join("python");
+    let succeeds = |args: &[&str]| {
+        Command::new(&python)
+            .args(args)
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !succeeds(&["-m", "pip", "--version"]) {
+        // A venv without pip (made where python3-venv is missing) is made again.
+        let _ = fs::remove_dir_all(&venv);
         eprintln!("xtask: making the project venv .venv/ (python3 -m venv)");
-        run(Command::new("python3").args(["-m", "venv"]).arg(root.join(".venv")))?;
+        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))
+            .map_err(|e| format!("{e}; on Debian and Ubuntu, install python3-venv"))?;
+    }
+    let stamp_file = venv.join("taction-build.stamp");
+    let stamp = python_sources_stamp(&root);
+    if fs::read_to_string(&stamp_file).is_ok_and(|s| s == stamp) && succeeds(&["-c", "import taction"]) {
+        return Ok(());
     }
     // As in an activated venv: maturin's backend runs the `maturin` program it installed there.
     let path = std::env::join_paths(
-        std::iter::once(root.join(".venv").join("bin"))
+        std::iter::once(venv.join("bin"))
             .chain(std::env::var_os("PATH").iter().flat_map(std::env::split_paths)),
     )
     .map_err(|e| format!("PATH: {e}"))?;
@@ -157,14 +173,47 @@ fn install_python_package() -> Result<(), String> {
             .args(args)
             .current_dir(&root))
     };
-    let has_maturin = Command::new(&python)
-        .args(["-c", "import maturin"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_maturin {
+    if !succeeds(&["-c", "import maturin"]) {
         pip(&["maturin>=1.5,<2"])?;
     }
-    pip(&["--no-build-isolation", ".[dev]"])
+    pip(&["--no-build-isolation", ".[dev]"])?;
+    fs::write(&stamp_file, stamp).map_err(|e| format!("{}: {e}", stamp_file.display()))
+}
+
+/// The newest modification time and the number of the files the Python package is built from.
+fn python_sources_stamp(root: &Path) -> String {
+    fn visit(path: &Path, newest: &mut std::time::SystemTime, count: &mut usize) {
+        if path.file_name().is_some_and(|n| n == "__pycache__") {
+            return;
+        }
+        if path.is_dir() {
+            for entry in fs::read_dir(path).into_iter().flatten().flatten() {
+                visit(&entry.path(), newest, count);
+            }
+        } else if let Ok(modified) = fs::metadata(path).and_then(|m| m.modified()) {
+            *newest = (*newest).max(modified);
+            *count += 1;
+        }
+    }
+    let mut newest = std::time::SystemTime::UNIX_EPOCH;
+    let mut count = 0;
+    for input in [
+        "src",
+        "python/src",
+        "python/taction",
+        "python/Cargo.toml",
+        "python/build.rs",
+        "python/build_backend.py",
+        "Cargo.toml",
+        "Cargo.lock",
+        "pyproject.toml",
+    ] {
+        visit(&root.join(input), &mut newest, &mut count);
+    }
+    let since = newest
+        .duration_since(std::time::SystemTime::UNIX_EPOCH)
+        .unwrap_or_default();
+    format!("{} {count}\n", since.as_nanos())
 }
 
 /// Runs the Python package's tests in the project venv.
