@@ -39,6 +39,7 @@ use obvhs::triangle::Triangle;
 use sensor_support::{geodesic_sphere, icosphere, taxel_centre};
 use taction::control::FreePad;
 use taction::mesh::TriMesh;
+use taction::mesh::{BuildOptions, ObjectSet};
 use taction::pose::PadPose;
 use taction::sim::COLLISION_GROUP;
 use taction::sim::numbers;
@@ -695,10 +696,33 @@ fn summary(_: &mut Criterion) {
     }
 }
 
+/// The reading `taction.Sensor().read(pawn, pose)` makes from Python (`benches/python_reading.py`
+/// times that call against this one): the paper's 6x6 sensor on the free pad, placed 0.6 mm into the
+/// top of the chess pawn, then read.
+fn python_parity(c: &mut Criterion) {
+    let pawn = ObjectSet::chess()
+        .build_object("pawn", &BuildOptions::default())
+        .unwrap();
+    let top_m = pawn.mesh.vertices.iter().map(|v| v.z).fold(f64::MIN, f64::max);
+    let pose = PadPose::new(DVec3::new(0.0, 0.0, top_m + 0.0006), DVec3::NEG_Z, DVec3::Y).unwrap();
+    let config = Valid::new(SensorConfig::paper()).unwrap();
+    let mut pad = FreePad::new(ObjectSpec::from(pawn), &config).unwrap();
+    assert!(
+        pad.read_at(&pose).unwrap().max() > 0.0,
+        "the pad should touch the pawn"
+    );
+    let mut group = c.benchmark_group("sensor/python_parity");
+    group_settings(&mut group);
+    group.bench_function("free_pad_read_at_6x6", |b| {
+        b.iter(|| black_box(pad.read_at(&pose).unwrap()))
+    });
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     // Criterion's plot backend fails on this machine (no fonts for its PDF plots); numbers only.
     config = Criterion::default().without_plots().output_directory(&criterion_dir());
-    targets = sensor, mesh_size, build, summary
+    targets = sensor, mesh_size, build, python_parity, summary
 }
 criterion_main!(benches);

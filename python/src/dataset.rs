@@ -165,7 +165,12 @@ impl Dataset {
 
     #[getter]
     fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let values = self.inner.readings().iter().map(|r| i64::from(r.iterations)).collect();
+        let values = self
+            .inner
+            .readings()
+            .iter()
+            .map(|r| i64::from(r.iterations))
+            .collect();
         array::from_i64(py, values)
     }
 
@@ -211,7 +216,7 @@ pub fn collect(
     object_set: &str,
 ) -> PyResult<Dataset> {
     let sensor = match sensor {
-        Some(s) => s.config.clone(),
+        Some(s) => s.config,
         None => Sensor::paper_config()?,
     }
     .into_inner();

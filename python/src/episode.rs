@@ -86,13 +86,14 @@ impl TouchEpisode {
     /// The box every candidate target of an episode among `objects` lies in, metres: `[[min x, y,
     /// z], [max x, y, z]]`.
     #[staticmethod]
-    fn workspace_m<'py>(
-        py: Python<'py>,
-        objects: Vec<PyRef<'py, Object>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn workspace_m<'py>(py: Python<'py>, objects: Vec<PyRef<'py, Object>>) -> PyResult<Bound<'py, PyAny>> {
         let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
         let planner = planner_for(&specs, 0.5);
-        let values = [planner.workspace_min_m.to_array(), planner.workspace_max_m.to_array()].concat();
+        let values = [
+            planner.workspace_min_m.to_array(),
+            planner.workspace_max_m.to_array(),
+        ]
+        .concat();
         array::from_f64(py, &values, &[2, 3], "float64")
     }
 
@@ -119,7 +120,10 @@ impl TouchEpisode {
     fn touch(&self, py: Python<'_>, index: usize) -> PyResult<bool> {
         let mut episode = self.episode()?;
         let episode = &mut *episode;
-        Ok(py.detach(move || episode.touch(index)).map_err(refused)?.is_some())
+        Ok(py
+            .detach(move || episode.touch(index))
+            .map_err(refused)?
+            .is_some())
     }
 
     /// The last converged reading, `(rows, cols)` float32; zeros before one.

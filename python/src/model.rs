@@ -252,7 +252,13 @@ fn fit(
             kind.build().as_ref(),
             &mut |_| {},
         )?)),
-        _ => Recognizer::Fused(FusedModel::fit(config, training, validation, choice, &mut |_| {})?),
+        _ => Recognizer::Fused(FusedModel::fit(
+            config,
+            training,
+            validation,
+            choice,
+            &mut |_| {},
+        )?),
     })
 }
 

@@ -105,10 +105,7 @@ pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Ve
             })
         })
         .map_err(refused)?;
-    Ok(built
-        .into_iter()
-        .map(|o| Object { inner: Arc::new(o) })
-        .collect())
+    Ok(built.into_iter().map(|o| Object { inner: Arc::new(o) }).collect())
 }
 
 /// The MJCF world the arm explores, for stock `mujoco`: the arm, the table, `object` (its mesh
@@ -119,7 +116,7 @@ pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Ve
 #[pyo3(signature = (object, sensor=None))]
 pub fn scene(object: &Object, sensor: Option<PyRef<'_, Sensor>>) -> PyResult<String> {
     let config = match sensor {
-        Some(s) => s.config.clone(),
+        Some(s) => s.config,
         None => Sensor::paper_config()?,
     };
     let builder = SceneBuilder::with_arm_and_table().object(object.spec());

@@ -62,12 +62,8 @@ pub fn pad_pose(value: &Bound<'_, PyAny>) -> PyResult<PadPose> {
         ));
     }
     let vec = |i: usize| DVec3::new(v[i], v[i + 1], v[i + 2]);
-    PadPose::new(vec(0), vec(3), vec(6)).ok_or_else(|| {
-        bad_argument(
-            "pad_pose",
-            "the normal and up must be non-zero and not parallel",
-        )
-    })
+    PadPose::new(vec(0), vec(3), vec(6))
+        .ok_or_else(|| bad_argument("pad_pose", "the normal and up must be non-zero and not parallel"))
 }
 
 #[pymethods]
@@ -130,7 +126,7 @@ impl Sensor {
 
     /// The configuration as a dataset's header writes it.
     fn config(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        crate::dataset::json_to_python(py, &serde_json::to_value(&*self.config).map_err(refused)?)
+        crate::dataset::json_to_python(py, &serde_json::to_value(*self.config).map_err(refused)?)
     }
 
     fn __repr__(&self) -> String {
