@@ -10,7 +10,7 @@ Every policy declares its best guess once the belief reaches ``--declare-at`` (e
 runs to the budget, and the final best guess is scored). One core: the environment steps in this
 process only. Writes one CSV row per episode and prints the table.
 
-    .venv/bin/python examples/python/active_touch_baselines.py --objects shapes --episodes 24
+    taskset -c 1 .venv/bin/python examples/python/active_touch_baselines.py --objects shapes --episodes 36
 """
 
 import argparse
@@ -61,9 +61,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--objects", default="chess", help="set name (default chess)")
     parser.add_argument("--episodes", type=int, default=12, help="episodes per policy")
-    parser.add_argument("--budget", type=int, default=30, help="touches per episode at most")
+    parser.add_argument("--budget", type=int, default=100, help="touches per episode at most")
     parser.add_argument("--declare-at", type=float, default=0.95, help="belief that declares")
-    parser.add_argument("--training-readings", type=int, default=300)
+    parser.add_argument("--training-readings", type=int, default=1000)
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("baselines.csv"))
     args = parser.parse_args(argv)
     if args.episodes < 1 or args.budget < 1 or not 0 < args.declare_at <= 1:

@@ -41,7 +41,7 @@ def _objects_of(objects: Union[str, Sequence["taction.Object"]]) -> list:
     return list(objects)
 
 
-def default_model(objects, training_readings: int = 300, seed: int = 1) -> "taction.Model":
+def default_model(objects, training_readings: int = 1000, seed: int = 1) -> "taction.Model":
     """The recogniser ``taction demo`` trains for the arm (``taction.train_for_arm``) on ``objects``
     (a set name or a list of objects); trained once per process for a set name."""
     key = (objects, training_readings, seed) if isinstance(objects, str) else None
@@ -82,7 +82,7 @@ class ActiveTouchEnv(gymnasium.Env):
         self,
         objects: Union[str, Sequence["taction.Object"]] = "chess",
         model: Union[None, str, os.PathLike, "taction.Model"] = None,
-        budget: int = 30,
+        budget: int = 100,
         candidates: int = 12,
         local_probability: float = 0.5,
         perturb_deg: float = 0.0,
@@ -90,7 +90,7 @@ class ActiveTouchEnv(gymnasium.Env):
         touch_cost: float = 0.01,
         right_reward: float = 1.0,
         wrong_reward: float = -1.0,
-        training_readings: int = 300,
+        training_readings: int = 1000,
         training_seed: int = 1,
     ):
         if budget < 1:
