@@ -215,14 +215,14 @@ pub fn collect(
     reachable_by_arm: bool,
     object_set: &str,
 ) -> PyResult<Dataset> {
+    if objects.is_empty() {
+        return Err(bad_argument("objects", "no object to touch"));
+    }
     let sensor = match sensor {
         Some(s) => s.config,
         None => Sensor::paper_config()?,
     }
     .into_inner();
-    if objects.is_empty() {
-        return Err(bad_argument("objects", "no object to touch"));
-    }
     let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
     let collect = match mode {
@@ -231,15 +231,7 @@ pub fn collect(
             let c = if from_above { c.from_above() } else { c };
             if reachable_by_arm { c.reachable_by_arm() } else { c }
         }
-        "planner" => Collect::planner(
-            sensor,
-            PlannerConfig {
-                local_probability,
-                max_iterations: PlannerConfig::iterations_for(readings),
-                ..PlannerConfig::default()
-            }
-            .fitted_to(&specs),
-        ),
+        "planner" => Collect::planner(sensor, planner_for(&specs, readings, local_probability)),
         other => {
             return Err(bad_argument(
                 "mode",
@@ -254,8 +246,26 @@ pub fn collect(
     let dataset = py
         .detach(|| collect.dataset(object_set, &specs))
         .map_err(refused)?;
-    // A run that gathered fewer readings than asked says so (the planner may run out of
-    // iterations on an object it cannot reach well).
+    warn_of_shortfalls(py, &dataset, readings)?;
+    Ok(Dataset {
+        inner: Arc::new(dataset),
+    })
+}
+
+/// The planner `taction collect --mode planner` runs: its iteration budget sized to `readings`,
+/// the workspace fitted to the objects.
+fn planner_for(objects: &[ObjectSpec], readings: usize, local_probability: f64) -> PlannerConfig {
+    PlannerConfig {
+        local_probability,
+        max_iterations: PlannerConfig::iterations_for(readings),
+        ..PlannerConfig::default()
+    }
+    .fitted_to(objects)
+}
+
+/// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run
+/// out of iterations on an object it cannot reach well).
+fn warn_of_shortfalls(py: Python<'_>, dataset: &taction::dataset::Dataset, readings: usize) -> PyResult<()> {
     let shortfalls = dataset.shortfalls(readings);
     if !shortfalls.is_empty() {
         let message = format!(
@@ -264,7 +274,5 @@ pub fn collect(
         );
         py.import("warnings")?.call_method1("warn", (message,))?;
     }
-    Ok(Dataset {
-        inner: Arc::new(dataset),
-    })
+    Ok(())
 }
