@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use taction::dataset::{ExportFormat, Reading};
 use taction::explore::{Collect, PlannerConfig};
 use taction::sim::{ObjectSpec, PerturbationBounds};
@@ -46,6 +47,23 @@ impl Dataset {
         let dataset = py
             .detach(|| taction::dataset::Dataset::read(&path))
             .map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(dataset),
+        })
+    }
+
+    /// Pickled as its file's contents.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let bytes = self.inner.to_file_bytes("the pickle").map_err(refused)?;
+        let rebuild = py.get_type::<Self>().getattr("from_bytes")?;
+        Ok((rebuild, (PyBytes::new(py, &bytes),)))
+    }
+
+    /// A dataset from the contents of its file.
+    #[staticmethod]
+    fn from_bytes(bytes: &[u8]) -> PyResult<Self> {
+        let text = std::str::from_utf8(bytes).map_err(|e| bad_argument("bytes", e))?;
+        let dataset = taction::dataset::Dataset::parse(text, "the pickled dataset").map_err(refused)?;
         Ok(Self {
             inner: Arc::new(dataset),
         })

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use taction::active_touch::ArmTrainingRecipe;
 use taction::describe::Feature;
 use taction::recognize::{
@@ -51,6 +52,22 @@ impl Model {
 
     fn __deepcopy__<'py>(slf: PyRef<'py, Self>, _memo: &Bound<'py, PyAny>) -> PyRef<'py, Self> {
         slf
+    }
+
+    /// Pickled as its model file's contents (what vector environments in subprocesses need).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let bytes = self.inner.to_json().map_err(refused)?;
+        let rebuild = py.get_type::<Self>().getattr("from_json")?;
+        Ok((rebuild, (PyBytes::new(py, &bytes),)))
+    }
+
+    /// A model from the contents of a model file.
+    #[staticmethod]
+    fn from_json(bytes: &[u8]) -> PyResult<Self> {
+        let model = Recognizer::from_json(bytes, "the pickled model").map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(model),
+        })
     }
 
     /// The objects it tells apart, in the order of the posterior's probabilities.

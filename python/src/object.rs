@@ -9,13 +9,33 @@ use taction::mesh::{BuildOptions, ObjectSet};
 use taction::sim::{ObjectSpec, PAD_SITE, SceneBuilder};
 use taction::tactile::add_sensor;
 
-use crate::error::refused;
+use crate::error::{bad_argument, refused};
 use crate::sensor::Sensor;
 
 /// One object the sensor can touch: a name and a checked triangle mesh in metres.
 #[pyclass(module = "taction", frozen)]
 pub struct Object {
     pub inner: Arc<taction::mesh::Object>,
+}
+
+/// An object's fields, as a pickle carries them.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Parts {
+    name: String,
+    mesh: taction::mesh::TriMesh,
+    warnings: taction::mesh::ValidationReport,
+    flipped: bool,
+}
+
+impl Parts {
+    fn of(object: &taction::mesh::Object) -> Self {
+        Self {
+            name: object.name.clone(),
+            mesh: object.mesh.clone(),
+            warnings: object.warnings,
+            flipped: object.flipped,
+        }
+    }
 }
 
 impl Object {
@@ -51,6 +71,26 @@ impl Object {
 
     fn __deepcopy__<'py>(slf: PyRef<'py, Self>, _memo: &Bound<'py, PyAny>) -> PyRef<'py, Self> {
         slf
+    }
+
+    /// Pickled as its name, mesh and checks (what vector environments in subprocesses need).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let json = serde_json::to_string(&Parts::of(&self.inner)).map_err(refused)?;
+        Ok((py.get_type::<Self>().getattr("_from_parts")?, (json,)))
+    }
+
+    /// The object [`__reduce__`](Self::__reduce__) pickled; its mesh was checked when it was made.
+    #[staticmethod]
+    fn _from_parts(json: &str) -> PyResult<Self> {
+        let parts: Parts = serde_json::from_str(json).map_err(|e| bad_argument("pickle", e))?;
+        Ok(Self {
+            inner: Arc::new(taction::mesh::Object {
+                name: parts.name,
+                mesh: parts.mesh,
+                warnings: parts.warnings,
+                flipped: parts.flipped,
+            }),
+        })
     }
 
     #[getter]

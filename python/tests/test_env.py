@@ -45,6 +45,19 @@ def test_make_vec_steps_two_environments(small_model):
     envs.close()
 
 
+def test_async_vector_environments_match_sync_ones(small_model):
+    kwargs = dict(objects="chess", model=small_model, budget=3)
+    actions = [np.array([0, 5]), np.array([2, 1])]
+    runs = []
+    for mode in ("async", "sync"):
+        envs = gymnasium.make_vec(ENV, num_envs=2, vectorization_mode=mode, **kwargs)
+        obs, _ = envs.reset(seed=4)
+        steps = [obs] + [envs.step(a)[:2] for a in actions]
+        envs.close()
+        runs.append(steps)
+    assert same(runs[0], runs[1])
+
+
 def trace(env, seed, actions):
     obs, _ = env.reset(seed=seed)
     out = [obs]

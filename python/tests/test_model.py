@@ -53,3 +53,21 @@ def test_bad_training_arguments_name_the_argument(small_dataset, small_model):
         small_model.posterior().observe(np.zeros(6))
     with pytest.raises(taction.TactionError, match="image"):
         small_model.posterior().observe(np.zeros((14, 14)))
+
+
+def test_models_objects_and_datasets_pickle(small_model, small_dataset, chess):
+    import pickle
+
+    model = pickle.loads(pickle.dumps(small_model))
+    assert model.objects == small_model.objects and model.k == small_model.k
+    image = small_dataset.images[small_dataset.status == "converged"][0]
+    assert np.array_equal(model.posterior().observe(image), small_model.posterior().observe(image))
+    dataset = pickle.loads(pickle.dumps(small_dataset))
+    assert np.array_equal(dataset.images, small_dataset.images)
+    assert list(dataset.cause) == list(small_dataset.cause)
+    pawn = pickle.loads(pickle.dumps(chess[0]))
+    assert pawn.name == "pawn" and np.array_equal(pawn.bounds_m, chess[0].bounds_m)
+    pose = [0, 0, chess[0].bounds_m[1, 2] + 0.0006, 0, 0, -1, 0, 1, 0]
+    assert np.array_equal(taction.Sensor().read(pawn, pose), taction.Sensor().read(chess[0], pose))
+    with pytest.raises(taction.TactionError, match="pickled model"):
+        taction.Model.from_json(b"{}")

@@ -293,16 +293,33 @@ impl Recognizer {
     /// Reads a model written by `taction train`, fused (a `fused` list) or not.
     pub fn load(path: &Path) -> Result<Self, RecognizeError> {
         let (bytes, name) = read_model_file(path)?;
-        let fused = serde_json::from_slice::<serde_json::Value>(&bytes)
+        Self::from_json(&bytes, &name)
+    }
+
+    /// Parses the contents of a model file ([`load`](Self::load)); `origin` names it in errors.
+    pub fn from_json(bytes: &[u8], origin: &str) -> Result<Self, RecognizeError> {
+        let fused = serde_json::from_slice::<serde_json::Value>(bytes)
             .ok()
             .filter(|v| v.get("fused").is_some());
         match fused {
             Some(value) => {
-                check_version(&value, &name)?;
-                Ok(Self::Fused(FusedModel::from_json(&value, &name)?))
+                check_version(&value, origin)?;
+                Ok(Self::Fused(FusedModel::from_json(&value, origin)?))
             }
-            None => Ok(Self::Single(Box::new(TrainedModel::from_json(&bytes, &name)?))),
+            None => Ok(Self::Single(Box::new(TrainedModel::from_json(bytes, origin)?))),
         }
+    }
+
+    /// The contents of its model file, what [`from_json`](Self::from_json) reads back.
+    pub fn to_json(&self) -> Result<Vec<u8>, RecognizeError> {
+        let encoded = match self {
+            Self::Single(m) => serde_json::to_vec(m.as_ref()),
+            Self::Fused(f) => serde_json::to_vec(f),
+        };
+        encoded.map_err(|e| RecognizeError::NotAModel {
+            path: "the model in memory".into(),
+            what: format!("cannot encode: {e}"),
+        })
     }
 
     /// The descriptor name (`mnti`, `mnti+mn`).
