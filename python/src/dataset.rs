@@ -249,7 +249,10 @@ pub fn collect(
             let c = if from_above { c.from_above() } else { c };
             if reachable_by_arm { c.reachable_by_arm() } else { c }
         }
-        "planner" => Collect::planner(sensor, planner_for(&specs, readings, local_probability)),
+        "planner" => Collect::planner(
+            sensor,
+            PlannerConfig::for_collection(&specs, readings, local_probability, None),
+        ),
         other => {
             return Err(bad_argument(
                 "mode",
@@ -268,17 +271,6 @@ pub fn collect(
     Ok(Dataset {
         inner: Arc::new(dataset),
     })
-}
-
-/// The planner `taction collect --mode planner` runs: its iteration budget sized to `readings`,
-/// the workspace fitted to the objects.
-fn planner_for(objects: &[ObjectSpec], readings: usize, local_probability: f64) -> PlannerConfig {
-    PlannerConfig {
-        local_probability,
-        max_iterations: PlannerConfig::iterations_for(readings),
-        ..PlannerConfig::default()
-    }
-    .fitted_to(objects)
 }
 
 /// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run

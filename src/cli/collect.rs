@@ -174,17 +174,10 @@ fn collection(args: &CollectArgs, sensor: SensorConfig, objects: &[ObjectSpec]) 
                 collect
             }
         }
-        Mode::Planner => {
-            let max_iterations = args
-                .max_iterations
-                .unwrap_or_else(|| PlannerConfig::iterations_for(args.readings));
-            let config = PlannerConfig {
-                local_probability: args.local_prob,
-                max_iterations,
-                ..PlannerConfig::default()
-            };
-            Collect::planner(sensor, config.fitted_to(objects))
-        }
+        Mode::Planner => Collect::planner(
+            sensor,
+            PlannerConfig::for_collection(objects, args.readings, args.local_prob, args.max_iterations),
+        ),
     }
 }
 

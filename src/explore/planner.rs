@@ -114,6 +114,24 @@ impl PlannerConfig {
             .max(Self::default().max_iterations)
     }
 
+    /// The planner `collect --mode planner` runs for `readings` converged readings per object of
+    /// `objects`: the defaults with local probability L = `local_probability`, `max_iterations`
+    /// or else [`iterations_for`](Self::iterations_for) `readings`, the workspace
+    /// [`fitted_to`](Self::fitted_to) the objects. Checked where it is used.
+    pub fn for_collection(
+        objects: &[ObjectSpec],
+        readings: usize,
+        local_probability: f64,
+        max_iterations: Option<usize>,
+    ) -> Self {
+        Self {
+            local_probability,
+            max_iterations: max_iterations.unwrap_or_else(|| Self::iterations_for(readings)),
+            ..Self::default()
+        }
+        .fitted_to(objects)
+    }
+
     /// The largest object the arm explores: the diagonal of the workspace box (Sec. III-A), the
     /// only region the planner's targets are drawn from.
     pub fn object_size_limit(&self) -> SizeLimit {
