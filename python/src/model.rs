@@ -37,11 +37,7 @@ impl Model {
     }
 
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| match self.inner.as_ref() {
-            Recognizer::Single(m) => m.save(&path),
-            Recognizer::Fused(f) => f.save(&path),
-        })
-        .map_err(refused)
+        py.detach(|| self.inner.save(&path)).map_err(refused)
     }
 
     /// A model does not change: copies are the model itself (Gymnasium copies an environment's
@@ -101,7 +97,6 @@ impl Model {
         Ok(Posterior {
             model: self.inner.clone(),
             observed: Vec::new(),
-            probabilities: vec![1.0 / self.inner.objects().len() as f64; self.inner.objects().len()],
             belief: None,
         })
     }
@@ -136,7 +131,7 @@ pub struct Posterior {
     model: Arc<Recognizer>,
     /// Every observed reading's features under each of the model's descriptors.
     observed: Vec<Vec<Vec<Feature>>>,
-    probabilities: Vec<f64>,
+    /// The belief after them; `None` before any (uniform).
     belief: Option<Belief>,
 }
 
@@ -169,7 +164,6 @@ impl Posterior {
             .observe_features(&features)
             .map_err(|e| bad_argument("image", e))?;
         self.observed.push(features);
-        self.probabilities = belief.probabilities().to_vec();
         self.belief = Some(belief);
         self.probabilities(py)
     }
@@ -177,7 +171,12 @@ impl Posterior {
     /// P(object | readings so far), in the order of `Model.objects`.
     #[getter]
     fn probabilities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        array::from_f64(py, &self.probabilities, &[self.probabilities.len()], "float64")
+        let n = self.model.objects().len();
+        let p = match &self.belief {
+            Some(belief) => belief.probabilities().to_vec(),
+            None => vec![1.0 / n as f64; n],
+        };
+        array::from_f64(py, &p, &[n], "float64")
     }
 
     /// The most probable object (the first of equal ones).
@@ -221,13 +220,7 @@ pub fn train(
     trial_readings: usize,
 ) -> PyResult<Model> {
     let choice = DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?;
-    let codebook = CodebookKind::from_name(codebook).ok_or_else(|| {
-        let names: Vec<&str> = CodebookKind::ALL.iter().map(|k| k.name()).collect();
-        bad_argument(
-            "codebook",
-            format!("unknown codebook '{codebook}'; expected {}", names.join(", ")),
-        )
-    })?;
+    let codebook = CodebookKind::parse(codebook).map_err(|e| bad_argument("codebook", e))?;
     let config = TrainConfig {
         codebook,
         restarts,

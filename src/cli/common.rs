@@ -128,10 +128,7 @@ impl ThreadsArg {
 
 /// Parses a `--codebook` value, naming the kinds there are when it is none of them.
 pub fn parse_codebook(name: &str) -> Result<CodebookKind, String> {
-    CodebookKind::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = CodebookKind::ALL.iter().map(|k| k.name()).collect();
-        format!("unknown codebook '{name}'; expected {}", names.join(", "))
-    })
+    CodebookKind::parse(name)
 }
 
 /// `--control`, the surface contact controllers' configuration, shared by the commands that settle

@@ -97,6 +97,14 @@ impl CodebookKind {
         }
     }
 
+    /// The kind a command-line name names; else the message the CLI and Python give.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Self::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown codebook '{name}'; expected {}", names.join(", "))
+        })
+    }
+
     /// Whether fitting draws random numbers, so that seeded restarts can differ (the neighbour
     /// codebook is a function of the data).
     pub fn is_random(self) -> bool {

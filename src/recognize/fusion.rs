@@ -21,7 +21,7 @@ use crate::describe::{DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
 use crate::recognize::model::{
-    MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, read_model_file, save_json,
+    MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, encode_json, read_model_file, save_json,
 };
 use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
@@ -312,14 +312,18 @@ impl Recognizer {
 
     /// The contents of its model file, what [`from_json`](Self::from_json) reads back.
     pub fn to_json(&self) -> Result<Vec<u8>, RecognizeError> {
-        let encoded = match self {
-            Self::Single(m) => serde_json::to_vec(m.as_ref()),
-            Self::Fused(f) => serde_json::to_vec(f),
-        };
-        encoded.map_err(|e| RecognizeError::NotAModel {
-            path: "the model in memory".into(),
-            what: format!("cannot encode: {e}"),
-        })
+        match self {
+            Self::Single(m) => encode_json(m.as_ref(), "the model in memory"),
+            Self::Fused(f) => encode_json(f, "the model in memory"),
+        }
+    }
+
+    /// Writes the model file [`load`](Self::load) reads, atomically.
+    pub fn save(&self, path: &Path) -> Result<(), RecognizeError> {
+        match self {
+            Self::Single(m) => m.save(path),
+            Self::Fused(f) => f.save(path),
+        }
     }
 
     /// The descriptor name (`mnti`, `mnti+mn`).

@@ -373,11 +373,16 @@ pub(crate) fn read_model_file(path: &Path) -> Result<(Vec<u8>, String), Recogniz
 }
 
 /// Writes a model file (`value` as JSON) atomically: a reader never sees half of it.
-pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), RecognizeError> {
-    let json = serde_json::to_vec(value).map_err(|e| RecognizeError::NotAModel {
-        path: path.display().to_string(),
+/// A model file's contents; `origin` names the destination in errors.
+pub(crate) fn encode_json<T: serde::Serialize>(value: &T, origin: &str) -> Result<Vec<u8>, RecognizeError> {
+    serde_json::to_vec(value).map_err(|e| RecognizeError::NotAModel {
+        path: origin.to_string(),
         what: format!("cannot encode: {e}"),
-    })?;
+    })
+}
+
+pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(), RecognizeError> {
+    let json = encode_json(value, &path.display().to_string())?;
     write_atomic(path, &json)?;
     Ok(())
 }
