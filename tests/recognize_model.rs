@@ -5,8 +5,8 @@ mod recognize_toy;
 
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    CodebookKind, LabelledFeatures, ReadingRange, RecognizeError, TrainConfig, TrainedModel,
-    TrainingProvenance, evaluate, make_trials, train,
+    CodebookKind, LabelledFeatures, PosteriorRule, ReadingRange, RecognizeError, Tempering, TrainConfig,
+    TrainedModel, TrainingProvenance, evaluate, make_trials, train,
 };
 use taction::valid::Valid;
 
@@ -192,4 +192,45 @@ fn inconsistent_or_foreign_content() {
         matches!(e, RecognizeError::Io { .. }) && e.to_string().contains("missing.json"),
         "{e}"
     );
+}
+
+/// Issue 38: the posterior's tempering is fitted at training, travels in the model file, and a
+/// file written before calibration existed (no `tempering`) recognises with Eq. 15, exactly as
+/// `--posterior eq15` does with a new one; a tempering out of range is refused naming it.
+#[test]
+fn the_fitted_tempering_travels_in_the_file_and_old_files_recognise_with_eq15() {
+    let dir = tempfile::tempdir().unwrap();
+    let test = recognize_toy::dataset(10, 77);
+    let original = model(CodebookKind::Knn);
+    assert_ne!(
+        original.bag.tempering(),
+        Tempering::EQ15,
+        "a tempering was fitted"
+    );
+    let path = dir.path().join("model.json");
+    original.save(&path).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(json["bag"]["tempering"]["tau"].is_f64(), "{}", json["bag"]);
+    json["bag"].as_object_mut().unwrap().remove("tempering");
+    let old = TrainedModel::from_json(json.to_string().as_bytes(), "old.json").unwrap();
+    assert_eq!(old.bag.tempering(), Tempering::EQ15);
+    let eq15 = original.clone().with_posterior(PosteriorRule::Eq15);
+    let descriptor = original.build_descriptor().unwrap();
+    let features = LabelledFeatures::from_dataset(&test, descriptor.as_ref());
+    let trials = make_trials(&features, original.bag.objects(), 5).unwrap();
+    let range = ReadingRange::new(1, 5).unwrap();
+    let calibrated = evaluate(&original.bag, &trials, range).unwrap();
+    let from_old = evaluate(&old.bag, &trials, range).unwrap();
+    assert_eq!(from_old, evaluate(&eq15.bag, &trials, range).unwrap());
+    assert_ne!(
+        from_old.touches, calibrated.touches,
+        "the tempering changes the probabilities"
+    );
+    // ... but never the guesses (Eq. 4).
+    for (a, b) in from_old.touches.iter().zip(&calibrated.touches) {
+        assert_eq!(a.object_guess, b.object_guess);
+    }
+    json["bag"]["tempering"] = serde_json::json!({"tau": -1.0, "beta": 1.0});
+    let err = TrainedModel::from_json(json.to_string().as_bytes(), "bad.json").unwrap_err();
+    assert!(err.to_string().contains("tau"), "{err}");
 }

@@ -91,6 +91,23 @@ impl Model {
         self.inner.chosen_ks()
     }
 
+    /// The posterior's calibration fitted on validation at training: `{"tau", "beta", "floor"}`
+    /// (1, 1, 0 is the paper's Eq. 15).
+    #[getter]
+    fn calibration(&self) -> std::collections::BTreeMap<&'static str, f64> {
+        let t = self.inner.tempering();
+        [("tau", t.tau()), ("beta", t.beta()), ("floor", t.floor())].into()
+    }
+
+    /// The same model recognising with the posterior `rule`: "calibrated" (the default) or
+    /// "eq15" (the paper's Eq. 15-16, readings as independent evidence).
+    fn with_posterior(&self, rule: &str) -> PyResult<Self> {
+        let rule = taction::recognize::PosteriorRule::parse(rule).map_err(refused)?;
+        Ok(Self {
+            inner: Arc::new(Recognizer::clone(&self.inner).with_posterior(rule)),
+        })
+    }
+
     /// A fresh posterior: uniform over the objects until it observes a reading.
     fn posterior(&self) -> PyResult<Posterior> {
         let _ = self.inner.posterior().map_err(refused)?;

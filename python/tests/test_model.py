@@ -37,6 +37,21 @@ def test_a_model_file_round_trips(small_model, small_dataset, tmp_path):
     assert scores["trials"] > 0 and len(scores["accuracy"]) == 5
 
 
+def test_the_calibrated_posterior_keeps_the_guess_and_eq15_is_a_choice(small_model, small_dataset):
+    calibration = small_model.calibration
+    assert set(calibration) == {"tau", "beta", "floor"}
+    assert calibration["tau"] > 0 and 0 <= calibration["floor"] < 1
+    eq15 = small_model.with_posterior("eq15")
+    assert eq15.calibration == {"tau": 1.0, "beta": 1.0, "floor": 0.0}
+    images = small_dataset.images[small_dataset.status == "converged"][:5]
+    calibrated, paper = small_model.posterior(), eq15.posterior()
+    for image in images:
+        p, q = calibrated.observe(image), paper.observe(image)
+        assert np.argmax(p) == np.argmax(q)
+    with pytest.raises(taction.TactionError, match="posterior"):
+        small_model.with_posterior("bayes")
+
+
 def test_training_is_seeded(small_dataset):
     a = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)
     b = taction.train(small_dataset, descriptor="mnti", ks=[4], restarts=1, seed=3)

@@ -44,6 +44,8 @@ mod episode;
 
 pub use episode::{EpisodeConfig, TouchEpisode};
 
+use std::collections::BTreeMap;
+
 use glam::DVec3;
 
 use crate::control::ControlError;
@@ -57,7 +59,7 @@ use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, ModelPosterior};
 use crate::recognize::{
-    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer,
+    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer, Tempering,
     TrainConfig, TrainedModel,
 };
 use crate::sim::{PerturbationBounds, Scene};
@@ -74,36 +76,57 @@ pub const PRIOR_READINGS: f64 = 1.0;
 pub struct InformationGain<'a> {
     models: &'a ObjectModels,
     probabilities: Vec<f64>,
+    /// The belief the next reading updates: `probabilities` with its evidence reweighed from
+    /// `w(n)` to `w(n + 1)` (equal to it under Eq. 15).
+    next_prior: Vec<f64>,
     features: usize,
+    /// Readings recorded, with a pad pose or without.
+    observed: usize,
     /// Pad location and normalised cluster histogram of every reading observed.
     readings: Vec<(DVec3, Vec<f64>)>,
+    /// The posterior's tempering (`recognize::calibration`): how much the next reading will move it.
+    tempering: Tempering,
     /// Readings within this distance of a candidate predict what a touch there shows, metres.
     pub neighbourhood_m: f64,
 }
 
 impl<'a> InformationGain<'a> {
-    /// No reading yet: a uniform posterior.
+    /// No reading yet: a uniform posterior, updated as Eq. 15-16 update it.
     pub fn new(models: &'a ObjectModels, neighbourhood_m: f64) -> Self {
         let n = models.objects().len();
         Self {
             models,
             probabilities: vec![1.0 / n as f64; n],
+            next_prior: vec![1.0 / n as f64; n],
             features: 0,
+            observed: 0,
             readings: Vec::new(),
+            tempering: Tempering::EQ15,
             neighbourhood_m,
         }
+    }
+
+    /// The same scorer for a posterior tempered by `tempering`.
+    pub fn with_tempering(mut self, tempering: Tempering) -> Self {
+        self.tempering = tempering;
+        self
     }
 
     /// Records one reading: its cluster histogram, where it was taken (readings without a pad pose
     /// predict nothing about places) and the posterior after it.
     pub fn record(&mut self, location_m: Option<DVec3>, reading: &ClusterHistogram, posterior: &[f64]) {
         self.features += reading.features();
+        self.observed += 1;
         if let Some(l) = location_m
             && reading.features() > 0
         {
             self.readings.push((l, reading.distribution()));
         }
         self.probabilities = posterior.to_vec();
+        let reweigh = self.tempering.weight(self.observed + 1) / self.tempering.weight(self.observed);
+        let log_prior: Vec<f64> = posterior.iter().map(|p| reweigh * p.ln()).collect();
+        let lse = crate::recognize::gmm::log_sum_exp(&log_prior);
+        self.next_prior = log_prior.iter().map(|l| (l - lse).exp()).collect();
     }
 
     /// The posterior the scores start from.
@@ -111,44 +134,82 @@ impl<'a> InformationGain<'a> {
         &self.probabilities
     }
 
-    /// `m(c) = sum_j pi_j p(c | O_j)`: the cluster a touch anywhere is expected to show.
+    /// `m(c) = sum_j pi_j p_w(c | O_j)`: the cluster a touch anywhere (near no earlier reading) is
+    /// expected to show, under the clusters' likelihood as the next reading weighs it
+    /// ([`entropies_after`](Self::entropies_after)).
     pub fn belief_prediction(&self) -> Vec<f64> {
+        let log_p = self.weighed_log_likelihoods(self.reading_weight(0));
         let mut m = vec![0.0; self.models.clusters()];
-        for (j, pi) in self.probabilities.iter().enumerate() {
-            for (mc, p) in m.iter_mut().zip(self.models.probabilities(j)) {
-                *mc += pi * p;
+        for (pi, log_p) in self.next_prior.iter().zip(&log_p) {
+            for (mc, l) in m.iter_mut().zip(log_p) {
+                *mc += pi * l.exp();
             }
         }
         m
     }
 
+    /// `w`: how much the next reading's features weigh in the posterior, near `nearby` earlier
+    /// readings ([`entropies_after`](Self::entropies_after)).
+    fn reading_weight(&self, nearby: usize) -> f64 {
+        let per_reading = if self.observed == 0 || self.features == 0 {
+            1.0
+        } else {
+            self.features as f64 / self.observed as f64
+        };
+        self.tempering.weight(self.observed + 1) * per_reading / (1.0 + nearby as f64)
+    }
+
+    /// `ln p_w(c | O_j) = w ln p(c | O_j) - ln sum_c' p(c' | O_j)^w` for every object `j` and
+    /// cluster `c`: the object models raised to `w` and normalised, a likelihood the update by `w`
+    /// is exact Bayes under, so that the expected gain of a touch predicted by the belief is a
+    /// mutual information, never negative (`p_1` is Eq. 4's `p(c | O_j)` itself).
+    fn weighed_log_likelihoods(&self, w: f64) -> Vec<Vec<f64>> {
+        (0..self.models.objects().len())
+            .map(|j| {
+                let raised: Vec<f64> = self.models.log_probabilities(j).iter().map(|l| w * l).collect();
+                let lse = crate::recognize::gmm::log_sum_exp(&raised);
+                raised.iter().map(|l| l - lse).collect()
+            })
+            .collect()
+    }
+
     /// `q_x`: the belief's prediction `m` mixed with the clusters of the readings near `target_m`.
     pub fn predicted_clusters(&self, target_m: DVec3, m: &[f64]) -> Vec<f64> {
+        self.neighbourhood(target_m, m).0
+    }
+
+    /// `q_x` and `n_x`, the readings within [`neighbourhood_m`](Self::neighbourhood_m) of `target_m`.
+    fn neighbourhood(&self, target_m: DVec3, m: &[f64]) -> (Vec<f64>, usize) {
         let mut q: Vec<f64> = m.iter().map(|v| v * PRIOR_READINGS).collect();
-        let mut weight = PRIOR_READINGS;
+        let mut nearby = 0;
         for (location, distribution) in &self.readings {
             if location.distance(target_m) <= self.neighbourhood_m {
                 q.iter_mut().zip(distribution).for_each(|(a, b)| *a += b);
-                weight += 1.0;
+                nearby += 1;
             }
         }
+        let weight = PRIOR_READINGS + nearby as f64;
         q.iter_mut().for_each(|v| *v /= weight);
-        q
+        (q, nearby)
     }
 
-    /// `H(pi | c)` for every cluster `c`, nats.
-    pub fn entropies_after(&self) -> Vec<f64> {
-        let w = if self.readings.is_empty() || self.features == 0 {
-            1.0
-        } else {
-            self.features as f64 / self.readings.len() as f64
-        };
-        let log_pi: Vec<f64> = self.probabilities.iter().map(|p| p.ln()).collect();
+    /// `H(pi | c)` for every cluster `c`, nats, for a touch near `nearby` earlier readings.
+    ///
+    /// The predicted reading moves the belief as the posterior would: the evidence so far
+    /// reweighed from `w(n)` to `w(n + 1)` and the reading's features at `w(n + 1)`
+    /// (`recognize::calibration`; both 1 under Eq. 15). A touch of a place already touched
+    /// `n_x` times mostly repeats what those touches showed (neighbouring readings are
+    /// correlated, which is why the calibrated posterior's `beta` is below 1), so its evidence
+    /// counts `1 / (1 + n_x)` of a fresh place's: without the discount the scorer returns to the
+    /// one telling place it found and the belief stops improving.
+    pub fn entropies_after(&self, nearby: usize) -> Vec<f64> {
+        let log_p = self.weighed_log_likelihoods(self.reading_weight(nearby));
+        let log_pi: Vec<f64> = self.next_prior.iter().map(|p| p.ln()).collect();
         let mut log_post = vec![0.0; log_pi.len()];
         (0..self.models.clusters())
             .map(|c| {
                 for (j, l) in log_post.iter_mut().enumerate() {
-                    *l = log_pi[j] + w * self.models.log_probabilities(j)[c];
+                    *l = log_pi[j] + log_p[j][c];
                 }
                 let lse = crate::recognize::gmm::log_sum_exp(&log_post);
                 let post: Vec<f64> = log_post.iter().map(|l| (l - lse).exp()).collect();
@@ -160,17 +221,24 @@ impl<'a> InformationGain<'a> {
     /// `EIG(x)` for a prediction `q` given [`entropies_after`](Self::entropies_after), nats.
     pub fn expected_gain_nats(&self, q: &[f64], entropies_after: &[f64]) -> f64 {
         let expected: f64 = q.iter().zip(entropies_after).map(|(q, h)| q * h).sum();
-        entropy_nats(&self.probabilities) - expected
+        entropy_nats(&self.next_prior) - expected
     }
 }
 
 impl TouchScorer for InformationGain<'_> {
     fn score(&self, candidates_m: &[DVec3]) -> Vec<f64> {
         let m = self.belief_prediction();
-        let after = self.entropies_after();
+        // `H(pi | c)` depends on a candidate only through its count of nearby readings.
+        let mut after: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         candidates_m
             .iter()
-            .map(|&x| self.expected_gain_nats(&self.predicted_clusters(x, &m), &after))
+            .map(|&x| {
+                let (q, nearby) = self.neighbourhood(x, &m);
+                let entropies = after
+                    .entry(nearby)
+                    .or_insert_with(|| self.entropies_after(nearby));
+                self.expected_gain_nats(&q, entropies)
+            })
             .collect()
     }
 }
@@ -188,7 +256,12 @@ pub struct ActiveRecognition<'a> {
 impl<'a> ActiveRecognition<'a> {
     /// The recogniser of one model, describing images with the model's descriptor.
     pub fn new(model: &'a TrainedModel, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
-        Ok(Self::with(&model.bag, model.posterior()?, neighbourhood_m))
+        Ok(Self::with(
+            &model.bag,
+            model.posterior()?,
+            model.bag.tempering(),
+            neighbourhood_m,
+        ))
     }
 
     /// The recogniser of a fused model, describing images with each model's descriptor.
@@ -196,6 +269,7 @@ impl<'a> ActiveRecognition<'a> {
         Ok(Self::with(
             &model.fused[0].bag,
             model.image_posterior()?,
+            model.tempering,
             neighbourhood_m,
         ))
     }
@@ -208,11 +282,16 @@ impl<'a> ActiveRecognition<'a> {
         }
     }
 
-    fn with(bag: &'a BagOfFeatures, posterior: ModelPosterior<'a>, neighbourhood_m: f64) -> Self {
+    fn with(
+        bag: &'a BagOfFeatures,
+        posterior: ModelPosterior<'a>,
+        tempering: Tempering,
+        neighbourhood_m: f64,
+    ) -> Self {
         Self {
             bag,
             posterior,
-            gain: InformationGain::new(bag.models(), neighbourhood_m),
+            gain: InformationGain::new(bag.models(), neighbourhood_m).with_tempering(tempering),
         }
     }
 
@@ -500,6 +579,38 @@ mod tests {
         // Near the shared readings the prediction is 3/4 cluster 0, which says nothing.
         let q = gain.predicted_clusters(candidates[0], &gain.belief_prediction());
         assert!((q[0] - (0.4 + 3.0) / 4.0).abs() < 1e-6, "{q:?}");
+    }
+
+    /// A place touched six times over, all showing a telling cluster, loses to an unexplored one:
+    /// a seventh touch there mostly repeats them (the discount), while once it wins. Hand-computed:
+    /// the discounted weight 1/7 moves the uniform belief only to about (0.58, 0.42).
+    #[test]
+    fn repeated_touches_of_one_place_are_discounted() {
+        let models = toy_models();
+        let uniform = [0.5, 0.5];
+        let telling = DVec3::new(-0.1, 0.0, 0.0);
+        let candidates = [telling + DVec3::splat(0.002), DVec3::new(0.0, 0.1, 0.0)];
+        let mut once = InformationGain::new(&models, 0.01);
+        once.record(Some(telling), &one_feature(2), &uniform);
+        let scores = once.score(&candidates);
+        assert!(scores[0] > scores[1], "{scores:?}");
+        let mut often = InformationGain::new(&models, 0.01);
+        for _ in 0..6 {
+            often.record(Some(telling), &one_feature(2), &uniform);
+        }
+        let scores = often.score(&candidates);
+        assert!(scores[1] > scores[0], "{scores:?}");
+        assert!(scores[0] < 0.02, "{scores:?}");
+    }
+
+    /// A tempered posterior (evidence worth less than Eq. 15's) expects less of a touch.
+    #[test]
+    fn a_tempered_posterior_expects_less_of_a_touch() {
+        let models = toy_models();
+        let plain = InformationGain::new(&models, 0.01);
+        let tempered = plain.clone().with_tempering(Tempering::new(0.3, 1.0).unwrap());
+        let x = [DVec3::ZERO];
+        assert!(tempered.score(&x)[0] < plain.score(&x)[0]);
     }
 
     /// Once the posterior is certain nothing is left to learn anywhere.

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use taction::control::ControlConfig;
 use taction::paper::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
-use taction::recognize::CodebookKind;
+use taction::recognize::{CodebookKind, PosteriorRule};
 use taction::valid::{Check, Valid};
 
 /// The seed a command uses when `--seed` is not given.
@@ -124,6 +124,20 @@ impl ThreadsArg {
         NonZeroUsize::new(self.threads)
             .unwrap_or_else(|| NonZeroUsize::new(cores()).unwrap_or(NonZeroUsize::MIN))
     }
+}
+
+/// `--posterior`, how recognition turns likelihoods into probabilities.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct PosteriorArg {
+    /// calibrated (the tempering fitted on validation when the model was trained: a stop at
+    /// p = 0.95 is right about 95% of the time) | eq15 (the paper's Eq. 15-16: readings counted as
+    /// independent evidence). Models trained before calibration existed recognise with eq15.
+    #[arg(long = "posterior", value_name = "RULE", default_value = "calibrated", value_parser = parse_posterior)]
+    pub rule: PosteriorRule,
+}
+
+fn parse_posterior(name: &str) -> Result<PosteriorRule, String> {
+    PosteriorRule::parse(name).map_err(|e| e.to_string())
 }
 
 /// Parses a `--codebook` value, naming the kinds there are when it is none of them.

@@ -35,7 +35,7 @@ use taction::tactile::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, OutputLock, SeedArg, flag_error};
+use crate::cli::common::{ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error};
 use crate::cli::plausible::{Carrier, build_objects};
 
 /// The random stream that draws the unknown object and its pose, and the planner's own stream
@@ -77,6 +77,8 @@ pub struct DemoArgs {
     /// (e.g. 0.95) [default: spend all --touches].
     #[arg(long, value_name = "P")]
     pub stop_at_confidence: Option<Probability>,
+    #[command(flatten)]
+    pub posterior: PosteriorArg,
 }
 
 /// How the demo's arm chooses its touches.
@@ -93,7 +95,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let set = ObjectSet::resolve(std::slice::from_ref(&args.objects), None, args.object_size.m)?;
     let objects = build_objects(&set, "demo", Carrier::Arm)?;
     // 1. The model: cached per (object set, readings, training seed, descriptors), else trained now.
-    let model = load_or_train(args, &set, &objects, sensor)?;
+    let model = load_or_train(args, &set, &objects, sensor)?.with_posterior(args.posterior.rule);
     // 2. The unknown object, at a pose the planner is not told.
     let mut unknown = place_unknown(args, &objects, model.objects(), sensor)?;
     // 3. The exploration, recognising after every converged touch.
@@ -132,7 +134,7 @@ fn load_or_train(
     };
     let choice = recipe.descriptors()?;
     let model_path = args.out.join(format!(
-        "model-{}-{}-{}-{}-reachable-knn.json",
+        "model-{}-{}-{}-{}-reachable-knn-calibrated.json",
         set.id(),
         args.training_readings,
         TRAINING_SEED,

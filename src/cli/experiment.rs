@@ -14,7 +14,9 @@ use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 use taction::paper::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::paper::{SHORTFALLS_FILE, read_shortfalls};
 
-use crate::cli::common::{ObjectSizeArg, OutputLock, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook};
+use crate::cli::common::{
+    ObjectSizeArg, OutputLock, PosteriorArg, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook,
+};
 use crate::cli::plausible::{Carrier, build_objects};
 use taction::recognize::CodebookKind;
 
@@ -66,6 +68,8 @@ pub struct PaperArgs {
     /// another codebook needs its own `--out`.
     #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
     pub codebook: CodebookKind,
+    #[command(flatten)]
+    pub posterior: PosteriorArg,
 }
 
 impl PaperArgs {
@@ -91,7 +95,8 @@ impl PaperArgs {
         Ok(
             PaperContext::new(self.scale, self.seed.seed, run, shapes, letters, real)
                 .with_real_frames(real_frames)
-                .with_codebook(self.codebook),
+                .with_codebook(self.codebook)
+                .with_posterior(self.posterior.rule),
         )
     }
 }

@@ -12,6 +12,7 @@ use taction::experiment::build_figure;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer};
 
+use crate::cli::common::PosteriorArg;
 use crate::cli::dataset::read_dataset;
 
 #[derive(Debug, Args)]
@@ -32,10 +33,12 @@ pub struct RecognizeArgs {
     /// object as trial k, the band from the lowest to the highest).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub posterior: PosteriorArg,
 }
 
 pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let model = Recognizer::load(&args.model)?;
+    let model = Recognizer::load(&args.model)?.with_posterior(args.posterior.rule);
     let test = read_dataset(&args.dataset)?;
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
@@ -64,10 +67,13 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     )?);
     let ks: Vec<String> = model.chosen_ks().iter().map(usize::to_string).collect();
     println!(
-        "{trials} trials of up to {used} readings over {} objects (model k = {}, {})",
+        "{trials} trials of up to {used} readings over {} objects (model k = {}, {}; posterior {}: tau = {:.3}, beta = {:.2})",
         model.objects().len(),
         ks.join("+"),
-        model.choice().name()
+        model.choice().name(),
+        args.posterior.rule.name(),
+        model.tempering().tau(),
+        model.tempering().beta()
     );
     for n in [1, 10, 30, 100] {
         if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {

@@ -8,8 +8,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, TrainConfig, TrainProgress,
-    TrainedModel, VarianceFraction,
+    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, Tempering, TrainConfig,
+    TrainProgress, TrainedModel, VarianceFraction,
 };
 use taction::valid::Valid;
 
@@ -91,7 +91,9 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         models.push(model);
     }
     if args.descriptor.is_fused() {
-        FusedModel::new(models)?.save(&args.out)?;
+        let fused = FusedModel::new(models)?.calibrated(&config, &training, validation.as_ref())?;
+        print_tempering("fused", fused.tempering);
+        fused.save(&args.out)?;
         println!(
             "fused model ({}) written to {}",
             args.descriptor.name(),
@@ -179,4 +181,17 @@ fn print_selection(model: &TrainedModel) {
         )
     });
     println!("chosen k = {}, restart {}{chosen}", s.chosen_k, s.chosen_restart);
+    print_tempering(model.descriptor.kind().name(), model.bag.tempering());
+}
+
+/// The posterior's tempering fitted on validation (`--posterior eq15` at recognition turns it off).
+fn print_tempering(name: &str, t: Tempering) {
+    println!(
+        "{name} posterior calibrated on validation: tau = {:.3}, beta = {:.2}, floor = {:.3} (10 readings count as {:.1} independent ones, 30 as {:.1})",
+        t.tau(),
+        t.beta(),
+        t.floor(),
+        t.effective_readings(10),
+        t.effective_readings(30)
+    );
 }

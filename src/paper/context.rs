@@ -15,7 +15,7 @@ use crate::experiment::unit::BoxError;
 use crate::mesh::letters::LetterStyle;
 use crate::mesh::letters::letter_from_name;
 use crate::mesh::{NamedObject, ObjectSet, ObjectSource};
-use crate::recognize::CodebookKind;
+use crate::recognize::{CodebookKind, PosteriorRule};
 
 /// The synthetic example recording shipped with the product (`data/real_letters_example.csv`):
 /// the sim-to-real experiment's default input, so that its whole path runs without a recording.
@@ -134,6 +134,17 @@ impl PaperContext {
     pub fn with_codebook(mut self, codebook: CodebookKind) -> Self {
         self.codebook = codebook;
         self
+    }
+
+    /// Recognises with the posterior `rule` (the calibrated one unless `--posterior eq15`).
+    pub fn with_posterior(mut self, rule: PosteriorRule) -> Self {
+        self.store.posterior = rule;
+        self
+    }
+
+    /// The posterior rule every model recognises with.
+    pub fn posterior(&self) -> PosteriorRule {
+        self.store.posterior
     }
 
     /// The real recording, calibrated when it has a calibration, normalised to the sensing range by

@@ -31,7 +31,7 @@ use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::{Collect, CollectPlan};
 use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
-use crate::recognize::{TrainConfig, TrainedModel};
+use crate::recognize::{PosteriorRule, TrainConfig, TrainedModel};
 use crate::sim::ObjectSpec;
 use crate::valid::Valid;
 
@@ -107,6 +107,8 @@ pub struct DataStore {
     datasets: Mutex<HashMap<String, Arc<Dataset>>>,
     /// The objects of each prepared dataset (by key) that got fewer converged readings than asked.
     shortfalls: Mutex<HashMap<String, Vec<Shortfall>>>,
+    /// How every model's posterior turns likelihoods into probabilities (`--posterior`).
+    pub(crate) posterior: PosteriorRule,
 }
 
 /// The file in an experiment's folder naming the datasets it used that fell short of their
@@ -165,6 +167,7 @@ impl DataStore {
             threads,
             datasets: Mutex::new(HashMap::new()),
             shortfalls: Mutex::new(HashMap::new()),
+            posterior: PosteriorRule::default(),
         }
     }
 
@@ -278,7 +281,8 @@ impl DataStore {
         self.datasets.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// The model trained with `descriptor` and `config` on `training`, chosen on `validation`:
+    /// The model trained with `descriptor` and `config` on `training`, chosen on `validation`
+    /// (and its posterior calibrated there), with the run's posterior rule:
     /// read from `<out>/models/` when an earlier run trained it, otherwise trained and saved.
     /// No two units of one experiment need the same model (one unit per setting and descriptor)
     /// and experiments run one after another, so no two threads save the same model file; nothing
@@ -296,21 +300,27 @@ impl DataStore {
             validation: String,
             descriptor: crate::describe::DescriptorParams,
             config: &'a TrainConfig,
+            /// Models cached before their posterior was calibrated are not reused.
+            calibrated: bool,
         }
         let key = hash_of(&ModelKey {
             training: training.key(),
             validation: validation.key(),
             descriptor: descriptor.params(),
             config,
+            calibrated: true,
         });
         let path = self
             .root
             .join("models")
             .join(format!("{}-{key}.json", descriptor.kind().name()));
         if path.exists() {
-            return TrainedModel::load(&path).map_err(|e| {
-                format!("{e} (a model cached by an earlier run; delete the file to train it again)").into()
-            });
+            return TrainedModel::load(&path)
+                .map(|m| m.with_posterior(self.posterior))
+                .map_err(|e| {
+                    format!("{e} (a model cached by an earlier run; delete the file to train it again)")
+                        .into()
+                });
         }
         let training_data = self.dataset(training)?;
         let validation_data = self.dataset(validation)?;
@@ -323,6 +333,6 @@ impl DataStore {
         )?;
         crate::experiment::files::create_dir_all(&self.root.join("models"))?;
         model.save(&path)?;
-        Ok(model)
+        Ok(model.with_posterior(self.posterior))
     }
 }

@@ -37,7 +37,9 @@ use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::paper::sim_to_real::{GaussianBlur, square_root};
 use crate::paper::split::{SplitSizes, split_per_label};
-use crate::recognize::{Evaluation, LabelledFeatures, ReadingRange, TrainConfig, Trial, evaluate, train};
+use crate::recognize::{
+    Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, TrainConfig, Trial, evaluate, train,
+};
 use crate::rng;
 use crate::tactile::TactileImage;
 use crate::valid::{Check, Valid};
@@ -214,6 +216,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         options,
         blur: GaussianBlur::new(options.blur_sigma_taxels)?,
         seed: context.seed,
+        posterior: context.posterior(),
     });
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let units = DescriptorKind::ALL
@@ -278,6 +281,7 @@ struct TrialPlan<'a> {
     options: &'a RealFramesOptions,
     blur: GaussianBlur,
     seed: u64,
+    posterior: PosteriorRule,
 }
 
 impl TrialPlan<'_> {
@@ -354,7 +358,8 @@ impl TrialPlan<'_> {
             })
             .collect();
         let longest = trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
-        Ok(evaluate(&trained.bag, &trials, ReadingRange::new(1, longest)?)?)
+        let bag = trained.bag.with_posterior(self.posterior);
+        Ok(evaluate(&bag, &trials, ReadingRange::new(1, longest)?)?)
     }
 
     /// The features of `frames`, grouped by label.

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::describe::Feature;
 use crate::recognize::RecognizeError;
+use crate::recognize::calibration::{PosteriorRule, Tempering};
 use crate::recognize::codebook::{Codebook, CodebookModel};
 use crate::recognize::decision::Decision;
 use crate::recognize::features::FeatureMatrix;
@@ -13,12 +14,17 @@ use crate::recognize::features::check_feature;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::pca::Pca;
 
-/// A trained PCA, codebook and object models whose dimensions agree (checked on construction).
+/// A trained PCA, codebook and object models whose dimensions agree (checked on construction),
+/// and the tempering its posterior applies (`recognize::calibration`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BagOfFeatures {
     pca: Pca,
     codebook: CodebookModel,
     models: ObjectModels,
+    /// Fitted on validation trials by [`train`](crate::recognize::train); a model file written
+    /// before calibration existed has none and recognises with Eq. 15 as it did.
+    #[serde(default)]
+    tempering: Tempering,
 }
 
 impl BagOfFeatures {
@@ -29,6 +35,7 @@ impl BagOfFeatures {
             pca,
             codebook,
             models,
+            tempering: Tempering::EQ15,
         };
         bag.check().map_err(|what| RecognizeError::InvalidParameter {
             name: "bag of features",
@@ -71,6 +78,23 @@ impl BagOfFeatures {
 
     pub fn objects(&self) -> &[String] {
         self.models.objects()
+    }
+
+    /// The tempering its posterior applies ([`Tempering::EQ15`] until one is fitted).
+    pub fn tempering(&self) -> Tempering {
+        self.tempering
+    }
+
+    /// The same pipeline with its posterior tempered by `tempering`.
+    pub fn with_tempering(mut self, tempering: Tempering) -> Self {
+        self.tempering = tempering;
+        self
+    }
+
+    /// The same pipeline with the posterior `rule` applies: its fitted tempering or Eq. 15.
+    pub fn with_posterior(self, rule: PosteriorRule) -> Self {
+        let tempering = rule.tempering(self.tempering);
+        self.with_tempering(tempering)
     }
 
     /// Length of the raw (descriptor) features it takes.

@@ -1,6 +1,7 @@
 //! The decision rule (Sec. IV-A, Eq. 1-4) and the distribution over objects it implies
 //! (Appendix, Eq. 12-16).
 
+use crate::recognize::calibration::Tempering;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 
 /// The cross-entropy of Eq. 4, `H(U, O_j) = -sum_i p(c_i | U) ln p(c_i | O_j)`: the KL divergence
@@ -66,6 +67,13 @@ impl Decision {
     /// The decision given `ln p(U | O_j)` for every object and the number of features `n_U` behind
     /// them: the most likely object and the softmax of the log-likelihoods (Eq. 16).
     pub fn from_log_likelihoods(log_likelihood: Vec<f64>, n: usize) -> Decision {
+        Self::calibrated(log_likelihood, n, Tempering::EQ15, 1)
+    }
+
+    /// [`from_log_likelihoods`](Self::from_log_likelihoods) with the probabilities of a calibrated
+    /// posterior after `readings` readings (`recognize::calibration`). The guess and the
+    /// cross-entropies are Eq. 4's whatever the tempering.
+    pub fn calibrated(log_likelihood: Vec<f64>, n: usize, tempering: Tempering, readings: usize) -> Decision {
         let cross_entropy: Vec<f64> = log_likelihood
             .iter()
             .map(|l| if n == 0 { 0.0 } else { -l / n as f64 })
@@ -77,8 +85,7 @@ impl Decision {
                 best
             }
         });
-        let lse = crate::recognize::gmm::log_sum_exp(&log_likelihood);
-        let probabilities = log_likelihood.iter().map(|l| (l - lse).exp()).collect();
+        let probabilities = tempering.probabilities(&log_likelihood, readings);
         Decision {
             guess,
             cross_entropy,

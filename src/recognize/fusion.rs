@@ -19,7 +19,9 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::Dataset;
 use crate::describe::{DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
-use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
+use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
+use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
+use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::model::{
     MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, encode_json, read_model_file, save_json,
 };
@@ -115,6 +117,11 @@ pub struct FusedModel {
     pub format_version: u32,
     /// The models, in the order of the fused name.
     pub fused: Vec<TrainedModel>,
+    /// The fused posterior's tempering (`recognize::calibration`), fitted on the fused
+    /// validation trials: the parts' evidence overlaps (they describe the same readings), which no
+    /// part's own tempering knows. A file written before calibration existed has none: Eq. 15.
+    #[serde(default)]
+    pub tempering: Tempering,
 }
 
 impl FusedModel {
@@ -148,6 +155,7 @@ impl FusedModel {
         Ok(Self {
             format_version: MODEL_FORMAT_VERSION,
             fused: models,
+            tempering: Tempering::EQ15,
         })
     }
 
@@ -165,7 +173,76 @@ impl FusedModel {
             .iter()
             .map(|kind| TrainedModel::fit(config, training, validation, kind.build().as_ref(), progress))
             .collect::<Result<Vec<_>, _>>()?;
-        Self::new(models)
+        Self::new(models)?.calibrated(config, training, validation)
+    }
+
+    /// The same models with the fused posterior's tempering fitted on the validation trials
+    /// they were chosen on (`validation`, or the readings held out of `training` by `config`):
+    /// what [`fit`](Self::fit) does after fitting the parts.
+    pub fn calibrated(
+        mut self,
+        config: &TrainConfig,
+        training: &Dataset,
+        validation: Option<&Dataset>,
+    ) -> Result<Self, RecognizeError> {
+        let trials = self.validation_trials(config, training, validation)?;
+        self.tempering = Tempering::fit(&self.evidence_paths(&trials)?);
+        Ok(self)
+    }
+
+    /// The validation trials every part was chosen on, fused: `validation` when given, else the
+    /// readings each part held out of `training` ([`TrainConfig::holdout`]).
+    fn validation_trials(
+        &self,
+        config: &TrainConfig,
+        training: &Dataset,
+        validation: Option<&Dataset>,
+    ) -> Result<Vec<Trial<Vec<Vec<Feature>>>>, RecognizeError> {
+        if let Some(v) = validation {
+            return self.trials(v, config.trial_readings);
+        }
+        let per_model = self
+            .fused
+            .iter()
+            .map(|model| {
+                let descriptor = model.build_descriptor()?;
+                let features = LabelledFeatures::from_dataset(training, descriptor.as_ref());
+                let (_, held_out) = features.split_validation(config.holdout)?;
+                make_trials(&held_out, self.objects(), config.trial_readings)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(zip_trials(per_model))
+    }
+
+    /// Each fused trial's summed Eq. 15 log-likelihoods after each reading.
+    fn evidence_paths(
+        &self,
+        trials: &[Trial<Vec<Vec<Feature>>>],
+    ) -> Result<Vec<EvidencePath>, RecognizeError> {
+        trials
+            .iter()
+            .map(|trial| {
+                let mut posterior = self.posterior();
+                let log_likelihoods = trial
+                    .readings
+                    .iter()
+                    .map(|reading| {
+                        posterior.observe(reading)?;
+                        Ok(posterior.log_likelihoods())
+                    })
+                    .collect::<Result<_, RecognizeError>>()?;
+                Ok(EvidencePath {
+                    object: trial.object,
+                    log_likelihoods,
+                })
+            })
+            .collect()
+    }
+
+    /// The same models with the posterior `rule` applies: the fitted tempering or Eq. 15.
+    pub fn with_posterior(mut self, rule: PosteriorRule) -> Self {
+        self.tempering = rule.tempering(self.tempering);
+        self
     }
 
     /// The objects, in the models' (common) order.
@@ -184,6 +261,7 @@ impl FusedModel {
     pub fn posterior(&self) -> FusedPosterior<'_> {
         FusedPosterior {
             parts: self.fused.iter().map(|m| m.bag.posterior()).collect(),
+            tempering: self.tempering,
         }
     }
 
@@ -224,10 +302,18 @@ impl FusedModel {
                 TrainedModel::from_json(&bytes, &format!("{origin} (fused model {})", i + 1))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Self::new(models).map_err(|e| RecognizeError::Inconsistent {
+        let tempering = match value.get("tempering") {
+            None => Tempering::EQ15,
+            Some(t) => Tempering::deserialize(t).map_err(|e| RecognizeError::Inconsistent {
+                path: origin.to_string(),
+                what: format!("tempering: {e}"),
+            })?,
+        };
+        let fused = Self::new(models).map_err(|e| RecognizeError::Inconsistent {
             path: origin.to_string(),
             what: e.to_string(),
-        })
+        })?;
+        Ok(Self { tempering, ..fused })
     }
 
     /// Each reading of `dataset` described by every model's descriptor, as trials of up to
@@ -355,6 +441,23 @@ impl Recognizer {
         match self {
             Self::Single(m) => vec![m.selection.chosen_k],
             Self::Fused(f) => f.fused.iter().map(|m| m.selection.chosen_k).collect(),
+        }
+    }
+
+    /// The same model with the posterior `rule` applies: the fitted tempering (the default) or
+    /// the paper's Eq. 15 (`--posterior eq15`).
+    pub fn with_posterior(self, rule: PosteriorRule) -> Self {
+        match self {
+            Self::Single(m) => Self::Single(Box::new(m.with_posterior(rule))),
+            Self::Fused(f) => Self::Fused(f.with_posterior(rule)),
+        }
+    }
+
+    /// The tempering its posterior applies.
+    pub fn tempering(&self) -> Tempering {
+        match self {
+            Self::Single(m) => m.bag.tempering(),
+            Self::Fused(f) => f.tempering,
         }
     }
 

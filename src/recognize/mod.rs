@@ -18,6 +18,7 @@
 //! sensor configuration and persistence.
 
 pub(crate) mod bag;
+pub(crate) mod calibration;
 pub(crate) mod codebook;
 pub(crate) mod confusion;
 pub(crate) mod decision;
@@ -51,7 +52,8 @@ pub use selection::{
     codebook_sizes, supported_codebook_sizes, train,
 };
 
-// The posterior over objects, touch by touch (Eq. 15-16).
+// The posterior over objects, touch by touch (Eq. 15-16), calibrated by a fitted tempering.
+pub use calibration::{EvidencePath, PosteriorRule, Tempering};
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use posterior::{Belief, FusedPosterior, ModelPosterior, OnlinePosterior};
 

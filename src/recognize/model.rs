@@ -17,6 +17,7 @@ use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
+use crate::recognize::calibration::PosteriorRule;
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::posterior::ModelPosterior;
@@ -155,6 +156,15 @@ impl TrainedModel {
                 config: TrainConfig::clone(config),
             },
         ))
+    }
+
+    /// The same model with the posterior `rule` applies: the tempering fitted on validation
+    /// (the default) or the paper's Eq. 15 (`--posterior eq15`).
+    pub fn with_posterior(self, rule: PosteriorRule) -> Self {
+        Self {
+            bag: self.bag.with_posterior(rule),
+            ..self
+        }
     }
 
     /// A posterior over the model's objects (Eq. 15-16) that takes tactile images one at a time,

@@ -5,6 +5,7 @@
 use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
+use crate::recognize::calibration::Tempering;
 use crate::recognize::decision::Decision;
 use crate::recognize::object_model::ClusterHistogram;
 use crate::tactile::TactileImage;
@@ -71,11 +72,17 @@ impl<'a> OnlinePosterior<'a> {
         Ok(self.belief())
     }
 
-    /// The belief now.
+    /// The belief now: Eq. 16 tempered by the bag's `w(n)` (`recognize::calibration`).
     pub fn belief(&self) -> Belief {
+        let models = self.bag.models();
         Belief {
             readings: self.readings,
-            decision: self.bag.models().decide(&self.histogram),
+            decision: Decision::calibrated(
+                models.log_likelihoods(&self.histogram),
+                self.histogram.features(),
+                self.bag.tempering(),
+                self.readings,
+            ),
         }
     }
 
@@ -96,10 +103,12 @@ impl<'a> OnlinePosterior<'a> {
 }
 
 /// The fused belief after each reading of a fused model (`recognize::fusion`): the softmax of the
-/// models' summed log-likelihoods.
+/// models' summed log-likelihoods, tempered by the fused model's own `w(n)` (each part's tempering
+/// is fitted for that part alone and is not applied here).
 #[derive(Debug, Clone)]
 pub struct FusedPosterior<'a> {
     pub(crate) parts: Vec<OnlinePosterior<'a>>,
+    pub(crate) tempering: Tempering,
 }
 
 impl FusedPosterior<'_> {
@@ -129,13 +138,21 @@ impl FusedPosterior<'_> {
         self.parts.first().map_or(0, OnlinePosterior::readings)
     }
 
-    /// The fused belief now: the softmax of the summed log-likelihoods.
+    /// The fused belief now: the tempered softmax of the summed log-likelihoods.
     pub fn belief(&self) -> Belief {
+        let features = self.parts.iter().map(|p| p.histogram().features()).sum();
+        let readings = self.readings();
+        Belief {
+            readings,
+            decision: Decision::calibrated(self.log_likelihoods(), features, self.tempering, readings),
+        }
+    }
+
+    /// `ln p(U | O_j)` summed over the models (Eq. 15 for each, untempered).
+    pub fn log_likelihoods(&self) -> Vec<f64> {
         let mut log_likelihood: Vec<f64> = Vec::new();
-        let mut features = 0;
         for part in &self.parts {
-            let models = part.bag().models();
-            let l = models.log_likelihoods(part.histogram());
+            let l = part.bag().models().log_likelihoods(part.histogram());
             if log_likelihood.is_empty() {
                 log_likelihood = l;
             } else {
@@ -143,12 +160,8 @@ impl FusedPosterior<'_> {
                     *sum += x;
                 }
             }
-            features += part.histogram().features();
         }
-        Belief {
-            readings: self.readings(),
-            decision: Decision::from_log_likelihoods(log_likelihood, features),
-        }
+        log_likelihood
     }
 }
 

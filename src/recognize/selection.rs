@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use crate::dataset::{ContactStatus, Dataset};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
+use crate::recognize::calibration::{EvidencePath, Tempering};
 use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
 use crate::recognize::evaluate::{Trial, make_trials};
 use crate::recognize::features::FeatureMatrix;
@@ -327,6 +328,10 @@ pub fn train(
     let trials = reduce_trials(&reduced.pca, &trials)?;
     let fitted = fit_candidates(config, &reduced, training.objects(), &trials, progress);
     let chosen = choose_candidate(fitted)?;
+    let evidence: Vec<EvidencePath> = trials
+        .iter()
+        .map(|t| evidence_path(&chosen.codebook, &chosen.models, t))
+        .collect();
     let selection = SelectionReport {
         chosen_k: chosen.score.k,
         chosen_restart: chosen.score.restart,
@@ -338,7 +343,8 @@ pub fn train(
         pca_variance_ratio: reduced.pca.kept_variance_ratio(),
     };
     Ok(Trained {
-        bag: BagOfFeatures::new(reduced.pca, chosen.codebook, chosen.models)?,
+        bag: BagOfFeatures::new(reduced.pca, chosen.codebook, chosen.models)?
+            .with_tempering(Tempering::fit(&evidence)),
         selection,
     })
 }
@@ -654,10 +660,7 @@ fn score_candidate(
     for t in trials {
         let mut histogram = ClusterHistogram::new(codebook.clusters());
         for m in &t.features {
-            for x in m.iter_rows() {
-                codebook.membership(x, &mut membership);
-                histogram.add(&membership);
-            }
+            add_reading(codebook, m, &mut histogram, &mut membership);
         }
         let decision = models.decide(&histogram);
         if decision.guess == t.object {
@@ -673,6 +676,38 @@ fn score_candidate(
         trials: n,
         reliability: if n == 0 { 0.0 } else { reliability / n as f64 },
         failure: None,
+    }
+}
+
+/// Adds one reading's reduced features to `histogram` (`membership` is scratch space).
+fn add_reading(
+    codebook: &CodebookModel,
+    reading: &FeatureMatrix,
+    histogram: &mut ClusterHistogram,
+    membership: &mut [f64],
+) {
+    for x in reading.iter_rows() {
+        codebook.membership(x, membership);
+        histogram.add(membership);
+    }
+}
+
+/// A validation trial's Eq. 15 log-likelihoods after each of its readings: what the posterior's
+/// tempering is fitted on (`recognize::calibration`).
+fn evidence_path(codebook: &CodebookModel, models: &ObjectModels, trial: &ReducedTrial) -> EvidencePath {
+    let mut histogram = ClusterHistogram::new(codebook.clusters());
+    let mut membership = vec![0.0; codebook.clusters()];
+    let log_likelihoods = trial
+        .features
+        .iter()
+        .map(|m| {
+            add_reading(codebook, m, &mut histogram, &mut membership);
+            models.log_likelihoods(&histogram)
+        })
+        .collect();
+    EvidencePath {
+        object: trial.object,
+        log_likelihoods,
     }
 }
 
