@@ -8,8 +8,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, Tempering, TrainConfig,
-    TrainProgress, TrainedModel, VarianceFraction,
+    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, Recognizer, Tempering,
+    TrainConfig, TrainProgress, TrainedModel, VarianceFraction,
 };
 use taction::valid::Valid;
 
@@ -56,6 +56,12 @@ pub struct TrainArgs {
     /// Readings per validation trial.
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub trial_readings: usize,
+    /// Calibration dataset: the posterior's tempering is fitted on it (in trials of
+    /// `--trial-readings`) instead of on the validation readings. Give the arm's own explorations
+    /// (`collect --mode planner`) when the model will recognise them: their successive touches are
+    /// correlated, which sampler validation readings cannot show.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -90,19 +96,36 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         print_selection(&model);
         models.push(model);
     }
-    if args.descriptor.is_fused() {
+    let model = if args.descriptor.is_fused() {
         let fused = FusedModel::new(models)?.calibrated(&config, &training, validation.as_ref())?;
         print_tempering("fused", fused.tempering);
-        fused.save(&args.out)?;
-        println!(
-            "fused model ({}) written to {}",
-            args.descriptor.name(),
-            args.out.display()
-        );
-    } else if let Some(model) = models.first() {
-        model.save(&args.out)?;
-        println!("model written to {}", args.out.display());
-    }
+        Recognizer::Fused(fused)
+    } else {
+        let model = models.into_iter().next().ok_or("no descriptor to train")?;
+        Recognizer::Single(Box::new(model))
+    };
+    let model = match &args.calibration {
+        Some(path) => {
+            let data = read_dataset(path)?;
+            let model = model
+                .calibrate_on(&data, args.trial_readings)
+                .map_err(|e| format!("--calibration {}: {e}", path.display()))?;
+            print_tempering(&format!("on {}:", path.display()), model.tempering());
+            model
+        }
+        None => model,
+    };
+    model.save(&args.out)?;
+    let kind = if args.descriptor.is_fused() {
+        "fused model"
+    } else {
+        "model"
+    };
+    println!(
+        "{kind} ({}) written to {}",
+        args.descriptor.name(),
+        args.out.display()
+    );
     Ok(())
 }
 

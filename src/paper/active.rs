@@ -3,17 +3,20 @@
 //! object fixed and perturbed after every reading (Sec. V-B4), and how many touches each needs
 //! before a confidence stop would fire.
 //!
-//! The L curves recognise the same planner datasets as Figs. 8 and 10 (shared through `<out>/data`),
-//! with the same model as Fig. 8's Polar-Fourier curve. The active curves cannot come from a
+//! The model is the end-to-end recipe's (`end-to-end`, "reachable"): three times the scale's
+//! sampler readings per object from starts the arm can reach, with the run's codebook, its
+//! posterior calibrated on the arm's own explorations (a planner dataset at L = 0.5 on a stream
+//! of its own, `recognize::calibration`). The L curves recognise the same planner datasets as
+//! Figs. 8 and 10 (shared through `<out>/data`). The active curves cannot come from a
 //! dataset collected beforehand: where the arm touches next depends on the model's belief, so each
 //! unit explores with the trained model in the loop, with the random streams and sensor of the
 //! L = 0.5 datasets (common random numbers) and no stop, `test_per_object` touches per object.
 //!
 //! The confidence stop needs no second run: the planner's draws do not depend on it, so a run with
 //! the stop is the run without it cut at the first touch whose posterior's largest probability
-//! reaches [`STOP_AT_CONFIDENCE`]. Each row adds the fraction of objects stopped by then
-//! (`confident`, the cumulative distribution of touches-to-confidence) and the fraction stopped
-//! with the right guess (`correct_at_stop`).
+//! reaches the threshold. Each row adds, for each threshold of [`STOPS`], the fraction of objects
+//! stopped by then (`confident`, the cumulative distribution of touches-to-confidence) and the
+//! fraction stopped with the right guess (`correct_at_stop`).
 
 use std::sync::Arc;
 
@@ -25,7 +28,7 @@ use serde::{Deserialize, Serialize};
 use super::context::Family;
 use super::context::PaperContext;
 use super::data::Objects;
-use super::figures::default_sensor;
+use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
 use super::recognition::{Curve, RecognitionSweep, Setting, SettingData, TestData, training_config};
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
@@ -41,14 +44,18 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
-use crate::recognize::{Evaluation, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate};
+use crate::recognize::{Evaluation, PosteriorRule, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate};
 use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "active";
 pub const DESCRIPTION: &str = "Beyond the paper: active touch by expected information gain vs L = 1 and L = 0.5 (3D set, fixed and perturbed; PF), with touches to 95% confidence";
 
-/// The confidence stop the `confident` column applies.
+/// The confidence stop the `confident` and `correct_at_stop` columns apply.
 pub const STOP_AT_CONFIDENCE: f64 = 0.95;
+
+/// The stops of the rows' columns: 0.95 as `confident` and `correct_at_stop`, the others as
+/// `confident_<p>` and `correct_at_stop_<p>`.
+pub const STOPS: [f64; 3] = [0.9, STOP_AT_CONFIDENCE, 0.99];
 
 /// The descriptor: Polar-Fourier, one of the paper's top three (Sec. V-B2) and the demo's.
 const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
@@ -69,16 +76,36 @@ const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActiveRow {
     pub accuracy: AccuracyRow,
+    /// Per threshold of [`STOPS`], in order: the fraction of objects stopped by `n_readings`
+    /// readings, and of them stopped with the right guess.
+    pub stops: [StopShare; 3],
+}
+
+/// The confidence stop at one threshold after some readings (the columns of [`ActiveRow`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopShare {
     pub confident: f64,
     pub correct_at_stop: f64,
 }
 
+/// The column names of stop `i` of [`STOPS`].
+fn stop_columns(i: usize) -> (&'static str, &'static str) {
+    match i {
+        0 => ("confident_0.9", "correct_at_stop_0.9"),
+        1 => ("confident", "correct_at_stop"),
+        _ => ("confident_0.99", "correct_at_stop_0.99"),
+    }
+}
+
 impl Serialize for ActiveRow {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("ActiveRow", self.accuracy.width() + 2)?;
+        let mut row = serializer.serialize_struct("ActiveRow", self.accuracy.width() + 6)?;
         self.accuracy.serialize_columns(&mut row)?;
-        row.serialize_field("confident", &self.confident)?;
-        row.serialize_field("correct_at_stop", &self.correct_at_stop)?;
+        for (i, stop) in self.stops.iter().enumerate() {
+            let (confident, correct) = stop_columns(i);
+            row.serialize_field(confident, &stop.confident)?;
+            row.serialize_field(correct, &stop.correct_at_stop)?;
+        }
         row.end()
     }
 }
@@ -87,10 +114,16 @@ impl<'de> Deserialize<'de> for ActiveRow {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let record = TidyRecord::deserialize(deserializer)?;
         let row = || -> Result<Self, String> {
+            let stop = |i: usize| -> Result<StopShare, String> {
+                let (confident, correct) = stop_columns(i);
+                Ok(StopShare {
+                    confident: record.number(confident)?,
+                    correct_at_stop: record.number(correct)?,
+                })
+            };
             Ok(Self {
                 accuracy: AccuracyRow::from_record(&record)?,
-                confident: record.number("confident")?,
-                correct_at_stop: record.number("correct_at_stop")?,
+                stops: [stop(0)?, stop(1)?, stop(2)?],
             })
         };
         row().map_err(de::Error::custom)
@@ -143,8 +176,11 @@ pub fn sweep() -> RecognitionSweep {
         settings: vec![Setting {
             label: "active".into(),
             sensor: default_sensor(),
-            sampler: SamplerConfig::default(),
-            training_fraction: 1.0,
+            sampler: SamplerConfig {
+                reachable_by_arm: true,
+                ..SamplerConfig::default()
+            },
+            training_fraction: END_TO_END_TRAINING_FRACTION,
             curves,
         }],
     }
@@ -156,7 +192,11 @@ struct ActiveConfig<'a> {
     active_local_probability: f64,
     active_candidates: usize,
     neighbourhood_m: f64,
-    stop_at_confidence: f64,
+    stops: [f64; 3],
+    /// The posterior: `calibrated` on the arm's explorations (`calibration_trial_readings` per
+    /// trial), or the paper's `eq15`.
+    posterior: PosteriorRule,
+    calibration_trial_readings: usize,
     scale: f64,
     counts: DataCounts,
     seed: u64,
@@ -169,16 +209,16 @@ struct ActiveConfig<'a> {
 pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
     let sweep = sweep();
     let objects = context.objects(Family::Shapes)?;
-    let counts = context.scale.counts();
+    let counts = sweep.settings[0].counts(context.scale.counts());
     let training = training_config(context, counts, objects.specs.len());
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let key = SafeName::builder(DESCRIPTOR.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
-        context.store.prepare(
-            &SettingData::new(context, &objects, &sweep.settings[0], counts).requests()?,
-            dir.root(),
-        )?;
+        let data = SettingData::new(context, &objects, &sweep.settings[0], counts);
+        let mut requests = data.requests()?;
+        requests.push(data.calibration_request()?);
+        context.store.prepare(&requests, dir.root())?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -213,7 +253,9 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
             active_local_probability: ACTIVE_LOCAL_PROBABILITY,
             active_candidates: DEFAULT_CANDIDATES,
             neighbourhood_m,
-            stop_at_confidence: STOP_AT_CONFIDENCE,
+            stops: STOPS,
+            posterior: context.posterior(),
+            calibration_trial_readings: training.trial_readings,
             scale: context.scale.fraction(),
             counts,
             seed: context.seed,
@@ -255,6 +297,13 @@ impl ActiveUnit<'_> {
             descriptor.as_ref(),
             &self.training,
         )?;
+        let model = match self.context.posterior() {
+            PosteriorRule::Calibrated => {
+                let arm = self.context.store.dataset(&data.calibration_request()?)?;
+                model.calibrate_on(&arm, self.training.trial_readings)?
+            }
+            PosteriorRule::Eq15 => model,
+        };
         let (mut rows, mut per_object) = (Vec::new(), Vec::new());
         for curve in &self.sweep.settings[0].curves {
             let (curve_rows, curve_objects) = self.planner_curve(curve, &model, descriptor.as_ref())?;
@@ -391,7 +440,10 @@ fn curve_rows(
     counts: DataCounts,
     run_seed: u64,
 ) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
-    let threshold = Probability::new(STOP_AT_CONFIDENCE)?;
+    let thresholds = STOPS
+        .iter()
+        .map(|p| Probability::new(*p))
+        .collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     for (trial, (seed, object_trials)) in trials.iter().enumerate() {
         let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
@@ -401,12 +453,15 @@ fn curve_rows(
             );
         }
         let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
-        let stops = stops(
-            &evaluation,
-            object_trials.len(),
-            threshold,
-            counts.test_per_object,
-        );
+        let mut stops_at = Vec::with_capacity(STOPS.len());
+        for &threshold in &thresholds {
+            stops_at.push(stops(
+                &evaluation,
+                object_trials.len(),
+                threshold,
+                counts.test_per_object,
+            ));
+        }
         let meta = AccuracyCurve {
             experiment: sweep.name.to_string(),
             descriptor: DESCRIPTOR.name().to_string(),
@@ -418,11 +473,16 @@ fn curve_rows(
         let objects = object_trials.len().max(1) as f64;
         for accuracy in meta.rows(&evaluation.accuracy) {
             let n = accuracy.n_readings as usize;
-            let stopped: Vec<&(usize, bool)> = stops.iter().flatten().filter(|(k, _)| *k <= n).collect();
+            let share = |stops: &[Option<(usize, bool)>]| {
+                let stopped: Vec<&(usize, bool)> = stops.iter().flatten().filter(|(k, _)| *k <= n).collect();
+                StopShare {
+                    confident: stopped.len() as f64 / objects,
+                    correct_at_stop: stopped.iter().filter(|(_, right)| *right).count() as f64 / objects,
+                }
+            };
             rows.push(ActiveRow {
                 accuracy,
-                confident: stopped.len() as f64 / objects,
-                correct_at_stop: stopped.iter().filter(|(_, right)| *right).count() as f64 / objects,
+                stops: [share(&stops_at[0]), share(&stops_at[1]), share(&stops_at[2])],
             });
         }
         per_object.extend(meta.object_rows(&evaluation)?);

@@ -45,6 +45,7 @@ const VALIDATION_STREAM: u64 = 2;
 const MODEL_STREAM: u64 = 3;
 const NOISE_STREAM: u64 = 4;
 const ORDERING_STREAM: u64 = 5;
+const CALIBRATION_STREAM: u64 = 6;
 /// Test trial `t` draws from stream `TEST_STREAM + t`.
 const TEST_STREAM: u64 = 100;
 
@@ -444,6 +445,45 @@ impl<'a> SettingData<'a> {
         self.sampler_request(self.counts.validation_per_object, VALIDATION_STREAM)
     }
 
+    /// The planner exploring each object blind with the arm at L = `local_probability`, the object
+    /// perturbed within `perturbation`, `readings` per object, seeded by the run's `stream`.
+    fn planner_request(
+        &self,
+        local_probability: f64,
+        perturbation: PerturbationBounds,
+        readings: usize,
+        stream: u64,
+    ) -> Result<DataRequest, RangeError> {
+        let config = PlannerConfig {
+            local_probability,
+            ..PlannerConfig::default()
+        };
+        Ok(DataRequest::new(
+            self.objects,
+            CollectPlan {
+                mode: CollectMode::Planner(Valid::new(config.fitted_to(&self.objects.specs))?),
+                sensor: self.setting.sensor_of_run(self.context),
+                control: self.setting.control()?,
+                perturbation,
+                readings_per_object: readings,
+                seed: rng::substream(self.context.seed, stream),
+            },
+        ))
+    }
+
+    /// The arm's own explorations a model's posterior is calibrated on when it will recognise
+    /// the arm's touches (`recognize::calibration`): the planner at L = 0.5, the object fixed, as
+    /// many readings per object as the validation set, on a stream of its own (never a test
+    /// trial's).
+    pub(super) fn calibration_request(&self) -> Result<DataRequest, RangeError> {
+        self.planner_request(
+            0.5,
+            PerturbationBounds::NONE,
+            self.counts.validation_per_object,
+            CALIBRATION_STREAM,
+        )
+    }
+
     /// The datasets of curve `test`, one per trial (none for real frames).
     pub(super) fn test_requests(&self, test: TestData) -> Result<Vec<DataRequest>, RangeError> {
         let trial_stream = |t: usize| TEST_STREAM + t as u64;
@@ -457,21 +497,12 @@ impl<'a> SettingData<'a> {
                 perturbation,
             } => (0..self.counts.trials)
                 .map(|t| {
-                    let config = PlannerConfig {
+                    self.planner_request(
                         local_probability,
-                        ..PlannerConfig::default()
-                    };
-                    Ok(DataRequest::new(
-                        self.objects,
-                        CollectPlan {
-                            mode: CollectMode::Planner(Valid::new(config.fitted_to(&self.objects.specs))?),
-                            sensor: self.setting.sensor_of_run(self.context),
-                            control: self.setting.control()?,
-                            perturbation,
-                            readings_per_object: self.counts.test_per_object,
-                            seed: rng::substream(self.context.seed, trial_stream(t)),
-                        },
-                    ))
+                        perturbation,
+                        self.counts.test_per_object,
+                        trial_stream(t),
+                    )
                 })
                 .collect(),
             TestData::Real => Ok(Vec::new()),

@@ -190,6 +190,14 @@ impl FusedModel {
         Ok(self)
     }
 
+    /// The same models with the fused posterior's tempering fitted again on the converged
+    /// readings of `data` in trials of `trial_readings` ([`TrainedModel::calibrate_on`]).
+    pub fn calibrate_on(mut self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
+        let trials = self.trials(data, trial_readings)?;
+        self.tempering = Tempering::fit(&self.evidence_paths(&trials)?);
+        Ok(self)
+    }
+
     /// The validation trials every part was chosen on, fused: `validation` when given, else the
     /// readings each part held out of `training` ([`TrainConfig::holdout`]).
     fn validation_trials(
@@ -451,6 +459,14 @@ impl Recognizer {
             Self::Single(m) => Self::Single(Box::new(m.with_posterior(rule))),
             Self::Fused(f) => Self::Fused(f.with_posterior(rule)),
         }
+    }
+
+    /// The same model with its posterior calibrated on `data` ([`TrainedModel::calibrate_on`]).
+    pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
+        Ok(match self {
+            Self::Single(m) => Self::Single(Box::new(m.calibrate_on(data, trial_readings)?)),
+            Self::Fused(f) => Self::Fused(f.calibrate_on(data, trial_readings)?),
+        })
     }
 
     /// The tempering its posterior applies.

@@ -17,7 +17,7 @@ use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
-use crate::recognize::calibration::PosteriorRule;
+use crate::recognize::calibration::{PosteriorRule, Tempering};
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::posterior::ModelPosterior;
@@ -201,6 +201,23 @@ impl TrainedModel {
         let descriptor = self.build_descriptor()?;
         let features = LabelledFeatures::from_dataset(test, descriptor.as_ref());
         make_trials(&features, self.bag.objects(), readings_per_trial)
+    }
+
+    /// The same model with its posterior's tempering fitted again, on the converged readings of
+    /// `data` in trials of `trial_readings` (`recognize::calibration`): calibration data of the
+    /// kind the model will be judged on (the arm's own explorations, whose successive touches are
+    /// correlated) rather than the validation readings it was chosen on (`taction train
+    /// --calibration`).
+    pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
+        let paths = self
+            .trials(data, trial_readings)?
+            .iter()
+            .map(|t| self.bag.evidence_path(t))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            bag: self.bag.with_tempering(Tempering::fit(&paths)),
+            ..self
+        })
     }
 
     /// Builds the descriptor the model was trained with.
