@@ -510,6 +510,28 @@ mod tests {
     }
 
     #[test]
+    fn reliability_rows_write_empty_bins_as_empty_fields_and_read_back() {
+        let mut table = ReliabilityTable::default();
+        table.add(0.95, true);
+        table.add(0.55, false);
+        let rows = curve().reliability_rows(&table);
+        assert_eq!(rows.len(), 10);
+        let text = csv_of(&rows);
+        assert!(
+            text.starts_with(
+                "experiment,descriptor,noise_fraction,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n"
+            ),
+            "{text}"
+        );
+        // (1/2)|1 - 0.95| + (1/2)|0 - 0.55| = 0.3
+        assert!(text.contains("\nnoise,mnti,0.1,0,0.0,0.1,0,,,0.30000000000000004\n"), "{text}");
+        assert_eq!(read::<ReliabilityRow>(&text).unwrap(), rows);
+        let none = curve().reliability_rows(&ReliabilityTable::default());
+        assert!(none.iter().all(|r| r.ece.is_none() && r.count == 0));
+        assert_eq!(read::<ReliabilityRow>(&csv_of(&none)).unwrap(), none);
+    }
+
+    #[test]
     fn per_object_rows_average_to_the_accuracy_row() {
         let objects = ["a", "b", "c", "d", "e"].map(String::from).to_vec();
         let points = vec![point(1, 1, 0.3), point(2, 4, 0.7)];
