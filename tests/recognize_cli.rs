@@ -388,7 +388,8 @@ fn recognize_writes_the_reliability_table_and_prints_its_ece() {
     assert!(stdout.contains(&printed), "expected '{printed}' in {stdout}");
 
     let svg = std::fs::read_to_string(dir.path().join("out/reliability.svg")).unwrap();
-    for needle in ["mean confidence", "perfect calibration", "polar-fourier (ECE "] {
+    let named = format!("(ECE {ece:.3})");
+    for needle in ["mean confidence", "perfect calibration", &named] {
         assert!(svg.contains(needle), "reliability.svg lacks '{needle}'");
     }
     let png = std::fs::read(dir.path().join("out/reliability.png")).unwrap();
