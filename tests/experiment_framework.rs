@@ -81,7 +81,10 @@ fn paced_toy<'a>(
 }
 
 /// The toy experiment of `units`, made with `seed`.
-fn toy_experiment<'a, D: DetailTables>(seed: u64, units: Vec<Unit<'a, ToyRow, D>>) -> Experiment<'a, ToyRow, ToyConfig, D> {
+fn toy_experiment<'a, D: DetailTables>(
+    seed: u64,
+    units: Vec<Unit<'a, ToyRow, D>>,
+) -> Experiment<'a, ToyRow, ToyConfig, D> {
     Experiment {
         spec: toy_spec(),
         config: ToyConfig {
@@ -487,7 +490,10 @@ fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
         assert_eq!(pair[0].share + pair[1].share, row.value);
     }
     let manifest = std::fs::read_to_string(reference.path().join("toy/manifest.json")).unwrap();
-    assert!(manifest.contains("\"details\": [\n    \"per_part\"\n  ]"), "{manifest}");
+    assert!(
+        manifest.contains("\"details\": [\n    \"per_part\"\n  ]"),
+        "{manifest}"
+    );
     let index = std::fs::read_to_string(reference.path().join("README.md")).unwrap();
     assert!(
         index.contains("Data: [toy.csv](toy/toy.csv), [toy_per_part.csv](toy/toy_per_part.csv)\n"),
@@ -578,9 +584,10 @@ fn calibrated_toy<'a>(
         })
         .collect();
     let mut experiment = toy_experiment(seed, units);
-    experiment.spec.plots.push(
-        PlotSpec::reliability(SafeName::new("toy-reliability").unwrap(), "Toy calibration").unwrap(),
-    );
+    experiment
+        .spec
+        .plots
+        .push(PlotSpec::reliability(SafeName::new("toy-reliability").unwrap(), "Toy calibration").unwrap());
     experiment
 }
 
@@ -588,14 +595,21 @@ fn calibrated_toy<'a>(
 fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
     let reference = tempfile::tempdir().unwrap();
     let calls = AtomicUsize::new(0);
-    let report = run(&calibrated_toy(7, &calls, None), &options(reference.path(), 2, "1/1")).unwrap();
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(reference.path(), 2, "1/1"),
+    )
+    .unwrap();
     let table = reference.path().join("toy/toy_reliability.csv");
     let done = report.finished.clone().unwrap();
     assert_eq!(
         done.details,
         vec![reference.path().join("toy/toy_per_part.csv"), table.clone()]
     );
-    assert!(done.plots.contains(&reference.path().join("toy/toy-reliability.svg")));
+    assert!(
+        done.plots
+            .contains(&reference.path().join("toy/toy-reliability.svg"))
+    );
     let rows: Vec<ReliabilityRow> = csv::Reader::from_path(&table)
         .unwrap()
         .deserialize()
@@ -603,7 +617,11 @@ fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
         .unwrap();
     assert_eq!(rows.len(), 10 * TOY_UNITS, "ten bins per unit's curve");
     for curve in rows.chunks(10) {
-        assert_eq!(curve.iter().map(|r| r.count).sum::<u64>(), 3, "three steps per unit");
+        assert_eq!(
+            curve.iter().map(|r| r.count).sum::<u64>(),
+            3,
+            "three steps per unit"
+        );
         let ece = curve[0].ece.unwrap();
         let recomputed: f64 = curve
             .iter()
@@ -614,7 +632,9 @@ fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
     }
     let text = std::fs::read_to_string(&table).unwrap();
     assert!(
-        text.starts_with("experiment,descriptor,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n"),
+        text.starts_with(
+            "experiment,descriptor,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n"
+        ),
         "{text}"
     );
     let svg = std::fs::read_to_string(reference.path().join("toy/toy-reliability.svg")).unwrap();
@@ -623,9 +643,17 @@ fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
     // A failed run resumes to the same files, every table included.
     let resumed = tempfile::tempdir().unwrap();
     let calls = AtomicUsize::new(0);
-    run(&calibrated_toy(7, &calls, Some(4)), &options(resumed.path(), 1, "1/1")).unwrap_err();
+    run(
+        &calibrated_toy(7, &calls, Some(4)),
+        &options(resumed.path(), 1, "1/1"),
+    )
+    .unwrap_err();
     let calls = AtomicUsize::new(0);
-    let report = run(&calibrated_toy(7, &calls, None), &options(resumed.path(), 2, "1/1")).unwrap();
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(resumed.path(), 2, "1/1"),
+    )
+    .unwrap();
     assert_eq!((report.reused, report.ran), (3, TOY_UNITS - 3));
     assert_same_tree(reference.path(), resumed.path());
 
@@ -640,18 +668,37 @@ fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
     assert_ne!(old, text, "{text}");
     std::fs::write(&manifest, old).unwrap();
     std::fs::remove_dir_all(resumed.path().join("toy/units/reliability")).unwrap();
-    for file in ["toy_reliability.csv", "toy-reliability.svg", "toy-reliability.png"] {
+    for file in [
+        "toy_reliability.csv",
+        "toy-reliability.svg",
+        "toy-reliability.png",
+    ] {
         std::fs::remove_file(resumed.path().join("toy").join(file)).unwrap();
     }
     let calls = AtomicUsize::new(0);
-    let report = run(&calibrated_toy(7, &calls, None), &options(resumed.path(), 2, "1/1")).unwrap();
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(resumed.path(), 2, "1/1"),
+    )
+    .unwrap();
     assert_eq!((report.reused, report.ran), (TOY_UNITS, 0));
     let done = report.finished.clone().unwrap();
     assert_eq!(done.details, vec![resumed.path().join("toy/toy_per_part.csv")]);
-    assert_eq!(done.incomplete, vec![(SafeName::new("reliability").unwrap(), TOY_UNITS)]);
+    assert_eq!(
+        done.incomplete,
+        vec![(SafeName::new("reliability").unwrap(), TOY_UNITS)]
+    );
     assert!(!resumed.path().join("toy/toy-reliability.svg").exists());
-    assert!(report.to_string().contains("no reliability table: 10 units were saved by a build before it"));
-    assert_eq!(std::fs::read_to_string(&manifest).unwrap(), text, "the manifest is rewritten");
+    assert!(
+        report
+            .to_string()
+            .contains("no reliability table: 10 units were saved by a build before it")
+    );
+    assert_eq!(
+        std::fs::read_to_string(&manifest).unwrap(),
+        text,
+        "the manifest is rewritten"
+    );
     let index = std::fs::read_to_string(resumed.path().join("README.md")).unwrap();
     assert!(
         index.contains("`toy_reliability.csv` is not here: 10 of 10 units were saved before"),

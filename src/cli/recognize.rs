@@ -8,8 +8,8 @@ use clap::Args;
 use indicatif::ProgressBar;
 use taction::atomic::write_atomic;
 use taction::dataset::Dataset;
-use taction::experiment::{build_figure, reliability_figure};
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
+use taction::experiment::{build_figure, reliability_figure};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer};
 
 use crate::cli::dataset::read_dataset;

@@ -524,7 +524,10 @@ mod tests {
             "{text}"
         );
         // (1/2)|1 - 0.95| + (1/2)|0 - 0.55| = 0.3
-        assert!(text.contains("\nnoise,mnti,0.1,0,0.0,0.1,0,,,0.30000000000000004\n"), "{text}");
+        assert!(
+            text.contains("\nnoise,mnti,0.1,0,0.0,0.1,0,,,0.30000000000000004\n"),
+            "{text}"
+        );
         assert_eq!(read::<ReliabilityRow>(&text).unwrap(), rows);
         let none = curve().reliability_rows(&ReliabilityTable::default());
         assert!(none.iter().all(|r| r.ece.is_none() && r.count == 0));

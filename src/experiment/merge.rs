@@ -90,7 +90,12 @@ fn merge_experiment(
 
     let target = ExperimentDir::new(out, name);
     let mut folders = vec![out.to_path_buf(), target.root().to_path_buf(), target.units_dir()];
-    folders.extend(manifest.details.iter().map(|table| target.detail_units_dir(table)));
+    folders.extend(
+        manifest
+            .details
+            .iter()
+            .map(|table| target.detail_units_dir(table)),
+    );
     for folder in &folders {
         create_dir_all(folder)?;
         remove_stale_temporaries(folder)?;
@@ -100,8 +105,13 @@ fn merge_experiment(
     let mut copied = 0;
     for key in &manifest.units {
         let files = |dir: &ExperimentDir| {
-            let details = manifest.details.iter().map(|table| dir.detail_unit_csv(table, key));
-            std::iter::once(dir.unit_csv(key)).chain(details).collect::<Vec<_>>()
+            let details = manifest
+                .details
+                .iter()
+                .map(|table| dir.detail_unit_csv(table, key));
+            std::iter::once(dir.unit_csv(key))
+                .chain(details)
+                .collect::<Vec<_>>()
         };
         let sources: Vec<Vec<PathBuf>> = sources.iter().map(files).collect();
         for (i, dest) in files(&target).into_iter().enumerate() {

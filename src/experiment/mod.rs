@@ -53,7 +53,9 @@ pub use layout::ExperimentDir;
 
 // Plots: the spec of a plot, the figure it builds, its panels and series.
 pub use figure::{Figure, Panel, ReferenceLine, Series};
-pub use plot::{ACCURACY_LABEL, Axis, PERFECT_CALIBRATION, PlotKind, PlotSpec, build_figure, reliability_figure};
+pub use plot::{
+    ACCURACY_LABEL, Axis, PERFECT_CALIBRATION, PlotKind, PlotSpec, build_figure, reliability_figure,
+};
 
 // Progress of a long collection, on the terminal.
 pub use progress::CollectionProgress;

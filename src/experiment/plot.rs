@@ -8,13 +8,13 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::accuracy::{AccuracyRow, ReliabilityRow};
-use super::unit::DetailRow;
-use crate::recognize::ReliabilityTable;
 use super::error::ExperimentError;
 use super::factor::Factors;
 use super::figure::{Figure, Panel, ReferenceLine, Series};
 use super::layout::ExperimentDir;
 use super::name::SafeName;
+use super::unit::DetailRow;
+use crate::recognize::ReliabilityTable;
 
 /// One axis of a line plot: the CSV column it reads and its label (with units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -144,7 +144,10 @@ pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentErr
     let panels = match &spec.kind {
         PlotKind::Accuracy => accuracy_panels(csv, spec.objects, spec.legend.as_deref())?,
         PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series, spec.legend.as_deref())?,
-        PlotKind::Reliability => vec![reliability_panel(read_reliability_series(csv, spec.legend.as_deref())?)],
+        PlotKind::Reliability => vec![reliability_panel(read_reliability_series(
+            csv,
+            spec.legend.as_deref(),
+        )?)],
     };
     Ok(Figure {
         title: spec.title.clone(),
@@ -426,7 +429,11 @@ fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Serie
     if curves.items.is_empty() {
         return Err(csv_error(csv, "no rows to plot"));
     }
-    let descriptors = curves.items.iter().map(|((d, _), _)| d).collect::<std::collections::BTreeSet<_>>();
+    let descriptors = curves
+        .items
+        .iter()
+        .map(|((d, _), _)| d)
+        .collect::<std::collections::BTreeSet<_>>();
     curves
         .items
         .iter()
@@ -438,7 +445,11 @@ fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Serie
             };
             let mut points = points.clone();
             points.sort_by_key(|(bin, _, _)| *bin);
-            Ok(calibration_series(&name, *ece, points.iter().map(|&(_, c, a)| (c, a)).collect()))
+            Ok(calibration_series(
+                &name,
+                *ece,
+                points.iter().map(|&(_, c, a)| (c, a)).collect(),
+            ))
         })
         .collect()
 }

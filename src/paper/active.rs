@@ -43,7 +43,9 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
-use crate::recognize::{Evaluation, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate};
+use crate::recognize::{
+    Evaluation, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
+};
 use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "active";

@@ -233,8 +233,11 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                PlotSpec::accuracy(name.clone(), &format!("Trained and tested on {}", real.frames_words()))
-                    .with_chance(plan.labels.len()),
+                PlotSpec::accuracy(
+                    name.clone(),
+                    &format!("Trained and tested on {}", real.frames_words()),
+                )
+                .with_chance(plan.labels.len()),
                 PlotSpec::reliability(
                     SafeName::new(&format!("{name}-reliability"))?,
                     &format!("Calibration: trained and tested on {}", real.frames_words()),

@@ -31,8 +31,8 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
-    CodebookKind, LabelledFeatures, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
-    make_trials,
+    CodebookKind, LabelledFeatures, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial,
+    evaluate, make_trials,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -213,7 +213,11 @@ impl RecognitionSweep {
                 name: name.clone(),
                 description: self.description.to_string(),
                 plots: vec![
-                    self.plot(name.clone(), &self.plot_title(real.as_deref()), objects.specs.len()),
+                    self.plot(
+                        name.clone(),
+                        &self.plot_title(real.as_deref()),
+                        objects.specs.len(),
+                    ),
                     self.reliability_plot(&name, &self.plot_title(real.as_deref()))?,
                 ],
             },

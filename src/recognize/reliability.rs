@@ -120,7 +120,9 @@ impl ReliabilityTable {
         (n > 0).then(|| {
             self.bins
                 .iter()
-                .filter_map(|b| Some(b.count as f64 / n as f64 * (b.accuracy()? - b.mean_confidence()?).abs()))
+                .filter_map(|b| {
+                    Some(b.count as f64 / n as f64 * (b.accuracy()? - b.mean_confidence()?).abs())
+                })
                 .sum()
         })
     }
@@ -217,7 +219,14 @@ mod tests {
     fn merging_equals_pooling() {
         // Dyadic confidences: sums are exact in any order.
         let rows: Vec<TouchRow> = (0..40)
-            .map(|i| row(i / 4, i % 4 + 1, [0.25, 0.5, 0.625, 0.875, 1.0][i % 5], i % 3 != 0))
+            .map(|i| {
+                row(
+                    i / 4,
+                    i % 4 + 1,
+                    [0.25, 0.5, 0.625, 0.875, 1.0][i % 5],
+                    i % 3 != 0,
+                )
+            })
             .collect();
         let mut merged = ReliabilityTable::of(&rows[..17]);
         merged.merge(&ReliabilityTable::of(&rows[17..]));
