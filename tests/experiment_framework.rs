@@ -610,6 +610,16 @@ fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
         done.plots
             .contains(&reference.path().join("toy/toy-reliability.svg"))
     );
+    assert_eq!(
+        done.calibration.len(),
+        TOY_UNITS,
+        "one curve per unit, each with its ECE"
+    );
+    let said = report.to_string();
+    assert!(
+        said.contains("\ncalibration (10 bins): toy__noise=0__trial=0 (ECE "),
+        "{said}"
+    );
     let rows: Vec<ReliabilityRow> = csv::Reader::from_path(&table)
         .unwrap()
         .deserialize()

@@ -8,7 +8,7 @@ use super::files::read;
 use super::layout::ExperimentDir;
 use super::name::SafeName;
 use super::name::UnitKey;
-use super::plot::{PlotSpec, render_plot};
+use super::plot::{PERFECT_CALIBRATION, PlotKind, PlotSpec, render_plot};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
 
@@ -91,6 +91,8 @@ pub struct Finished {
     /// The detail tables not assembled, each with the number of units that lack its file (saved by
     /// a build before the table existed).
     pub incomplete: Vec<(SafeName, usize)>,
+    /// Each curve of the reliability diagrams, named with its ECE (`pf (ECE 0.042)`).
+    pub calibration: Vec<String>,
     pub config: PathBuf,
     pub plots: Vec<PathBuf>,
 }
@@ -129,17 +131,25 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
         write_if_changed(&path, &concatenate(&units)?)?;
         details.push(path);
     }
-    let mut plots = Vec::new();
+    let (mut plots, mut calibration) = (Vec::new(), Vec::new());
     for spec in &manifest.spec.plots {
         let source = plot_source(dir, spec);
         if source == csv || details.contains(&source) {
-            plots.extend(render_plot(spec, &source, dir)?);
+            let (figure, paths) = render_plot(spec, &source, dir)?;
+            plots.extend(paths);
+            if spec.kind == PlotKind::Reliability {
+                calibration.extend(figure.panels.iter().flat_map(|panel| {
+                    let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
+                    curves.map(|s| s.label.clone())
+                }));
+            }
         }
     }
     Ok(Finished {
         csv,
         details,
         incomplete,
+        calibration,
         config: dir.config(),
         plots,
     })

@@ -102,6 +102,17 @@ fn merge_experiment(
     }
     write_manifest(&target.manifest(), &manifest, &manifest_bytes, target.root())?;
     write_or_check(&target.config(), &config_bytes, target.root(), "configuration")?;
+    let copied = copy_units(&manifest, sources, &target)?;
+    Ok((finish(&target, &manifest)?, copied))
+}
+
+/// Copies every unit's files (its rows and each detail table's) found among `sources` into
+/// `target`; how many it wrote.
+fn copy_units(
+    manifest: &Manifest,
+    sources: &[ExperimentDir],
+    target: &ExperimentDir,
+) -> Result<usize, ExperimentError> {
     let mut copied = 0;
     for key in &manifest.units {
         let files = |dir: &ExperimentDir| {
@@ -114,12 +125,12 @@ fn merge_experiment(
                 .collect::<Vec<_>>()
         };
         let sources: Vec<Vec<PathBuf>> = sources.iter().map(files).collect();
-        for (i, dest) in files(&target).into_iter().enumerate() {
+        for (i, dest) in files(target).into_iter().enumerate() {
             let paths: Vec<&PathBuf> = sources.iter().map(|s| &s[i]).collect();
             copied += usize::from(copy_unit_file(key, &paths, &dest)?);
         }
     }
-    Ok((finish(&target, &manifest)?, copied))
+    Ok(copied)
 }
 
 /// Copies the unit file of `key` found among `sources` (which must agree where several have it) to

@@ -125,18 +125,18 @@ impl PlotSpec {
     }
 }
 
-/// Draws `spec` from the assembled `csv` into `dir`; returns the SVG and PNG paths.
+/// Draws `spec` from the assembled `csv` into `dir`; returns the figure and the SVG and PNG paths.
 pub fn render_plot(
     spec: &PlotSpec,
     csv: &Path,
     dir: &ExperimentDir,
-) -> Result<Vec<PathBuf>, ExperimentError> {
+) -> Result<(Figure, Vec<PathBuf>), ExperimentError> {
     let figure = build_figure(spec, csv)?;
     let svg = dir.plot(&spec.stem, "svg");
     let png = dir.plot(&spec.stem, "png");
     figure.write_svg(&svg)?;
     figure.write_png(&png)?;
-    Ok(vec![svg, png])
+    Ok((figure, vec![svg, png]))
 }
 
 /// The figure `spec` describes, from the rows of `csv`.
@@ -406,12 +406,16 @@ fn calibration_series(name: &str, ece: Option<f64>, points: Vec<(f64, f64)>) -> 
     }
 }
 
+/// Per curve (descriptor, factor levels): its ECE and its non-empty bins as (bin, mean confidence,
+/// accuracy).
+type CalibrationCurves = Ordered<(String, Factors), (Option<f64>, Vec<(u32, f64, f64)>)>;
+
 /// The reliability rows of `csv`, one series per curve (descriptor, factor levels) in order of
 /// first appearance, named as accuracy plots name their lines; a curve's bin seen twice (a curve
 /// split over units) is an error.
 fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Series>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
-    let mut curves: Ordered<(String, Factors), (Option<f64>, Vec<(u32, f64, f64)>)> = Ordered::new();
+    let mut curves: CalibrationCurves = Ordered::new();
     for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
         let row = row.map_err(|e| csv_error(csv, e))?;
         let (ece, points) = curves.entry((row.descriptor, row.factors));

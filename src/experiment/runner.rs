@@ -103,6 +103,9 @@ impl fmt::Display for RunReport {
                 for plot in done.details.iter().chain(&done.plots) {
                     write!(f, ", {}", plot.display())?;
                 }
+                if !done.calibration.is_empty() {
+                    write!(f, "\ncalibration (10 bins): {}", done.calibration.join("; "))?;
+                }
                 for (table, missing) in &done.incomplete {
                     write!(
                         f,

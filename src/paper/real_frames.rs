@@ -239,7 +239,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
                 )
                 .with_chance(plan.labels.len()),
                 PlotSpec::reliability(
-                    SafeName::new(&format!("{name}-reliability"))?,
+                    SafeName::new(format!("{name}-reliability"))?,
                     &format!("Calibration: trained and tested on {}", real.frames_words()),
                 )?,
             ],

@@ -264,7 +264,7 @@ impl RecognitionSweep {
     /// The reliability diagram of the sweep's curves, `<name>-reliability`, titled `title`.
     pub(super) fn reliability_plot(&self, name: &SafeName, title: &str) -> Result<PlotSpec, BoxError> {
         let plot = PlotSpec::reliability(
-            SafeName::new(&format!("{name}-reliability"))?,
+            SafeName::new(format!("{name}-reliability"))?,
             &format!("Calibration: {title}"),
         )?;
         Ok(match self.legend {
