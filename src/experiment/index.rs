@@ -26,7 +26,8 @@ const MAX_LINE_COLUMNS: usize = 8;
 pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
     let mut text = String::from(
         "# Results\n\nOne directory per experiment: `<name>.csv` (tidy, one row per observation; beside a \
-         recognition experiment's, `<name>_per_object.csv` with one row per test object), its plots \
+         recognition experiment's, `<name>_per_object.csv` with one row per test object and \
+         `<name>_reliability.csv`, each curve's calibration in 10 bins of top probability with its ECE), its plots \
          (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
          per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
     );
