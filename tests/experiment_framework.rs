@@ -14,12 +14,12 @@ use taction::dataset::parse_real_csv;
 use taction::dataset::{Normalisation, RealImport, import_real_csv};
 use taction::experiment::build_figure;
 use taction::experiment::{
-    AccuracyCurve, AccuracyRow, Axis, DetailRow, Experiment, ExperimentError, ExperimentSpec, Factor,
-    Factors, PlotSpec, RunOptions, SafeName, Shard, Unit, merge, run,
+    AccuracyCurve, AccuracyRow, Axis, DetailRow, DetailTables, Experiment, ExperimentError, ExperimentSpec,
+    Factor, Factors, PlotSpec, ReliabilityRow, RunOptions, SafeName, Shard, Unit, merge, run,
 };
 use taction::paper::square_root;
 use taction::paper::{GaussianBlur, SimToRealPreprocess, SplitSizes, split_per_label};
-use taction::recognize::{AccuracyPoint, TrialOutcome};
+use taction::recognize::{AccuracyPoint, ReliabilityTable, TrialOutcome};
 use taction::tactile::TactileImage;
 
 // ---------------------------------------------------------------------------------------------
@@ -81,7 +81,10 @@ fn paced_toy<'a>(
 }
 
 /// The toy experiment of `units`, made with `seed`.
-fn toy_experiment<'a, D>(seed: u64, units: Vec<Unit<'a, ToyRow, D>>) -> Experiment<'a, ToyRow, ToyConfig, D> {
+fn toy_experiment<'a, D: DetailTables>(
+    seed: u64,
+    units: Vec<Unit<'a, ToyRow, D>>,
+) -> Experiment<'a, ToyRow, ToyConfig, D> {
     Experiment {
         spec: toy_spec(),
         config: ToyConfig {
@@ -474,7 +477,7 @@ fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
     )
     .unwrap();
     let detail = reference.path().join("toy/toy_per_part.csv");
-    assert_eq!(report.finished.unwrap().detail, Some(detail.clone()));
+    assert_eq!(report.finished.unwrap().details, vec![detail.clone()]);
     let parts: Vec<ToyPart> = csv::Reader::from_path(&detail)
         .unwrap()
         .deserialize()
@@ -487,7 +490,10 @@ fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
         assert_eq!(pair[0].share + pair[1].share, row.value);
     }
     let manifest = std::fs::read_to_string(reference.path().join("toy/manifest.json")).unwrap();
-    assert!(manifest.contains("\"detail\": \"per_part\""), "{manifest}");
+    assert!(
+        manifest.contains("\"details\": [\n    \"per_part\"\n  ]"),
+        "{manifest}"
+    );
     let index = std::fs::read_to_string(reference.path().join("README.md")).unwrap();
     assert!(
         index.contains("Data: [toy.csv](toy/toy.csv), [toy_per_part.csv](toy/toy_per_part.csv)\n"),
@@ -526,7 +532,7 @@ fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
     let calls = AtomicUsize::new(0);
     let report = run(&detailed_toy(7, &calls, None), &options(resumed.path(), 2, "1/1")).unwrap();
     assert_eq!((report.reused, report.ran), (TOY_UNITS, 0));
-    assert_eq!(report.finished.unwrap().detail, None);
+    assert_eq!(report.finished.unwrap().details, Vec::<PathBuf>::new());
     assert!(!resumed.path().join("toy/toy_per_part.csv").exists());
     assert_eq!(
         std::fs::read(resumed.path().join("toy/toy.csv")).unwrap(),
@@ -537,6 +543,178 @@ fn detail_rows_survive_resume_and_merge_and_old_units_without_them_are_kept() {
         index.contains("`toy_per_part.csv` is not here: 10 of 10 units were saved before"),
         "{index}"
     );
+}
+
+/// [`detailed_toy`] with a third table, the reliability rows of the recognition experiments: each
+/// unit a curve whose predictions are its steps (confidence (value + 1) / 2, right when value > 0),
+/// and the reliability diagram beside the toy plot.
+fn calibrated_toy<'a>(
+    seed: u64,
+    calls: &'a AtomicUsize,
+    fail_on_call: Option<usize>,
+) -> Experiment<'a, ToyRow, ToyConfig, (ToyPart, ReliabilityRow)> {
+    let units = (0..TOY_UNITS)
+        .map(|i| {
+            let work = toy_work(seed, i, calls, fail_on_call, Duration::ZERO);
+            Unit::with_detail(toy_key(i), move || {
+                let rows = work()?;
+                let parts = rows
+                    .iter()
+                    .map(|r| ToyPart {
+                        unit: r.unit.clone(),
+                        step: r.step,
+                        part: 0,
+                        share: r.value,
+                    })
+                    .collect();
+                let mut table = ReliabilityTable::default();
+                for r in &rows {
+                    table.add((r.value + 1.0) / 2.0, r.value > 0.0);
+                }
+                let curve = AccuracyCurve {
+                    experiment: "toy".into(),
+                    descriptor: toy_key(i).to_string(),
+                    factors: Factors::none(),
+                    trial: 0,
+                    seed,
+                    stream_seed: 0,
+                };
+                Ok((rows, (parts, curve.reliability_rows(&table))))
+            })
+        })
+        .collect();
+    let mut experiment = toy_experiment(seed, units);
+    experiment
+        .spec
+        .plots
+        .push(PlotSpec::reliability(SafeName::new("toy-reliability").unwrap(), "Toy calibration").unwrap());
+    experiment
+}
+
+#[test]
+fn reliability_tables_survive_resume_and_units_saved_without_them_are_kept() {
+    let reference = tempfile::tempdir().unwrap();
+    let calls = AtomicUsize::new(0);
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(reference.path(), 2, "1/1"),
+    )
+    .unwrap();
+    let table = reference.path().join("toy/toy_reliability.csv");
+    let done = report.finished.clone().unwrap();
+    assert_eq!(
+        done.details,
+        vec![reference.path().join("toy/toy_per_part.csv"), table.clone()]
+    );
+    assert!(
+        done.plots
+            .contains(&reference.path().join("toy/toy-reliability.svg"))
+    );
+    assert_eq!(
+        done.calibration.len(),
+        TOY_UNITS,
+        "one curve per unit, each with its ECE"
+    );
+    let said = report.to_string();
+    assert!(
+        said.contains("\ncalibration (10 bins): toy__noise=0__trial=0 (ECE "),
+        "{said}"
+    );
+    let rows: Vec<ReliabilityRow> = csv::Reader::from_path(&table)
+        .unwrap()
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .unwrap();
+    assert_eq!(rows.len(), 10 * TOY_UNITS, "ten bins per unit's curve");
+    for curve in rows.chunks(10) {
+        assert_eq!(
+            curve.iter().map(|r| r.count).sum::<u64>(),
+            3,
+            "three steps per unit"
+        );
+        let ece = curve[0].ece.unwrap();
+        let recomputed: f64 = curve
+            .iter()
+            .filter_map(|r| Some(r.count as f64 / 3.0 * (r.accuracy? - r.mean_confidence?).abs()))
+            .sum();
+        assert!((ece - recomputed).abs() < 1e-12);
+        assert!(curve.iter().all(|r| r.ece == Some(ece)));
+    }
+    let text = std::fs::read_to_string(&table).unwrap();
+    assert!(
+        text.starts_with(
+            "experiment,descriptor,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n"
+        ),
+        "{text}"
+    );
+    let svg = std::fs::read_to_string(reference.path().join("toy/toy-reliability.svg")).unwrap();
+    assert!(svg.contains("perfect calibration") && svg.contains("(ECE "));
+
+    // A failed run resumes to the same files, every table included.
+    let resumed = tempfile::tempdir().unwrap();
+    let calls = AtomicUsize::new(0);
+    run(
+        &calibrated_toy(7, &calls, Some(4)),
+        &options(resumed.path(), 1, "1/1"),
+    )
+    .unwrap_err();
+    let calls = AtomicUsize::new(0);
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(resumed.path(), 2, "1/1"),
+    )
+    .unwrap();
+    assert_eq!((report.reused, report.ran), (3, TOY_UNITS - 3));
+    assert_same_tree(reference.path(), resumed.path());
+
+    // Units saved by a build that had only the per-part table, under its manifest: reused, not
+    // rerun; the reliability table and its plot are left out and the report and index say why.
+    let manifest = resumed.path().join("toy/manifest.json");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let old = text.replace(
+        "\"details\": [\n    \"per_part\",\n    \"reliability\"\n  ]",
+        "\"detail\": \"per_part\"",
+    );
+    assert_ne!(old, text, "{text}");
+    std::fs::write(&manifest, old).unwrap();
+    std::fs::remove_dir_all(resumed.path().join("toy/units/reliability")).unwrap();
+    for file in [
+        "toy_reliability.csv",
+        "toy-reliability.svg",
+        "toy-reliability.png",
+    ] {
+        std::fs::remove_file(resumed.path().join("toy").join(file)).unwrap();
+    }
+    let calls = AtomicUsize::new(0);
+    let report = run(
+        &calibrated_toy(7, &calls, None),
+        &options(resumed.path(), 2, "1/1"),
+    )
+    .unwrap();
+    assert_eq!((report.reused, report.ran), (TOY_UNITS, 0));
+    let done = report.finished.clone().unwrap();
+    assert_eq!(done.details, vec![resumed.path().join("toy/toy_per_part.csv")]);
+    assert_eq!(
+        done.incomplete,
+        vec![(SafeName::new("reliability").unwrap(), TOY_UNITS)]
+    );
+    assert!(!resumed.path().join("toy/toy-reliability.svg").exists());
+    assert!(
+        report
+            .to_string()
+            .contains("no reliability table: 10 units were saved by a build before it")
+    );
+    assert_eq!(
+        std::fs::read_to_string(&manifest).unwrap(),
+        text,
+        "the manifest is rewritten"
+    );
+    let index = std::fs::read_to_string(resumed.path().join("README.md")).unwrap();
+    assert!(
+        index.contains("`toy_reliability.csv` is not here: 10 of 10 units were saved before"),
+        "{index}"
+    );
+    assert!(!index.contains("toy-reliability.svg"), "{index}");
 }
 
 #[test]

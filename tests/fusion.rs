@@ -221,6 +221,13 @@ fn train_and_recognise_a_fused_descriptor_from_the_cli() {
     assert!(ok, "{out}");
     assert!(out.contains("mnti+mn"), "{out}");
     assert!(dir.path().join("results/accuracy.csv").exists());
+    // A fused model's beliefs are measured for calibration like any model's.
+    assert!(
+        out.contains("ECE (10 bins): ") && out.contains("over 30 predictions"),
+        "{out}"
+    );
+    assert!(dir.path().join("results/reliability.csv").exists());
+    assert!(dir.path().join("results/reliability.svg").exists());
     let (ok, out) = run(&[
         "train",
         "--dataset",

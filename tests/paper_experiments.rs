@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use taction::experiment::{AccuracyRow, Factor, PerObjectRow};
+use taction::experiment::{AccuracyRow, Factor, PerObjectRow, ReliabilityRow};
 use taction::mesh::Font;
 use taction::mesh::LetterStyle;
 use taction::mesh::ObjectSet;
@@ -132,18 +132,73 @@ fn assert_per_object_rows_average_to(name: &str, out: &Path, rows: &[AccuracyRow
     );
 }
 
+/// Checks the reliability table beside `name`'s accuracy table: one curve per (descriptor, levels)
+/// of the accuracy rows, pooled over its trials, ten bins each with the curve's ECE, at most one
+/// belief per per-object row (an object whose trial ended early keeps its last belief there), and
+/// its diagram.
+fn assert_reliability_pools_every_curve(name: &str, out: &Path, rows: &[AccuracyRow]) {
+    let csv = out.join(name).join(format!("{name}_reliability.csv"));
+    let table: Vec<ReliabilityRow> = csv::Reader::from_path(&csv)
+        .unwrap_or_else(|e| panic!("{}: {e}", csv.display()))
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    let curves: BTreeSet<(String, String)> = rows
+        .iter()
+        .map(|r| (r.descriptor.clone(), r.factors.to_string()))
+        .collect();
+    assert_eq!(table.len(), 10 * curves.len(), "{name}: ten bins per curve");
+    let per_object: Vec<PerObjectRow> =
+        csv::Reader::from_path(out.join(name).join(format!("{name}_per_object.csv")))
+            .unwrap()
+            .deserialize()
+            .collect::<Result<_, _>>()
+            .unwrap();
+    for (descriptor, levels) in &curves {
+        let bins: Vec<&ReliabilityRow> = table
+            .iter()
+            .filter(|r| (&r.descriptor, &r.factors.to_string()) == (descriptor, levels))
+            .collect();
+        assert_eq!(bins.len(), 10, "{name} {descriptor} {levels}");
+        let predictions: u64 = bins.iter().map(|r| r.count).sum();
+        let beliefs = per_object
+            .iter()
+            .filter(|r| (&r.descriptor, &r.factors.to_string()) == (descriptor, levels))
+            .count() as u64;
+        assert!(
+            predictions >= 1 && predictions <= beliefs,
+            "{name} {descriptor} {levels}: {predictions} of {beliefs}"
+        );
+        let ece = bins[0].ece.expect("a curve with predictions has an ECE");
+        assert!((0.0..=1.0).contains(&ece) && bins.iter().all(|r| r.ece == Some(ece)));
+    }
+    let stem = out.join(name).join(format!("{name}-reliability"));
+    let svg = valid_svg_and_png(&stem);
+    assert!(
+        svg.contains("mean confidence") && svg.contains("perfect calibration") && svg.contains("(ECE "),
+        "{}",
+        stem.display()
+    );
+}
+
 fn assert_svg_and_png(stem: &Path) {
-    let svg = std::fs::read_to_string(stem.with_extension("svg")).expect("SVG written");
-    let tree = resvg::usvg::Tree::from_str(&svg, &resvg::usvg::Options::default());
-    assert!(tree.is_ok(), "{}: not a valid SVG", stem.display());
+    let svg = valid_svg_and_png(stem);
     assert!(
         svg.contains("number of readings")
             && svg.contains("accuracy (fraction correct)")
             && svg.contains("chance (1/")
     );
+}
+
+/// The text of `stem`.svg, once it and `stem`.png are valid.
+fn valid_svg_and_png(stem: &Path) -> String {
+    let svg = std::fs::read_to_string(stem.with_extension("svg")).expect("SVG written");
+    let tree = resvg::usvg::Tree::from_str(&svg, &resvg::usvg::Options::default());
+    assert!(tree.is_ok(), "{}: not a valid SVG", stem.display());
     let png = std::fs::read(stem.with_extension("png")).expect("PNG written");
     let decoded = png::Decoder::new(std::io::Cursor::new(png)).read_info();
     assert!(decoded.is_ok(), "{}: not a valid PNG", stem.display());
+    svg
 }
 
 #[test]
@@ -220,6 +275,7 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
             );
         }
         assert_per_object_rows_average_to(name, &out, &rows);
+        assert_reliability_pools_every_curve(name, &out, &rows);
         assert_svg_and_png(&root.join(name));
         let config = std::fs::read_to_string(root.join("config.json")).expect("config.json written");
         assert!(

@@ -8,7 +8,7 @@ use std::process::{Command, Output};
 
 use taction::dataset::{Calibration, RealImport, parse_real_csv};
 use taction::dataset::{ContactStatus, Dataset, Strategy};
-use taction::experiment::{AccuracyRow, PerObjectRow};
+use taction::experiment::{AccuracyRow, PerObjectRow, ReliabilityRow};
 use taction::paper::EXAMPLE_REAL_CSV;
 use taction::paper::{prune, scaled_split_sizes, trial_split};
 
@@ -40,6 +40,7 @@ fn two_trials_of(text: &str) -> (Vec<AccuracyRow>, Vec<PerObjectRow>) {
         "--out",
         out.to_str().unwrap(),
     ]);
+    assert_reliability_per_descriptor(&out);
     (
         rows(&out),
         read_csv(
@@ -47,6 +48,28 @@ fn two_trials_of(text: &str) -> (Vec<AccuracyRow>, Vec<PerObjectRow>) {
             PER_OBJECT_HEADER,
         ),
     )
+}
+
+/// The run's reliability table: one curve per descriptor, its ten bins pooling both trials'
+/// beliefs, with the curve's ECE on each row; and its diagram.
+fn assert_reliability_per_descriptor(out: &Path) {
+    let table: Vec<ReliabilityRow> =
+        csv::Reader::from_path(out.join("real-frames/real-frames_reliability.csv"))
+            .unwrap()
+            .deserialize()
+            .collect::<Result<_, _>>()
+            .unwrap();
+    assert_eq!(table.len(), 10 * 6, "ten bins for each of the six descriptors");
+    for curve in table.chunks(10) {
+        assert!(
+            curve
+                .iter()
+                .all(|r| r.descriptor == curve[0].descriptor && r.ece == curve[0].ece)
+        );
+        assert!(curve.iter().map(|r| r.count).sum::<u64>() > 0);
+        assert!(curve[0].ece.is_some_and(|e| (0.0..=1.0).contains(&e)));
+    }
+    assert!(out.join("real-frames/real-frames-reliability.svg").is_file());
 }
 
 fn run_ok(args: &[&str]) {

@@ -344,3 +344,54 @@ fn recognize_plots_accuracy_with_its_band_and_chance_beside_the_csvs() {
         assert!((mean - pooled).abs() < 1e-12, "{n}: {mean} vs {pooled}");
     }
 }
+
+/// `recognize` measures calibration: reliability.csv bins every row of posterior.csv (10 bins of
+/// top probability, empty bins with empty fields), its diagram is drawn beside it, and the ECE it
+/// prints is the one the CSV gives, `sum_b (count_b / N) |accuracy_b - mean_confidence_b|`.
+#[test]
+fn recognize_writes_the_reliability_table_and_prints_its_ece() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    toy_model(dir.path());
+    recognize_toy::dataset(20, 3)
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), "1..10", &p("out"));
+    assert!(ok, "{stderr}");
+    let posterior = std::fs::read_to_string(dir.path().join("out/posterior.csv")).unwrap();
+    let predictions = posterior.lines().count() - 1;
+    assert_eq!(predictions, 3 * 2 * 10);
+
+    let table = std::fs::read_to_string(dir.path().join("out/reliability.csv")).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next(),
+        Some("bin,confidence_low,confidence_high,count,mean_confidence,accuracy")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 10);
+    let count = |r: &Vec<&str>| r[3].parse::<usize>().unwrap();
+    assert_eq!(rows.iter().map(count).sum::<usize>(), predictions);
+    let mut ece = 0.0;
+    for (b, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], b.to_string());
+        if count(row) == 0 {
+            assert_eq!((row[4], row[5]), ("", ""), "an empty bin has no mean or accuracy");
+            continue;
+        }
+        let (confidence, accuracy): (f64, f64) = (row[4].parse().unwrap(), row[5].parse().unwrap());
+        let low: f64 = row[1].parse().unwrap();
+        assert!(confidence >= low && confidence <= low + 0.1 + 1e-12, "{row:?}");
+        ece += count(row) as f64 / predictions as f64 * (accuracy - confidence).abs();
+    }
+    let printed = format!("ECE (10 bins): {ece:.3} over {predictions} predictions");
+    assert!(stdout.contains(&printed), "expected '{printed}' in {stdout}");
+
+    let svg = std::fs::read_to_string(dir.path().join("out/reliability.svg")).unwrap();
+    let named = format!("(ECE {ece:.3})");
+    for needle in ["mean confidence", "perfect calibration", &named] {
+        assert!(svg.contains(needle), "reliability.svg lacks '{needle}'");
+    }
+    let png = std::fs::read(dir.path().join("out/reliability.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+}

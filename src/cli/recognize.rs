@@ -1,6 +1,6 @@
 //! `taction recognize`: run a saved model over a test dataset touch by touch and write the
-//! per-touch posterior, accuracy against the number of readings (CSV and plot), and the confusion
-//! matrix.
+//! per-touch posterior, accuracy against the number of readings (CSV and plot), the confusion
+//! matrix, and calibration: the reliability table of every belief (CSV and diagram) and its ECE.
 
 use std::path::{Path, PathBuf};
 
@@ -8,9 +8,9 @@ use clap::Args;
 use indicatif::ProgressBar;
 use taction::atomic::write_atomic;
 use taction::dataset::Dataset;
-use taction::experiment::build_figure;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
-use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer};
+use taction::experiment::{build_figure, reliability_figure};
+use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer, Tempering};
 
 use crate::cli::common::PosteriorArg;
 use crate::cli::dataset::read_dataset;
@@ -28,9 +28,11 @@ pub struct RecognizeArgs {
     #[arg(long, default_value = "1..100", value_name = "A..B")]
     pub readings: ReadingRange,
     /// Directory for posterior.csv (p(true) per touch), posterior_long.csv (the whole posterior per
-    /// touch, one row per object), accuracy.csv, confusion.csv, and the plot of accuracy against
-    /// readings: accuracy.svg and accuracy.png, from accuracy_trials.csv (the k-th trial of every
-    /// object as trial k, the band from the lowest to the highest).
+    /// touch, one row per object), accuracy.csv, confusion.csv, reliability.csv (the beliefs of
+    /// posterior.csv in 10 bins of top probability: count, mean confidence, accuracy) with its
+    /// diagram reliability.svg and reliability.png, and the plot of accuracy against readings:
+    /// accuracy.svg and accuracy.png, from accuracy_trials.csv (the k-th trial of every object as
+    /// trial k, the band from the lowest to the highest).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]
@@ -65,15 +67,41 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
         &plot_title(args),
         model.objects().len(),
     )?);
+    paths.extend(write_reliability_plot(
+        &args.out,
+        &evaluation,
+        &model.choice().name(),
+        &plot_title(args),
+    )?);
+    print_summary(&model, &evaluation, trials, used);
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    Ok(())
+}
+
+/// The run in a few lines: trials and model, accuracy at the headline reading counts, calibration.
+/// The posterior a recognition used: the paper's Eq. 15 or a fitted tempering.
+fn posterior_words(t: Tempering) -> String {
+    if t == Tempering::EQ15 {
+        "Eq. 15".to_string()
+    } else {
+        format!(
+            "calibrated: tau = {:.3}, beta = {:.2}, floor = {:.3}",
+            t.tau(),
+            t.beta(),
+            t.floor()
+        )
+    }
+}
+
+fn print_summary(model: &Recognizer, evaluation: &Evaluation, trials: usize, used: usize) {
     let ks: Vec<String> = model.chosen_ks().iter().map(usize::to_string).collect();
     println!(
-        "{trials} trials of up to {used} readings over {} objects (model k = {}, {}; posterior {}: tau = {:.3}, beta = {:.2})",
+        "{trials} trials of up to {used} readings over {} objects (model k = {}, {}; posterior {})",
         model.objects().len(),
         ks.join("+"),
         model.choice().name(),
-        args.posterior.rule.name(),
-        model.tempering().tau(),
-        model.tempering().beta()
+        posterior_words(model.tempering())
     );
     for n in [1, 10, 30, 100] {
         if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {
@@ -86,9 +114,36 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-    println!("wrote {}", names.join(", "));
-    Ok(())
+    let reliability = evaluation.reliability();
+    match reliability.ece() {
+        Some(ece) => println!(
+            "ECE (10 bins): {ece:.3} over {} predictions",
+            reliability.predictions()
+        ),
+        None => println!("ECE (10 bins): none, no predictions"),
+    }
+}
+
+/// Draws the reliability diagram of every belief of `evaluation` as reliability.svg and
+/// reliability.png in `dir` (none without predictions); returns the paths.
+fn write_reliability_plot(
+    dir: &Path,
+    evaluation: &Evaluation,
+    descriptor: &str,
+    title: &str,
+) -> Result<Vec<PathBuf>, Box<dyn std::error::Error>> {
+    let table = evaluation.reliability();
+    if table.predictions() == 0 {
+        return Ok(Vec::new());
+    }
+    let figure = reliability_figure(
+        &format!("Calibration: {title}"),
+        &[(descriptor.to_string(), &table)],
+    );
+    let (svg, png) = (dir.join("reliability.svg"), dir.join("reliability.png"));
+    figure.write_svg(&svg)?;
+    figure.write_png(&png)?;
+    Ok(vec![svg, png])
 }
 
 /// Warns that `--readings` asks for more readings per trial than the test data's longest trial,

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::factor::{Factor, FactorError, Factors};
 use super::unit::DetailRow;
-use crate::recognize::{AccuracyPoint, Evaluation};
+use crate::recognize::{AccuracyPoint, Evaluation, ReliabilityTable};
 
 /// One point of one recognition curve.
 ///
@@ -68,6 +68,76 @@ impl DetailRow for PerObjectRow {
     const TABLE: Option<&'static str> = Some("per_object");
 }
 
+/// One confidence bin of one curve's reliability table, pooled over all the curve's trials
+/// (`recognize::ReliabilityTable`: every belief after every number of readings of every trial is a
+/// prediction; its confidence is its top probability). A curve's rows are its table's 10 bins, all
+/// from one unit (each recognition experiment evaluates a curve's trials in one unit).
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] (no `trial`: pooled over trials) |
+/// | `bin` | 0-9: confidences in [`confidence_low`, `confidence_high`), the last bin with 1.0 |
+/// | `confidence_low`, `confidence_high` | the bin's bounds, b/10 and (b+1)/10 |
+/// | `count` | the predictions in the bin |
+/// | `mean_confidence` | their mean top probability; empty when `count` is 0 |
+/// | `accuracy` | the fraction of them whose guess is the true object; empty when `count` is 0 |
+/// | `ece` | the curve's expected calibration error, `sum_b (count_b / N) abs(accuracy_b - mean_confidence_b)`, the same on each of its rows; empty for a curve without predictions |
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReliabilityRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub factors: Factors,
+    pub bin: u32,
+    pub confidence_low: f64,
+    pub confidence_high: f64,
+    pub count: u64,
+    pub mean_confidence: Option<f64>,
+    pub accuracy: Option<f64>,
+    pub ece: Option<f64>,
+}
+
+impl DetailRow for ReliabilityRow {
+    const TABLE: Option<&'static str> = Some("reliability");
+}
+
+impl Serialize for ReliabilityRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("ReliabilityRow", 9 + self.factors.len())?;
+        row.serialize_field("experiment", &self.experiment)?;
+        row.serialize_field("descriptor", &self.descriptor)?;
+        self.factors.serialize_columns(&mut row)?;
+        row.serialize_field("bin", &self.bin)?;
+        row.serialize_field("confidence_low", &self.confidence_low)?;
+        row.serialize_field("confidence_high", &self.confidence_high)?;
+        row.serialize_field("count", &self.count)?;
+        row.serialize_field("mean_confidence", &self.mean_confidence)?;
+        row.serialize_field("accuracy", &self.accuracy)?;
+        row.serialize_field("ece", &self.ece)?;
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for ReliabilityRow {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let record = TidyRecord::deserialize(deserializer)?;
+        let row = || -> Result<Self, String> {
+            Ok(Self {
+                experiment: record.text("experiment")?,
+                descriptor: record.text("descriptor")?,
+                factors: record.factors_before("bin")?,
+                bin: record.number("bin")?,
+                confidence_low: record.number("confidence_low")?,
+                confidence_high: record.number("confidence_high")?,
+                count: record.number("count")?,
+                mean_confidence: record.optional_number("mean_confidence")?,
+                accuracy: record.optional_number("accuracy")?,
+                ece: record.optional_number("ece")?,
+            })
+        };
+        row().map_err(de::Error::custom)
+    }
+}
+
 /// Everything an [`AccuracyRow`] holds but the point itself: one curve of one trial.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccuracyCurve {
@@ -109,6 +179,32 @@ impl AccuracyCurve {
                 reliability: point.reliability,
                 seed: self.seed,
                 stream_seed: self.stream_seed as i64,
+            })
+            .collect()
+    }
+
+    /// The curve's reliability rows: `table` pooled over all its trials (so `trial` and the seeds
+    /// are not columns), one row per bin, each with the table's ECE.
+    pub fn reliability_rows(&self, table: &ReliabilityTable) -> Vec<ReliabilityRow> {
+        let ece = table.ece();
+        table
+            .bins()
+            .iter()
+            .enumerate()
+            .map(|(b, bin)| {
+                let (low, high) = ReliabilityTable::bounds(b);
+                ReliabilityRow {
+                    experiment: self.experiment.clone(),
+                    descriptor: self.descriptor.clone(),
+                    factors: self.factors.clone(),
+                    bin: b as u32,
+                    confidence_low: low,
+                    confidence_high: high,
+                    count: bin.count as u64,
+                    mean_confidence: bin.mean_confidence(),
+                    accuracy: bin.accuracy(),
+                    ece,
+                }
             })
             .collect()
     }
@@ -168,7 +264,7 @@ impl AccuracyRow {
         Ok(Self {
             experiment: record.text("experiment")?,
             descriptor: record.text("descriptor")?,
-            factors: record.factors()?,
+            factors: record.factors_before("trial")?,
             trial: record.number("trial")?,
             n_readings: record.number("n_readings")?,
             accuracy: record.number("accuracy")?,
@@ -215,7 +311,7 @@ impl<'de> Deserialize<'de> for PerObjectRow {
             Ok(Self {
                 experiment: record.text("experiment")?,
                 descriptor: record.text("descriptor")?,
-                factors: record.factors()?,
+                factors: record.factors_before("trial")?,
                 trial: record.number("trial")?,
                 object: record.text("object")?,
                 n_readings: record.number("n_readings")?,
@@ -261,15 +357,24 @@ impl TidyRecord {
         })
     }
 
-    /// The columns between `descriptor` and `trial`, each a [`Factor`] with a valid level.
-    fn factors(&self) -> Result<Factors, String> {
+    /// The cell of `column` as a number, `None` when it is empty.
+    pub(crate) fn optional_number<T: std::str::FromStr>(&self, column: &str) -> Result<Option<T>, String> {
+        match self.cell(column)? {
+            "" => Ok(None),
+            _ => self.number(column).map(Some),
+        }
+    }
+
+    /// The columns between `descriptor` and `end` (`trial`, or `bin` in a reliability table), each
+    /// a [`Factor`] with a valid level.
+    fn factors_before(&self, end: &str) -> Result<Factors, String> {
         let position = |column: &str| {
             self.cells
                 .iter()
                 .position(|(c, _)| c == column)
                 .ok_or_else(|| format!("no column '{column}'"))
         };
-        let (first, end) = (position("descriptor")? + 1, position("trial")?);
+        let (first, end) = (position("descriptor")? + 1, position(end)?);
         let factors = Factors::new(
             self.cells
                 .get(first..end)
@@ -402,6 +507,31 @@ mod tests {
                    noise,mnti,noise_fraction,0.1,0,1,0.5,0.5,1,2\n";
         let e = read::<AccuracyRow>(old).unwrap_err().to_string();
         assert!(e.contains("'parameter'") && e.contains("no factor"), "{e}");
+    }
+
+    #[test]
+    fn reliability_rows_write_empty_bins_as_empty_fields_and_read_back() {
+        let mut table = ReliabilityTable::default();
+        table.add(0.95, true);
+        table.add(0.55, false);
+        let rows = curve().reliability_rows(&table);
+        assert_eq!(rows.len(), 10);
+        let text = csv_of(&rows);
+        assert!(
+            text.starts_with(
+                "experiment,descriptor,noise_fraction,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n"
+            ),
+            "{text}"
+        );
+        // (1/2)|1 - 0.95| + (1/2)|0 - 0.55| = 0.3
+        assert!(
+            text.contains("\nnoise,mnti,0.1,0,0.0,0.1,0,,,0.30000000000000004\n"),
+            "{text}"
+        );
+        assert_eq!(read::<ReliabilityRow>(&text).unwrap(), rows);
+        let none = curve().reliability_rows(&ReliabilityTable::default());
+        assert!(none.iter().all(|r| r.ece.is_none() && r.count == 0));
+        assert_eq!(read::<ReliabilityRow>(&csv_of(&none)).unwrap(), none);
     }
 
     #[test]

@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use super::error::ExperimentError;
 use super::files::read;
 use super::layout::ExperimentDir;
+use super::name::SafeName;
 use super::name::UnitKey;
-use super::plot::render_plot;
+use super::plot::{PERFECT_CALIBRATION, PlotKind, PlotSpec, render_plot};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
 
@@ -70,32 +71,36 @@ pub fn missing_units<'m>(dir: &ExperimentDir, manifest: &'m Manifest) -> Vec<&'m
         .collect()
 }
 
-/// The units of `manifest` whose detail file is not in `dir` (none when the experiment has no
-/// detail table). Units saved before their experiment had one lack it.
-pub fn missing_detail<'m>(dir: &ExperimentDir, manifest: &'m Manifest) -> Vec<&'m UnitKey> {
-    match &manifest.detail {
-        None => Vec::new(),
-        Some(table) => manifest
-            .units
-            .iter()
-            .filter(|key| !dir.detail_unit_csv(table, key).is_file())
-            .collect(),
-    }
+/// The units of `manifest` whose file of detail table `table` is not in `dir`. Units saved before
+/// their experiment had that table lack it.
+pub fn missing_detail<'m>(dir: &ExperimentDir, manifest: &'m Manifest, table: &SafeName) -> Vec<&'m UnitKey> {
+    manifest
+        .units
+        .iter()
+        .filter(|key| !dir.detail_unit_csv(table, key).is_file())
+        .collect()
 }
 
 /// The files an assembled experiment has.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Finished {
     pub csv: PathBuf,
-    /// `<experiment>_<table>.csv`, when the experiment has a detail table and every unit its file.
-    pub detail: Option<PathBuf>,
+    /// `<experiment>_<table>.csv` of each detail table every unit has a file of, in the manifest's
+    /// order.
+    pub details: Vec<PathBuf>,
+    /// The detail tables not assembled, each with the number of units that lack its file (saved by
+    /// a build before the table existed).
+    pub incomplete: Vec<(SafeName, usize)>,
+    /// Each curve of the reliability diagrams, named with its ECE (`pf (ECE 0.042)`).
+    pub calibration: Vec<String>,
     pub config: PathBuf,
     pub plots: Vec<PathBuf>,
 }
 
 /// Assembles `<experiment>.csv` from every unit file in manifest order (one header; every unit must
-/// have the same header), the detail table likewise when every unit has its detail file, and draws
-/// the manifest's plots. Fails with [`ExperimentError::Incomplete`] when a unit file is missing.
+/// have the same header), each detail table likewise when every unit has its file, and draws the
+/// manifest's plots (a plot of a detail table not assembled is skipped). Fails with
+/// [`ExperimentError::Incomplete`] when a unit file is missing.
 pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, ExperimentError> {
     let missing = missing_units(dir, manifest);
     if let Some(first) = missing.first() {
@@ -110,29 +115,52 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
     let csv = dir.csv();
     let units: Vec<PathBuf> = manifest.units.iter().map(|key| dir.unit_csv(key)).collect();
     write_if_changed(&csv, &concatenate(&units)?)?;
-    let detail = match &manifest.detail {
-        Some(table) if missing_detail(dir, manifest).is_empty() => {
-            let path = dir.detail_csv(table);
-            let units: Vec<PathBuf> = manifest
-                .units
-                .iter()
-                .map(|key| dir.detail_unit_csv(table, key))
-                .collect();
-            write_if_changed(&path, &concatenate(&units)?)?;
-            Some(path)
+    let (mut details, mut incomplete) = (Vec::new(), Vec::new());
+    for table in &manifest.details {
+        let lacking = missing_detail(dir, manifest, table).len();
+        if lacking > 0 {
+            incomplete.push((table.clone(), lacking));
+            continue;
         }
-        _ => None,
-    };
-    let mut plots = Vec::new();
+        let path = dir.detail_csv(table);
+        let units: Vec<PathBuf> = manifest
+            .units
+            .iter()
+            .map(|key| dir.detail_unit_csv(table, key))
+            .collect();
+        write_if_changed(&path, &concatenate(&units)?)?;
+        details.push(path);
+    }
+    let (mut plots, mut calibration) = (Vec::new(), Vec::new());
     for spec in &manifest.spec.plots {
-        plots.extend(render_plot(spec, &csv, dir)?);
+        let source = plot_source(dir, spec);
+        if source == csv || details.contains(&source) {
+            let (figure, paths) = render_plot(spec, &source, dir)?;
+            plots.extend(paths);
+            if spec.kind == PlotKind::Reliability {
+                calibration.extend(figure.panels.iter().flat_map(|panel| {
+                    let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
+                    curves.map(|s| s.label.clone())
+                }));
+            }
+        }
     }
     Ok(Finished {
         csv,
-        detail,
+        details,
+        incomplete,
+        calibration,
         config: dir.config(),
         plots,
     })
+}
+
+/// The assembled table `spec` draws: the main one, or the detail table it names.
+pub(crate) fn plot_source(dir: &ExperimentDir, spec: &PlotSpec) -> PathBuf {
+    match &spec.table {
+        Some(table) => dir.detail_csv(table),
+        None => dir.csv(),
+    }
 }
 
 /// The unit files `paths` as one table: the first one's header, then every file's rows in order;

@@ -5,14 +5,14 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::assemble::{missing_detail, missing_units};
+use super::assemble::{missing_detail, missing_units, plot_source};
 use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
 use super::files::read;
 use super::layout::ExperimentDir;
 use super::layout::{experiments_in, folders_holding};
 use super::name::SafeName;
-use super::plot::{PlotKind, build_figure};
+use super::plot::{PERFECT_CALIBRATION, PlotKind, build_figure};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
 
@@ -26,7 +26,8 @@ const MAX_LINE_COLUMNS: usize = 8;
 pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
     let mut text = String::from(
         "# Results\n\nOne directory per experiment: `<name>.csv` (tidy, one row per observation; beside a \
-         recognition experiment's, `<name>_per_object.csv` with one row per test object), its plots \
+         recognition experiment's, `<name>_per_object.csv` with one row per test object and \
+         `<name>_reliability.csv`, each curve's calibration in 10 bins of top probability with its ECE), its plots \
          (SVG and PNG), `config.json` (the run's configuration), `manifest.json` and `units/` (one file \
          per work unit, what resuming and `taction merge` use). This file is rewritten by every run.\n",
     );
@@ -54,45 +55,60 @@ fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Resul
         return Ok(());
     }
     let _ = write!(text, "Data: [{name}.csv]({name}/{name}.csv)");
-    match &manifest.detail {
-        Some(table) => detail_data(text, dir, manifest, table),
-        None => text.push('\n'),
+    let absent: Vec<&SafeName> = manifest
+        .details
+        .iter()
+        .filter(|table| !detail_data(text, dir, manifest, table))
+        .collect();
+    text.push('\n');
+    for table in &absent {
+        absent_detail(text, dir, manifest, table);
     }
     for spec in &manifest.spec.plots {
+        let source = plot_source(dir, spec);
+        if !source.is_file() {
+            continue;
+        }
         let stem = &spec.stem;
         let _ = write!(
             text,
             "\n![{}]({name}/{stem}.svg)\n([PNG]({name}/{stem}.png))\n\n",
             spec.title
         );
-        let figure = build_figure(spec, &csv)?;
+        let figure = build_figure(spec, &source)?;
         for panel in &figure.panels {
             match spec.kind {
                 PlotKind::Accuracy => accuracy_table(text, panel),
                 PlotKind::Lines { .. } => line_table(text, panel),
+                PlotKind::Reliability => calibration_list(text, panel),
             }
         }
     }
     Ok(())
 }
 
-/// Ends the data line with the experiment's detail table, or says after it why that table is not
-/// there: units saved before their experiment had one lack its rows, which cannot be made up from
-/// the main rows.
-fn detail_data(text: &mut String, dir: &ExperimentDir, manifest: &Manifest, table: &SafeName) {
+/// Adds the experiment's detail table `table` to the data line when it is assembled; whether it is.
+fn detail_data(text: &mut String, dir: &ExperimentDir, manifest: &Manifest, table: &SafeName) -> bool {
     let name = dir.name();
-    let missing = missing_detail(dir, manifest).len();
-    if missing == 0 && dir.detail_csv(table).is_file() {
-        let _ = writeln!(text, ", [{name}_{table}.csv]({name}/{name}_{table}.csv)");
-    } else {
-        let _ = writeln!(
-            text,
-            "\n\n`{name}_{table}.csv` is not here: {missing} of {} units were saved before their `{table}` rows \
-             were written, and those rows cannot be derived from the averaged ones; a run into a fresh \
-             folder (or after deleting `{name}/units/`) writes them.",
-            manifest.units.len()
-        );
+    let here = missing_detail(dir, manifest, table).is_empty() && dir.detail_csv(table).is_file();
+    if here {
+        let _ = write!(text, ", [{name}_{table}.csv]({name}/{name}_{table}.csv)");
     }
+    here
+}
+
+/// Says why detail table `table` is not there: units saved before their experiment had it lack its
+/// rows, which cannot be made up from the main rows.
+fn absent_detail(text: &mut String, dir: &ExperimentDir, manifest: &Manifest, table: &SafeName) {
+    let name = dir.name();
+    let missing = missing_detail(dir, manifest, table).len();
+    let _ = writeln!(
+        text,
+        "\n`{name}_{table}.csv` is not here: {missing} of {} units were saved before their `{table}` rows \
+         were written, and those rows cannot be derived from the averaged ones; a run into a fresh \
+         folder (or after deleting `{name}/units/`) writes them.",
+        manifest.units.len()
+    );
 }
 
 /// A picture experiment (Fig. 1) is one drawing, not a run of units: its folder holds
@@ -168,6 +184,14 @@ fn accuracy_table(text: &mut String, panel: &Panel) {
             }
         }
         text.push('\n');
+    }
+}
+
+/// A reliability plot's curves, each named with its ECE (the diagonal, the reference, left out).
+fn calibration_list(text: &mut String, panel: &Panel) {
+    table_title(text, panel);
+    for series in panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION) {
+        let _ = writeln!(text, "- {}", series.label);
     }
 }
 

@@ -5,8 +5,8 @@
 //! <out>/<experiment>/manifest.json     name, description, plots, the ordered unit keys
 //! <out>/<experiment>/config.json       the run's full configuration
 //! <out>/<experiment>/units/<key>.csv   one unit's rows, header first
-//! <out>/<experiment>/units/<table>/<key>.csv   one unit's detail rows (experiments with a second
-//!                                      table, e.g. `per_object`)
+//! <out>/<experiment>/units/<table>/<key>.csv   one unit's detail rows (experiments with further
+//!                                      tables, e.g. `per_object`, `reliability`)
 //! <out>/<experiment>/<experiment>.csv  all rows, units in manifest order, one header
 //! <out>/<experiment>/<experiment>_<table>.csv  all detail rows, likewise
 //! <out>/<experiment>/<stem>.svg|.png   the plots

@@ -90,26 +90,47 @@ fn merge_experiment(
 
     let target = ExperimentDir::new(out, name);
     let mut folders = vec![out.to_path_buf(), target.root().to_path_buf(), target.units_dir()];
-    folders.extend(manifest.detail.iter().map(|table| target.detail_units_dir(table)));
+    folders.extend(
+        manifest
+            .details
+            .iter()
+            .map(|table| target.detail_units_dir(table)),
+    );
     for folder in &folders {
         create_dir_all(folder)?;
         remove_stale_temporaries(folder)?;
     }
     write_manifest(&target.manifest(), &manifest, &manifest_bytes, target.root())?;
     write_or_check(&target.config(), &config_bytes, target.root(), "configuration")?;
+    let copied = copy_units(&manifest, sources, &target)?;
+    Ok((finish(&target, &manifest)?, copied))
+}
+
+/// Copies every unit's files (its rows and each detail table's) found among `sources` into
+/// `target`; how many it wrote.
+fn copy_units(
+    manifest: &Manifest,
+    sources: &[ExperimentDir],
+    target: &ExperimentDir,
+) -> Result<usize, ExperimentError> {
     let mut copied = 0;
     for key in &manifest.units {
-        let files = |dir: &ExperimentDir| match &manifest.detail {
-            Some(table) => vec![dir.unit_csv(key), dir.detail_unit_csv(table, key)],
-            None => vec![dir.unit_csv(key)],
+        let files = |dir: &ExperimentDir| {
+            let details = manifest
+                .details
+                .iter()
+                .map(|table| dir.detail_unit_csv(table, key));
+            std::iter::once(dir.unit_csv(key))
+                .chain(details)
+                .collect::<Vec<_>>()
         };
         let sources: Vec<Vec<PathBuf>> = sources.iter().map(files).collect();
-        for (i, dest) in files(&target).into_iter().enumerate() {
+        for (i, dest) in files(target).into_iter().enumerate() {
             let paths: Vec<&PathBuf> = sources.iter().map(|s| &s[i]).collect();
             copied += usize::from(copy_unit_file(key, &paths, &dest)?);
         }
     }
-    Ok((finish(&target, &manifest)?, copied))
+    Ok(copied)
 }
 
 /// Copies the unit file of `key` found among `sources` (which must agree where several have it) to

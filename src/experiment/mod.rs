@@ -3,8 +3,8 @@
 //!
 //! An experiment is a list of [`Unit`]s, each a stable [`UnitKey`] and a deterministic function
 //! producing rows (any serde record; [`AccuracyRow`] for the recognition curves) and, for an
-//! experiment with a second table ([`DetailRow`]; [`PerObjectRow`] beside the recognition curves),
-//! its detail rows. [`run`] executes the units of one [`Shard`] on a thread pool, writing each
+//! experiment with further tables ([`DetailTables`] of [`DetailRow`]s; [`PerObjectRow`] and
+//! [`ReliabilityRow`] beside the recognition curves), their rows. [`run`] executes the units of one [`Shard`] on a thread pool, writing each
 //! unit's rows atomically to `<out>/<experiment>/units/<key>.csv`, so a killed run resumes where it
 //! stopped and never duplicates a row; once every unit is present it assembles `<experiment>.csv`
 //! (and `<experiment>_<table>.csv`), draws the
@@ -41,10 +41,10 @@ pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
 pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};
-pub use unit::{BoxError, DetailRow, NoDetail, Unit};
+pub use unit::{BoxError, DetailRow, DetailTables, NoDetail, Unit};
 
-// Its rows: recognition curves and per-object detail.
-pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, RepeatedObject};
+// Its rows: recognition curves, per-object detail and reliability tables.
+pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, RepeatedObject};
 
 // Its outputs on disk: the layout, the assembled tables, the index.
 pub use assemble::Finished;
@@ -53,7 +53,9 @@ pub use layout::ExperimentDir;
 
 // Plots: the spec of a plot, the figure it builds, its panels and series.
 pub use figure::{Figure, Panel, ReferenceLine, Series};
-pub use plot::{ACCURACY_LABEL, Axis, PlotKind, PlotSpec, build_figure};
+pub use plot::{
+    ACCURACY_LABEL, Axis, PERFECT_CALIBRATION, PlotKind, PlotSpec, build_figure, reliability_figure,
+};
 
 // Progress of a long collection, on the terminal.
 pub use progress::CollectionProgress;

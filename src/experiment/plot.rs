@@ -7,12 +7,14 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::accuracy::AccuracyRow;
+use super::accuracy::{AccuracyRow, ReliabilityRow};
 use super::error::ExperimentError;
 use super::factor::Factors;
 use super::figure::{Figure, Panel, ReferenceLine, Series};
 use super::layout::ExperimentDir;
 use super::name::SafeName;
+use super::unit::DetailRow;
+use crate::recognize::ReliabilityTable;
 
 /// One axis of a line plot: the CSV column it reads and its label (with units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,6 +50,10 @@ pub enum PlotKind {
         y: Vec<Axis>,
         series: Vec<String>,
     },
+    /// A reliability diagram from [`ReliabilityRow`] columns: per curve (descriptor, factor
+    /// levels), accuracy against mean confidence at each non-empty confidence bin, the curve named
+    /// with its ECE, and the diagonal of perfect calibration as reference.
+    Reliability,
 }
 
 /// One plot of an experiment, written as `<stem>.svg` and `<stem>.png` beside its CSV.
@@ -65,6 +71,9 @@ pub struct PlotSpec {
     /// (`factor = level`, joined by commas), a line plot by its series columns.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub legend: Option<String>,
+    /// The detail table the plot reads (`<experiment>_<table>.csv`); absent: the main table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub table: Option<SafeName>,
 }
 
 impl PlotSpec {
@@ -75,6 +84,7 @@ impl PlotSpec {
             kind: PlotKind::Accuracy,
             objects: None,
             legend: None,
+            table: None,
         }
     }
 
@@ -98,22 +108,35 @@ impl PlotSpec {
             kind: PlotKind::Lines { x, y, series },
             objects: None,
             legend: None,
+            table: None,
         }
+    }
+
+    /// The reliability diagram of the experiment's `reliability` table ([`ReliabilityRow`]).
+    pub fn reliability(stem: SafeName, title: &str) -> Result<Self, ExperimentError> {
+        Ok(Self {
+            stem,
+            title: title.to_string(),
+            kind: PlotKind::Reliability,
+            objects: None,
+            legend: None,
+            table: ReliabilityRow::TABLE.map(SafeName::new).transpose()?,
+        })
     }
 }
 
-/// Draws `spec` from the assembled `csv` into `dir`; returns the SVG and PNG paths.
+/// Draws `spec` from the assembled `csv` into `dir`; returns the figure and the SVG and PNG paths.
 pub fn render_plot(
     spec: &PlotSpec,
     csv: &Path,
     dir: &ExperimentDir,
-) -> Result<Vec<PathBuf>, ExperimentError> {
+) -> Result<(Figure, Vec<PathBuf>), ExperimentError> {
     let figure = build_figure(spec, csv)?;
     let svg = dir.plot(&spec.stem, "svg");
     let png = dir.plot(&spec.stem, "png");
     figure.write_svg(&svg)?;
     figure.write_png(&png)?;
-    Ok(vec![svg, png])
+    Ok((figure, vec![svg, png]))
 }
 
 /// The figure `spec` describes, from the rows of `csv`.
@@ -121,6 +144,10 @@ pub fn build_figure(spec: &PlotSpec, csv: &Path) -> Result<Figure, ExperimentErr
     let panels = match &spec.kind {
         PlotKind::Accuracy => accuracy_panels(csv, spec.objects, spec.legend.as_deref())?,
         PlotKind::Lines { x, y, series } => line_panels(csv, x, y, series, spec.legend.as_deref())?,
+        PlotKind::Reliability => vec![reliability_panel(read_reliability_series(
+            csv,
+            spec.legend.as_deref(),
+        )?)],
     };
     Ok(Figure {
         title: spec.title.clone(),
@@ -343,6 +370,113 @@ fn setting_label(
                 .collect::<Vec<_>>()
                 .join(", "),
         }),
+    }
+}
+
+/// The label of a reliability diagram's diagonal.
+pub const PERFECT_CALIBRATION: &str = "perfect calibration";
+
+/// A reliability diagram of `curves`, each a name and its table: what `taction recognize` draws
+/// (the experiments draw theirs from their `reliability` table, [`PlotKind::Reliability`]).
+pub fn reliability_figure(title: &str, curves: &[(String, &ReliabilityTable)]) -> Figure {
+    let series = curves
+        .iter()
+        .map(|(name, table)| {
+            let points = table
+                .bins()
+                .iter()
+                .filter_map(|bin| Some((bin.mean_confidence()?, bin.accuracy()?)))
+                .collect();
+            calibration_series(name, table.ece(), points)
+        })
+        .collect();
+    Figure {
+        title: title.to_string(),
+        panels: vec![reliability_panel(series)],
+    }
+}
+
+/// One curve of a reliability diagram, named with its ECE.
+fn calibration_series(name: &str, ece: Option<f64>, points: Vec<(f64, f64)>) -> Series {
+    let ece = ece.map_or_else(|| "no predictions".to_string(), |e| format!("{e:.3}"));
+    Series {
+        label: format!("{name} (ECE {ece})"),
+        points,
+        band: Vec::new(),
+    }
+}
+
+/// Per curve (descriptor, factor levels): its ECE and its non-empty bins as (bin, mean confidence,
+/// accuracy).
+type CalibrationCurves = Ordered<(String, Factors), (Option<f64>, Vec<(u32, f64, f64)>)>;
+
+/// The reliability rows of `csv`, one series per curve (descriptor, factor levels) in order of
+/// first appearance, named as accuracy plots name their lines; a curve's bin seen twice (a curve
+/// split over units) is an error.
+fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Series>, ExperimentError> {
+    let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
+    let mut curves: CalibrationCurves = Ordered::new();
+    for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
+        let row = row.map_err(|e| csv_error(csv, e))?;
+        let (ece, points) = curves.entry((row.descriptor, row.factors));
+        if points.iter().any(|(bin, _, _)| *bin == row.bin) {
+            return Err(csv_error(
+                csv,
+                format!("line {}: bin {} of this curve is there twice", i + 2, row.bin),
+            ));
+        }
+        *ece = row.ece;
+        if let (Some(confidence), Some(accuracy)) = (row.mean_confidence, row.accuracy) {
+            points.push((row.bin, confidence, accuracy));
+        }
+    }
+    if curves.items.is_empty() {
+        return Err(csv_error(csv, "no rows to plot"));
+    }
+    let descriptors = curves
+        .items
+        .iter()
+        .map(|((d, _), _)| d)
+        .collect::<std::collections::BTreeSet<_>>();
+    curves
+        .items
+        .iter()
+        .map(|((descriptor, factors), (ece, points))| {
+            let name = match (factors.len(), legend) {
+                (0, None) => descriptor.clone(),
+                (_, None) if descriptors.len() > 1 => format!("{descriptor}: {factors}"),
+                _ => setting_label(csv, legend, descriptor, factors)?,
+            };
+            let mut points = points.clone();
+            points.sort_by_key(|(bin, _, _)| *bin);
+            Ok(calibration_series(
+                &name,
+                *ece,
+                points.iter().map(|&(_, c, a)| (c, a)).collect(),
+            ))
+        })
+        .collect()
+}
+
+/// A reliability diagram: accuracy against mean confidence over [0, 1], the diagonal of perfect
+/// calibration first.
+fn reliability_panel(curves: Vec<Series>) -> Panel {
+    let diagonal = Series {
+        label: PERFECT_CALIBRATION.to_string(),
+        points: vec![(0.0, 0.0), (1.0, 1.0)],
+        band: Vec::new(),
+    };
+    Panel {
+        title: String::new(),
+        x_label: "mean confidence (top probability)".to_string(),
+        y_label: ACCURACY_LABEL.to_string(),
+        x_range: (0.0, 1.0),
+        y_range: (0.0, 1.0),
+        series: std::iter::once(diagonal).chain(curves).collect(),
+        markers: true,
+        legend: true,
+        integer_x: false,
+        reference: None,
     }
 }
 

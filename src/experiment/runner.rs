@@ -19,7 +19,7 @@ use super::name::SafeName;
 use super::progress::progress_bar;
 use super::shard::Shard;
 use super::spec::{ExperimentSpec, Manifest, check_unchanged, to_json, write_manifest, write_or_check};
-use super::unit::{DetailRow, NoDetail, Unit, parse_rows, read_rows, rows_to_csv};
+use super::unit::{DetailTables, NoDetail, Unit, encode_table, read_rows};
 use crate::atomic::{remove_stale_temporaries, write_atomic};
 
 /// Where and how to run: the flags every experiment command shares.
@@ -57,9 +57,9 @@ impl RunOptions {
 
 /// An experiment ready to run: what it is, its full configuration (written to `config.json`; it
 /// should hold everything the rows depend on, such as the seed, and nothing they do not, such as
-/// the thread count) and its units in their fixed order. `D` is the rows of its second table, if
-/// it has one ([`DetailRow`]).
-pub struct Experiment<'a, R, C, D = NoDetail> {
+/// the thread count) and its units in their fixed order. `D` is its further tables, if it has any
+/// ([`DetailTables`]: a [`super::unit::DetailRow`], or a pair of them).
+pub struct Experiment<'a, R, C, D: DetailTables = NoDetail> {
     pub spec: ExperimentSpec,
     pub config: C,
     pub units: Vec<Unit<'a, R, D>>,
@@ -100,8 +100,17 @@ impl fmt::Display for RunReport {
         match &self.finished {
             Some(done) => {
                 write!(f, "\nwrote {}", done.csv.display())?;
-                for plot in done.detail.iter().chain(&done.plots) {
+                for plot in done.details.iter().chain(&done.plots) {
                     write!(f, ", {}", plot.display())?;
+                }
+                if !done.calibration.is_empty() {
+                    write!(f, "\ncalibration (10 bins): {}", done.calibration.join("; "))?;
+                }
+                for (table, missing) in &done.incomplete {
+                    write!(
+                        f,
+                        "\nno {table} table: {missing} units were saved by a build before it (a run into a fresh folder writes it)"
+                    )?;
                 }
                 Ok(())
             }
@@ -138,9 +147,10 @@ pub fn check_resumable<C: Serialize>(
 ///    results; its description and plots may change.
 /// 2. Takes this shard's units; a unit whose `units/<key>.csv` exists and reads back as rows of `R`
 ///    is reused, one that does not read back is an error naming the file. (Its detail file is not
-///    required: units saved before their experiment had a detail table are kept as they are.)
+///    required: units saved before their experiment had a detail table are kept as they are, and
+///    that table is then not assembled.)
 /// 3. Runs the rest on a pool of `--threads` workers, writing each unit's rows atomically as soon
-///    as it finishes (its detail rows first), so a run killed at any point loses only the units in
+///    as it finishes (its detail tables first), so a run killed at any point loses only the units in
 ///    flight. After a unit
 ///    fails no new unit starts; the finished ones are kept and the error names every failed unit.
 /// 4. When every unit of the experiment is present (from any shard), assembles the CSV and the
@@ -152,19 +162,22 @@ pub fn run<R, C, D>(
 where
     R: Serialize + DeserializeOwned,
     C: Serialize,
-    D: DetailRow,
+    D: DetailTables,
 {
     let spec = &experiment.spec;
     let units = &experiment.units;
     check_units(spec, units)?;
     let dir = ExperimentDir::new(&options.out, &spec.name);
-    let detail = D::TABLE.map(SafeName::new).transpose()?;
-    prepare_folders(options, &dir, detail.as_ref())?;
-    let manifest = record_experiment(experiment, &dir, detail.clone())?;
+    let details = D::names()
+        .into_iter()
+        .map(SafeName::new)
+        .collect::<Result<Vec<_>, _>>()?;
+    prepare_folders(options, &dir, &details)?;
+    let manifest = record_experiment(experiment, &dir, details.clone())?;
 
     let ShardUnits { in_shard, pending } = pending_in_shard::<R, D>(units, options, &dir)?;
     let reused = in_shard - pending.len();
-    let ran = run_pending(&pending, options, &dir, detail.as_ref(), &spec.name.to_string())?;
+    let ran = run_pending(&pending, options, &dir, &details, &spec.name.to_string())?;
 
     let missing = missing_units(&dir, &manifest).len();
     let finished = if missing == 0 {
@@ -186,7 +199,7 @@ where
 }
 
 /// An experiment has units, each key once.
-fn check_units<R, D: DetailRow>(
+fn check_units<R, D: DetailTables>(
     spec: &ExperimentSpec,
     units: &[Unit<'_, R, D>],
 ) -> Result<(), ExperimentError> {
@@ -209,10 +222,10 @@ fn check_units<R, D: DetailRow>(
 fn prepare_folders(
     options: &RunOptions,
     dir: &ExperimentDir,
-    detail: Option<&SafeName>,
+    details: &[SafeName],
 ) -> Result<(), ExperimentError> {
     let mut folders = vec![options.out.clone(), dir.root().to_path_buf(), dir.units_dir()];
-    folders.extend(detail.iter().map(|table| dir.detail_units_dir(table)));
+    folders.extend(details.iter().map(|table| dir.detail_units_dir(table)));
     for folder in &folders {
         create_dir_all(folder)?;
         remove_stale_temporaries(folder)?;
@@ -221,14 +234,14 @@ fn prepare_folders(
 }
 
 /// Step 1: `manifest.json` and `config.json`, written, or checked against a resumed run's.
-fn record_experiment<R, C: Serialize, D: DetailRow>(
+fn record_experiment<R, C: Serialize, D: DetailTables>(
     experiment: &Experiment<'_, R, C, D>,
     dir: &ExperimentDir,
-    detail: Option<SafeName>,
+    details: Vec<SafeName>,
 ) -> Result<Manifest, ExperimentError> {
     let manifest = Manifest {
         spec: experiment.spec.clone(),
-        detail,
+        details,
         units: experiment.units.iter().map(|u| u.key().clone()).collect(),
     };
     write_manifest(
@@ -248,7 +261,7 @@ fn record_experiment<R, C: Serialize, D: DetailRow>(
 
 /// Step 2: this shard's unit count, and those of its units not yet saved (a saved one must read
 /// back as rows of `R`).
-fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
+fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailTables>(
     units: &'u [Unit<'a, R, D>],
     options: &RunOptions,
     dir: &ExperimentDir,
@@ -272,7 +285,7 @@ fn pending_in_shard<'u, 'a, R: DeserializeOwned, D: DetailRow>(
 }
 
 /// This shard's share of the units: how many it has, and those of them not yet saved.
-struct ShardUnits<'u, 'a, R, D> {
+struct ShardUnits<'u, 'a, R, D: DetailTables> {
     in_shard: usize,
     pending: Vec<&'u Unit<'a, R, D>>,
 }
@@ -283,12 +296,12 @@ fn run_pending<R, D>(
     pending: &[&Unit<'_, R, D>],
     options: &RunOptions,
     dir: &ExperimentDir,
-    detail: Option<&SafeName>,
+    details: &[SafeName],
     name: &str,
 ) -> Result<usize, ExperimentError>
 where
     R: Serialize + DeserializeOwned,
-    D: DetailRow,
+    D: DetailTables,
 {
     let threads = options.thread_count();
     let pool = rayon::ThreadPoolBuilder::new()
@@ -307,7 +320,7 @@ where
                 if stop.load(Ordering::Relaxed) {
                     return None;
                 }
-                let outcome = run_unit(unit, dir, detail);
+                let outcome = run_unit(unit, dir, details);
                 if outcome.is_err() {
                     stop.store(true, Ordering::Relaxed);
                 }
@@ -325,36 +338,28 @@ where
     Ok(ran)
 }
 
-/// Runs one unit and saves its detail rows into the `detail` table (when the experiment has one),
-/// then its rows, each after checking they read back as they will on resume: a header and every row
-/// (so rows must be structs with named fields, not tuples or scalars).
-fn run_unit<R: Serialize + DeserializeOwned, D: DetailRow>(
+/// Runs one unit and saves its detail tables (when the experiment has any), then its rows, each
+/// after checking they read back as they will on resume: a header and every row (so rows must be
+/// structs with named fields, not tuples or scalars).
+fn run_unit<R: Serialize + DeserializeOwned, D: DetailTables>(
     unit: &Unit<'_, R, D>,
     dir: &ExperimentDir,
-    detail: Option<&SafeName>,
+    details: &[SafeName],
 ) -> Result<(), UnitFailure> {
     let fail = |what: String| UnitFailure {
         key: unit.key().clone(),
         what,
     };
     let (rows, detail_rows) = unit.run().map_err(fail)?;
-    if let Some(table) = detail {
-        save_rows(&detail_rows, &dir.detail_unit_csv(table, unit.key())).map_err(fail)?;
+    let paths: Vec<PathBuf> = details
+        .iter()
+        .map(|table| dir.detail_unit_csv(table, unit.key()))
+        .collect();
+    let tables = D::encode(&detail_rows, &paths).map_err(fail)?;
+    let main = dir.unit_csv(unit.key());
+    let main_bytes = encode_table("main", &rows, &main).map_err(fail)?;
+    for (path, bytes) in paths.iter().zip(&tables).chain([(&main, &main_bytes)]) {
+        write_atomic(path, bytes).map_err(|e| fail(e.to_string()))?;
     }
-    save_rows(&rows, &dir.unit_csv(unit.key())).map_err(fail)
-}
-
-/// Writes `rows` to `path` as CSV once they read back from it.
-fn save_rows<R: Serialize + DeserializeOwned>(rows: &[R], path: &std::path::Path) -> Result<(), String> {
-    let bytes = rows_to_csv(rows, path).map_err(|e| e.to_string())?;
-    match parse_rows::<R>(&bytes, path) {
-        Ok(back) if back.len() == rows.len() => {}
-        _ => {
-            return Err(
-                "its rows do not read back from CSV: rows must be structs of plain fields (names become the header)"
-                    .to_string(),
-            );
-        }
-    }
-    write_atomic(path, &bytes).map_err(|e| e.to_string())
+    Ok(())
 }

@@ -26,11 +26,31 @@ pub struct ExperimentSpec {
 pub struct Manifest {
     #[serde(flatten)]
     pub spec: ExperimentSpec,
-    /// The experiment's second table ([`super::unit::DetailRow::TABLE`]), if it has one: absent
-    /// in experiments without one and in manifests written before there were any.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub detail: Option<SafeName>,
+    /// The experiment's further tables ([`super::unit::DetailTables::names`]), in order: absent in
+    /// experiments without any and in manifests written before there were any; manifests written
+    /// when there could be only one name it as `"detail": "<table>"`.
+    #[serde(
+        default,
+        alias = "detail",
+        deserialize_with = "one_or_many",
+        skip_serializing_if = "Vec::is_empty"
+    )]
+    pub details: Vec<SafeName>,
     pub units: Vec<UnitKey>,
+}
+
+/// A table name or a list of them (see [`Manifest::details`]).
+fn one_or_many<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<Vec<SafeName>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        One(SafeName),
+        Many(Vec<SafeName>),
+    }
+    Ok(match OneOrMany::deserialize(deserializer)? {
+        OneOrMany::One(name) => vec![name],
+        OneOrMany::Many(names) => names,
+    })
 }
 
 impl Manifest {

@@ -1,7 +1,7 @@
 //! Work units: the resumable pieces of an experiment, and their row files.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -12,12 +12,12 @@ use super::name::UnitKey;
 /// Any error a unit's work can return.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
-type Work<'a, R, D> = dyn Fn() -> Result<(Vec<R>, Vec<D>), BoxError> + Send + Sync + 'a;
+type Work<'a, R, D> = dyn Fn() -> Result<(Vec<R>, <D as DetailTables>::Rows), BoxError> + Send + Sync + 'a;
 
-/// The rows of an experiment's second table, finer than its main rows (the recognition
-/// experiments' per-object outcomes beside their averaged accuracy). Each unit writes them to
-/// `units/<TABLE>/<key>.csv` before its main file, so a unit whose main file exists has both, and
-/// they are assembled into `<experiment>_<TABLE>.csv`.
+/// The rows of one of an experiment's further tables, finer than its main rows (the recognition
+/// experiments' per-object outcomes and reliability tables beside their averaged accuracy). Each
+/// unit writes them to `units/<TABLE>/<key>.csv` before its main file, so a unit whose main file
+/// exists has them all, and they are assembled into `<experiment>_<TABLE>.csv`.
 pub trait DetailRow: Serialize + DeserializeOwned {
     /// The table's name; `None` for an experiment without a second table.
     const TABLE: Option<&'static str>;
@@ -31,14 +31,75 @@ impl DetailRow for NoDetail {
     const TABLE: Option<&'static str> = None;
 }
 
+/// The further tables of an experiment: none ([`NoDetail`]), one ([`DetailRow`] `D`, whose rows are
+/// `Vec<D>`), or two (`(D, E)`, whose rows are `(Vec<D>, Vec<E>)`).
+pub trait DetailTables {
+    /// What a unit's work gives besides its main rows.
+    type Rows;
+    /// The tables' names, in order.
+    fn names() -> Vec<&'static str>;
+    /// Each table's rows as CSV, in [`names`](Self::names) order, once they read back from it
+    /// (`paths` name the destinations); the name of a table without rows is an error.
+    fn encode(rows: &Self::Rows, paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String>;
+}
+
+impl<D: DetailRow> DetailTables for D {
+    type Rows = Vec<D>;
+
+    fn names() -> Vec<&'static str> {
+        D::TABLE.into_iter().collect()
+    }
+
+    fn encode(rows: &Vec<D>, paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String> {
+        match (D::TABLE, paths) {
+            (Some(table), [path]) => Ok(vec![encode_table(table, rows, path)?]),
+            _ => Ok(Vec::new()),
+        }
+    }
+}
+
+impl<D: DetailRow, E: DetailRow> DetailTables for (D, E) {
+    type Rows = (Vec<D>, Vec<E>);
+
+    fn names() -> Vec<&'static str> {
+        D::TABLE.into_iter().chain(E::TABLE).collect()
+    }
+
+    fn encode((d, e): &(Vec<D>, Vec<E>), paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String> {
+        let mut tables = D::encode(d, paths.get(..1).unwrap_or_default())?;
+        tables.extend(E::encode(e, paths.get(tables.len()..).unwrap_or_default())?);
+        Ok(tables)
+    }
+}
+
+/// `rows` of `table` as CSV for `path`, once they read back: a header and every row (so rows must
+/// be structs with named fields, not tuples or scalars); no rows is an error.
+pub(crate) fn encode_table<R: Serialize + DeserializeOwned>(
+    table: &str,
+    rows: &[R],
+    path: &Path,
+) -> Result<Vec<u8>, String> {
+    if rows.is_empty() {
+        return Err(format!("produced no {table} rows"));
+    }
+    let bytes = rows_to_csv(rows, path).map_err(|e| e.to_string())?;
+    match parse_rows::<R>(&bytes, path) {
+        Ok(back) if back.len() == rows.len() => Ok(bytes),
+        _ => Err(
+            "its rows do not read back from CSV: rows must be structs of plain fields (names become the header)"
+                .to_string(),
+        ),
+    }
+}
+
 /// One resumable piece of an experiment: a stable key and the work producing its rows (and, for an
-/// experiment with a [`DetailRow`] table, its detail rows).
+/// experiment with further tables ([`DetailTables`]), their rows).
 ///
 /// The rows must be a deterministic function of what the closure captured (settings and a seed
 /// derived from the run seed, e.g. with [`crate::rng::stream`]), never of the thread or the order in
 /// which units run: that is what makes `--threads`, `--shard` and resuming give identical files.
 /// `R` is a struct whose field names become the CSV header.
-pub struct Unit<'a, R, D = NoDetail> {
+pub struct Unit<'a, R, D: DetailTables = NoDetail> {
     key: UnitKey,
     work: Box<Work<'a, R, D>>,
 }
@@ -52,11 +113,12 @@ impl<'a, R: 'a> Unit<'a, R, NoDetail> {
     }
 }
 
-impl<'a, R, D: DetailRow> Unit<'a, R, D> {
-    /// A unit whose work gives its rows and its detail rows.
+impl<'a, R, D: DetailTables> Unit<'a, R, D> {
+    /// A unit whose work gives its rows and its detail rows (one `Vec` per table, a pair of them
+    /// for two tables).
     pub fn with_detail(
         key: UnitKey,
-        work: impl Fn() -> Result<(Vec<R>, Vec<D>), BoxError> + Send + Sync + 'a,
+        work: impl Fn() -> Result<(Vec<R>, D::Rows), BoxError> + Send + Sync + 'a,
     ) -> Self {
         Self {
             key,
@@ -70,12 +132,9 @@ impl<'a, R, D: DetailRow> Unit<'a, R, D> {
 
     /// Runs the work; a panic inside it becomes an error naming the unit, so one bad unit does not
     /// take down the units running beside it.
-    pub(crate) fn run(&self) -> Result<(Vec<R>, Vec<D>), String> {
+    pub(crate) fn run(&self) -> Result<(Vec<R>, D::Rows), String> {
         match catch_unwind(AssertUnwindSafe(|| (self.work)())) {
             Ok(Ok((rows, _))) if rows.is_empty() => Err("produced no rows".to_string()),
-            Ok(Ok((_, detail))) if D::TABLE.is_some() && detail.is_empty() => {
-                Err(format!("produced no {} rows", D::TABLE.unwrap_or_default()))
-            }
             Ok(Ok(rows)) => Ok(rows),
             Ok(Err(e)) => Err(e.to_string()),
             Err(panic) => Err(format!(

@@ -29,11 +29,13 @@ use super::context::Family;
 use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
-use super::recognition::{Curve, RecognitionSweep, Setting, SettingData, TestData, training_config};
+use super::recognition::{
+    Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData, TestData, training_config,
+};
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, TidyRecord};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
 use crate::experiment::factor::{Factor, Factors};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
@@ -44,7 +46,9 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
-use crate::recognize::{Evaluation, PosteriorRule, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate};
+use crate::recognize::{
+    Evaluation, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
+};
 use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "active";
@@ -230,14 +234,15 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
             training: training.clone(),
             neighbourhood_m,
         };
-        Unit::with_detail(key, move || work.rows())
+        Unit::<_, RecognitionDetail>::with_detail(key, move || work.rows())
     };
     let experiment = Experiment {
         spec: ExperimentSpec {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                sweep.plot(name, sweep.title, objects.specs.len()),
+                sweep.plot(name.clone(), sweep.title, objects.specs.len()),
+                sweep.reliability_plot(&name, sweep.title)?,
                 PlotSpec::lines(
                     SafeName::new("active-confidence")?,
                     "Objects recognised with 95% confidence (the stop's touches, cumulative)",
@@ -278,7 +283,7 @@ struct ActiveUnit<'a> {
     neighbourhood_m: f64,
 }
 
-type Rows = (Vec<ActiveRow>, Vec<PerObjectRow>);
+type Rows = (Vec<ActiveRow>, (Vec<PerObjectRow>, Vec<ReliabilityRow>));
 
 impl ActiveUnit<'_> {
     /// The data of the sweep's one setting.
@@ -304,19 +309,22 @@ impl ActiveUnit<'_> {
             }
             PosteriorRule::Eq15 => model,
         };
-        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        let (mut rows, mut per_object, mut reliability) = (Vec::new(), Vec::new(), Vec::new());
         for curve in &self.sweep.settings[0].curves {
-            let (curve_rows, curve_objects) = self.planner_curve(curve, &model, descriptor.as_ref())?;
+            let (curve_rows, (curve_objects, curve_reliability)) =
+                self.planner_curve(curve, &model, descriptor.as_ref())?;
             rows.extend(curve_rows);
             per_object.extend(curve_objects);
+            reliability.extend(curve_reliability);
         }
         for (state, perturbation) in object_states() {
-            let (curve_rows, curve_objects) =
+            let (curve_rows, (curve_objects, curve_reliability)) =
                 self.active_curve(state, perturbation, &model, descriptor.as_ref())?;
             rows.extend(curve_rows);
             per_object.extend(curve_objects);
+            reliability.extend(curve_reliability);
         }
-        Ok((rows, per_object))
+        Ok((rows, (per_object, reliability)))
     }
 
     /// An L curve: the planner's test datasets recognised by `model`.
@@ -431,7 +439,8 @@ fn active_trial(
 }
 
 /// The rows of one curve: accuracy and reliability as every recognition figure defines them
-/// ([`evaluate`]) with the confidence stop's columns, and the per-object outcomes they count.
+/// ([`evaluate`]) with the confidence stop's columns, the per-object outcomes they count, and the
+/// curve's reliability table pooled over its trials.
 fn curve_rows(
     sweep: &RecognitionSweep,
     model: &TrainedModel,
@@ -439,12 +448,13 @@ fn curve_rows(
     trials: &[(u64, Vec<Trial>)],
     counts: DataCounts,
     run_seed: u64,
-) -> Result<(Vec<ActiveRow>, Vec<PerObjectRow>), BoxError> {
+) -> Result<Rows, BoxError> {
     let thresholds = STOPS
         .iter()
         .map(|p| Probability::new(*p))
         .collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+    let (mut table, mut curve) = (ReliabilityTable::default(), None);
     for (trial, (seed, object_trials)) in trials.iter().enumerate() {
         let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
         if longest == 0 {
@@ -486,8 +496,11 @@ fn curve_rows(
             });
         }
         per_object.extend(meta.object_rows(&evaluation)?);
+        table.merge(&evaluation.reliability());
+        curve = Some(meta);
     }
-    Ok((rows, per_object))
+    let reliability = curve.map_or_else(Vec::new, |meta| meta.reliability_rows(&table));
+    Ok((rows, (per_object, reliability)))
 }
 
 /// Per object trial: the touch at which the stop fires and whether the guess there is right;

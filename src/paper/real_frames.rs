@@ -24,11 +24,11 @@ use serde::Serialize;
 
 use super::context::PaperContext;
 use super::real_frames_options::RealFramesOptions;
-use super::recognition::selection_config;
+use super::recognition::{RecognitionDetail, RecognitionRows, selection_config};
 use crate::dataset::recorded::{RealData, RealReading};
 use crate::dataset::{ContactStatus, Dataset};
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow};
+use crate::experiment::accuracy::AccuracyCurve;
 use crate::experiment::factor::Factors;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::PlotSpec;
@@ -38,7 +38,8 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::paper::sim_to_real::{GaussianBlur, square_root};
 use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{
-    Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, TrainConfig, Trial, evaluate, train,
+    Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, Trial,
+    evaluate, train,
 };
 use crate::rng;
 use crate::tactile::TactileImage;
@@ -224,7 +225,9 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         .map(|&kind| {
             let key = SafeName::builder(kind.name()).build()?;
             let plan = Arc::clone(&plan);
-            Ok(Unit::with_detail(key, move || plan.descriptor_rows(kind)))
+            Ok(Unit::<_, RecognitionDetail>::with_detail(key, move || {
+                plan.descriptor_rows(kind)
+            }))
         })
         .collect::<Result<Vec<_>, BoxError>>()?;
     let experiment = Experiment {
@@ -232,8 +235,15 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
             name: name.clone(),
             description: DESCRIPTION.to_string(),
             plots: vec![
-                PlotSpec::accuracy(name, &format!("Trained and tested on {}", real.frames_words()))
-                    .with_chance(plan.labels.len()),
+                PlotSpec::accuracy(
+                    name.clone(),
+                    &format!("Trained and tested on {}", real.frames_words()),
+                )
+                .with_chance(plan.labels.len()),
+                PlotSpec::reliability(
+                    SafeName::new(format!("{name}-reliability"))?,
+                    &format!("Calibration: trained and tested on {}", real.frames_words()),
+                )?,
             ],
         },
         config: plan.config(context, &real, &pruning),
@@ -311,13 +321,13 @@ impl TrialPlan<'_> {
         }
     }
 
-    /// Every trial's accuracy rows of one descriptor, and the per-label outcomes they count.
-    fn descriptor_rows(
-        &self,
-        kind: DescriptorKind,
-    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+    /// Every trial's accuracy rows of one descriptor, the per-label outcomes they count, and the
+    /// reliability table of the descriptor's curve, pooled over its trials.
+    fn descriptor_rows(&self, kind: DescriptorKind) -> Result<RecognitionRows, BoxError> {
         let descriptor = kind.build();
         let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        let mut table = ReliabilityTable::default();
+        let mut curve = None;
         for trial in 0..self.options.trials {
             let evaluation = self.evaluate_trial(descriptor.as_ref(), trial)?;
             let meta = AccuracyCurve {
@@ -332,8 +342,11 @@ impl TrialPlan<'_> {
             // One definition of accuracy (`recognize::AccuracyPoint`): every label counts.
             rows.extend(meta.rows(&evaluation.accuracy));
             per_object.extend(meta.object_rows(&evaluation)?);
+            table.merge(&evaluation.reliability());
+            curve = Some(meta);
         }
-        Ok((rows, per_object))
+        let reliability = curve.map_or_else(Vec::new, |meta| meta.reliability_rows(&table));
+        Ok((rows, (per_object, reliability)))
     }
 
     /// Trial `trial`: its split, a model trained and selected on it, each label's test frames

@@ -19,7 +19,7 @@ use super::scale::DataCounts;
 use crate::control::ControlConfig;
 use crate::dataset::recorded::RealData;
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow};
 use crate::experiment::factor::Factors;
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
@@ -31,7 +31,8 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::paper::sim_to_real::SimToRealPreprocess;
 use crate::recognize::{
-    CodebookKind, LabelledFeatures, ReadingRange, TrainConfig, TrainedModel, Trial, evaluate, make_trials,
+    CodebookKind, LabelledFeatures, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial,
+    evaluate, make_trials,
 };
 use crate::rng;
 use crate::sim::PerturbationBounds;
@@ -212,7 +213,14 @@ impl RecognitionSweep {
             spec: ExperimentSpec {
                 name: name.clone(),
                 description: self.description.to_string(),
-                plots: vec![self.plot(name, &self.plot_title(real.as_deref()), objects.specs.len())],
+                plots: vec![
+                    self.plot(
+                        name.clone(),
+                        &self.plot_title(real.as_deref()),
+                        objects.specs.len(),
+                    ),
+                    self.reliability_plot(&name, &self.plot_title(real.as_deref()))?,
+                ],
             },
             config,
             units: self.units(context, &objects, counts, &plans, real),
@@ -228,7 +236,7 @@ impl RecognitionSweep {
         counts: DataCounts,
         plans: &[UnitPlan<'a>],
         real: Option<Arc<RealData>>,
-    ) -> Vec<Unit<'a, AccuracyRow, PerObjectRow>> {
+    ) -> Vec<Unit<'a, AccuracyRow, RecognitionDetail>> {
         plans
             .iter()
             .map(|plan| {
@@ -252,6 +260,18 @@ impl RecognitionSweep {
             Some(template) => plot.with_legend(template),
             None => plot,
         }
+    }
+
+    /// The reliability diagram of the sweep's curves, `<name>-reliability`, titled `title`.
+    pub(super) fn reliability_plot(&self, name: &SafeName, title: &str) -> Result<PlotSpec, BoxError> {
+        let plot = PlotSpec::reliability(
+            SafeName::new(format!("{name}-reliability"))?,
+            &format!("Calibration: {title}"),
+        )?;
+        Ok(match self.legend {
+            Some(template) => plot.with_legend(template),
+            None => plot,
+        })
     }
 
     /// Every curve's levels are valid and of the same factors in the same order, so that every row
@@ -305,7 +325,7 @@ impl RecognitionSweep {
         kind: DescriptorKind,
         training: &TrainConfig,
         real: Option<&RealData>,
-    ) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+    ) -> Result<RecognitionRows, BoxError> {
         let descriptor = kind.build();
         let model = data.context.store.model(
             &data.training_request()?,
@@ -313,7 +333,7 @@ impl RecognitionSweep {
             descriptor.as_ref(),
             training,
         )?;
-        let (mut rows, mut per_object) = (Vec::new(), Vec::new());
+        let (mut rows, mut per_object, mut reliability) = (Vec::new(), Vec::new(), Vec::new());
         for curve in &data.setting.curves {
             let trials = match curve.test {
                 TestData::Real => {
@@ -328,35 +348,40 @@ impl RecognitionSweep {
                 }
                 test => data.dataset_trials(test, &model, descriptor.as_ref(), &curve.factors)?,
             };
+            let mut table = ReliabilityTable::default();
+            let mut meta = AccuracyCurve {
+                experiment: self.name.to_string(),
+                descriptor: kind.name().to_string(),
+                factors: curve.factors.clone(),
+                trial: 0,
+                seed: data.context.seed,
+                stream_seed: 0,
+            };
             for (trial, (seed, object_trials)) in trials.iter().enumerate() {
-                let meta = AccuracyCurve {
-                    experiment: self.name.to_string(),
-                    descriptor: kind.name().to_string(),
-                    factors: curve.factors.clone(),
-                    trial: trial as u32,
-                    seed: data.context.seed,
-                    stream_seed: *seed,
-                };
-                let (curve_rows, curve_objects) =
+                (meta.trial, meta.stream_seed) = (trial as u32, *seed);
+                let (curve_rows, curve_objects, trial_table) =
                     trial_rows(&meta, &model, object_trials, &curve.factors, trial)?;
                 rows.extend(curve_rows);
                 per_object.extend(curve_objects);
+                table.merge(&trial_table);
             }
+            reliability.extend(meta.reliability_rows(&table));
         }
-        Ok((rows, per_object))
+        Ok((rows, (per_object, reliability)))
     }
 }
 
 /// The rows of one trial of a curve: accuracy and reliability after every reading count up to the
 /// longest object trial. One definition of accuracy (`recognize::AccuracyPoint`): every object
-/// counts, an unread one as a miss; the per-object rows are the outcomes it counts.
+/// counts, an unread one as a miss; the per-object rows are the outcomes it counts; the reliability
+/// table holds every belief of the trial (pooled over trials into the curve's).
 fn trial_rows(
     meta: &AccuracyCurve,
     model: &TrainedModel,
     object_trials: &[Trial],
     curve: &Factors,
     trial: usize,
-) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>), BoxError> {
+) -> Result<(Vec<AccuracyRow>, Vec<PerObjectRow>, ReliabilityTable), BoxError> {
     let longest = object_trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
     if longest == 0 {
         return Err(
@@ -364,8 +389,18 @@ fn trial_rows(
         );
     }
     let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
-    Ok((meta.rows(&evaluation.accuracy), meta.object_rows(&evaluation)?))
+    Ok((
+        meta.rows(&evaluation.accuracy),
+        meta.object_rows(&evaluation)?,
+        evaluation.reliability(),
+    ))
 }
+
+/// The further tables of a recognition experiment: per-object outcomes and per-curve reliability.
+pub(crate) type RecognitionDetail = (PerObjectRow, ReliabilityRow);
+
+/// A recognition unit's rows: accuracy, and the per-object and reliability rows.
+pub(crate) type RecognitionRows = (Vec<AccuracyRow>, (Vec<PerObjectRow>, Vec<ReliabilityRow>));
 
 impl Setting {
     /// The scale's data counts with this setting's multiple of the training readings (at least

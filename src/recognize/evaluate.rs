@@ -421,14 +421,16 @@ impl Evaluation {
         out
     }
 
-    /// Writes `posterior.csv`, `posterior_long.csv`, `accuracy.csv` and `confusion.csv` into `dir`
-    /// (created if missing), each atomically; returns their paths.
+    /// Writes `posterior.csv`, `posterior_long.csv`, `accuracy.csv`, `confusion.csv` and
+    /// `reliability.csv` (the [`reliability`](Self::reliability) table of every row of
+    /// `posterior.csv`) into `dir` (created if missing), each atomically; returns their paths.
     pub fn write_csvs(&self, dir: &Path) -> Result<Vec<PathBuf>, RecognizeError> {
         let files = [
             ("posterior.csv", self.posterior_csv()),
             ("posterior_long.csv", self.posterior_long_csv()),
             ("accuracy.csv", self.accuracy_csv()),
             ("confusion.csv", self.confusion.to_csv_string()),
+            ("reliability.csv", self.reliability().to_csv_string()),
         ];
         let mut paths = Vec::new();
         for (name, text) in files {

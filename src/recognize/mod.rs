@@ -34,6 +34,7 @@ pub(crate) mod neighbours;
 pub(crate) mod object_model;
 pub(crate) mod pca;
 pub(crate) mod posterior;
+pub(crate) mod reliability;
 pub(crate) mod selection;
 
 // The model: trained, saved and loaded, one descriptor or several fused.
@@ -63,6 +64,8 @@ pub use evaluate::{
     AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, TrialOutcome, evaluate, evaluate_with,
     make_trials,
 };
+// Calibration: whether the top probability can be trusted (ECE, reliability table).
+pub use reliability::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
 
 /// The stages of Fig. 4 one by one, for code that fits or inspects them on their own (the tests,
 /// the benchmarks, the parity checks against scikit-learn): features as a matrix, the PCA, the
