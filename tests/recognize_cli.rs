@@ -395,3 +395,92 @@ fn recognize_writes_the_reliability_table_and_prints_its_ece() {
     let png = std::fs::read(dir.path().join("out/reliability.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
 }
+
+/// Issue 38: `train --calibration` refits the posterior's tempering on another dataset (printed,
+/// and stored: `recognize` then reports the same numbers), `recognize --posterior eq15` recognises
+/// with the paper's rule (same accuracy, other probabilities), and an unknown rule is refused
+/// naming the rules there are.
+#[test]
+fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    recognize_toy::dataset(40, 1)
+        .write(dir.path().join("train.csv").as_path())
+        .unwrap();
+    recognize_toy::dataset(20, 5)
+        .write(dir.path().join("arm.csv").as_path())
+        .unwrap();
+    recognize_toy::dataset(20, 3)
+        .write(dir.path().join("test.csv").as_path())
+        .unwrap();
+    let train = |extra: &[&str], out: &str| {
+        let (data, out) = (p("train.csv"), p(out));
+        let mut args = vec!["train", "--dataset", &data, "--descriptor", "polar-fourier"];
+        args.extend_from_slice(&["--k", "3", "--restarts", "1", "--out", &out]);
+        args.extend_from_slice(extra);
+        taction(&args)
+    };
+    let (ok, held_out, stderr) = train(&[], "held.json");
+    assert!(ok, "{stderr}");
+    let arm = p("arm.csv");
+    let (ok, calibrated, stderr) = train(&["--calibration", &arm], "arm.json");
+    assert!(ok, "{stderr}");
+    let line = |out: &str, key: &str| -> String {
+        out.lines()
+            .find(|l| l.contains(key))
+            .unwrap_or_default()
+            .to_string()
+    };
+    let on_arm = line(&calibrated, "arm.csv");
+    assert!(on_arm.contains("tau = "), "{calibrated}");
+    assert_ne!(
+        on_arm.split("tau").nth(1),
+        line(&held_out, "posterior calibrated").split("tau").nth(1),
+        "{held_out}\n{calibrated}"
+    );
+    let (ok, out, stderr) = recognise_30(&p("arm.json"), &p("test.csv"), &p("r_cal"));
+    assert!(ok, "{stderr}");
+    let tau = on_arm
+        .split("tau = ")
+        .nth(1)
+        .and_then(|t| t.split(',').next())
+        .unwrap();
+    assert!(out.contains(&format!("tau = {tau}")), "{out}\n{on_arm}");
+    let (ok, eq15, stderr) = taction(&[
+        "recognize",
+        "--model",
+        &p("arm.json"),
+        "--dataset",
+        &p("test.csv"),
+        "--readings",
+        "1..30",
+        "--out",
+        &p("r_eq15"),
+        "--posterior",
+        "eq15",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(eq15.contains("posterior Eq. 15"), "{eq15}");
+    let accuracy = |out: &str| line(out, "accuracy at  30");
+    assert_eq!(
+        accuracy(&out).split('(').next(),
+        accuracy(&eq15).split('(').next()
+    );
+    let read = |d: &str| std::fs::read_to_string(dir.path().join(d).join("posterior.csv")).unwrap();
+    assert_ne!(read("r_cal"), read("r_eq15"));
+    let (ok, _, stderr) = taction(&[
+        "recognize",
+        "--model",
+        &p("arm.json"),
+        "--dataset",
+        &p("test.csv"),
+        "--out",
+        &p("r_bad"),
+        "--posterior",
+        "bayes",
+    ]);
+    assert!(
+        !ok && stderr.contains("bayes") && stderr.contains("eq15"),
+        "{stderr}"
+    );
+}

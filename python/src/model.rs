@@ -291,16 +291,24 @@ fn fit(
 
 /// The recogniser `taction demo` trains for the arm's own touches (`ArmTrainingRecipe`): sampler
 /// readings from starts the arm can reach, MNTI and SIFT fused over the neighbour codebook.
-/// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`.
+/// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`; `calibration`, the
+/// arm's own explorations (`collect(..., mode="planner")`), calibrates the posterior (without it,
+/// the readings held out of `training` do).
 #[pyfunction]
-#[pyo3(signature = (training, seed=1))]
-pub fn train_for_arm(py: Python<'_>, training: &Dataset, seed: u64) -> PyResult<Model> {
+#[pyo3(signature = (training, seed=1, calibration=None))]
+pub fn train_for_arm(
+    py: Python<'_>,
+    training: &Dataset,
+    seed: u64,
+    calibration: Option<&Dataset>,
+) -> PyResult<Model> {
     let recipe = ArmTrainingRecipe {
         readings_per_object: training.inner.len(),
         seed,
     };
     let data = training.inner.clone();
-    let model = py.detach(|| recipe.fit(&data)).map_err(refused)?;
+    let arm = calibration.map(|c| c.inner.clone());
+    let model = py.detach(|| recipe.fit(&data, arm.as_deref())).map_err(refused)?;
     Ok(Model {
         inner: Arc::new(Recognizer::Fused(model)),
     })

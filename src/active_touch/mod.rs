@@ -53,7 +53,7 @@ use crate::dataset::{Dataset, Reading};
 use crate::describe::DescriptorKind;
 use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
 use crate::explore::collect::{CollectMode, CollectPlan};
-use crate::explore::{Planner, SamplerConfig};
+use crate::explore::{Planner, PlannerConfig, SamplerConfig};
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
@@ -62,9 +62,12 @@ use crate::recognize::{
     CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer, Tempering,
     TrainConfig, TrainedModel,
 };
-use crate::sim::{PerturbationBounds, Scene};
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::{RangeError, Valid};
+
+/// The stream of the recipe's seed its calibration explorations draw from.
+const CALIBRATION_SEED_STREAM: u64 = 7;
 
 /// `kappa`: how many readings' worth of weight the belief's own prediction has against the readings
 /// of a neighbourhood (see the module docs). One: a single nearby reading already counts as much as
@@ -379,19 +382,53 @@ impl ArmTrainingRecipe {
         Valid::new(config.with_grid_for_dataset(training, false))
     }
 
-    /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan)).
-    pub fn fit(&self, training: &Dataset) -> Result<FusedModel, RecognizeError> {
+    /// Converged readings per object of the arm's own explorations the posterior is calibrated
+    /// on: a thirtieth of the training readings, 10 to 100 (100 for the demo's 3000).
+    pub fn calibration_readings(&self) -> usize {
+        (self.readings_per_object / 30).clamp(10, 100)
+    }
+
+    /// The calibration data's collection: the arm exploring blind (L = 0.5, the object fixed) with
+    /// the default controllers, [`calibration_readings`](Self::calibration_readings) per object of
+    /// `objects`, on a seed of its own.
+    pub fn calibration_plan(
+        &self,
+        sensor: SensorConfig,
+        objects: &[ObjectSpec],
+    ) -> Result<CollectPlan, RangeError> {
+        let readings = self.calibration_readings();
+        Ok(CollectPlan {
+            mode: CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
+                objects, readings, 0.5, None,
+            ))?),
+            sensor,
+            control: Valid::default(),
+            perturbation: PerturbationBounds::NONE,
+            readings_per_object: readings,
+            seed: crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM),
+        })
+    }
+
+    /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan))
+    /// and, given the arm's explorations `calibration` ([`calibration_plan`](Self::calibration_plan)),
+    /// calibrates its posterior on them (`recognize::calibration`: the arm's successive touches
+    /// are correlated, which the sampler's held-out readings cannot show); without them the
+    /// posterior is calibrated on the held-out readings.
+    pub fn fit(
+        &self,
+        training: &Dataset,
+        calibration: Option<&Dataset>,
+    ) -> Result<FusedModel, RecognizeError> {
         let choice = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
             name: "descriptors",
             what: e.to_string(),
         })?;
-        FusedModel::fit(
-            &self.train_config(training)?,
-            training,
-            None,
-            &choice,
-            &mut |_| {},
-        )
+        let config = self.train_config(training)?;
+        let model = FusedModel::fit(&config, training, None, &choice, &mut |_| {})?;
+        match calibration {
+            Some(arm) => model.calibrate_on(arm, config.trial_readings),
+            None => Ok(model),
+        }
     }
 }
 

@@ -18,7 +18,7 @@ use clap::Args;
 use rand::RngExt;
 use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, TouchRun, explore_recognizing};
 use taction::control::sensor_reader;
-use taction::dataset::describe_shortfalls;
+use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::CollectionProgress;
 use taction::experiment::{Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
@@ -178,6 +178,7 @@ fn train_model(
     if !short.is_empty() {
         eprintln!("warning: training: {}", describe_shortfalls(&short));
     }
+    let calibration = collect_calibration(recipe, set, objects, sensor)?;
     let config = recipe.train_config(&dataset)?;
     println!(
         "training {}: {} training readings; trying k = {:?}",
@@ -185,7 +186,37 @@ fn train_model(
         config.grid_training_features(converged, false),
         config.ks
     );
-    Ok(recipe.fit(&dataset)?)
+    let model = recipe.fit(&dataset, Some(&calibration))?;
+    let t = model.tempering;
+    println!(
+        "posterior calibrated on the arm's explorations: tau = {:.3}, beta = {:.2}, floor = {:.3}",
+        t.tau(),
+        t.beta(),
+        t.floor()
+    );
+    Ok(model)
+}
+
+/// The arm's own blind explorations the recipe calibrates the posterior on, with a progress bar.
+fn collect_calibration(
+    recipe: &ArmTrainingRecipe,
+    set: &ObjectSet,
+    objects: &[ObjectSpec],
+    sensor: SensorConfig,
+) -> Result<Dataset, Box<dyn std::error::Error>> {
+    let readings = recipe.calibration_readings();
+    println!("calibration: the arm exploring each object blind for {readings} readings");
+    let progress = CollectionProgress::new("calibration data", objects.len(), readings);
+    let dataset =
+        recipe
+            .calibration_plan(sensor, objects)?
+            .collect_dataset(&set.id(), objects, 0, &|| progress.converged())?;
+    progress.finish(dataset.converged_only().len());
+    let short = dataset.shortfalls(readings);
+    if !short.is_empty() {
+        eprintln!("warning: calibration: {}", describe_shortfalls(&short));
+    }
+    Ok(dataset)
 }
 
 /// The object to explore and its scene.
