@@ -33,6 +33,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
+use crate::recognize::evaluate::Trial;
 use crate::recognize::gmm::log_sum_exp;
 
 /// `w(n) = tau n^(beta - 1)`, the weight of the log-likelihood after `n` readings (module docs).
@@ -206,6 +207,25 @@ impl Tempering {
 pub struct EvidencePath {
     pub object: usize,
     pub log_likelihoods: Vec<Vec<f64>>,
+}
+
+impl EvidencePath {
+    /// The path of `trial`: each reading given to `observe`, which adds it to a posterior and
+    /// returns the untempered log-likelihoods of everything observed so far.
+    pub fn of<R>(
+        trial: &Trial<R>,
+        mut observe: impl FnMut(&R) -> Result<Vec<f64>, RecognizeError>,
+    ) -> Result<Self, RecognizeError> {
+        let log_likelihoods = trial
+            .readings
+            .iter()
+            .map(&mut observe)
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            object: trial.object,
+            log_likelihoods,
+        })
+    }
 }
 
 /// `-ln p(true object | r_1..r_n)` under `tempering`, averaged over every prefix of every trial.

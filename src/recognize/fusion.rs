@@ -231,17 +231,9 @@ impl FusedModel {
             .iter()
             .map(|trial| {
                 let mut posterior = self.posterior();
-                let log_likelihoods = trial
-                    .readings
-                    .iter()
-                    .map(|reading| {
-                        posterior.observe(reading)?;
-                        Ok(posterior.log_likelihoods())
-                    })
-                    .collect::<Result<_, RecognizeError>>()?;
-                Ok(EvidencePath {
-                    object: trial.object,
-                    log_likelihoods,
+                EvidencePath::of(trial, |reading| {
+                    posterior.observe(reading)?;
+                    Ok(posterior.log_likelihoods())
                 })
             })
             .collect()

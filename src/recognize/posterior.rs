@@ -22,17 +22,9 @@ impl BagOfFeatures {
     /// (`recognize::calibration`).
     pub fn evidence_path(&self, trial: &Trial) -> Result<EvidencePath, RecognizeError> {
         let mut posterior = self.posterior();
-        let log_likelihoods = trial
-            .readings
-            .iter()
-            .map(|reading| {
-                posterior.observe(reading)?;
-                Ok(self.models().log_likelihoods(posterior.histogram()))
-            })
-            .collect::<Result<_, RecognizeError>>()?;
-        Ok(EvidencePath {
-            object: trial.object,
-            log_likelihoods,
+        EvidencePath::of(trial, |reading| {
+            posterior.observe(reading)?;
+            Ok(self.models().log_likelihoods(posterior.histogram()))
         })
     }
 }
