@@ -95,7 +95,9 @@ fn rows(csv: &Path) -> Vec<AccuracyRow> {
     let active = csv.file_stem().is_some_and(|s| s == "active");
     let after = "n_readings,accuracy,reliability,seed,stream_seed";
     if active {
-        tidy_rows(csv, &format!("{after},confident,correct_at_stop"))
+        let stops =
+            "confident_0.9,correct_at_stop_0.9,confident,correct_at_stop,confident_0.99,correct_at_stop_0.99";
+        tidy_rows(csv, &format!("{after},{stops}"))
     } else {
         tidy_rows(csv, after)
     }

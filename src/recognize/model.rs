@@ -17,7 +17,7 @@ use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
-use crate::recognize::calibration::{PosteriorRule, Tempering};
+use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::posterior::ModelPosterior;
@@ -212,7 +212,13 @@ impl TrainedModel {
         let paths = self
             .trials(data, trial_readings)?
             .iter()
-            .map(|t| self.bag.evidence_path(t))
+            .map(|trial| {
+                let mut posterior = self.bag.posterior();
+                EvidencePath::of(trial, |reading| {
+                    posterior.observe(reading)?;
+                    Ok(self.bag.models().log_likelihoods(posterior.histogram()))
+                })
+            })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             bag: self.bag.with_tempering(Tempering::fit(&paths)),

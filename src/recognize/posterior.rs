@@ -5,9 +5,8 @@
 use crate::describe::{Descriptor, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
-use crate::recognize::calibration::{EvidencePath, Tempering};
+use crate::recognize::calibration::Tempering;
 use crate::recognize::decision::Decision;
-use crate::recognize::evaluate::Trial;
 use crate::recognize::object_model::ClusterHistogram;
 use crate::tactile::TactileImage;
 
@@ -16,16 +15,6 @@ impl BagOfFeatures {
     /// posterior, so that the bag's file need not know it.)
     pub fn posterior(&self) -> OnlinePosterior<'_> {
         OnlinePosterior::new(self)
-    }
-
-    /// A trial's Eq. 15 log-likelihoods after each of its readings: what a tempering is fitted on
-    /// (`recognize::calibration`).
-    pub fn evidence_path(&self, trial: &Trial) -> Result<EvidencePath, RecognizeError> {
-        let mut posterior = self.posterior();
-        EvidencePath::of(trial, |reading| {
-            posterior.observe(reading)?;
-            Ok(self.models().log_likelihoods(posterior.histogram()))
-        })
     }
 }
 
