@@ -2,7 +2,9 @@
 //! vertices consist of collision-free configurations, while edges indicate collision-free motions
 //! between the configurations that they connect."
 
-use glam::DVec3;
+use std::collections::HashMap;
+
+use glam::{DVec3, IVec3};
 
 /// One vertex: a configuration and where it puts the pad.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,10 +25,14 @@ pub struct Vertex {
 #[derive(Debug, Clone)]
 pub struct ExplorationTree {
     vertices: Vec<Vertex>,
+    /// The vertices' pad positions binned into cubes, for [`nearest`](Self::nearest).
+    cells: PadCells,
 }
 
 impl ExplorationTree {
     pub fn new(root_q: Vec<f64>, pad_m: DVec3, pad_normal: DVec3) -> Self {
+        let mut cells = PadCells::default();
+        cells.insert(0, pad_m);
         Self {
             vertices: vec![Vertex {
                 q: root_q,
@@ -35,6 +41,7 @@ impl ExplorationTree {
                 parent: None,
                 blocked: false,
             }],
+            cells,
         }
     }
 
@@ -59,7 +66,9 @@ impl ExplorationTree {
             parent: Some(parent),
             blocked: false,
         });
-        self.vertices.len() - 1
+        let i = self.vertices.len() - 1;
+        self.cells.insert(i, pad_m);
+        i
     }
 
     /// Marks vertex `i` as in collision (see [`Vertex::blocked`]).
@@ -69,15 +78,138 @@ impl ExplorationTree {
 
     /// The vertex whose pad position is nearest to `p` (the first of equals, so ties are
     /// deterministic), among those not blocked; the root when every other one is.
+    ///
+    /// Every planner iteration asks this once of a tree of up to tens of thousands of vertices, so
+    /// it searches the cells around `p` ring by ring instead of every vertex (a linear scan was 62%
+    /// of an active-touch run's time); the answer is the scan's, ties included.
     pub fn nearest(&self, p: DVec3) -> usize {
-        let mut best = (0, f64::INFINITY);
-        for (i, v) in self.vertices.iter().enumerate().filter(|(_, v)| !v.blocked) {
-            let d = v.pad_m.distance_squared(p);
-            if d < best.1 {
-                best = (i, d);
+        let Some(centre) = PadCells::cell(p) else {
+            return self.nearest_by_scan(p);
+        };
+        let mut best = Nearest::default();
+        let offer = |best: &mut Nearest, i: usize| {
+            let v = &self.vertices[i];
+            if !v.blocked {
+                best.offer(i, v.pad_m.distance_squared(p));
+            }
+        };
+        self.cells.strays.iter().for_each(|&i| offer(&mut best, i));
+        for ring in 0..=self.cells.rings_to_cover(centre) {
+            for cell in self.cells.ring(centre, ring) {
+                self.cells.members(cell).iter().for_each(|&i| offer(&mut best, i));
+            }
+            // Vertices outside rings 0..=ring are at least `ring` cells from `p` (less a margin
+            // far above the rounding of `p / CELL_M`).
+            let reach_m = (ring as f64 * PadCells::CELL_M - 1e-9).max(0.0);
+            if best.distance_sq < reach_m * reach_m {
+                break;
             }
         }
-        best.0
+        best.index
+    }
+
+    fn nearest_by_scan(&self, p: DVec3) -> usize {
+        let mut best = Nearest::default();
+        for (i, v) in self.vertices.iter().enumerate().filter(|(_, v)| !v.blocked) {
+            best.offer(i, v.pad_m.distance_squared(p));
+        }
+        best.index
+    }
+}
+
+/// The best vertex so far of a nearest-vertex search: smallest distance, then smallest index.
+struct Nearest {
+    index: usize,
+    distance_sq: f64,
+}
+
+impl Default for Nearest {
+    fn default() -> Self {
+        Self {
+            index: 0,
+            distance_sq: f64::INFINITY,
+        }
+    }
+}
+
+impl Nearest {
+    fn offer(&mut self, index: usize, distance_sq: f64) {
+        if distance_sq < self.distance_sq || (distance_sq == self.distance_sq && index < self.index) {
+            self.index = index;
+            self.distance_sq = distance_sq;
+        }
+    }
+}
+
+/// Vertex indices binned by pad position into cubes of [`CELL_M`](Self::CELL_M), with the bounds
+/// of the occupied cells (a ring beyond them holds nothing).
+#[derive(Debug, Clone)]
+struct PadCells {
+    members: HashMap<IVec3, Vec<usize>>,
+    /// Vertices with no cell (a non-finite pad position): offered to every search.
+    strays: Vec<usize>,
+    low: IVec3,
+    high: IVec3,
+}
+
+impl Default for PadCells {
+    fn default() -> Self {
+        Self {
+            members: HashMap::new(),
+            strays: Vec::new(),
+            low: IVec3::MAX,
+            high: IVec3::MIN,
+        }
+    }
+}
+
+impl PadCells {
+    /// About the pad's own size: a tree near the object holds a few vertices a cell.
+    const CELL_M: f64 = 0.01;
+
+    /// `p`'s cell; `None` beyond 10 km (or NaN), where the search scans every cell.
+    fn cell(p: DVec3) -> Option<IVec3> {
+        let c = (p / Self::CELL_M).floor();
+        (c.abs().max_element() <= 1e6).then(|| c.as_ivec3())
+    }
+
+    fn insert(&mut self, i: usize, p: DVec3) {
+        let Some(c) = Self::cell(p) else {
+            self.strays.push(i);
+            return;
+        };
+        self.members.entry(c).or_default().push(i);
+        self.low = self.low.min(c);
+        self.high = self.high.max(c);
+    }
+
+    fn members(&self, c: IVec3) -> &[usize] {
+        self.members.get(&c).map_or(&[], Vec::as_slice)
+    }
+
+    /// The ring whose cube around `centre` contains every occupied cell.
+    fn rings_to_cover(&self, centre: IVec3) -> i32 {
+        let far = (centre - self.low).abs().max((self.high - centre).abs());
+        far.max_element().max(0)
+    }
+
+    /// The occupied-bounds cells at Chebyshev distance exactly `ring` from `centre`.
+    fn ring(&self, centre: IVec3, ring: i32) -> impl Iterator<Item = IVec3> + '_ {
+        let lo = (centre - IVec3::splat(ring)).max(self.low);
+        let hi = (centre + IVec3::splat(ring)).min(self.high);
+        (lo.x..=hi.x).flat_map(move |x| {
+            (lo.y..=hi.y).flat_map(move |y| {
+                let on_side = (x - centre.x).abs() == ring || (y - centre.y).abs() == ring;
+                let clip = |z: i32| z.max(lo.z)..=z.min(hi.z);
+                // On the ring's sides every z; inside them only its top and bottom faces.
+                let (first, second) = if on_side {
+                    (lo.z..=hi.z, 1..=0)
+                } else {
+                    (clip(centre.z - ring), clip(centre.z + ring))
+                };
+                first.chain(second).map(move |z| IVec3::new(x, y, z))
+            })
+        })
     }
 }
 
@@ -94,5 +226,54 @@ mod tests {
         assert_eq!(tree.nearest(DVec3::new(0.0, 1.8, 0.3)), b);
         assert_eq!(tree.nearest(DVec3::new(-0.1, 0.0, 0.0)), 0);
         assert_eq!(tree.vertices()[b].parent, Some(a));
+    }
+
+    /// The linear scan the cell search replaces: its answer, ties and blocked vertices included.
+    fn nearest_by_scan(tree: &ExplorationTree, p: DVec3) -> usize {
+        let mut best = (0, f64::INFINITY);
+        for (i, v) in tree.vertices().iter().enumerate().filter(|(_, v)| !v.blocked) {
+            let d = v.pad_m.distance_squared(p);
+            if d < best.1 {
+                best = (i, d);
+            }
+        }
+        best.0
+    }
+
+    #[test]
+    fn the_cell_search_finds_what_a_scan_finds() {
+        use rand::RngExt;
+        let mut rng = crate::rng::rng(7);
+        let mut point = |spread: f64| {
+            DVec3::new(rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>()) * spread - spread / 2.0
+        };
+        let mut tree = ExplorationTree::new(vec![0.0], DVec3::new(0.0, 0.0, 0.5), DVec3::Z);
+        for i in 0..3000 {
+            // Clustered pads, some exactly repeated (ties), some blocked.
+            let p = if i % 10 == 0 {
+                tree.vertices()[i / 2].pad_m
+            } else {
+                point(0.3)
+            };
+            let v = tree.add(i / 3, vec![0.0], p, DVec3::Z);
+            if i % 17 == 0 {
+                tree.block(v);
+            }
+        }
+        let queries: Vec<DVec3> = (0..500)
+            .map(|i| match i % 4 {
+                0 => point(0.3),
+                1 => point(3.0),
+                2 => tree.vertices()[i].pad_m,
+                _ => point(0.3) + DVec3::new(40.0, -7.0, 0.0),
+            })
+            .collect();
+        for q in queries {
+            assert_eq!(tree.nearest(q), nearest_by_scan(&tree, q), "query {q}");
+        }
+        let mut all_blocked = ExplorationTree::new(vec![0.0], DVec3::ZERO, DVec3::Z);
+        let v = all_blocked.add(0, vec![0.0], DVec3::X, DVec3::Z);
+        all_blocked.block(v);
+        assert_eq!(all_blocked.nearest(DVec3::X), 0);
     }
 }
