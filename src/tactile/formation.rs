@@ -386,7 +386,13 @@ mod tests {
             return;
         }
         let mut rng = crate::rng::rng(31);
-        for (n, rays, sigma) in [(6, 4, None), (6, 16, None), (14, 4, None), (26, 16, None), (7, 9, Some(0.0))] {
+        for (n, rays, sigma) in [
+            (6, 4, None),
+            (6, 16, None),
+            (14, 4, None),
+            (26, 16, None),
+            (7, 9, Some(0.0)),
+        ] {
             let base = SensorConfig::default();
             let config = SensorConfig {
                 rows: n,

@@ -471,30 +471,12 @@ impl FaceSetup {
             SPAN_MIN_COLUMNS_IN_FRONT
         };
         let spans = (cols.len() > span_min).then(|| [ax, bx, cx].map(|slope| (slope, 1.0 / slope)));
-        let widen_m = grid.dx_m();
         for i in rows {
             let (wa_row, wb_row, z_row) = self.at_row(grid.y(i));
-            let mut scan = cols.clone();
-            if let Some(slopes) = &spans {
-                // The row's span inside the triangle: each weight is affine in x, so `w >= tol` is
-                // a half-line. Widened by a sample on each side, the span only skips samples the
-                // exact test below rejects, whatever the rounding of its bounds.
-                let mut span = (f64::NEG_INFINITY, f64::INFINITY);
-                let at_zero = [wa_row, wb_row, 1.0 - wa_row - wb_row];
-                for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
-                    let bound = (tol - w0) * inv_slope;
-                    if *slope > 0.0 {
-                        span.0 = span.0.max(bound);
-                    } else if *slope < 0.0 {
-                        span.1 = span.1.min(bound);
-                    } else if w0 < tol {
-                        span = (f64::INFINITY, f64::NEG_INFINITY);
-                    }
-                }
-                let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
-                let first = in_span.start.max(cols.start);
-                scan = first..in_span.end.min(cols.end).max(first);
-            }
+            let scan = match &spans {
+                Some(slopes) => row_span(grid, slopes, [wa_row, wb_row, 1.0 - wa_row - wb_row], &cols),
+                None => cols.clone(),
+            };
             let row = i * grid.cols;
             if !behind_possible {
                 // The whole face is at or in front of the pad plane: a branch-free z-buffer update.
@@ -526,6 +508,35 @@ impl FaceSetup {
             }
         }
     }
+}
+
+/// The columns of `cols` a face may cover on one sample row: each weight is affine in x
+/// (`slopes`: its slope and the slope's inverse; `at_zero`: its value at x = 0), so `w >= tol`
+/// is a half-line. Widened by a sample on each side, the span only skips samples the exact test
+/// rejects, whatever the rounding of its bounds.
+#[inline(always)]
+fn row_span(
+    grid: &SampleGrid,
+    slopes: &[(f64, f64); 3],
+    at_zero: [f64; 3],
+    cols: &std::ops::Range<usize>,
+) -> std::ops::Range<usize> {
+    let tol = -EDGE_EPS;
+    let mut span = (f64::NEG_INFINITY, f64::INFINITY);
+    for ((slope, inv_slope), w0) in slopes.iter().zip(at_zero) {
+        let bound = (tol - w0) * inv_slope;
+        if *slope > 0.0 {
+            span.0 = span.0.max(bound);
+        } else if *slope < 0.0 {
+            span.1 = span.1.min(bound);
+        } else if w0 < tol {
+            span = (f64::INFINITY, f64::NEG_INFINITY);
+        }
+    }
+    let widen_m = grid.dx_m();
+    let in_span = grid.col_range(span.0 - widen_m, span.1 + widen_m);
+    let first = in_span.start.max(cols.start);
+    first..in_span.end.min(cols.end).max(first)
 }
 
 #[cfg(test)]
@@ -687,7 +698,10 @@ mod tests {
             }
         }
         // Not vacuous: surfaces in the covering, pad points inside the object, and no contact.
-        assert!(covered > 60 && inside > 30 && empty > 10, "{covered} covered, {inside} inside, {empty} empty");
+        assert!(
+            covered > 60 && inside > 30 && empty > 10,
+            "{covered} covered, {inside} inside, {empty} empty"
+        );
     }
 
     fn grid() -> SampleGrid {
