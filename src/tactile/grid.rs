@@ -85,6 +85,12 @@ impl SampleGrid {
         self.xs_m[j]
     }
 
+    /// x of every sample column, in column order.
+    #[inline]
+    pub fn xs_m(&self) -> &[f64] {
+        &self.xs_m
+    }
+
     /// y of sample row `i`.
     #[inline]
     pub fn y(&self, i: usize) -> f64 {
