@@ -174,3 +174,15 @@ fn indices<'a>(values: impl Iterator<Item = &'a u32>) -> String {
     }
     text
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_indices_are_the_space_separated_decimal_indices() {
+        let triangles = [[0u32, 1, 2], [3, 40, 5_000_000]];
+        assert_eq!(indices(triangles.iter().flatten()), "0 1 2 3 40 5000000");
+        assert_eq!(indices([].iter()), "");
+    }
+}
