@@ -5,12 +5,21 @@
 /// `v` in shortest round-trip form, for files: plain decimals for ordinary magnitudes, exponent
 /// form for tiny or huge ones (where plain decimals would run to hundreds of digits).
 pub fn round_trip(v: f64) -> String {
+    let mut text = String::new();
+    push_round_trip(&mut text, v);
+    text
+}
+
+/// Appends [`round_trip`]`(v)` to `out` without a string of its own: MJCF writes a scanned mesh's
+/// million coordinates this way (issue 39).
+pub fn push_round_trip(out: &mut String, v: f64) {
+    use std::fmt::Write;
     let a = v.abs();
-    if a == 0.0 || (1e-5..1e16).contains(&a) {
-        v.to_string()
+    let _ = if a == 0.0 || (1e-5..1e16).contains(&a) {
+        write!(out, "{v}")
     } else {
-        format!("{v:e}")
-    }
+        write!(out, "{v:e}")
+    };
 }
 
 /// `v` with at most four significant digits, trailing zeros dropped: `1.2`, `0.576`, `12`, and

@@ -6,7 +6,7 @@
 //! the files, with the object slot filled by a mesh and extra parts (sensor plugins) added.
 
 use crate::sim::SimError;
-use crate::units::round_trip;
+use crate::units::push_round_trip;
 
 /// `mjcf/arm.xml`: the arm of Sec. V-A1 with the sensor pad site.
 pub const ARM_XML: &str = include_str!("../../mjcf/arm.xml");
@@ -147,7 +147,7 @@ pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
         if i > 0 {
             s.push(' ');
         }
-        s.push_str(&round_trip(v));
+        push_round_trip(&mut s, v);
     }
     s
 }

@@ -133,14 +133,7 @@ impl ObjectSpec {
             ),
             None => {
                 let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
-                let face = self
-                    .mesh
-                    .triangles
-                    .iter()
-                    .flatten()
-                    .map(|i| i.to_string())
-                    .collect::<Vec<_>>()
-                    .join(" ");
+                let face = indices(self.mesh.triangles.iter().flatten());
                 format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
             }
         }
@@ -166,5 +159,30 @@ impl ObjectSpec {
             ));
         }
         shell
+    }
+}
+
+/// Space-separated vertex indices, written into one string (a scanned mesh has millions).
+fn indices<'a>(values: impl Iterator<Item = &'a u32>) -> String {
+    use std::fmt::Write;
+    let mut text = String::new();
+    for (k, i) in values.enumerate() {
+        if k > 0 {
+            text.push(' ');
+        }
+        let _ = write!(text, "{i}");
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_indices_are_the_space_separated_decimal_indices() {
+        let triangles = [[0u32, 1, 2], [3, 40, 5_000_000]];
+        assert_eq!(indices(triangles.iter().flatten()), "0 1 2 3 40 5000000");
+        assert_eq!(indices([].iter()), "");
     }
 }

@@ -1,0 +1,32 @@
+//! Writes test spheres for the large-mesh measurements (issue 39): icospheres and geodesic spheres
+//! 8 cm across, as a scanned object would be, as OBJ files.
+//!
+//! `cargo run --release --example icosphere -- OUT_DIR` writes `sphere_20k.obj` (20,480 triangles),
+//! `sphere_200k.obj` (200,000) and `sphere_1300k.obj` (1,310,720) into `OUT_DIR`.
+
+#[path = "../tests/sensor_support/mod.rs"]
+mod sensor_support;
+
+use std::path::PathBuf;
+
+use glam::DVec3;
+use sensor_support::{geodesic_sphere, icosphere};
+use taction::mesh::write_obj;
+
+const RADIUS_M: f64 = 0.04;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = PathBuf::from(std::env::args().nth(1).ok_or("usage: icosphere OUT_DIR")?);
+    std::fs::create_dir_all(&out)?;
+    let spheres = [
+        ("sphere_20k", icosphere(DVec3::ZERO, RADIUS_M, 5)),
+        ("sphere_200k", geodesic_sphere(DVec3::ZERO, RADIUS_M, 100)),
+        ("sphere_1300k", icosphere(DVec3::ZERO, RADIUS_M, 8)),
+    ];
+    for (name, mesh) in spheres {
+        let path = out.join(format!("{name}.obj"));
+        write_obj(&mesh, &path, &format!("{name}: a sphere 8 cm across"))?;
+        println!("{}: {} triangles", path.display(), mesh.triangles.len());
+    }
+    Ok(())
+}
