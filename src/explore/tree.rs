@@ -203,7 +203,7 @@ impl PadCells {
                 let clip = |z: i32| z.max(lo.z)..=z.min(hi.z);
                 // On the ring's sides every z; inside them only its top and bottom faces.
                 let (first, second) = if on_side {
-                    (lo.z..=hi.z, 1..=0)
+                    (lo.z..=hi.z, hi.z + 1..=hi.z)
                 } else {
                     (clip(centre.z - ring), clip(centre.z + ring))
                 };

@@ -138,7 +138,8 @@ struct VertexBoxes {
 impl VertexBoxes {
     fn new(mut points: Vec<DVec3>) -> Self {
         let mut boxes = Vec::new();
-        let mut stack = vec![0..points.len()];
+        let mut stack = Vec::new();
+        stack.push(0..points.len());
         while let Some(range) = stack.pop() {
             let (lo, hi) = points[range.clone()]
                 .iter()
