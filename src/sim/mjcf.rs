@@ -139,7 +139,7 @@ fn xml_chars(text: &str) -> String {
         .collect()
 }
 
-/// Space-separated numbers in shortest round-trip form ([`round_trip`]), so the compiled model
+/// Space-separated numbers in shortest round-trip form ([`round_trip`](crate::units::round_trip)), so the compiled model
 /// holds exactly these values.
 pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
     let mut s = String::new();
