@@ -2,7 +2,8 @@
 //! 8 cm across, as a scanned object would be, as OBJ files.
 //!
 //! `cargo run --release --example icosphere -- OUT_DIR` writes `sphere_20k.obj` (20,480 triangles),
-//! `sphere_200k.obj` (200,000) and `sphere_1300k.obj` (1,310,720) into `OUT_DIR`.
+//! `sphere_200k.obj` (200,000) and `sphere_1300k.obj` (1,310,720) into `OUT_DIR`; without `OUT_DIR`
+//! it writes the 20k sphere alone into the system's temporary folder.
 
 #[path = "../tests/sensor_support/mod.rs"]
 mod sensor_support;
@@ -16,13 +17,15 @@ use taction::mesh::write_obj;
 const RADIUS_M: f64 = 0.04;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out = PathBuf::from(std::env::args().nth(1).ok_or("usage: icosphere OUT_DIR")?);
+    let out_dir = std::env::args().nth(1).map(PathBuf::from);
+    let all = out_dir.is_some();
+    let out = out_dir.unwrap_or_else(|| std::env::temp_dir().join("taction-spheres"));
     std::fs::create_dir_all(&out)?;
-    let spheres = [
-        ("sphere_20k", icosphere(DVec3::ZERO, RADIUS_M, 5)),
-        ("sphere_200k", geodesic_sphere(DVec3::ZERO, RADIUS_M, 100)),
-        ("sphere_1300k", icosphere(DVec3::ZERO, RADIUS_M, 8)),
-    ];
+    let mut spheres = vec![("sphere_20k", icosphere(DVec3::ZERO, RADIUS_M, 5))];
+    if all {
+        spheres.push(("sphere_200k", geodesic_sphere(DVec3::ZERO, RADIUS_M, 100)));
+        spheres.push(("sphere_1300k", icosphere(DVec3::ZERO, RADIUS_M, 8)));
+    }
     for (name, mesh) in spheres {
         let path = out.join(format!("{name}.obj"));
         write_obj(&mesh, &path, &format!("{name}: a sphere 8 cm across"))?;

@@ -2,8 +2,12 @@
 //! object's build (parse, validate, face outward, size), the scene's MJCF text (with the collision
 //! shell), MuJoCo's compile, the data (the sensor's BVH is built there), the first reading.
 //!
-//! `cargo run --release --example mesh_phases -- MESH.obj`; run it under `/usr/bin/time -v` for the
+//! `cargo run --release --example mesh_phases -- MESH.obj` (without a mesh: a 20,480-triangle sphere
+//! 8 cm across, written to the temporary folder first); run it under `/usr/bin/time -v` for the
 //! peak memory.
+
+#[path = "../tests/sensor_support/mod.rs"]
+mod sensor_support;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -19,7 +23,15 @@ use taction::tactile::{SensorConfig, free_floating_builder};
 use taction::valid::Valid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = PathBuf::from(std::env::args().nth(1).ok_or("usage: mesh_phases MESH")?);
+    let path = match std::env::args().nth(1) {
+        Some(path) => PathBuf::from(path),
+        None => {
+            let path = std::env::temp_dir().join("taction-mesh-phases-sphere_20k.obj");
+            let sphere = sensor_support::icosphere(DVec3::ZERO, 0.04, 5);
+            taction::mesh::write_obj(&sphere, &path, "a sphere 8 cm across")?;
+            path
+        }
+    };
     let lap = |what: &str, since: &mut Instant| {
         eprintln!("{what:<28} {:8.3} s", since.elapsed().as_secs_f64());
         *since = Instant::now();
