@@ -139,15 +139,21 @@ fn xml_chars(text: &str) -> String {
         .collect()
 }
 
-/// Space-separated numbers in shortest round-trip form ([`round_trip`](crate::units::round_trip)), so the compiled model
-/// holds exactly these values.
+/// Space-separated numbers in shortest round-trip form
+/// ([`round_trip`](crate::units::round_trip)), so the compiled model holds exactly these values.
 pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
+    space_separated(values, push_round_trip)
+}
+
+/// `values` written by `write` into one string, separated by spaces: MJCF's list attributes, built
+/// without a string per value (a scanned mesh has millions).
+pub fn space_separated<T>(values: impl IntoIterator<Item = T>, write: impl Fn(&mut String, T)) -> String {
     let mut s = String::new();
     for (i, v) in values.into_iter().enumerate() {
         if i > 0 {
             s.push(' ');
         }
-        push_round_trip(&mut s, v);
+        write(&mut s, v);
     }
     s
 }

@@ -8,7 +8,7 @@ use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh};
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
-use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers};
+use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, space_separated};
 
 use crate::bodies::OBJECT_BODY;
 
@@ -162,17 +162,12 @@ impl ObjectSpec {
     }
 }
 
-/// Space-separated vertex indices, written into one string (a scanned mesh has millions).
+/// Space-separated vertex indices.
 fn indices<'a>(values: impl Iterator<Item = &'a u32>) -> String {
     use std::fmt::Write;
-    let mut text = String::new();
-    for (k, i) in values.enumerate() {
-        if k > 0 {
-            text.push(' ');
-        }
+    space_separated(values, |text, i| {
         let _ = write!(text, "{i}");
-    }
-    text
+    })
 }
 
 #[cfg(test)]
