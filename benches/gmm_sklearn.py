@@ -14,7 +14,7 @@ Data: target/bench-data/gmm_features.csv, 10 objects x 1000 readings x 20 dimens
 benchmark from its fixed seed. Settings, as in `taction::recognize::pipeline::GmmConfig` and the benchmark:
 full covariances, reg_covar 1e-6, responsibilities initialised from one k-means run (k-means++
 seeding, at most 300 Lloyd iterations, tolerance 1e-4; scikit-learn's `init_params="kmeans"`,
-which is KMeans(n_init=1)), k = 10, 20, 50, and two stopping rules:
+which is KMeans(n_init=1)), k = 10, 20, 50, 100, 200, 400, and two stopping rules:
   gmm_fit_10x1000x20          exactly 100 EM iterations (tol=0): the same work on both sides;
   gmm_fit_10x1000x20_tol1e-3  the default: stop when the mean log-likelihood changes by < 1e-3,
                               at most 100 iterations.
@@ -45,7 +45,7 @@ from sklearn.mixture import GaussianMixture
 from threadpoolctl import threadpool_limits
 
 GROUPS = {"gmm_fit_10x1000x20": 0.0, "gmm_fit_10x1000x20_tol1e-3": 1e-3}
-KS = (10, 20, 50, 100)
+KS = (10, 20, 50, 100, 200, 400)
 MAX_ITER = 100
 
 

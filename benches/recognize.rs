@@ -5,7 +5,8 @@
 //! Two GMM groups: `gmm_fit_10x1000x20` runs exactly 100 EM iterations (tolerance 0, the same work
 //! for every implementation) and `gmm_fit_10x1000x20_tol1e-3` runs with the default settings (stop
 //! when the mean log-likelihood changes by < 1e-3, at most 100 iterations), each for k = 10, 20, 50,
-//! 100 (the grid model selection tries for 10 objects, [`codebook_sizes`](taction::recognize::codebook_sizes)).
+//! 100 (the grid model selection tries for 10 objects, [`codebook_sizes`](taction::recognize::codebook_sizes))
+//! and 200, 400 (the range of the letters' grid, 26 and 52 objects).
 //! The features are written to `target/bench-data/gmm_features.csv` and each fit's iterations and
 //! final mean log-likelihood to `target/bench-data/gmm_taction.json`, so that
 //! `benches/gmm_sklearn.py` times scikit-learn's `GaussianMixture` on exactly the same data with the
@@ -132,7 +133,7 @@ fn gmm_fit(c: &mut Criterion) {
         let mut group = c.benchmark_group(name);
         group.sample_size(10);
         let mut fits = Vec::new();
-        for k in [10, 20, 50, 100] {
+        for k in [10, 20, 50, 100, 200, 400] {
             let mut last = None;
             group.bench_with_input(BenchmarkId::new("k", k), &k, |b, &k| {
                 b.iter(|| {

@@ -6,7 +6,7 @@
 //! readings, MuJoCo-free), `control` (Algorithm 1), `explore` (the planner and the sampler),
 //! `describe` (the six descriptors), `recognize` (bag of features), `active_touch`, `experiment`
 //! (the run framework) and `paper` (the paper's experiments on it); `rng`, `units`, `valid`,
-//! `atomic`, `pose` and `bodies` serve them all. `describe` and `recognize` know nothing of
+//! `atomic`, `pose`, `bodies` and `simd` serve them all. `describe` and `recognize` know nothing of
 //! MuJoCo, so recorded frames of a real sensor feed them the same way.
 //!
 //! The module map, with the paper's section and the files to start from for each module, is
@@ -21,6 +21,7 @@ pub mod atomic;
 pub mod bodies;
 pub mod pose;
 pub mod rng;
+pub(crate) mod simd;
 pub mod units;
 pub mod valid;
 

@@ -8,7 +8,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Modules every module may use: no domain, no MuJoCo.
-const LEAVES: [&str; 6] = ["atomic", "bodies", "pose", "rng", "units", "valid"];
+const LEAVES: [&str; 7] = ["atomic", "bodies", "pose", "rng", "simd", "units", "valid"];
 
 /// The paper's modules in the order of the flow: world -> sensor -> hand-off -> control/explore ->
 /// descriptors -> recognizer.
@@ -30,6 +30,7 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
         ("bodies", vec![]),
         ("pose", vec![]),
         ("rng", vec![]),
+        ("simd", vec![]),
         ("units", vec![]),
         ("valid", vec![]),
         ("mesh", vec![]),

@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
 use crate::recognize::features::FeatureMatrix;
+use crate::recognize::gmm_products::{weighted_scatter, whitened_distances};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
 use crate::rng::Rng;
 
@@ -257,7 +258,7 @@ impl GaussianMixture {
     pub fn responsibilities(&self, x: &[f64], out: &mut [f64]) -> f64 {
         self.weighted_log_densities(x, out);
         let lse = log_sum_exp(out);
-        out.iter_mut().for_each(|v| *v = (*v - lse).exp());
+        out.iter_mut().for_each(|v| *v = exp(*v - lse));
         lse
     }
 
@@ -273,25 +274,18 @@ impl GaussianMixture {
     }
 
     /// For each component `i`, `ln pi_i + ln N(x_r; mu_i, Sigma_i)` over all rows `x_r` of `x`,
-    /// with `P_i^T (x - mu_i)` computed for all rows at once as `X P_i - mu_i^T P_i` (one matrix
-    /// product per component).
+    /// with `P_i^T (x - mu_i)` computed for all rows at once as `X P_i - mu_i^T P_i` (one
+    /// triangular product per component, `gmm_products`).
     fn weighted_log_prob_columns(&self, x: &DMatrix<f64>) -> Vec<Vec<f64>> {
-        let (n, d) = x.shape();
+        let d = x.ncols();
         let constant = -0.5 * d as f64 * LN_2PI;
         (0..self.k())
             .into_par_iter()
             .map(|i| {
                 let p = &self.precision_chol[i];
-                let y = x * p;
                 let mu_p = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
-                let mut q = vec![0.0; n];
-                // Column j of the column-major `y` is one contiguous run of `n` values.
-                for (column, &shift) in y.as_slice().chunks_exact(n).zip(mu_p.iter()) {
-                    for (q, v) in q.iter_mut().zip(column) {
-                        let t = v - shift;
-                        *q += t * t;
-                    }
-                }
+                let q = whitened_distances(x, p, mu_p.as_slice())
+                    .unwrap_or_else(|| whitened_distances_general(x, p, mu_p.as_slice()));
                 let offset = constant + self.log_det_precision[i] + self.log_weights[i];
                 q.iter().map(|q| offset - 0.5 * q).collect()
             })
@@ -303,13 +297,27 @@ impl GaussianMixture {
         let n = x.nrows();
         let mut columns = self.weighted_log_prob_columns(x);
         let norms = log_sum_exp_rows(&columns);
-        columns.par_iter_mut().for_each(|c| {
-            c.iter_mut()
-                .zip(&norms)
-                .for_each(|(v, lse)| *v = (*v - lse).exp())
-        });
+        columns
+            .par_iter_mut()
+            .for_each(|c| c.iter_mut().zip(&norms).for_each(|(v, lse)| *v = exp(*v - lse)));
         (norms.iter().sum::<f64>() / n as f64, columns)
     }
+}
+
+/// `|P^T x_r - shift|^2` of every row of `x` as one general product `X P`: the sums that
+/// [`whitened_distances`] repeats on the triangle, for the machines and sizes it leaves alone.
+fn whitened_distances_general(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Vec<f64> {
+    let n = x.nrows();
+    let y = x * p;
+    let mut q = vec![0.0; n];
+    // Column j of the column-major `y` is one contiguous run of `n` values.
+    for (column, &shift) in y.as_slice().chunks_exact(n).zip(shift) {
+        for (q, v) in q.iter_mut().zip(column) {
+            let t = v - shift;
+            *q += t * t;
+        }
+    }
+    q
 }
 
 /// The M-step: weights, means and covariances from responsibilities (scikit-learn's
@@ -379,25 +387,16 @@ impl Component {
     /// The M-step for the component with responsibilities `resp` (`x` column-major, `x_rows` the
     /// same data row-major); `None` when its covariance is not positive definite.
     fn estimate(x: &DMatrix<f64>, x_rows: &[f64], resp: &[f64], reg_covar: f64) -> Option<Self> {
-        let (n_rows, d) = x.shape();
+        let d = x.ncols();
         let r = DVector::from_column_slice(resp);
         let n = r.sum() + 10.0 * f64::EPSILON;
         let mean = x.tr_mul(&r) / n;
-        // D = X - 1 mu^T, column-major, one contiguous column at a time.
-        let mut diff = Vec::with_capacity(n_rows * d);
-        for (column, &m) in x.as_slice().chunks_exact(n_rows).zip(mean.iter()) {
-            diff.extend(column.iter().map(|v| v - m));
-        }
-        let diff = DMatrix::from_vec(n_rows, d, diff);
-        // D^T diag(r), a column-major d x n matrix: its column `row` is (x_row - mu) r_row, read
-        // contiguously from the row-major copy of the data.
-        let mut weighted_t = Vec::with_capacity(n_rows * d);
-        for (row, &p) in x_rows.chunks_exact(d).zip(resp) {
-            weighted_t.extend(row.iter().zip(mean.iter()).map(|(v, m)| (v - m) * p));
-        }
-        let weighted_t = DMatrix::from_vec(d, n_rows, weighted_t);
-        // (D^T diag(r)) D as one blocked matrix product.
-        let mut sigma = &weighted_t * &diff / n;
+        // The scatter's lower triangle; the general product fills the whole square.
+        let scatter = match weighted_scatter(x_rows, mean.as_slice(), resp) {
+            Some(lower) => DMatrix::from_row_slice(d, d, &lower),
+            None => weighted_scatter_general(x, x_rows, mean.as_slice(), resp),
+        };
+        let mut sigma = scatter / n;
         for a in 0..d {
             sigma[(a, a)] += reg_covar;
             for b in 0..a {
@@ -416,14 +415,46 @@ impl Component {
     }
 }
 
+/// `(D^T diag(r)) D` with `D = X - 1 mu^T` as one blocked general product: the sums that
+/// [`weighted_scatter`] repeats on the lower triangle, for the machines and sizes it leaves alone.
+/// `x` is the data column-major and `x_rows` the same values row-major.
+fn weighted_scatter_general(x: &DMatrix<f64>, x_rows: &[f64], mean: &[f64], resp: &[f64]) -> DMatrix<f64> {
+    let (n_rows, d) = x.shape();
+    // D, column-major, one contiguous column at a time.
+    let mut diff = Vec::with_capacity(n_rows * d);
+    for (column, &m) in x.as_slice().chunks_exact(n_rows).zip(mean) {
+        diff.extend(column.iter().map(|v| v - m));
+    }
+    let diff = DMatrix::from_vec(n_rows, d, diff);
+    // D^T diag(r), a column-major d x n matrix: its column `row` is (x_row - mu) r_row, read
+    // contiguously from the row-major copy of the data.
+    let mut weighted_t = Vec::with_capacity(n_rows * d);
+    for (row, &p) in x_rows.chunks_exact(d).zip(resp) {
+        weighted_t.extend(row.iter().zip(mean).map(|(v, m)| (v - m) * p));
+    }
+    let weighted_t = DMatrix::from_vec(d, n_rows, weighted_t);
+    &weighted_t * &diff
+}
+
 /// `(P, sum_j ln P_jj)` with `P = L^-T` for `Sigma = L L^T`; `None` when `Sigma` is not positive
 /// definite.
-fn precision_cholesky(sigma: DMatrix<f64>) -> Option<(DMatrix<f64>, f64)> {
+pub(super) fn precision_cholesky(sigma: DMatrix<f64>) -> Option<(DMatrix<f64>, f64)> {
     let d = sigma.nrows();
     let l = Cholesky::new(sigma)?.unpack();
     let p = l.transpose().solve_upper_triangular(&DMatrix::identity(d, d))?;
     let log_det = (0..d).map(|j| p[(j, j)].ln()).sum::<f64>();
     log_det.is_finite().then_some((p, log_det))
+}
+
+/// Below this `f64::exp` returns exactly 0: the smallest subnormal is `e^-744.4`, and anything
+/// under half of it (`e^-745.1`) rounds to zero.
+const EXP_UNDERFLOW: f64 = -746.0;
+
+/// `e^x`, the arguments far below the smallest subnormal answered 0 without calling `exp` (the
+/// same bits; its underflow path is slow, and with many components most of a feature's
+/// responsibilities underflow).
+fn exp(x: f64) -> f64 {
+    if x < EXP_UNDERFLOW { 0.0 } else { x.exp() }
 }
 
 /// `ln sum_i exp(v_i)`, stable for any magnitudes; `-inf` for an empty slice.
@@ -432,35 +463,42 @@ pub fn log_sum_exp(v: &[f64]) -> f64 {
     if !max.is_finite() {
         return max;
     }
-    max + v.iter().map(|x| (x - max).exp()).sum::<f64>().ln()
+    max + v.iter().map(|x| exp(x - max)).sum::<f64>().ln()
 }
 
 /// `ln sum_i exp(columns[i][r])` for every row `r`: the same arithmetic as [`log_sum_exp`] on each
-/// row (the exponentials summed in component order), computed a column at a time so every pass
-/// reads contiguous memory.
+/// row (the exponentials summed in component order), computed a block of rows at a time so every
+/// pass reads contiguous memory, the blocks in parallel.
 fn log_sum_exp_rows(columns: &[Vec<f64>]) -> Vec<f64> {
+    /// Rows per block: the block's maxima and sums stay in the first-level cache.
+    const BLOCK: usize = 512;
     let n = columns.first().map_or(0, Vec::len);
-    let mut max = vec![f64::NEG_INFINITY; n];
-    for column in columns {
-        for (m, &v) in max.iter_mut().zip(column) {
-            *m = m.max(v);
+    let mut out = vec![0.0; n];
+    out.par_chunks_mut(BLOCK).enumerate().for_each(|(b, out)| {
+        let rows = b * BLOCK..b * BLOCK + out.len();
+        let mut max = vec![f64::NEG_INFINITY; out.len()];
+        for column in columns {
+            for (m, &v) in max.iter_mut().zip(&column[rows.clone()]) {
+                *m = m.max(v);
+            }
         }
-    }
-    let mut sum = vec![0.0; n];
-    for column in columns {
-        for ((s, &v), &m) in sum.iter_mut().zip(column).zip(&max) {
-            *s += (v - m).exp();
+        let mut sum = vec![0.0; out.len()];
+        for column in columns {
+            for ((s, &v), &m) in sum.iter_mut().zip(&column[rows.clone()]).zip(&max) {
+                *s += exp(v - m);
+            }
         }
-    }
-    max.iter()
-        .zip(&sum)
-        .map(|(&m, &s)| if m.is_finite() { m + s.ln() } else { m })
-        .collect()
+        for ((o, &m), &s) in out.iter_mut().zip(&max).zip(&sum) {
+            *o = if m.is_finite() { m + s.ln() } else { m };
+        }
+    });
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::has_avx2_fma;
 
     #[test]
     fn density_matches_the_closed_form_in_two_dimensions() {
@@ -499,6 +537,97 @@ mod tests {
             covariances: vec![vec![1.0]; 2],
         };
         assert!(GaussianMixture::from_parameters(bad_weights).is_err());
+    }
+
+    fn random_matrix(rng: &mut crate::rng::Rng, rows: usize, cols: usize) -> DMatrix<f64> {
+        use rand::RngExt;
+        DMatrix::from_fn(rows, cols, |_, _| rng.random_range(-3.0..3.0))
+    }
+
+    #[test]
+    fn the_triangular_distances_give_the_general_products_bits() {
+        use rand::RngExt;
+        if !has_avx2_fma() {
+            return;
+        }
+        let mut rng = crate::rng::rng(41);
+        // Row counts with and without a partial group of eight; d from nalgebra's smallest
+        // product size to beyond one group, with and without a partial group of four.
+        for (n, d) in [(1003, 6), (517, 7), (2000, 20), (64, 23), (300, 33)] {
+            let x = random_matrix(&mut rng, n, d);
+            let a = random_matrix(&mut rng, d, d);
+            let sigma = &a * a.transpose() + DMatrix::identity(d, d) * 0.1;
+            let (p, _) = precision_cholesky(sigma).expect("a random SPD matrix has a Cholesky factor");
+            let mu = DVector::from_fn(d, |_, _| rng.random_range(-1.0..1.0));
+            let shift = p.tr_mul(&mu);
+            let fast = whitened_distances(&x, &p, shift.as_slice()).expect("the fast path applies");
+            let general = whitened_distances_general(&x, &p, shift.as_slice());
+            for (r, (a, b)) in fast.iter().zip(&general).enumerate() {
+                assert_eq!(a.to_bits(), b.to_bits(), "n {n}, d {d}, row {r}: {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_triangular_scatter_gives_the_general_products_bits() {
+        use rand::RngExt;
+        if !has_avx2_fma() {
+            return;
+        }
+        let mut rng = crate::rng::rng(43);
+        // Feature counts within one block of the product's KC and across several (with a partial
+        // pass); d with partial tiles in both directions.
+        for (n, d) in [(200, 6), (600, 20), (1000, 13), (257, 23)] {
+            let x = random_matrix(&mut rng, n, d);
+            let x_rows: Vec<f64> = x.transpose().as_slice().to_vec();
+            // Responsibilities in [0, 1], some exactly 0 and some exactly 1 as after k-means.
+            let resp: Vec<f64> = (0..n)
+                .map(|r| match r % 7 {
+                    0 => 0.0,
+                    1 => 1.0,
+                    _ => rng.random_range(0.0..1.0),
+                })
+                .collect();
+            let mean: Vec<f64> = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let lower = weighted_scatter(&x_rows, &mean, &resp).expect("the fast path applies");
+            let general = weighted_scatter_general(&x, &x_rows, &mean, &resp);
+            for a in 0..d {
+                for b in 0..=a {
+                    let (got, want) = (lower[a * d + b], general[(a, b)]);
+                    assert_eq!(
+                        got.to_bits(),
+                        want.to_bits(),
+                        "n {n}, d {d}, ({a}, {b}): {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_underflow_shortcut_gives_the_bits_of_exp() {
+        // Across the threshold (every representable step near it), through the subnormal range
+        // and far below, and on the special values.
+        let near = (-4000..4000).map(|i| EXP_UNDERFLOW + f64::from(i) * 1e-3);
+        let wide = (0..2000).map(|i| -f64::from(i) * 0.75);
+        let special = [
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NAN,
+            -1e300,
+            0.0,
+            -0.0,
+            709.0,
+        ];
+        let mut zeros = 0;
+        for x in near.chain(wide).chain(special) {
+            assert_eq!(exp(x).to_bits(), x.exp().to_bits(), "exp({x})");
+            zeros += usize::from(x < EXP_UNDERFLOW);
+        }
+        // Not vacuous: the shortcut answered many of them.
+        assert!(zeros > 3000, "{zeros}");
+        // The threshold is not too low to matter: the last subnormals are just above it.
+        assert!((EXP_UNDERFLOW + 2.0).exp() > 0.0);
     }
 
     #[test]

@@ -27,6 +27,7 @@ pub(crate) mod evaluate;
 pub(crate) mod features;
 pub(crate) mod fusion;
 pub(crate) mod gmm;
+pub(crate) mod gmm_products;
 pub(crate) mod kmeans;
 pub(crate) mod labelled;
 pub(crate) mod model;

@@ -32,9 +32,9 @@
 
 use rand::RngExt;
 
+use crate::simd::has_avx2;
 use crate::tactile::SensorConfig;
 use crate::tactile::grid::SampleGrid;
-use crate::tactile::simd::has_avx2;
 
 /// Kernel support in standard deviations.
 const PSF_SUPPORT_SIGMAS: f64 = 4.0;

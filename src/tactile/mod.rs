@@ -11,7 +11,6 @@
 //! primitive   planes, spheres, capsules, ellipsoids, cylinders, boxes cut analytically
 //! grid        where the (supersampled) rays pierce the pad
 //! formation   penetration -> PSF -> taxels -> [0, 1] -> noise
-//! simd        whether the hot loops run four lanes wide (AVX2), the same bits either way
 //! sensor      the Rust handle (read an image from sensordata) and the MJCF helpers
 //! free_floating  the scene of the pad on a mocap body, no arm (Sec. V-A3; `control::FreePad`)
 //! image       TactileImage (and PadPose, from `pose`)
@@ -30,7 +29,6 @@ pub(crate) mod plugin;
 pub(crate) mod primitive;
 pub(crate) mod raster;
 pub(crate) mod sensor;
-pub(crate) mod simd;
 
 // The sensor: its configuration, its image, and the handle that reads it from `sensordata`.
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};

@@ -30,9 +30,9 @@
 
 use glam::{DMat3, DVec3};
 
+use crate::simd::has_avx2;
 use crate::tactile::grid::{CellBounds, SampleGrid};
 use crate::tactile::mesh_bvh::{Leaf, MeshBvh};
-use crate::tactile::simd::has_avx2;
 
 /// Relative tolerance of the edge test: samples on a shared edge belong to both triangles (both
 /// give the same depth there), so rounding never opens a crack between neighbours.
@@ -209,7 +209,7 @@ impl DepthBuffer {
     }
 
     /// [`Self::draw_mesh_body`] compiled with AVX2, the sample loops four lanes wide: the same
-    /// operations lane by lane, so the same depths bit for bit ([`crate::tactile::simd`]).
+    /// operations lane by lane, so the same depths bit for bit ([`crate::simd`]).
     ///
     /// # Safety
     /// The processor must have AVX2.

@@ -1,0 +1,291 @@
+//! The Gaussian mixture's two heavy sums (Sec. V-B1, Eq. 9-10), each on the triangle that
+//! matters, four lanes at a time.
+//!
+//! Every EM iteration does, per component, two matrix products over all `n` training features:
+//! the E-step's whitened residuals `X P_i` (`P_i` upper triangular, so half of a general product
+//! multiplies structural zeros) and the M-step's weighted scatter `(D^T diag(r)) D` (symmetric, so
+//! half of a general product is thrown away when the covariance is symmetrised). Both also wrote
+//! `n x d` intermediates per component. Here each is computed on its triangle only, from blocks
+//! small enough to stay in the cache.
+//!
+//! They replace the general products exactly. nalgebra multiplies these sizes with
+//! `matrixmultiply`, whose kernel on a processor with AVX2 and FMA forms every output value as a
+//! chain of fused multiply-adds starting from zero over the summed index, in blocks of [`KC`]
+//! terms whose chains are added in order. The functions here form each value by the same chain,
+//! lane by lane. A chain never holds -0 (it starts at +0, and a sum that cancels exactly rounds to
+//! +0), so a fused multiply-add by a structural zero leaves it unchanged and skipping those terms
+//! changes no bit; the tests compare with nalgebra's product bit for bit. Where `matrixmultiply`
+//! would sum another way (a processor without FMA runs its plain AVX kernel; nalgebra multiplies
+//! dimensions of at most [`NALGEBRA_SMALL_DIM`] without it) the functions return `None` and the
+//! mixture keeps the general product, so a fit gives the same bits as before on every machine.
+
+use nalgebra::DMatrix;
+
+use crate::simd::has_avx2_fma;
+
+/// The block of the summed index in `matrixmultiply`'s `f64` product (its `D_KC`): each output
+/// value is the in-order sum of one chain per block.
+pub(super) const KC: usize = 256;
+
+/// nalgebra hands a product to `matrixmultiply` only when the dimensions exceed this (its
+/// `SMALL_DIM`).
+const NALGEBRA_SMALL_DIM: usize = 5;
+
+/// Columns `j` of `P` per pass of the E-step.
+const COLS: usize = 4;
+/// Feature rows per pass of the E-step: two lanes of four.
+const ROWS: usize = 8;
+/// Rows `a` of the scatter per tile (broadcast).
+const TILE_A: usize = 4;
+/// Columns `b` of the scatter per tile: two lanes of four.
+const TILE_B: usize = 8;
+/// Features per pass of the scatter, so that the pass's residuals stay in the first-level cache.
+const PASS: usize = 64;
+
+/// Whether the triangular sums repeat nalgebra's products for `n` features of `d` values on this
+/// processor.
+fn repeats_the_general_product(n: usize, d: usize) -> bool {
+    has_avx2_fma() && n > NALGEBRA_SMALL_DIM && d > NALGEBRA_SMALL_DIM && d <= KC
+}
+
+/// `q_r = sum_j ((X P)_rj - shift_j)^2` for every row `r` of `x` (`n x d`, column-major), the
+/// squared Mahalanobis distance of the E-step with `shift = P^T mu`: the squares added in column
+/// order, each `(X P)_rj` the chain over `i <= j` of the general product. `p` is the upper
+/// triangular precision factor. `None` where the general product would sum another way.
+pub(super) fn whitened_distances(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Option<Vec<f64>> {
+    let (n, d) = x.shape();
+    if !repeats_the_general_product(n, d) || p.shape() != (d, d) || shift.len() != d {
+        return None;
+    }
+    let rows = PaddedRows::upper(p);
+    let mut q = vec![0.0; n];
+    // SAFETY: `repeats_the_general_product` checked that the processor has AVX2 and FMA.
+    unsafe { distances_fma(x.as_slice(), n, &rows, shift, &mut q) };
+    Some(q)
+}
+
+/// The rows of an upper-triangular `d x d` matrix, row-major, each padded with zeros to a whole
+/// number of [`COLS`]-wide groups (the E-step reads `P_ij` for `j` in one group at once).
+struct PaddedRows {
+    d: usize,
+    stride: usize,
+    values: Vec<f64>,
+}
+
+impl PaddedRows {
+    fn upper(p: &DMatrix<f64>) -> Self {
+        let d = p.nrows();
+        let stride = d.next_multiple_of(COLS);
+        let mut values = vec![0.0; d * stride];
+        for i in 0..d {
+            for j in i..d {
+                values[i * stride + j] = p[(i, j)];
+            }
+        }
+        Self { d, stride, values }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
+    distances(x, n, p, shift, q);
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
+    distances(x, n, p, shift, q);
+}
+
+#[inline(always)]
+fn distances(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
+    let whole = n - n % ROWS;
+    for (group, out) in q[..whole].chunks_exact_mut(ROWS).enumerate() {
+        out.copy_from_slice(&distances_of_rows::<ROWS>(x, n, group * ROWS, p, shift));
+    }
+    for (r, out) in q.iter_mut().enumerate().skip(whole) {
+        *out = distances_of_rows::<1>(x, n, r, p, shift)[0];
+    }
+}
+
+/// [`whitened_distances`] of the `R` rows from `first`: per group of [`COLS`] columns `j`, the
+/// chains over `i` up to the group's last column (beyond a column's own `j` the factor is a
+/// structural zero, which leaves a chain unchanged), then the squares added in column order.
+#[inline(always)]
+fn distances_of_rows<const R: usize>(
+    x: &[f64],
+    n: usize,
+    first: usize,
+    p: &PaddedRows,
+    shift: &[f64],
+) -> [f64; R] {
+    let mut sum = [0.0; R];
+    for j0 in (0..p.d).step_by(COLS) {
+        let end = (j0 + COLS).min(p.d);
+        let mut chain = [[0.0; R]; COLS];
+        for i in 0..end {
+            let xi = &x[i * n + first..][..R];
+            let pi = &p.values[i * p.stride + j0..][..COLS];
+            for (chain, &pij) in chain.iter_mut().zip(pi) {
+                for (c, &v) in chain.iter_mut().zip(xi) {
+                    *c = v.mul_add(pij, *c);
+                }
+            }
+        }
+        for (chain, &s) in chain.iter().zip(&shift[j0..end]) {
+            for (sum, &c) in sum.iter_mut().zip(chain) {
+                let t = c - s;
+                *sum += t * t;
+            }
+        }
+    }
+    sum
+}
+
+/// The lower triangle of the M-step's weighted scatter `S = sum_r resp_r (x_r - mean)(x_r -
+/// mean)^T`, row-major `d x d` (`S_ab` for `a >= b`; the entries above the diagonal are not
+/// written), from `x_rows` (`n x d`, row-major): `S_ab` is the general product's
+/// `sum_r ((x_ra - mean_a) resp_r) (x_rb - mean_b)`, chained over the features in blocks of [`KC`].
+/// `None` where the general product would sum another way.
+pub(super) fn weighted_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Option<Vec<f64>> {
+    let (n, d) = (resp.len(), mean.len());
+    if !repeats_the_general_product(n, d) || x_rows.len() != n * d {
+        return None;
+    }
+    let mut lower = vec![0.0; d * d];
+    // SAFETY: `repeats_the_general_product` checked that the processor has AVX2 and FMA.
+    unsafe { scatter_fma(x_rows, mean, resp, &mut lower) };
+    Some(lower)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn scatter_fma(x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f64]) {
+    Scatter::new(mean.len()).sum(x_rows, mean, resp, lower);
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+unsafe fn scatter_fma(x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f64]) {
+    Scatter::new(mean.len()).sum(x_rows, mean, resp, lower);
+}
+
+/// The scatter's working set: one pass of residuals `D` and weighted residuals `W` (row-major,
+/// padded with zeros to whole tiles), the current [`KC`] block's chains and the blocks' total, and
+/// the tiles `(a0, b0)` that touch the lower triangle.
+struct Scatter {
+    d: usize,
+    stride: usize,
+    residuals: Vec<f64>,
+    weighted: Vec<f64>,
+    block: Vec<f64>,
+    total: Vec<f64>,
+    tiles: Vec<(usize, usize)>,
+}
+
+impl Scatter {
+    fn new(d: usize) -> Self {
+        let stride = d.next_multiple_of(TILE_B);
+        let tiles = (0..d)
+            .step_by(TILE_A)
+            .flat_map(|a0| {
+                (0..d)
+                    .step_by(TILE_B)
+                    .take_while(move |&b0| b0 < a0 + TILE_A)
+                    .map(move |b0| (a0, b0))
+            })
+            .collect();
+        let square = d.next_multiple_of(TILE_A) * stride;
+        Self {
+            d,
+            stride,
+            residuals: vec![0.0; PASS * stride],
+            weighted: vec![0.0; PASS * stride],
+            block: vec![0.0; square],
+            total: vec![0.0; square],
+            tiles,
+        }
+    }
+
+    #[inline(always)]
+    fn sum(mut self, x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f64]) {
+        let n = resp.len();
+        for k0 in (0..n).step_by(KC) {
+            let k_end = (k0 + KC).min(n);
+            for first in (k0..k_end).step_by(PASS) {
+                let count = self.residuals_of(x_rows, mean, resp, first..(first + PASS).min(k_end));
+                self.chain(count);
+            }
+            // `matrixmultiply` adds each block's chain to the value so far (`c = ab + c`).
+            for (t, b) in self.total.iter_mut().zip(&mut self.block) {
+                *t += *b;
+                *b = 0.0;
+            }
+        }
+        for (a, row) in lower.chunks_exact_mut(self.d).enumerate() {
+            row[..=a].copy_from_slice(&self.total[a * self.stride..][..=a]);
+        }
+    }
+
+    /// Fills the pass's `D` and `W` rows with the features `rows`; returns how many.
+    #[inline(always)]
+    fn residuals_of(
+        &mut self,
+        x_rows: &[f64],
+        mean: &[f64],
+        resp: &[f64],
+        rows: std::ops::Range<usize>,
+    ) -> usize {
+        let (d, stride) = (self.d, self.stride);
+        let count = rows.len();
+        for (t, r) in rows.enumerate() {
+            let x = &x_rows[r * d..][..d];
+            let weight = resp[r];
+            let residual = &mut self.residuals[t * stride..][..d];
+            let weighted = &mut self.weighted[t * stride..][..d];
+            for (((res, w), &v), &m) in residual.iter_mut().zip(weighted).zip(x).zip(mean) {
+                *res = v - m;
+                *w = *res * weight;
+            }
+        }
+        count
+    }
+
+    /// Continues every tile's chains over the pass's `count` features.
+    #[inline(always)]
+    fn chain(&mut self, count: usize) {
+        let stride = self.stride;
+        for &(a0, b0) in &self.tiles {
+            let mut chain = [[0.0; TILE_B]; TILE_A];
+            for (a, c) in chain.iter_mut().enumerate() {
+                c.copy_from_slice(&self.block[(a0 + a) * stride + b0..][..TILE_B]);
+            }
+            for t in 0..count {
+                let w = &self.weighted[t * stride + a0..][..TILE_A];
+                let res = &self.residuals[t * stride + b0..][..TILE_B];
+                for (c, &wa) in chain.iter_mut().zip(w) {
+                    for (c, &rb) in c.iter_mut().zip(res) {
+                        *c = wa.mul_add(rb, *c);
+                    }
+                }
+            }
+            for (a, c) in chain.iter().enumerate() {
+                self.block[(a0 + a) * stride + b0..][..TILE_B].copy_from_slice(c);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_the_general_product_sums_another_way_are_left_to_it() {
+        let x = DMatrix::from_element(100, 5, 1.0);
+        let p = DMatrix::identity(5, 5);
+        assert!(whitened_distances(&x, &p, &[0.0; 5]).is_none());
+        assert!(weighted_scatter(&[1.0; 500], &[0.0; 5], &[1.0; 100]).is_none());
+        let x = DMatrix::from_element(5, 8, 1.0);
+        assert!(whitened_distances(&x, &DMatrix::identity(8, 8), &[0.0; 8]).is_none());
+    }
+}
