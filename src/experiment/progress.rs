@@ -18,42 +18,65 @@ pub fn progress_bar(len: usize, name: &str, unit: &str) -> ProgressBar {
     bar
 }
 
-/// Converged readings collected against those asked, over an object set (`collect`, and the data
-/// collection of `demo` and the experiments).
-pub struct CollectionProgress {
+/// Items done against those asked, with the one summary line when stderr is no terminal.
+pub struct Progress {
     bar: ProgressBar,
     name: String,
+    unit: String,
     asked: usize,
     started: Instant,
 }
 
-impl CollectionProgress {
-    /// `readings_per_object` converged readings asked of each of `objects` objects.
-    pub fn new(name: &str, objects: usize, readings_per_object: usize) -> Self {
-        let asked = objects.saturating_mul(readings_per_object);
+impl Progress {
+    /// `asked` items named `unit` (e.g. "objects explored"), prefixed `name`.
+    pub fn new(name: &str, asked: usize, unit: &str) -> Self {
         Self {
-            bar: progress_bar(asked, name, "converged readings"),
+            bar: progress_bar(asked, name, unit),
             name: name.to_string(),
+            unit: unit.to_string(),
             asked,
             started: Instant::now(),
         }
     }
 
-    /// One more converged reading (any thread).
-    pub fn converged(&self) {
+    /// One more item done (any thread).
+    pub fn inc(&self) {
         self.bar.inc(1);
     }
 
     /// Clears the bar; without a terminal, prints the summary line instead.
-    pub fn finish(&self, converged: usize) {
+    pub fn finish(&self, done: usize) {
         self.bar.finish_and_clear();
         if !std::io::stderr().is_terminal() {
             eprintln!(
-                "{}: {converged} of {} converged readings in {:.1} s",
+                "{}: {done} of {} {} in {:.1} s",
                 self.name,
                 self.asked,
+                self.unit,
                 self.started.elapsed().as_secs_f64()
             );
         }
+    }
+}
+
+/// Converged readings collected against those asked, over an object set (`collect`, and the data
+/// collection of `demo` and the experiments).
+pub struct CollectionProgress(Progress);
+
+impl CollectionProgress {
+    /// `readings_per_object` converged readings asked of each of `objects` objects.
+    pub fn new(name: &str, objects: usize, readings_per_object: usize) -> Self {
+        let asked = objects.saturating_mul(readings_per_object);
+        Self(Progress::new(name, asked, "converged readings"))
+    }
+
+    /// One more converged reading (any thread).
+    pub fn converged(&self) {
+        self.0.inc();
+    }
+
+    /// Clears the bar; without a terminal, prints the summary line instead.
+    pub fn finish(&self, converged: usize) {
+        self.0.finish(converged);
     }
 }

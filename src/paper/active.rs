@@ -40,6 +40,7 @@ use crate::experiment::factor::{Factor, Factors};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::{Axis, PlotSpec};
+use crate::experiment::progress::Progress;
 use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
@@ -365,10 +366,16 @@ impl ActiveUnit<'_> {
         let jobs: Vec<(usize, usize)> = (0..base.len())
             .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
             .collect();
+        // The curve is one unit of the run, saved when whole: the bar says how far it is.
+        let progress = Progress::new(
+            &format!("active touch, object {state}"),
+            jobs.len(),
+            "objects explored",
+        );
         let explored: Vec<Trial> = jobs
             .par_iter()
             .map(|&(t, o)| {
-                active_trial(
+                let trial = active_trial(
                     &base[t].plan,
                     objects,
                     o,
@@ -376,9 +383,12 @@ impl ActiveUnit<'_> {
                     descriptor,
                     self.counts.test_per_object,
                     self.neighbourhood_m,
-                )
+                );
+                progress.inc();
+                trial
             })
             .collect::<Result<_, BoxError>>()?;
+        progress.finish(explored.len());
         let objects_per_trial = objects.specs.len().max(1);
         let trials: Vec<(u64, Vec<Trial>)> = base
             .iter()
