@@ -438,7 +438,7 @@ fn weighted_scatter_general(x: &DMatrix<f64>, x_rows: &[f64], mean: &[f64], resp
 
 /// `(P, sum_j ln P_jj)` with `P = L^-T` for `Sigma = L L^T`; `None` when `Sigma` is not positive
 /// definite.
-pub(super) fn precision_cholesky(sigma: DMatrix<f64>) -> Option<(DMatrix<f64>, f64)> {
+fn precision_cholesky(sigma: DMatrix<f64>) -> Option<(DMatrix<f64>, f64)> {
     let d = sigma.nrows();
     let l = Cholesky::new(sigma)?.unpack();
     let p = l.transpose().solve_upper_triangular(&DMatrix::identity(d, d))?;

@@ -14,10 +14,11 @@
 //! terms whose chains are added in order. The functions here form each value by the same chain,
 //! lane by lane. A chain never holds -0 (it starts at +0, and a sum that cancels exactly rounds to
 //! +0), so a fused multiply-add by a structural zero leaves it unchanged and skipping those terms
-//! changes no bit; the tests compare with nalgebra's product bit for bit. Where `matrixmultiply`
-//! would sum another way (a processor without FMA runs its plain AVX kernel; nalgebra multiplies
-//! dimensions of at most [`NALGEBRA_SMALL_DIM`] without it) the functions return `None` and the
-//! mixture keeps the general product, so a fit gives the same bits as before on every machine.
+//! changes no bit; the tests in `gmm` compare with nalgebra's product bit for bit. Where
+//! `matrixmultiply` would sum another way (a processor without FMA runs its plain AVX kernel;
+//! nalgebra multiplies dimensions of at most [`NALGEBRA_SMALL_DIM`] without it; `d` beyond one
+//! block) the functions return `None` and the mixture keeps the general product, so a fit gives
+//! the same bits as before on every machine.
 
 use nalgebra::DMatrix;
 
@@ -86,19 +87,10 @@ impl PaddedRows {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+/// The E-step's distances, compiled with AVX2 and FMA where they exist (callers check the
+/// processor first; elsewhere nothing calls it).
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
 unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
-    distances(x, n, p, shift, q);
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
-    distances(x, n, p, shift, q);
-}
-
-#[inline(always)]
-fn distances(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
     let whole = n - n % ROWS;
     for (group, out) in q[..whole].chunks_exact_mut(ROWS).enumerate() {
         out.copy_from_slice(&distances_of_rows::<ROWS>(x, n, group * ROWS, p, shift));
@@ -158,13 +150,9 @@ pub(super) fn weighted_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Op
     Some(lower)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn scatter_fma(x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f64]) {
-    Scatter::new(mean.len()).sum(x_rows, mean, resp, lower);
-}
-
-#[cfg(not(target_arch = "x86_64"))]
+/// The M-step's scatter, compiled with AVX2 and FMA where they exist (callers check the
+/// processor first; elsewhere nothing calls it).
+#[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
 unsafe fn scatter_fma(x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f64]) {
     Scatter::new(mean.len()).sum(x_rows, mean, resp, lower);
 }
@@ -212,7 +200,9 @@ impl Scatter {
         for k0 in (0..n).step_by(KC) {
             let k_end = (k0 + KC).min(n);
             for first in (k0..k_end).step_by(PASS) {
-                let count = self.residuals_of(x_rows, mean, resp, first..(first + PASS).min(k_end));
+                let rows = first..(first + PASS).min(k_end);
+                let count = rows.len();
+                self.residuals_of(x_rows, mean, resp, rows);
                 self.chain(count);
             }
             // `matrixmultiply` adds each block's chain to the value so far (`c = ab + c`).
@@ -226,17 +216,10 @@ impl Scatter {
         }
     }
 
-    /// Fills the pass's `D` and `W` rows with the features `rows`; returns how many.
+    /// Fills the pass's `D` and `W` rows with the features `rows`.
     #[inline(always)]
-    fn residuals_of(
-        &mut self,
-        x_rows: &[f64],
-        mean: &[f64],
-        resp: &[f64],
-        rows: std::ops::Range<usize>,
-    ) -> usize {
+    fn residuals_of(&mut self, x_rows: &[f64], mean: &[f64], resp: &[f64], rows: std::ops::Range<usize>) {
         let (d, stride) = (self.d, self.stride);
-        let count = rows.len();
         for (t, r) in rows.enumerate() {
             let x = &x_rows[r * d..][..d];
             let weight = resp[r];
@@ -247,7 +230,6 @@ impl Scatter {
                 *w = *res * weight;
             }
         }
-        count
     }
 
     /// Continues every tile's chains over the pass's `count` features.
