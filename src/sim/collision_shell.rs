@@ -76,7 +76,7 @@ pub fn collision_shell(mesh: &TriMesh, options: &ShellOptions) -> Vec<Vec<DVec3>
             || extent <= options.min_extent_m
             || (extent <= options.max_extent_m && is_convex_piece(mesh, &triangles, options.tolerance_m));
         if done {
-            pieces.push(thickened_points(mesh, &triangles, options.thickness_m));
+            pieces.push(thickened_points(mesh, &triangles, options));
             continue;
         }
         let axis = (hi - lo).max_position();
@@ -172,11 +172,24 @@ impl VertexBoxes {
     }
 }
 
-/// The piece's vertices and the same pushed `thickness_m` against its area-weighted mean normal.
-fn thickened_points(mesh: &TriMesh, triangles: &[usize], thickness_m: f64) -> Vec<DVec3> {
+/// Surface vertices up to which a piece goes to MuJoCo whole. The pieces of every built-in object
+/// have at most 1,729 (the rook's), so their shells are the exact vertex sets; a mesh finer than
+/// the shell's tolerance (a scan: 1.3M triangles make pieces of about 2,300 vertices, hundreds of
+/// them) has its pieces thinned by [`one_vertex_per_cell`], since MuJoCo's compile of their hulls
+/// was most of the time from such a file to its first reading (issue 39).
+const WHOLE_PIECE_VERTICES: usize = 2048;
+
+/// The piece's vertices (thinned to one per cell of half the tolerance when there are more than
+/// [`WHOLE_PIECE_VERTICES`]) and the same pushed `thickness_m` against its area-weighted mean
+/// normal.
+fn thickened_points(mesh: &TriMesh, triangles: &[usize], options: &ShellOptions) -> Vec<DVec3> {
     let mut vertices: Vec<u32> = triangles.iter().flat_map(|&t| mesh.triangles[t]).collect();
     vertices.sort_unstable();
     vertices.dedup();
+    if vertices.len() > WHOLE_PIECE_VERTICES {
+        vertices = one_vertex_per_cell(mesh, &vertices, options.tolerance_m / 2.0);
+    }
+    let thickness_m = options.thickness_m;
     let area_normal = |t: usize| {
         let [a, b, c] = mesh.corners(t);
         (b - a).cross(c - a)
@@ -200,6 +213,26 @@ fn thickened_points(mesh: &TriMesh, triangles: &[usize], thickness_m: f64) -> Ve
         .clone()
         .chain(points.map(|p| p - normal * thickness_m))
         .collect()
+}
+
+/// Of `vertices` (sorted), the lowest-numbered in each cube of side `cell_m` of a grid, sorted.
+/// Every dropped vertex lies within a cube's diagonal `sqrt(3) cell_m` of a kept one, so the hull
+/// of the kept points lies inside the hull of all of them by at most that: the shell stands at
+/// most 1.7 mm below its tolerance for the default 2 mm (the arm's links may come that much
+/// closer to such an object; the sensor reads the exact mesh).
+fn one_vertex_per_cell(mesh: &TriMesh, vertices: &[u32], cell_m: f64) -> Vec<u32> {
+    let cell = |v: u32| {
+        (mesh.vertices[v as usize] / cell_m)
+            .floor()
+            .as_i64vec3()
+            .to_array()
+    };
+    let mut keyed: Vec<([i64; 3], u32)> = vertices.iter().map(|&v| (cell(v), v)).collect();
+    keyed.sort_unstable();
+    keyed.dedup_by_key(|(key, _)| *key);
+    let mut kept: Vec<u32> = keyed.into_iter().map(|(_, v)| v).collect();
+    kept.sort_unstable();
+    kept
 }
 
 #[cfg(test)]
@@ -301,6 +334,44 @@ mod tests {
             for p in piece {
                 assert!(p.length() <= 0.06 + 1e-9, "a shell point outside the sphere: {p}");
             }
+        }
+    }
+
+    /// A piece finer than the tolerance (a 1 cm plate of 101 x 101 vertices, one piece) goes to
+    /// MuJoCo thinned to one vertex per 1 mm cell: a few hundred points instead of 20,402, every
+    /// one a vertex of the plate or its thickened copy, and every vertex of the plate within a
+    /// cell's diagonal of a kept one.
+    #[test]
+    fn a_piece_finer_than_the_tolerance_keeps_one_vertex_per_cell() {
+        let n = 100u32;
+        let mut mesh = TriMesh::default();
+        for i in 0..=n {
+            for j in 0..=n {
+                mesh.vertices
+                    .push(DVec3::new(i as f64 * 1e-4, j as f64 * 1e-4, 0.0));
+            }
+        }
+        let at = |i: u32, j: u32| i * (n + 1) + j;
+        for i in 0..n {
+            for j in 0..n {
+                mesh.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                mesh.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let options = ShellOptions::default();
+        let pieces = collision_shell(&mesh, &options);
+        assert_eq!(pieces.len(), 1);
+        let piece = &pieces[0];
+        let surface: Vec<DVec3> = piece.iter().copied().filter(|p| p.z == 0.0).collect();
+        assert_eq!(surface.len() * 2, piece.len());
+        assert!((100..=2 * 11 * 11).contains(&surface.len()), "{}", surface.len());
+        assert!(surface.iter().all(|p| mesh.vertices.contains(p)));
+        let reach = 3f64.sqrt() * options.tolerance_m / 2.0;
+        for v in &mesh.vertices {
+            assert!(
+                surface.iter().any(|p| p.distance(*v) <= reach),
+                "{v} far from the shell"
+            );
         }
     }
 
