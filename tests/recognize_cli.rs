@@ -433,6 +433,32 @@ fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
     };
     let on_arm = line(&calibrated, "arm.csv");
     assert!(on_arm.contains("tau = "), "{calibrated}");
+    // The trials' length is the runs' to be judged: each object's 20 readings as one trial by
+    // default, shorter trials on request (fitted at other reading counts: another tempering).
+    assert!(on_arm.contains("each object's readings one trial"), "{on_arm}");
+    let (ok, short, stderr) = train(
+        &["--calibration", &arm, "--calibration-trial-readings", "2"],
+        "arm2.json",
+    );
+    assert!(ok, "{stderr}");
+    let on_arm_short = line(&short, "arm.csv");
+    assert!(on_arm_short.contains("trials of 2 readings"), "{short}");
+    assert_ne!(
+        on_arm_short.split("tau").nth(1),
+        on_arm.split("tau").nth(1),
+        "{on_arm_short}\n{on_arm}"
+    );
+    for (extra, needle) in [
+        (
+            vec!["--calibration", arm.as_str(), "--calibration-trial-readings", "0"],
+            "--calibration-trial-readings 0",
+        ),
+        (vec!["--calibration-trial-readings", "5"], "--calibration <FILE>"),
+    ] {
+        let (ok, _, stderr) = train(&extra, "refused.json");
+        assert!(!ok && stderr.contains(needle), "{extra:?}: {stderr}");
+        assert!(!dir.path().join("refused.json").exists());
+    }
     assert_ne!(
         on_arm.split("tau").nth(1),
         line(&held_out, "posterior calibrated").split("tau").nth(1),

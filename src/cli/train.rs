@@ -13,7 +13,7 @@ use taction::recognize::{
 };
 use taction::valid::Valid;
 
-use crate::cli::common::{SeedArg, parse_codebook};
+use crate::cli::common::{SeedArg, flag_error, parse_codebook};
 use crate::cli::dataset::read_dataset;
 
 #[derive(Debug, Args)]
@@ -56,18 +56,26 @@ pub struct TrainArgs {
     /// Readings per validation trial.
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub trial_readings: usize,
-    /// Calibration dataset: the posterior's tempering is fitted on it (in trials of
-    /// `--trial-readings`) instead of on the validation readings. Give the arm's own explorations
-    /// (`collect --mode planner`) when the model will recognise them: their successive touches are
-    /// correlated, which sampler validation readings cannot show.
+    /// Calibration dataset: the posterior's tempering is fitted on it instead of on the
+    /// validation readings. Give the arm's own explorations (`collect --mode planner`) when the
+    /// model will recognise them: their successive touches are correlated, which sampler
+    /// validation readings cannot show.
     #[arg(long, value_name = "FILE")]
     pub calibration: Option<PathBuf>,
+    /// Readings per calibration trial: the length of the runs the model will recognise (the
+    /// tempering is only fitted at the reading counts the trials reach) [default: each object's
+    /// readings in the calibration dataset as one trial].
+    #[arg(long, value_name = "N", requires = "calibration")]
+    pub calibration_trial_readings: Option<usize>,
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
 }
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if args.calibration_trial_readings == Some(0) {
+        return Err(flag_error("calibration-trial-readings", 0, "want 1 or more").into());
+    }
     let training = read_dataset(&args.dataset)?;
     let config = TrainConfig {
         codebook: args.codebook,
@@ -98,7 +106,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let model = if args.descriptor.is_fused() {
         let fused = FusedModel::new(models)?.calibrated(&config, &training, validation.as_ref())?;
-        print_tempering("fused", fused.tempering);
+        print_tempering("fused", "validation", fused.tempering);
         Recognizer::Fused(fused)
     } else {
         let model = models.into_iter().next().ok_or("no descriptor to train")?;
@@ -108,9 +116,17 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => {
             let data = read_dataset(path)?;
             let model = model
-                .calibrate_on(&data, args.trial_readings)
+                .calibrate_on(&data, args.calibration_trial_readings.unwrap_or(usize::MAX))
                 .map_err(|e| format!("--calibration {}: {e}", path.display()))?;
-            print_tempering(&format!("on {}:", path.display()), model.tempering());
+            let trials = match args.calibration_trial_readings {
+                Some(n) => format!("trials of {n} readings"),
+                None => "each object's readings one trial".to_string(),
+            };
+            print_tempering(
+                &args.descriptor.name(),
+                &format!("{} ({trials})", path.display()),
+                model.tempering(),
+            );
             model
         }
         None => model,
@@ -204,13 +220,17 @@ fn print_selection(model: &TrainedModel) {
         )
     });
     println!("chosen k = {}, restart {}{chosen}", s.chosen_k, s.chosen_restart);
-    print_tempering(model.descriptor.kind().name(), model.bag.tempering());
+    print_tempering(
+        model.descriptor.kind().short_name(),
+        "validation",
+        model.bag.tempering(),
+    );
 }
 
 /// The posterior's tempering fitted on validation (`--posterior eq15` at recognition turns it off).
-fn print_tempering(name: &str, t: Tempering) {
+fn print_tempering(name: &str, on: &str, t: Tempering) {
     println!(
-        "{name} posterior calibrated on validation: tau = {:.3}, beta = {:.2}, floor = {:.3} (10 readings count as {:.1} independent ones, 30 as {:.1})",
+        "{name} posterior calibrated on {on}: tau = {:.3}, beta = {:.2}, floor = {:.3} (10 readings count as {:.1} independent ones, 30 as {:.1})",
         t.tau(),
         t.beta(),
         t.floor(),

@@ -6,7 +6,8 @@
 //! The model is the end-to-end recipe's (`end-to-end`, "reachable"): three times the scale's
 //! sampler readings per object from starts the arm can reach, with the run's codebook, its
 //! posterior calibrated on the arm's own explorations (a planner dataset at L = 0.5 on a stream
-//! of its own, `recognize::calibration`). The L curves recognise the same planner datasets as
+//! of its own, `recognize::calibration`), each object's exploration one trial as long as a test
+//! run (`test_per_object` touches). The L curves recognise the same planner datasets as
 //! Figs. 8 and 10 (shared through `<out>/data`). The active curves cannot come from a
 //! dataset collected beforehand: where the arm touches next depends on the model's belief, so each
 //! unit explores with the trained model in the loop, with the random streams and sensor of the
@@ -261,7 +262,7 @@ pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
             neighbourhood_m,
             stops: STOPS,
             posterior: context.posterior(),
-            calibration_trial_readings: training.trial_readings,
+            calibration_trial_readings: counts.test_per_object,
             scale: context.scale.fraction(),
             counts,
             seed: context.seed,
@@ -306,7 +307,7 @@ impl ActiveUnit<'_> {
         let model = match self.context.posterior() {
             PosteriorRule::Calibrated => {
                 let arm = self.context.store.dataset(&data.calibration_request()?)?;
-                model.calibrate_on(&arm, self.training.trial_readings)?
+                model.calibrate_on(&arm, self.counts.test_per_object)?
             }
             PosteriorRule::Eq15 => model,
         };

@@ -28,7 +28,11 @@
 //! limit of data). For each `epsilon` and `beta` of a grid, a golden-section search finds `tau`
 //! (without the floor the loss is convex in `ln tau`, a log-softmax of a linear function). Validation trials of the kind the
 //! model will be judged on (the arm's explorations, not independent sampler readings) are what
-//! let `beta` see the correlation.
+//! let `beta` see the correlation, and they must be as long as the runs to be judged: `w(n)` is
+//! only fitted at the counts the trials reach. Fitted on the arm's explorations of the 3D set cut
+//! into 10-touch trials, the posterior of 100-touch runs was overconfident (ECE 0.196 on the
+//! L = 1 test runs, a stop at 0.95 right 75% of the time); fitted on the whole 100-touch
+//! explorations, ECE 0.097 and 95%.
 
 use serde::{Deserialize, Serialize};
 
@@ -78,10 +82,13 @@ impl Default for Tempering {
     }
 }
 
-/// The `beta` grid [`Tempering::fit`] searches: from evidence growing as the square root of the
-/// readings' count (0.3) to slightly faster than independent readings (1.2).
-const BETA_GRID: [f64; 19] = [
-    0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.15, 1.2,
+/// The `beta` grid [`Tempering::fit`] searches: from evidence that hardly grows with the readings'
+/// count (0.05: touches that repeat what the first ones felt) to slightly faster than independent
+/// readings (1.2). Fitted on the arm's whole 100-touch explorations of the 3D set, `beta` came out
+/// at 0.3, the end of a grid that began there, so the grid reaches lower.
+const BETA_GRID: [f64; 24] = [
+    0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95,
+    1.0, 1.05, 1.1, 1.15, 1.2,
 ];
 
 /// The range of `ln tau` the golden-section search covers: a thousandth to a hundred times Eq. 15.
@@ -363,8 +370,8 @@ mod tests {
         assert!(fitted.tau() < 0.5, "{fitted:?}");
     }
 
-    /// Trials that repeat one reading `n` times (perfectly correlated touches) are fitted with
-    /// `beta` near 0.3, the grid's end: the evidence does not grow with the count.
+    /// Trials that repeat one reading `n` times (perfectly correlated touches) are fitted with a
+    /// small `beta`: the evidence does not grow with the count.
     #[test]
     fn fit_sees_correlated_readings() {
         let mut rng = stream(8, 0);
@@ -383,7 +390,7 @@ mod tests {
             });
         }
         let fitted = Tempering::fit(&trials);
-        assert!(fitted.beta() <= 0.35, "{fitted:?}");
+        assert!(fitted.beta() <= 0.2, "{fitted:?}");
     }
 
     #[test]

@@ -207,7 +207,9 @@ impl TrainedModel {
     /// `data` in trials of `trial_readings` (`recognize::calibration`): calibration data of the
     /// kind the model will be judged on (the arm's own explorations, whose successive touches are
     /// correlated) rather than the validation readings it was chosen on (`taction train
-    /// --calibration`).
+    /// --calibration`). `trial_readings` should be the length of the runs the model will
+    /// recognise (`usize::MAX`: each object's readings as one trial), since the tempering is only
+    /// fitted at the reading counts the trials reach.
     pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
         let paths = self
             .trials(data, trial_readings)?
