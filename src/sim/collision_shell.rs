@@ -337,18 +337,14 @@ mod tests {
         }
     }
 
-    /// A piece finer than the tolerance (a 1 cm plate of 101 x 101 vertices, one piece) goes to
-    /// MuJoCo thinned to one vertex per 1 mm cell: a few hundred points instead of 20,402, every
-    /// one a vertex of the plate or its thickened copy, and every vertex of the plate within a
-    /// cell's diagonal of a kept one.
-    #[test]
-    fn a_piece_finer_than_the_tolerance_keeps_one_vertex_per_cell() {
-        let n = 100u32;
+    /// A square grid of `n x n` cells of side `spacing_m` from the origin, the surface
+    /// `z = height(x, y)`, two triangles a cell.
+    fn grid_mesh(n: u32, spacing_m: f64, height: impl Fn(f64, f64) -> f64) -> TriMesh {
         let mut mesh = TriMesh::default();
         for i in 0..=n {
             for j in 0..=n {
-                mesh.vertices
-                    .push(DVec3::new(i as f64 * 1e-4, j as f64 * 1e-4, 0.0));
+                let (x, y) = (i as f64 * spacing_m, j as f64 * spacing_m);
+                mesh.vertices.push(DVec3::new(x, y, height(x, y)));
             }
         }
         let at = |i: u32, j: u32| i * (n + 1) + j;
@@ -358,6 +354,16 @@ mod tests {
                 mesh.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
             }
         }
+        mesh
+    }
+
+    /// A piece finer than the tolerance (a 1 cm plate of 101 x 101 vertices, one piece) goes to
+    /// MuJoCo thinned to one vertex per 1 mm cell: a few hundred points instead of 20,402, every
+    /// one a vertex of the plate or its thickened copy, and every vertex of the plate within a
+    /// cell's diagonal of a kept one.
+    #[test]
+    fn a_piece_finer_than_the_tolerance_keeps_one_vertex_per_cell() {
+        let mesh = grid_mesh(100, 1e-4, |_, _| 0.0);
         let options = ShellOptions::default();
         let pieces = collision_shell(&mesh, &options);
         assert_eq!(pieces.len(), 1);
@@ -395,22 +401,9 @@ mod tests {
     fn the_boxed_convexity_test_answers_as_the_one_by_one_test() {
         // A wavy 40 x 40 grid (concave and convex patches) and its sub-patches, at tolerances
         // around the waves' height: both answers occur and every answer agrees.
-        let n = 40u32;
-        let mut mesh = TriMesh::default();
-        for i in 0..=n {
-            for j in 0..=n {
-                let (x, y) = (i as f64 * 1e-3, j as f64 * 1e-3);
-                let z = 1e-3 * (x * 300.0).sin() * (y * 200.0).cos() - 2.0 * (x * x + y * y);
-                mesh.vertices.push(DVec3::new(x, y, z));
-            }
-        }
-        let at = |i: u32, j: u32| i * (n + 1) + j;
-        for i in 0..n {
-            for j in 0..n {
-                mesh.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                mesh.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
+        let mesh = grid_mesh(40, 1e-3, |x, y| {
+            1e-3 * (x * 300.0).sin() * (y * 200.0).cos() - 2.0 * (x * x + y * y)
+        });
         let mut answers = [0usize; 2];
         for size in [4usize, 10, 25, 40] {
             for start in [0usize, 7, 300, 1000] {
