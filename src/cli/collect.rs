@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use taction::dataset::{Dataset, describe_shortfalls};
-use taction::experiment::CollectionProgress;
+use taction::experiment::Progress;
 use taction::explore::{Collect, ExplorationReport, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::sim::{ObjectSpec, PerturbationBounds};
@@ -107,8 +107,8 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         args.threads.count(),
         args.out.display()
     );
-    let progress = CollectionProgress::new(&format!("collect {}", set.name), objects.len(), args.readings);
-    let reports = collect.progress(&|| progress.converged()).run(&objects)?;
+    let progress = Progress::collection(&format!("collect {}", set.name), objects.len(), args.readings);
+    let reports = collect.progress(&|| progress.inc()).run(&objects)?;
     progress.finish(reports.iter().map(ExplorationReport::converged).sum());
     let planner_lines: Vec<String> = match args.mode {
         Mode::Planner => objects

@@ -19,7 +19,7 @@ use rand::RngExt;
 use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, TouchRun, explore_recognizing};
 use taction::control::sensor_reader;
 use taction::dataset::{Dataset, describe_shortfalls};
-use taction::experiment::CollectionProgress;
+use taction::experiment::Progress;
 use taction::experiment::{Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
 use taction::explore::Probability;
@@ -168,10 +168,10 @@ fn train_model(
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let progress = CollectionProgress::new("training data", objects.len(), readings);
+    let progress = Progress::collection("training data", objects.len(), readings);
     let dataset = recipe
         .collect_plan(sensor)?
-        .collect_dataset(&set.id(), objects, 0, &|| progress.converged())?;
+        .collect_dataset(&set.id(), objects, 0, &|| progress.inc())?;
     let converged = dataset.converged_only().len();
     progress.finish(converged);
     let short = dataset.shortfalls(readings);
@@ -206,11 +206,11 @@ fn collect_calibration(
 ) -> Result<Dataset, Box<dyn std::error::Error>> {
     let readings = recipe.calibration_readings();
     println!("calibration: the arm exploring each object blind for {readings} readings");
-    let progress = CollectionProgress::new("calibration data", objects.len(), readings);
+    let progress = Progress::collection("calibration data", objects.len(), readings);
     let dataset =
         recipe
             .calibration_plan(sensor, objects)?
-            .collect_dataset(&set.id(), objects, 0, &|| progress.converged())?;
+            .collect_dataset(&set.id(), objects, 0, &|| progress.inc())?;
     progress.finish(dataset.converged_only().len());
     let short = dataset.shortfalls(readings);
     if !short.is_empty() {

@@ -115,13 +115,13 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     let model = match &args.calibration {
         Some(path) => {
             let data = read_dataset(path)?;
-            let model = model
-                .calibrate_on(&data, args.calibration_trial_readings.unwrap_or(usize::MAX))
-                .map_err(|e| format!("--calibration {}: {e}", path.display()))?;
-            let trials = match args.calibration_trial_readings {
-                Some(n) => format!("trials of {n} readings"),
-                None => "each object's readings one trial".to_string(),
+            let (trial_readings, trials) = match args.calibration_trial_readings {
+                Some(n) => (n, format!("trials of {n} readings")),
+                None => (usize::MAX, "each object's readings one trial".to_string()),
             };
+            let model = model
+                .calibrate_on(&data, trial_readings)
+                .map_err(|e| format!("--calibration {}: {e}", path.display()))?;
             print_tempering(
                 &args.descriptor.name(),
                 &format!("{} ({trials})", path.display()),
@@ -227,7 +227,8 @@ fn print_selection(model: &TrainedModel) {
     );
 }
 
-/// The posterior's tempering fitted on validation (`--posterior eq15` at recognition turns it off).
+/// The posterior's tempering and what it was fitted `on` (`--posterior eq15` at recognition turns
+/// it off).
 fn print_tempering(name: &str, on: &str, t: Tempering) {
     println!(
         "{name} posterior calibrated on {on}: tau = {:.3}, beta = {:.2}, floor = {:.3} (10 readings count as {:.1} independent ones, 30 as {:.1})",

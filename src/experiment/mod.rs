@@ -57,5 +57,5 @@ pub use plot::{
     ACCURACY_LABEL, Axis, PERFECT_CALIBRATION, PlotKind, PlotSpec, build_figure, reliability_figure,
 };
 
-// Progress of a long collection, on the terminal.
-pub use progress::CollectionProgress;
+// Progress of a long collection or exploration, on the terminal.
+pub use progress::Progress;

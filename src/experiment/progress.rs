@@ -39,6 +39,16 @@ impl Progress {
         }
     }
 
+    /// Converged readings collected against those asked, `readings_per_object` of each of
+    /// `objects` objects (`collect`, and the data collection of `demo` and the experiments).
+    pub fn collection(name: &str, objects: usize, readings_per_object: usize) -> Self {
+        Self::new(
+            name,
+            objects.saturating_mul(readings_per_object),
+            "converged readings",
+        )
+    }
+
     /// One more item done (any thread).
     pub fn inc(&self) {
         self.bar.inc(1);
@@ -56,27 +66,5 @@ impl Progress {
                 self.started.elapsed().as_secs_f64()
             );
         }
-    }
-}
-
-/// Converged readings collected against those asked, over an object set (`collect`, and the data
-/// collection of `demo` and the experiments).
-pub struct CollectionProgress(Progress);
-
-impl CollectionProgress {
-    /// `readings_per_object` converged readings asked of each of `objects` objects.
-    pub fn new(name: &str, objects: usize, readings_per_object: usize) -> Self {
-        let asked = objects.saturating_mul(readings_per_object);
-        Self(Progress::new(name, asked, "converged readings"))
-    }
-
-    /// One more converged reading (any thread).
-    pub fn converged(&self) {
-        self.0.inc();
-    }
-
-    /// Clears the bar; without a terminal, prints the summary line instead.
-    pub fn finish(&self, converged: usize) {
-        self.0.finish(converged);
     }
 }

@@ -26,7 +26,7 @@ use serde::Serialize;
 
 use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
-use crate::experiment::progress::CollectionProgress;
+use crate::experiment::progress::Progress;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 use crate::explore::{Collect, CollectPlan};
 use crate::mesh::ObjectSet;
@@ -243,14 +243,14 @@ impl DataStore {
             request.plan.sensor.rows,
             request.plan.sensor.cols,
         );
-        let progress = CollectionProgress::new(
+        let progress = Progress::collection(
             &format!("  dataset {n}/{total}"),
             request.objects.specs.len(),
             request.plan.readings_per_object,
         );
         let dataset = Collect::from_plan(request.plan)
             .threads(self.threads)
-            .progress(&|| progress.converged())
+            .progress(&|| progress.inc())
             .dataset(&request.object_set, &request.objects.specs)?;
         progress.finish(dataset.converged().count());
         crate::experiment::files::create_dir_all(&self.root.join("data"))?;
