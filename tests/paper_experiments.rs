@@ -203,6 +203,56 @@ fn valid_svg_and_png(stem: &Path) -> String {
     svg
 }
 
+/// `<out>/timings.csv` has a line per experiment, in the run's order, whose phases add up to its
+/// wall time; experiments that train models are charged training time (no more than their units
+/// took), those that only collect or draw none; the table is printed too.
+fn assert_phases_add_up(out: &Path, stdout: &str) {
+    #[derive(serde::Deserialize)]
+    struct Line {
+        experiment: String,
+        wall_s: f64,
+        datasets_s: f64,
+        units_s: f64,
+        rest_s: f64,
+        unit_thread_s: f64,
+        training_thread_s: f64,
+    }
+    let lines: Vec<Line> = csv::Reader::from_path(out.join("timings.csv"))
+        .expect("timings.csv written")
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .expect("timings.csv reads back");
+    let names: Vec<&str> = lines.iter().map(|l| l.experiment.as_str()).collect();
+    let all: Vec<&str> = PaperExperiment::ALL.iter().map(|e| e.name()).collect();
+    assert_eq!(names, all);
+    for l in &lines {
+        let phases = l.datasets_s + l.units_s + l.rest_s;
+        assert!(
+            (phases - l.wall_s).abs() < 1e-6,
+            "{}: {phases} vs {}",
+            l.experiment,
+            l.wall_s
+        );
+        assert!(l.training_thread_s <= l.unit_thread_s, "{}", l.experiment);
+        // Fig. 7 trains the first models; a later experiment reading a model from the store is
+        // charged nothing for it, and the two that recognise nothing train nothing.
+        match l.experiment.as_str() {
+            "descriptors" | "letters" | "real-frames" => {
+                assert!(l.training_thread_s > 0.0, "{}", l.experiment)
+            }
+            "exploration" | "convergence" => {
+                assert_eq!(l.training_thread_s, 0.0, "{}", l.experiment)
+            }
+            _ => {}
+        }
+    }
+    assert!(
+        stdout.contains("| experiment | wall s | datasets s |"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("| total |"), "{stdout}");
+}
+
 #[test]
 fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     let dir = tempfile::tempdir().unwrap();
@@ -350,6 +400,7 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");
     }
+    assert_phases_add_up(&out, &stdout);
     // Fig. 1: the pawn explored by the planner, its placements as CSV, the picture in the index.
     let placements = std::fs::read_to_string(out.join("exploration/exploration.csv")).expect("Fig. 1 CSV");
     let mut lines = placements.lines();

@@ -13,6 +13,7 @@ use taction::paper::headline_table;
 use taction::paper::{PaperContext, PaperExperiment, RealRecording, Scale};
 use taction::paper::{REFERENCE_THREADS, RunEstimate, human_duration};
 use taction::paper::{SHORTFALLS_FILE, read_shortfalls};
+use taction::paper::{TIMINGS_FILE, timings_table, write_timings};
 
 use crate::cli::common::{
     ObjectSizeArg, OutputLock, PosteriorArg, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook,
@@ -153,8 +154,18 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
     check_earlier_runs(&[experiment.name()], &context)?;
     announce_estimate(&[experiment.name()], &context);
-    let report = experiment.run(&context).map_err(|e| e.to_string())?;
+    let (report, times) = experiment.run_timed(&context).map_err(|e| e.to_string())?;
     println!("{report}");
+    eprintln!(
+        "{experiment} took {:.1} s: datasets {:.1} s, units {:.1} s ({:.1} thread-s, of which training {:.1}), \
+         rest {:.1} s",
+        times.wall_s,
+        times.datasets_s,
+        times.units_s,
+        times.unit_thread_s,
+        times.training_thread_s,
+        times.rest_s
+    );
     check_shortfalls(&context, &[experiment.name()], args.paper.allow_short)
 }
 
@@ -283,13 +294,16 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
     check_earlier_runs(&names, &context)?;
     let started = Instant::now();
     let mut estimate = announce_estimate(&names, &context);
+    let mut timings = Vec::new();
     for experiment in &experiments {
-        let begun = Instant::now();
         eprintln!("== {experiment}: {}", experiment.description());
-        let report = experiment.run(&context).map_err(|e| e.to_string())?;
+        let (report, times) = experiment.run_timed(&context).map_err(|e| e.to_string())?;
         println!("{report}");
-        let seconds = begun.elapsed().as_secs_f64();
+        let seconds = times.wall_s;
         estimate.finished(experiment.name(), seconds);
+        timings.push(times);
+        // Written after every experiment, so a run stopped later keeps the phases it measured.
+        write_timings(&context.options.out, &timings).map_err(|e| e.to_string())?;
         eprintln!(
             "== {experiment} done in {seconds:.1} s; about {} to go",
             human_duration(estimate.remaining_s())
@@ -302,8 +316,12 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
         .collect();
     let table = headline_table(&context.options.out, &names)?;
     println!(
-        "\naccuracy (%) after n readings, mean over trials, scale {}:\n{table}\nreproduce took {:.1} s",
+        "\naccuracy (%) after n readings, mean over trials, scale {}:\n{table}\nwhere the time went \
+         (seconds, also in {}; datasets: collected or read, units: the experiments' work on the \
+         worker pool, rest: assembling and plotting; thread-s summed over the workers):\n{}\nreproduce took {:.1} s",
         context.scale,
+        context.options.out.join(TIMINGS_FILE).display(),
+        timings_table(&timings),
         started.elapsed().as_secs_f64()
     );
     let all: Vec<&str> = experiments.iter().map(|e| e.name()).collect();

@@ -4,7 +4,8 @@ use std::collections::HashSet;
 use std::fmt;
 use std::num::NonZeroUsize;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -82,6 +83,11 @@ pub struct RunReport {
     pub missing: usize,
     /// The assembled files, once every unit is present.
     pub finished: Option<Finished>,
+    /// Wall time of running the pending units on the pool.
+    pub units_wall: Duration,
+    /// The pending units' own durations, summed over the workers (up to `units_wall` times the
+    /// thread count).
+    pub units_thread: Duration,
 }
 
 impl fmt::Display for RunReport {
@@ -177,7 +183,9 @@ where
 
     let ShardUnits { in_shard, pending } = pending_in_shard::<R, D>(units, options, &dir)?;
     let reused = in_shard - pending.len();
-    let ran = run_pending(&pending, options, &dir, &details, &spec.name.to_string())?;
+    let started = Instant::now();
+    let Ran { ran, units_thread } = run_pending(&pending, options, &dir, &details, &spec.name.to_string())?;
+    let units_wall = started.elapsed();
 
     let missing = missing_units(&dir, &manifest).len();
     let finished = if missing == 0 {
@@ -195,6 +203,8 @@ where
         ran,
         missing,
         finished,
+        units_wall,
+        units_thread,
     })
 }
 
@@ -290,6 +300,12 @@ struct ShardUnits<'u, 'a, R, D: DetailTables> {
     pending: Vec<&'u Unit<'a, R, D>>,
 }
 
+/// What [`run_pending`] did: the units it ran and their durations summed.
+struct Ran {
+    ran: usize,
+    units_thread: Duration,
+}
+
 /// Step 3: the pending units on a pool of `--threads` workers; no unit starts after one failed.
 /// The units run now, or the error naming every failed one.
 fn run_pending<R, D>(
@@ -298,7 +314,7 @@ fn run_pending<R, D>(
     dir: &ExperimentDir,
     details: &[SafeName],
     name: &str,
-) -> Result<usize, ExperimentError>
+) -> Result<Ran, ExperimentError>
 where
     R: Serialize + DeserializeOwned,
     D: DetailTables,
@@ -313,6 +329,7 @@ where
         })?;
     let progress = progress_bar(pending.len(), name, "units");
     let stop = AtomicBool::new(false);
+    let thread_ns = AtomicU64::new(0);
     let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
         pending
             .par_iter()
@@ -320,7 +337,10 @@ where
                 if stop.load(Ordering::Relaxed) {
                     return None;
                 }
+                let started = Instant::now();
                 let outcome = run_unit(unit, dir, details);
+                let ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
+                thread_ns.fetch_add(ns, Ordering::Relaxed);
                 if outcome.is_err() {
                     stop.store(true, Ordering::Relaxed);
                 }
@@ -335,7 +355,10 @@ where
     if !failures.is_empty() {
         return Err(ExperimentError::UnitsFailed { failures });
     }
-    Ok(ran)
+    Ok(Ran {
+        ran,
+        units_thread: Duration::from_nanos(thread_ns.into_inner()),
+    })
 }
 
 /// Runs one unit and saves its detail tables (when the experiment has any), then its rows, each

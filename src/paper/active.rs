@@ -307,7 +307,10 @@ impl ActiveUnit<'_> {
         let model = match self.context.posterior() {
             PosteriorRule::Calibrated => {
                 let arm = self.context.store.dataset(&data.calibration_request()?)?;
-                model.calibrate_on(&arm, self.counts.test_per_object)?
+                let store = &self.context.store;
+                store
+                    .clock
+                    .training(|| model.calibrate_on(&arm, self.counts.test_per_object))?
             }
             PosteriorRule::Eq15 => model,
         };

@@ -24,6 +24,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::timing::PhaseClock;
 use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::Progress;
@@ -109,6 +110,8 @@ pub struct DataStore {
     shortfalls: Mutex<HashMap<String, Vec<Shortfall>>>,
     /// How every model's posterior turns likelihoods into probabilities (`--posterior`).
     pub(crate) posterior: PosteriorRule,
+    /// The time spent preparing datasets and fitting models (`timing.rs`).
+    pub(crate) clock: PhaseClock,
 }
 
 /// The file in an experiment's folder naming the datasets it used that fell short of their
@@ -168,6 +171,7 @@ impl DataStore {
             datasets: Mutex::new(HashMap::new()),
             shortfalls: Mutex::new(HashMap::new()),
             posterior: PosteriorRule::default(),
+            clock: PhaseClock::default(),
         }
     }
 
@@ -180,6 +184,11 @@ impl DataStore {
     /// order, each distinct dataset once. The short ones among them are recorded in
     /// `experiment_dir`'s [`SHORTFALLS_FILE`].
     pub fn prepare(&self, requests: &[DataRequest], experiment_dir: &Path) -> Result<(), BoxError> {
+        self.clock
+            .datasets(|| self.prepare_timed(requests, experiment_dir))
+    }
+
+    fn prepare_timed(&self, requests: &[DataRequest], experiment_dir: &Path) -> Result<(), BoxError> {
         let mut distinct = BTreeMap::new();
         for r in requests {
             distinct.entry(r.key()).or_insert(r);
@@ -324,13 +333,16 @@ impl DataStore {
         }
         let training_data = self.dataset(training)?;
         let validation_data = self.dataset(validation)?;
-        let model = TrainedModel::fit(
-            &Valid::new(config.clone())?,
-            &training_data,
-            Some(&validation_data),
-            descriptor,
-            &mut |_| {},
-        )?;
+        let config = Valid::new(config.clone())?;
+        let model = self.clock.training(|| {
+            TrainedModel::fit(
+                &config,
+                &training_data,
+                Some(&validation_data),
+                descriptor,
+                &mut |_| {},
+            )
+        })?;
         crate::experiment::files::create_dir_all(&self.root.join("models"))?;
         model.save(&path)?;
         Ok(model.with_posterior(self.posterior))

@@ -37,6 +37,7 @@ pub(crate) mod recognition;
 pub(crate) mod scale;
 pub(crate) mod sim_to_real;
 pub(crate) mod split;
+pub(crate) mod timing;
 
 use std::fmt;
 use std::path::PathBuf;
@@ -48,6 +49,7 @@ pub use data::{SHORTFALLS_FILE, read_shortfalls};
 pub use estimate::{PACE_AFTER_S, REFERENCE_THREADS, RunEstimate, human_duration};
 pub use headline::{HEADLINE_READINGS, headline_table};
 pub use scale::{DataCounts, Scale, ScaleError};
+pub use timing::{PhaseTimes, TIMINGS_FILE, timings_table, write_timings};
 
 // The recognition figures: a sweep of settings, each a curve over the readings.
 pub use recognition::{Curve, RecognitionSweep, Setting, TestData};
@@ -171,19 +173,31 @@ impl PaperExperiment {
     /// Runs the experiment in `context`.
     pub fn run(self, context: &PaperContext) -> Result<PaperOutput, BoxError> {
         Ok(match self.sweep() {
-            Some(sweep) => PaperOutput::Run(sweep.run(context)?),
+            Some(sweep) => PaperOutput::Run(Box::new(sweep.run(context)?)),
             None if self == Self::Exploration => PaperOutput::Picture(figure1::run_figure1(context)?),
-            None if self == Self::RealFrames => PaperOutput::Run(real_frames::run_real_frames(context)?),
-            None if self == Self::Active => PaperOutput::Run(active::run_active(context)?),
-            None => PaperOutput::Run(run_convergence(context)?),
+            None if self == Self::RealFrames => {
+                PaperOutput::Run(Box::new(real_frames::run_real_frames(context)?))
+            }
+            None if self == Self::Active => PaperOutput::Run(Box::new(active::run_active(context)?)),
+            None => PaperOutput::Run(Box::new(run_convergence(context)?)),
         })
+    }
+
+    /// [`run`](Self::run), and where its time went (`timing.rs`).
+    pub fn run_timed(self, context: &PaperContext) -> Result<(PaperOutput, PhaseTimes), BoxError> {
+        let before = context.store.clock.snapshot();
+        let started = std::time::Instant::now();
+        let output = self.run(context)?;
+        let wall = started.elapsed();
+        let times = PhaseTimes::of(self.name(), wall, before, context.store.clock.snapshot(), &output);
+        Ok((output, times))
     }
 }
 
 /// What running a paper experiment produced: a run of units, or (Fig. 1) one picture.
 #[derive(Debug)]
 pub enum PaperOutput {
-    Run(RunReport),
+    Run(Box<RunReport>),
     Picture(PathBuf),
 }
 

@@ -25,6 +25,7 @@ use serde::Serialize;
 use super::context::PaperContext;
 use super::real_frames_options::RealFramesOptions;
 use super::recognition::{RecognitionDetail, RecognitionRows, selection_config};
+use super::timing::PhaseClock;
 use crate::dataset::recorded::{RealData, RealReading};
 use crate::dataset::{ContactStatus, Dataset};
 use crate::describe::{Descriptor, DescriptorKind};
@@ -218,6 +219,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
         blur: GaussianBlur::new(options.blur_sigma_taxels)?,
         seed: context.seed,
         posterior: context.posterior(),
+        clock: &context.store.clock,
     });
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let units = DescriptorKind::ALL
@@ -292,6 +294,8 @@ struct TrialPlan<'a> {
     blur: GaussianBlur,
     seed: u64,
     posterior: PosteriorRule,
+    /// The run's clock, charged the training (`timing.rs`).
+    clock: &'a PhaseClock,
 }
 
 impl TrialPlan<'_> {
@@ -357,12 +361,14 @@ impl TrialPlan<'_> {
             seed: rng::substream(self.training.seed, trial as u64),
             ..self.training.clone()
         };
-        let trained = train(
-            &Valid::new(trial_training)?,
-            &self.describe(descriptor, &split.train)?,
-            Some(&self.describe(descriptor, &split.validation)?),
-            &mut |_| {},
-        )?;
+        let config = Valid::new(trial_training)?;
+        let (training, validation) = (
+            self.describe(descriptor, &split.train)?,
+            self.describe(descriptor, &split.validation)?,
+        );
+        let trained = self
+            .clock
+            .training(|| train(&config, &training, Some(&validation), &mut |_| {}))?;
         let test = self.describe(descriptor, &split.test)?;
         let trials: Vec<Trial> = (0..self.labels.len())
             .map(|object| Trial {

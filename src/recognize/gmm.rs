@@ -576,18 +576,33 @@ mod tests {
         }
         let mut rng = crate::rng::rng(43);
         // Feature counts within one block of the product's KC and across several (with a partial
-        // pass); d with partial tiles in both directions.
-        for (n, d) in [(200, 6), (600, 20), (1000, 13), (257, 23)] {
+        // pass); d with partial tiles in both directions. Responsibilities in [0, 1], some exactly
+        // 0 and some exactly 1 as after k-means; or mostly 0 as for most components of a large
+        // mixture (the skipped features), a whole block of the KC and a whole pass among them.
+        let dense = |r: usize, rng: &mut crate::rng::Rng| match r % 7 {
+            0 => 0.0,
+            1 => 1.0,
+            _ => rng.random_range(0.0..1.0),
+        };
+        let sparse = |r: usize, rng: &mut crate::rng::Rng| {
+            if (256..512).contains(&r) || r % 11 != 3 {
+                0.0
+            } else {
+                rng.random_range(1e-300..1.0)
+            }
+        };
+        let cases = [
+            (200, 6, dense as fn(usize, &mut crate::rng::Rng) -> f64),
+            (600, 20, dense),
+            (1000, 13, dense),
+            (257, 23, dense),
+            (1000, 20, sparse),
+            (3000, 7, sparse),
+        ];
+        for (n, d, weight) in cases {
             let x = random_matrix(&mut rng, n, d);
             let x_rows: Vec<f64> = x.transpose().as_slice().to_vec();
-            // Responsibilities in [0, 1], some exactly 0 and some exactly 1 as after k-means.
-            let resp: Vec<f64> = (0..n)
-                .map(|r| match r % 7 {
-                    0 => 0.0,
-                    1 => 1.0,
-                    _ => rng.random_range(0.0..1.0),
-                })
-                .collect();
+            let resp: Vec<f64> = (0..n).map(|r| weight(r, &mut rng)).collect();
             let mean: Vec<f64> = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
             let lower = weighted_scatter(&x_rows, &mean, &resp).expect("the fast path applies");
             let general = weighted_scatter_general(&x, &x_rows, &mean, &resp);

@@ -199,10 +199,19 @@ impl Scatter {
         let n = resp.len();
         for k0 in (0..n).step_by(KC) {
             let k_end = (k0 + KC).min(n);
-            for first in (k0..k_end).step_by(PASS) {
-                let rows = first..(first + PASS).min(k_end);
-                let count = rows.len();
-                self.residuals_of(x_rows, mean, resp, rows);
+            // A feature of zero responsibility adds an exact zero to every chain, which leaves it
+            // unchanged (a chain never holds -0): such features are skipped. With hundreds of
+            // components most of a component's responsibilities underflow to zero.
+            let mut count = 0;
+            for r in (k0..k_end).filter(|&r| resp[r] != 0.0) {
+                self.residual_of(x_rows, mean, resp[r], r, count);
+                count += 1;
+                if count == PASS {
+                    self.chain(count);
+                    count = 0;
+                }
+            }
+            if count > 0 {
                 self.chain(count);
             }
             // `matrixmultiply` adds each block's chain to the value so far (`c = ab + c`).
@@ -216,19 +225,16 @@ impl Scatter {
         }
     }
 
-    /// Fills the pass's `D` and `W` rows with the features `rows`.
+    /// Fills row `t` of the pass's `D` and `W` with feature `r`, of responsibility `weight`.
     #[inline(always)]
-    fn residuals_of(&mut self, x_rows: &[f64], mean: &[f64], resp: &[f64], rows: std::ops::Range<usize>) {
+    fn residual_of(&mut self, x_rows: &[f64], mean: &[f64], weight: f64, r: usize, t: usize) {
         let (d, stride) = (self.d, self.stride);
-        for (t, r) in rows.enumerate() {
-            let x = &x_rows[r * d..][..d];
-            let weight = resp[r];
-            let residual = &mut self.residuals[t * stride..][..d];
-            let weighted = &mut self.weighted[t * stride..][..d];
-            for (((res, w), &v), &m) in residual.iter_mut().zip(weighted).zip(x).zip(mean) {
-                *res = v - m;
-                *w = *res * weight;
-            }
+        let x = &x_rows[r * d..][..d];
+        let residual = &mut self.residuals[t * stride..][..d];
+        let weighted = &mut self.weighted[t * stride..][..d];
+        for (((res, w), &v), &m) in residual.iter_mut().zip(weighted).zip(x).zip(mean) {
+            *res = v - m;
+            *w = *res * weight;
         }
     }
 
