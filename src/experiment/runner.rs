@@ -300,6 +300,28 @@ struct ShardUnits<'u, 'a, R, D: DetailTables> {
     pending: Vec<&'u Unit<'a, R, D>>,
 }
 
+/// Durations of work done on any thread, summed: the runner's units, and the paper's phases
+/// (`paper::timing`), which may run on several workers at once.
+#[derive(Debug, Default)]
+pub(crate) struct SummedTime {
+    ns: AtomicU64,
+}
+
+impl SummedTime {
+    /// Runs `work`, adding its duration on this thread to the sum.
+    pub(crate) fn time<T>(&self, work: impl FnOnce() -> T) -> T {
+        let started = Instant::now();
+        let result = work();
+        let ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.ns.fetch_add(ns, Ordering::Relaxed);
+        result
+    }
+
+    pub(crate) fn total(&self) -> Duration {
+        Duration::from_nanos(self.ns.load(Ordering::Relaxed))
+    }
+}
+
 /// What [`run_pending`] did: the units it ran and their durations summed.
 struct Ran {
     ran: usize,
@@ -329,7 +351,7 @@ where
         })?;
     let progress = progress_bar(pending.len(), name, "units");
     let stop = AtomicBool::new(false);
-    let thread_ns = AtomicU64::new(0);
+    let units_thread = SummedTime::default();
     let outcomes: Vec<Option<Result<(), UnitFailure>>> = pool.install(|| {
         pending
             .par_iter()
@@ -337,10 +359,7 @@ where
                 if stop.load(Ordering::Relaxed) {
                     return None;
                 }
-                let started = Instant::now();
-                let outcome = run_unit(unit, dir, details);
-                let ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
-                thread_ns.fetch_add(ns, Ordering::Relaxed);
+                let outcome = units_thread.time(|| run_unit(unit, dir, details));
                 if outcome.is_err() {
                     stop.store(true, Ordering::Relaxed);
                 }
@@ -357,7 +376,7 @@ where
     }
     Ok(Ran {
         ran,
-        units_thread: Duration::from_nanos(thread_ns.into_inner()),
+        units_thread: units_thread.total(),
     })
 }
 

@@ -307,10 +307,8 @@ impl ActiveUnit<'_> {
         let model = match self.context.posterior() {
             PosteriorRule::Calibrated => {
                 let arm = self.context.store.dataset(&data.calibration_request()?)?;
-                let store = &self.context.store;
-                store
-                    .clock
-                    .training(|| model.calibrate_on(&arm, self.counts.test_per_object))?
+                let calibrate = || model.calibrate_on(&arm, self.counts.test_per_object);
+                self.context.store.clock.training(calibrate)?
             }
             PosteriorRule::Eq15 => model,
         };

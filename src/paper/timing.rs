@@ -17,12 +17,12 @@
 //! only its reading, which is what the later experiment is charged.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use serde::Serialize;
 
 use super::PaperOutput;
+use crate::experiment::runner::SummedTime;
 use crate::experiment::unit::{BoxError, rows_to_csv};
 
 /// The file of a run's per-phase timings, in the output root.
@@ -32,8 +32,8 @@ pub const TIMINGS_FILE: &str = "timings.csv";
 /// experiment of a run and read before and after each one ([`PhaseClock::snapshot`]).
 #[derive(Debug, Default)]
 pub struct PhaseClock {
-    datasets_ns: AtomicU64,
-    training_ns: AtomicU64,
+    datasets: SummedTime,
+    training: SummedTime,
 }
 
 /// The [`PhaseClock`]'s sums at one moment.
@@ -46,26 +46,18 @@ pub struct PhaseSnapshot {
 impl PhaseClock {
     /// Runs `work`, charging its wall time to dataset preparation.
     pub fn datasets<T>(&self, work: impl FnOnce() -> T) -> T {
-        Self::charge(&self.datasets_ns, work)
+        self.datasets.time(work)
     }
 
     /// Runs `work`, charging its duration on this thread to model training.
     pub fn training<T>(&self, work: impl FnOnce() -> T) -> T {
-        Self::charge(&self.training_ns, work)
-    }
-
-    fn charge<T>(counter: &AtomicU64, work: impl FnOnce() -> T) -> T {
-        let started = Instant::now();
-        let result = work();
-        let ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        counter.fetch_add(ns, Ordering::Relaxed);
-        result
+        self.training.time(work)
     }
 
     pub fn snapshot(&self) -> PhaseSnapshot {
         PhaseSnapshot {
-            datasets: Duration::from_nanos(self.datasets_ns.load(Ordering::Relaxed)),
-            training: Duration::from_nanos(self.training_ns.load(Ordering::Relaxed)),
+            datasets: self.datasets.total(),
+            training: self.training.total(),
         }
     }
 }
