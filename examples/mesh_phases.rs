@@ -1,10 +1,11 @@
-//! Times the phases from a mesh file to the free pad's first reading (issue 39, large meshes): the
-//! object's build (parse, validate, face outward, size), the scene's MJCF text (with the collision
-//! shell), MuJoCo's compile, the data (the sensor's BVH is built there), the first reading.
+//! Times the phases from a mesh file to the free pad's first reading (issue 39, large meshes), with
+//! the process's peak memory after each: the object's build (parse, validate, face outward, size),
+//! the pad's scene (the MJCF text with the collision shell, MuJoCo's compile of it with the mesh
+//! handed over as numbers, the data, in which the sensor builds its BVH), the first reading; then,
+//! apart, the sensor's BVH of the mesh alone (already inside the scene's time).
 //!
 //! `cargo run --release --example mesh_phases -- MESH.obj` (without a mesh: a 20,480-triangle sphere
-//! 8 cm across, written to the temporary folder first); run it under `/usr/bin/time -v` for the
-//! peak memory.
+//! 8 cm across, written to the temporary folder first).
 
 #[path = "../tests/sensor_support/mod.rs"]
 mod sensor_support;
@@ -13,14 +14,24 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::DVec3;
-use mujoco_rs::prelude::{MjData, MjModel};
 use taction::control::FreePad;
-use taction::mesh::TriMesh;
 use taction::mesh::{BuildOptions, ObjectSet};
 use taction::pose::PadPose;
-use taction::sim::{ObjectSpec, numbers};
-use taction::tactile::{SensorConfig, free_floating_builder};
+use taction::sim::ObjectSpec;
+use taction::tactile::SensorConfig;
+use taction::tactile::pipeline::MeshBvh;
 use taction::valid::Valid;
+
+/// The process's peak resident memory so far, MB (Linux's `VmHWM`; 0 elsewhere).
+fn peak_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|status| {
+            let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+            line.split_whitespace().nth(1)?.parse::<f64>().ok()
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = match std::env::args().nth(1) {
@@ -32,8 +43,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             path
         }
     };
+    let start = Instant::now();
     let lap = |what: &str, since: &mut Instant| {
-        eprintln!("{what:<28} {:8.3} s", since.elapsed().as_secs_f64());
+        eprintln!(
+            "{what:<36} {:8.3} s   peak {:7.0} MB",
+            since.elapsed().as_secs_f64(),
+            peak_mb()
+        );
         *since = Instant::now();
     };
     let mut t = Instant::now();
@@ -44,40 +60,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let config = Valid::new(SensorConfig::default())?;
     let spec = ObjectSpec::from(object);
     let (lo, hi) = spec.mesh.bounds().ok_or("empty mesh")?;
-    let builder = free_floating_builder(spec.clone(), &config);
-    let xml = builder.to_xml()?;
-    eprintln!("MJCF {} MB", xml.len() / 1_000_000);
-    lap("MJCF text (with shell)", &mut t);
-    let model = MjModel::from_xml_string(&xml)?;
-    lap("MuJoCo compile", &mut t);
-    let data = MjData::new(&model);
-    lap("MjData (sensor BVH)", &mut t);
-    drop(data);
-    drop(model);
-    drop(xml);
-    let alone = mesh_alone_xml(&spec.mesh);
-    let mut t = Instant::now();
-    let model = MjModel::from_xml_string(&alone)?;
-    lap("MuJoCo compile, mesh alone", &mut t);
-    drop(model);
-    drop(alone);
+    let vertex_xyz: Vec<f32> = spec
+        .mesh
+        .vertices
+        .iter()
+        .flat_map(|v| v.as_vec3().to_array())
+        .collect();
+    let face: Vec<i32> = spec.mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
     let mut t = Instant::now();
     let mut pad = FreePad::new(spec, &config)?;
-    lap("FreePad::new (all again)", &mut t);
+    lap("pad scene (text, compile, BVH)", &mut t);
     let top = DVec3::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0, hi.z - 0.001);
     let image = pad.read_at(&PadPose::new(top, DVec3::NEG_Z, DVec3::Y).ok_or("pad pose")?)?;
     lap("first reading", &mut t);
+    eprintln!("file to first reading {:.3} s", start.elapsed().as_secs_f64());
     eprintln!("image sum {}", image.values().iter().sum::<f64>());
+    drop(pad);
+    let mut t = Instant::now();
+    let bvh = MeshBvh::new(&vertex_xyz, &face)?;
+    lap("of the scene: the sensor's BVH alone", &mut t);
+    eprintln!("sensor BVH {:.0} MB on the heap", bvh.heap_bytes() as f64 / 1e6);
     Ok(())
-}
-
-/// A model of the object's mesh alone (no collision shell, no sensor), as the scene writes it.
-fn mesh_alone_xml(mesh: &TriMesh) -> String {
-    let vertex = numbers(mesh.vertices.iter().flat_map(|v| v.to_array()));
-    let face = numbers(mesh.triangles.iter().flatten().map(|&i| f64::from(i)));
-    format!(
-        "<mujoco><asset><mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/></asset>\
-         <worldbody><body mocap=\"true\"><geom type=\"mesh\" mesh=\"object\" contype=\"0\" conaffinity=\"0\"/>\
-         </body></worldbody></mujoco>"
-    )
 }

@@ -374,3 +374,57 @@ fn an_exported_scene_opens_at_its_touch_keyframe_with_the_pad_pressed_on_the_obj
         assert_eq!(q, ctrl, "{object}");
     }
 }
+
+/// `SceneBuilder::build` hands MuJoCo the object's mesh as numbers, not text (issue 39, large
+/// meshes); the model must be the one the builder's MJCF text compiles to, to the last bit, even
+/// where a coordinate lies exactly halfway between two single-precision values (the text rounds
+/// to its own side there, a cast to even).
+#[test]
+fn a_built_scene_is_the_model_its_mjcf_text_compiles_to_bit_for_bit() {
+    ensure_registered();
+    let mut mesh = sensor_support::icosphere(DVec3::new(0.0, 0.0, 0.04), 0.04, 2);
+    // Away from 0, where the tie would be a subnormal `strtof` refuses.
+    let halfway = |x: f64| {
+        let f = x as f32;
+        if x.abs() < 1e-3 {
+            x
+        } else {
+            (f64::from(f) + f64::from(f.next_up())) * 0.5
+        }
+    };
+    for v in mesh.vertices.iter_mut().step_by(3) {
+        *v = DVec3::new(halfway(v.x), halfway(v.y), v.z);
+    }
+    let ties_cast_to_even = mesh
+        .vertices
+        .iter()
+        .filter(|v| {
+            let text = taction::sim::numbers([v.x]);
+            text.parse::<f32>().unwrap() != v.x as f32
+        })
+        .count();
+    assert!(
+        ties_cast_to_even > 0,
+        "the mesh must hold ties the cast rounds otherwise"
+    );
+    let config = taction::valid::Valid::new(SensorConfig::default()).unwrap();
+    for builder in [
+        taction::sim::SceneBuilder::with_arm_and_table(),
+        taction::tactile::free_floating_builder(taction::sim::ObjectSpec::new("tied", mesh.clone()), &config),
+    ] {
+        let builder = builder.object(taction::sim::ObjectSpec::new("tied", mesh.clone()));
+        let built = builder.build().unwrap();
+        let from_text = MjModel::from_xml_string(&builder.to_xml().unwrap()).unwrap();
+        let bytes = |model: &MjModel| {
+            let mut buffer = vec![0u8; model.size()];
+            model.save_to_buffer(&mut buffer).unwrap();
+            buffer
+        };
+        let differing = (built.model().mesh_vert().iter().flatten())
+            .zip(from_text.mesh_vert().iter().flatten())
+            .filter(|(a, b)| a.to_bits() != b.to_bits())
+            .count();
+        assert_eq!(differing, 0, "mesh coordinates differ");
+        assert!(bytes(built.model()) == bytes(&from_text), "the MJB files differ");
+    }
+}

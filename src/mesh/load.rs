@@ -58,9 +58,14 @@ pub fn load(path: impl AsRef<Path>) -> Result<LoadedMesh, MeshError> {
 
 /// Parses the bytes of a mesh file of `format`; `path` only names the file in messages.
 pub fn parse(bytes: &[u8], format: MeshFormat, path: &Path) -> Result<LoadedMesh, MeshError> {
+    // UTF-8 checked first the fast way; only a file that is not gets its bad bytes replaced.
+    let text = || match std::str::from_utf8(bytes) {
+        Ok(text) => std::borrow::Cow::Borrowed(text),
+        Err(_) => String::from_utf8_lossy(bytes),
+    };
     let mesh = match format {
-        MeshFormat::Obj => obj::parse(&String::from_utf8_lossy(bytes), path)?,
-        MeshFormat::Off => off::parse(&String::from_utf8_lossy(bytes), path)?,
+        MeshFormat::Obj => obj::parse(&text(), path)?,
+        MeshFormat::Off => off::parse(&text(), path)?,
         MeshFormat::Stl => stl::parse(bytes, path)?,
     };
     let warnings = ValidationReport::of(&mesh);
@@ -73,9 +78,12 @@ pub fn parse(bytes: &[u8], format: MeshFormat, path: &Path) -> Result<LoadedMesh
 pub(crate) struct MeshBuilder {
     path: PathBuf,
     vertices: Vec<DVec3>,
-    /// Polygons as (resolved 0-based index, index as written) pairs, with where they were read;
-    /// checked in `finish`, since an OBJ face may name a vertex defined further down.
-    polygons: Vec<(Location, Vec<(i64, i64)>)>,
+    /// Every polygon's corners, one after another, as (resolved 0-based index, index as written)
+    /// pairs; checked in `finish`, since an OBJ face may name a vertex defined further down. One
+    /// list for all, not one per polygon: a scanned mesh has millions (issue 39).
+    corners: Vec<(i64, i64)>,
+    /// Each polygon: where it was read, and the end of its corners in `corners`.
+    polygons: Vec<(Location, usize)>,
     /// The index the file's format gives its first vertex (1 in OBJ, 0 in OFF), for messages.
     first_index: i64,
 }
@@ -85,6 +93,7 @@ impl MeshBuilder {
         Self {
             path: path.to_path_buf(),
             vertices: Vec::new(),
+            corners: Vec::new(),
             polygons: Vec::new(),
             first_index: 0,
         }
@@ -136,14 +145,15 @@ impl MeshBuilder {
     /// Adds a polygon of 0-based indices (possibly out of range: checked in `finish`), written
     /// 0-based in the file.
     pub(crate) fn push_polygon(&mut self, at: Location, indices: Vec<i64>) -> Result<(), MeshError> {
-        self.push_polygon_as_written(at, indices.into_iter().map(|i| (i, i)).collect())
+        let corners: Vec<(i64, i64)> = indices.into_iter().map(|i| (i, i)).collect();
+        self.push_polygon_as_written(at, &corners)
     }
 
     /// Adds a polygon of (0-based index, index as the file writes it) pairs.
     pub(crate) fn push_polygon_as_written(
         &mut self,
         at: Location,
-        indices: Vec<(i64, i64)>,
+        indices: &[(i64, i64)],
     ) -> Result<(), MeshError> {
         if indices.len() < 3 {
             return Err(self.parse_error(
@@ -151,7 +161,8 @@ impl MeshBuilder {
                 format!("a face needs at least 3 vertices, got {}", indices.len()),
             ));
         }
-        self.polygons.push((at, indices));
+        self.corners.extend_from_slice(indices);
+        self.polygons.push((at, self.corners.len()));
         Ok(())
     }
 
@@ -165,18 +176,21 @@ impl MeshBuilder {
         }
         let count = self.vertices.len();
         let mut triangles = Vec::with_capacity(self.polygons.len());
-        for (at, polygon) in &self.polygons {
+        let mut start = 0;
+        for &(at, end) in &self.polygons {
+            let polygon = &self.corners[start..end];
+            start = end;
             if let Some(&(_, index)) = polygon.iter().find(|&&(i, _)| i < 0 || i >= count as i64) {
                 return Err(MeshError::IndexOutOfRange {
                     path: self.path,
-                    at: *at,
+                    at,
                     index,
                     count,
                     first: self.first_index,
                 });
             }
-            let p: Vec<u32> = polygon.iter().map(|&(i, _)| i as u32).collect();
-            triangles.extend((1..p.len() - 1).map(|i| [p[0], p[i], p[i + 1]]));
+            let p = |k: usize| polygon[k].0 as u32;
+            triangles.extend((1..polygon.len() - 1).map(|k| [p(0), p(k), p(k + 1)]));
         }
         Ok(TriMesh {
             vertices: self.vertices,

@@ -13,15 +13,23 @@ use super::load::{MeshBuilder, content_lines};
 /// (relative to the vertices read so far); records other than `v` and `f` are ignored.
 pub(crate) fn parse(text: &str, path: &Path) -> Result<TriMesh, MeshError> {
     let mut builder = MeshBuilder::one_based(path);
+    // One buffer for every face's corners: a scanned mesh has millions of faces.
+    let mut corners: Vec<(i64, i64)> = Vec::with_capacity(8);
     for (line_no, line) in content_lines(text) {
         let at = Location::Line(line_no);
         let mut tokens = line.split_whitespace();
         match tokens.next() {
             Some("v") => {
-                let coords: Vec<&str> = tokens.collect();
-                if coords.len() < 3 {
-                    return Err(builder
-                        .parse_error(at, format!("a vertex needs 3 coordinates, got {}", coords.len())));
+                let mut coords = [""; 3];
+                let mut given = 0;
+                for token in tokens {
+                    if let Some(slot) = coords.get_mut(given) {
+                        *slot = token;
+                    }
+                    given += 1;
+                }
+                if given < 3 {
+                    return Err(builder.parse_error(at, format!("a vertex needs 3 coordinates, got {given}")));
                 }
                 let x = builder.coordinate(at, coords[0])?;
                 let y = builder.coordinate(at, coords[1])?;
@@ -30,20 +38,19 @@ pub(crate) fn parse(text: &str, path: &Path) -> Result<TriMesh, MeshError> {
             }
             Some("f") => {
                 let count = builder.vertex_count() as i64;
-                let indices = tokens
-                    .map(|corner| {
-                        let index = corner.split('/').next().unwrap_or("");
-                        let i: i64 = index.parse().map_err(|_| {
-                            builder.parse_error(at, format!("'{corner}' is not a vertex reference"))
-                        })?;
-                        match i {
-                            0 => Err(builder.parse_error(at, "vertex index 0 (OBJ indices start at 1)")),
-                            i if i > 0 => Ok((i - 1, i)),
-                            i => Ok((count.saturating_add(i), i)),
-                        }
-                    })
-                    .collect::<Result<Vec<(i64, i64)>, MeshError>>()?;
-                builder.push_polygon_as_written(at, indices)?;
+                corners.clear();
+                for corner in tokens {
+                    let index = corner.split('/').next().unwrap_or("");
+                    let i: i64 = index.parse().map_err(|_| {
+                        builder.parse_error(at, format!("'{corner}' is not a vertex reference"))
+                    })?;
+                    corners.push(match i {
+                        0 => return Err(builder.parse_error(at, "vertex index 0 (OBJ indices start at 1)")),
+                        i if i > 0 => (i - 1, i),
+                        i => (count.saturating_add(i), i),
+                    });
+                }
+                builder.push_polygon_as_written(at, &corners)?;
             }
             _ => {}
         }

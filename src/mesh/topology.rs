@@ -13,8 +13,9 @@ use super::TriMesh;
 /// How the triangles of a mesh use each undirected edge.
 #[derive(Debug, Clone)]
 pub struct EdgeTopology {
-    /// Undirected edge (low, high) -> (uses as low -> high, uses as high -> low).
-    uses: HashMap<(u32, u32), (u32, u32)>,
+    /// Each undirected edge (low, high), in increasing order, with (uses as low -> high, uses as
+    /// high -> low).
+    uses: Vec<((u32, u32), (u32, u32))>,
     vertex_count: usize,
     triangle_count: usize,
 }
@@ -22,19 +23,41 @@ pub struct EdgeTopology {
 impl EdgeTopology {
     /// Counts the edge uses of `mesh`. Edges from a vertex to itself (in triangles that repeat a
     /// vertex) are not edges and are skipped.
+    ///
+    /// The directed edges are bucketed by their lower vertex (a counting sort), and each bucket,
+    /// a vertex's few neighbours, is merged on its own: linear in the mesh, where a hash map of
+    /// the edges took a third of a scanned mesh's load (issue 39, large meshes).
     pub fn new(mesh: &TriMesh) -> Self {
-        let mut uses: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(mesh.triangles.len() * 2);
-        for &[a, b, c] in &mesh.triangles {
-            for (p, q) in [(a, b), (b, c), (c, a)] {
-                if p == q {
-                    continue;
-                }
-                let entry = uses.entry((p.min(q), p.max(q))).or_default();
-                if p < q {
-                    entry.0 += 1;
-                } else {
-                    entry.1 += 1;
-                }
+        let directed = || {
+            mesh.triangles
+                .iter()
+                .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+                .filter(|(p, q)| p != q)
+        };
+        // Sized by the indices used (a hand-made mesh may name vertices it lacks).
+        let bucket_count = directed().map(|(p, q)| p.max(q) as usize + 1).max().unwrap_or(0);
+        let mut bucket_end = vec![0usize; bucket_count + 1];
+        for (p, q) in directed() {
+            bucket_end[p.min(q) as usize + 1] += 1;
+        }
+        for v in 0..bucket_count {
+            bucket_end[v + 1] += bucket_end[v];
+        }
+        // (high, used low -> high) of each directed edge, filled bucket by bucket.
+        let mut next = bucket_end.clone();
+        let mut slots = vec![(0u32, false); bucket_end[bucket_count]];
+        for (p, q) in directed() {
+            let low = p.min(q) as usize;
+            slots[next[low]] = (p.max(q), p < q);
+            next[low] += 1;
+        }
+        let mut uses = Vec::with_capacity(slots.len() / 2 + 1);
+        for low in 0..bucket_count {
+            let bucket = &mut slots[bucket_end[low]..bucket_end[low + 1]];
+            bucket.sort_unstable_by_key(|&(high, _)| high);
+            for chunk in bucket.chunk_by(|a, b| a.0 == b.0) {
+                let forward = chunk.iter().filter(|&&(_, f)| f).count() as u32;
+                uses.push(((low as u32, chunk[0].0), (forward, chunk.len() as u32 - forward)));
             }
         }
         Self {
@@ -51,18 +74,26 @@ impl EdgeTopology {
 
     /// Edges used by exactly one triangle: the open boundary.
     pub fn boundary_edges(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
-        self.uses.iter().filter(|(_, (f, b))| f + b == 1).map(|(&e, _)| e)
+        self.uses.iter().filter(|(_, (f, b))| f + b == 1).map(|&(e, _)| e)
     }
 
     /// Number of edges used by more than two triangles.
     pub fn non_manifold_edge_count(&self) -> usize {
-        self.uses.values().filter(|(f, b)| f + b > 2).count()
+        self.uses
+            .iter()
+            .map(|(_, u)| u)
+            .filter(|(f, b)| f + b > 2)
+            .count()
     }
 
     /// Number of two-triangle edges traversed twice in the same direction: their triangles have
     /// opposite orientations.
     pub fn misoriented_edge_count(&self) -> usize {
-        self.uses.values().filter(|&&(f, b)| f + b == 2 && f != 1).count()
+        self.uses
+            .iter()
+            .map(|(_, u)| u)
+            .filter(|&&(f, b)| f + b == 2 && f != 1)
+            .count()
     }
 
     /// Number of closed loops the boundary edges form (connected components of the boundary graph).
@@ -102,13 +133,13 @@ impl EdgeTopology {
 
     /// True when every edge is shared by exactly two triangles (closed, manifold at edges).
     pub fn is_closed(&self) -> bool {
-        self.uses.values().all(|(f, b)| f + b == 2)
+        self.uses.iter().map(|(_, u)| u).all(|(f, b)| f + b == 2)
     }
 
     /// True when the mesh is closed and each edge is traversed once in each direction, i.e. all
     /// triangles of each connected shell wind the same way.
     pub fn is_consistently_oriented(&self) -> bool {
-        self.uses.values().all(|&(f, b)| f == 1 && b == 1)
+        self.uses.iter().map(|(_, u)| u).all(|&(f, b)| f == 1 && b == 1)
     }
 
     /// Euler characteristic chi = V - E + F, counting only vertices that some triangle uses. For a
@@ -150,4 +181,37 @@ pub fn connected_components(mesh: &TriMesh) -> usize {
     (0..mesh.vertices.len() as u32)
         .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
         .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+
+    #[test]
+    fn edges_are_counted_per_direction_in_order_even_past_the_vertices_given() {
+        // Two triangles on the edge {1, 2}, both as 1 -> 2 (opposite orientations), a third on it
+        // (non-manifold), and one naming a vertex the list lacks (a hand-made mesh).
+        let mesh = TriMesh {
+            vertices: vec![DVec3::ZERO; 4],
+            triangles: vec![[0, 1, 2], [3, 1, 2], [2, 1, 0], [0, 3, 9]],
+        };
+        let topology = EdgeTopology::new(&mesh);
+        assert_eq!(
+            topology.uses,
+            [
+                ((0, 1), (1, 1)),
+                ((0, 2), (1, 1)),
+                ((0, 3), (1, 0)),
+                ((0, 9), (0, 1)),
+                ((1, 2), (2, 1)),
+                ((1, 3), (0, 1)),
+                ((2, 3), (1, 0)),
+                ((3, 9), (1, 0)),
+            ]
+        );
+        assert_eq!(topology.non_manifold_edge_count(), 1);
+        assert_eq!(topology.boundary_edges().count(), 5);
+    }
 }

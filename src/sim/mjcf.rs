@@ -145,6 +145,30 @@ pub fn numbers<I: IntoIterator<Item = f64>>(values: I) -> String {
     space_separated(values, push_round_trip)
 }
 
+/// The single-precision value MuJoCo reads from `x` written by [`numbers`] (its parser, `strtof`,
+/// rounds the decimal text to the nearest `f32`), without the text: so a mesh handed to MuJoCo as
+/// numbers compiles to the model its MJCF text does, bit for bit.
+///
+/// The text is the shortest decimal that reads back as `x`, so it lies within half an `f64` step
+/// of `x`, closer than any `f32` rounding boundary other than `x` itself: rounding it and rounding
+/// `x` agree unless `x` is exactly halfway between two `f32`s, where `x` rounds to even and the
+/// text to its own side. Only there is the text written and read.
+pub fn as_read_f32(x: f64) -> f32 {
+    let nearest = x as f32;
+    let (below, above) = if f64::from(nearest) <= x {
+        (nearest, nearest.next_up())
+    } else {
+        (nearest.next_down(), nearest)
+    };
+    let halfway = (f64::from(below) + f64::from(above)) * 0.5;
+    if halfway != x || !x.is_finite() {
+        return nearest;
+    }
+    let mut text = String::new();
+    push_round_trip(&mut text, x);
+    text.parse().unwrap_or(nearest)
+}
+
 /// `values` written by `write` into one string, separated by spaces: MJCF's list attributes, built
 /// without a string per value (a scanned mesh has millions).
 pub fn space_separated<T>(values: impl IntoIterator<Item = T>, write: impl Fn(&mut String, T)) -> String {
@@ -184,6 +208,27 @@ mod tests {
         let document = format!("{wrapped}<m a=\"{}\"/>", escape_attr(text));
         let parsed = roxmltree::Document::parse(&document).expect("well-formed");
         assert_eq!(parsed.root_element().attribute("a"), Some("a--b --- c-\u{fffd}"));
+    }
+
+    #[test]
+    fn numbers_handed_over_are_the_numbers_the_text_reads_as() {
+        let halfway = |f: f32| (f64::from(f) + f64::from(f.next_up())) * 0.5;
+        let ties: Vec<f64> = [1.0f32, 0.04, -0.037_5, 3.0e-5, 0.123_456_7]
+            .into_iter()
+            .flat_map(|f| [halfway(f), -halfway(f)])
+            .collect();
+        let plain = [0.0, -0.0, 0.04, 1.0 / 3.0, -2.5e-6, 123.456_789, 1e-30];
+        let mut cast_differs = 0;
+        for &x in ties.iter().chain(&plain) {
+            let text = numbers([x]);
+            let read: f32 = text.parse().unwrap();
+            assert_eq!(as_read_f32(x).to_bits(), read.to_bits(), "{x} written as {text}");
+            cast_differs += usize::from((x as f32).to_bits() != read.to_bits());
+        }
+        // The tie above 1: its text (1.0000000596046448) lies above it and rounds up, where the
+        // cast rounds to even (1.0).
+        assert_eq!(as_read_f32(halfway(1.0)), 1.0f32.next_up());
+        assert!(cast_differs > 0);
     }
 
     #[test]

@@ -15,6 +15,8 @@ use crate::bodies::OBJECT_BODY;
 /// Geom and joint names of the object slot (its body: [`OBJECT_BODY`]).
 pub const OBJECT_GEOM: &str = "object";
 pub const OBJECT_JOINT: &str = "object_free";
+/// The name of the mesh asset of the object's exact surface.
+pub const OBJECT_MESH: &str = "object";
 
 /// How the object is held in the world.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -26,6 +28,21 @@ pub enum ObjectMount {
     Mocap,
     /// A free joint: gravity and contacts act on it; it rests on the table.
     Free,
+}
+
+/// Where the `<mesh>` asset of the object's exact surface (the one the sensor reads) gets its
+/// vertices and faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshData<'a> {
+    /// Inline `vertex` and `face` attributes: the text compiles alone.
+    Inline,
+    /// A file, relative to the MJCF file, which the caller writes beside it: a scene exported for
+    /// MuJoCo's own tools.
+    File(&'a str),
+    /// None in the text: the compiler of the scene sets them on the parsed specification
+    /// ([`SceneBuilder::build`](crate::sim::SceneBuilder::build)), sparing a scanned mesh's
+    /// millions of numbers their printing and MuJoCo's parsing (issue 39, large meshes).
+    Spec,
 }
 
 /// An object to place in the scene.
@@ -71,20 +88,13 @@ impl ObjectSpec {
         Ok(built.into_iter().map(Self::from).collect())
     }
 
-    /// Adds the mesh asset (its vertices and faces inline) and the object body to `doc`.
-    pub fn add_to(&self, doc: &mut Document) -> Result<(), SimError> {
-        self.add_to_with_mesh(doc, None)
-    }
-
-    /// Adds the mesh asset and the object body to `doc`; with `mesh_file`, the asset refers to that
-    /// file (relative to the MJCF file, which the caller writes beside it) instead of holding the
-    /// vertices inline, as a scene exported for MuJoCo users does.
+    /// Adds the mesh asset (its vertices and faces from `mesh_data`) and the object body to `doc`.
     ///
     /// The geom collides with the arm and the table (MuJoCo uses the mesh's convex hull for these
     /// contacts; the tactile sensor raycasts the exact triangles). The body gets an explicit inertia (a
     /// solid sphere of the mesh's bounding radius), so that open or thin user meshes, whose volume
     /// MuJoCo cannot compute, still load.
-    pub fn add_to_with_mesh(&self, doc: &mut Document, mesh_file: Option<&str>) -> Result<(), SimError> {
+    pub fn add_to(&self, doc: &mut Document, mesh_data: MeshData) -> Result<(), SimError> {
         let (lo, hi) = self.mesh.bounds().ok_or_else(|| SimError::Object {
             name: self.name.clone(),
             message: "the mesh has no vertices".into(),
@@ -95,7 +105,7 @@ impl ObjectSpec {
                 message: "the mesh has no triangles".into(),
             });
         }
-        doc.add(Section::Asset, self.mesh_asset(mesh_file));
+        doc.add(Section::Asset, self.mesh_asset(mesh_data));
         let shell = self.add_collision_shell(doc);
 
         let center = (lo + hi) * 0.5;
@@ -113,7 +123,7 @@ impl ObjectSpec {
                 "<body name=\"{OBJECT_BODY}\" pos=\"{pos}\" quat=\"{quat}\"{mount_attr}>\n\
                  {}\n{joint}\n\
                  <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>\n\
-                 <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"object\" rgba=\"0.8 0.5 0.3 1\" contype=\"0\" conaffinity=\"0\"/>\n\
+                 <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"{OBJECT_MESH}\" rgba=\"0.8 0.5 0.3 1\" contype=\"0\" conaffinity=\"0\"/>\n\
                  {shell}</body>",
                 comment(&self.name),
                 numbers(center.to_array()),
@@ -123,18 +133,20 @@ impl ObjectSpec {
         Ok(())
     }
 
-    /// The `<mesh>` asset of the exact surface the sensor reads: `mesh_file` when given, else the
-    /// vertices and faces inline.
-    fn mesh_asset(&self, mesh_file: Option<&str>) -> String {
-        match mesh_file {
-            Some(file) => format!(
-                "<mesh name=\"object\" inertia=\"shell\" file=\"{}\"/>",
+    /// The `<mesh>` asset of the exact surface the sensor reads.
+    fn mesh_asset(&self, mesh_data: MeshData) -> String {
+        match mesh_data {
+            MeshData::File(file) => format!(
+                "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" file=\"{}\"/>",
                 escape_attr(file)
             ),
-            None => {
+            MeshData::Spec => format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\"/>"),
+            MeshData::Inline => {
                 let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
                 let face = indices(self.mesh.triangles.iter().flatten());
-                format!("<mesh name=\"object\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
+                format!(
+                    "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"
+                )
             }
         }
     }

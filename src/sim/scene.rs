@@ -10,8 +10,8 @@ use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::arm::Arm;
-use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML};
-use crate::sim::object::{ObjectMount, ObjectSpec};
+use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML, as_read_f32};
+use crate::sim::object::{MeshData, OBJECT_MESH, ObjectMount, ObjectSpec};
 
 /// What goes into a scene. The arm and table come from `mjcf/`; the object and any extra parts (a
 /// sensor plugin, a free-floating pad) are added by the caller.
@@ -53,8 +53,8 @@ impl SceneBuilder {
 
     /// Makes the object's mesh asset refer to `file` (relative to where the MJCF is written; the
     /// caller writes the mesh there) instead of holding its vertices inline: for a scene written
-    /// out for MuJoCo's own tools. [`build`](Self::build) compiles from a string, which cannot
-    /// resolve the file, so such a builder is only for [`to_xml`](Self::to_xml).
+    /// out for MuJoCo's own tools. [`to_xml`](Self::to_xml) alone uses it: [`build`](Self::build)
+    /// hands MuJoCo the mesh in memory.
     pub fn object_mesh_file(mut self, file: impl Into<String>) -> Self {
         self.object_mesh_file = Some(file.into());
         self
@@ -72,8 +72,17 @@ impl SceneBuilder {
         self
     }
 
-    /// The MJCF document this builder compiles.
+    /// The MJCF document this builder compiles, complete: the object's mesh inline, or in the
+    /// [`object_mesh_file`](Self::object_mesh_file).
     pub fn to_xml(&self) -> Result<String, SimError> {
+        self.document(match &self.object_mesh_file {
+            Some(file) => MeshData::File(file),
+            None => MeshData::Inline,
+        })
+    }
+
+    /// The MJCF document with the object's mesh data from `mesh_data`.
+    fn document(&self, mesh_data: MeshData) -> Result<String, SimError> {
         let mut doc = Document::default();
         if self.arm {
             doc.include(ARM_XML, "mjcf/arm.xml")?;
@@ -90,7 +99,7 @@ impl SceneBuilder {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
         if let Some(object) = &self.object {
-            object.add_to_with_mesh(&mut doc, self.object_mesh_file.as_deref())?;
+            object.add_to(&mut doc, mesh_data)?;
         }
         for (section, xml) in &self.extra {
             doc.add(*section, xml.clone());
@@ -98,13 +107,16 @@ impl SceneBuilder {
         Ok(doc.to_xml("taction scene"))
     }
 
-    /// Compiles the scene and runs `mj_forward` once.
+    /// Compiles the scene and runs `mj_forward` once: the model [`to_xml`](Self::to_xml)'s text
+    /// compiles to, bit for bit, with the object's mesh handed to MuJoCo as numbers rather than
+    /// text (a scanned mesh's millions of them, issue 39).
     pub fn build(&self) -> Result<Scene, SimError> {
-        let xml = self.to_xml()?;
-        let model = compile_xml(&xml).map_err(|e| SimError::Mjcf {
-            origin: "assembled scene".into(),
-            message: mujoco_message(&e),
-        })?;
+        let xml = self.document(MeshData::Spec)?;
+        let model =
+            compile(&xml, self.object.as_ref().map(|o| &o.mesh)).map_err(|message| SimError::Mjcf {
+                origin: "assembled scene".into(),
+                message,
+            })?;
         Scene::new(model, self.object.as_ref())
     }
 }
@@ -116,7 +128,8 @@ const STRAY_ERRNO_MESSAGE: &str = "XML Error: unknown error in attribute";
 /// Compiles the assembled scene: at most this many attempts when MuJoCo reports a stray `errno`.
 const COMPILE_ATTEMPTS: usize = 4;
 
-/// `MjModel::from_xml_string`, tried again when the failure is MuJoCo's stray-`errno` report.
+/// Parses `xml`, sets the object's mesh on the specification when there is one ([`MeshData::Spec`]),
+/// and compiles; tried again when the failure is MuJoCo's stray-`errno` report.
 ///
 /// MuJoCo 3.17 reads an array attribute (a mesh's `vertex` and `face`) with `StringToVector`,
 /// which zeroes `errno`, reserves, parses and shrinks the vector; its caller then takes any
@@ -139,23 +152,59 @@ const COMPILE_ATTEMPTS: usize = 4;
 /// `mmap` and the allocation succeeds with `errno` left at `ENOMEM`, however the top moves. A
 /// thread other than the main one allocates from its own `mmap`ed arena and never calls `sbrk`,
 /// so each retry compiles on a fresh thread.
-fn compile_xml(xml: &str) -> Result<MjModel, MjModelError> {
+fn compile(xml: &str, mesh: Option<&TriMesh>) -> Result<MjModel, String> {
     keep_heap_top();
     let mut attempt = 1;
     let mut ballast: Vec<Vec<u8>> = Vec::new();
-    let mut result = MjModel::from_xml_string(xml);
-    while attempt < COMPILE_ATTEMPTS
-        && matches!(&result, Err(e) if mujoco_message(e).starts_with(STRAY_ERRNO_MESSAGE))
-    {
+    let mut result = compile_once(xml, mesh);
+    while attempt < COMPILE_ATTEMPTS && matches!(&result, Err(m) if m.starts_with(STRAY_ERRNO_MESSAGE)) {
         ballast.push(vec![1u8; 4096 << attempt]);
         attempt += 1;
         result = std::thread::scope(|s| {
-            s.spawn(|| MjModel::from_xml_string(xml))
+            s.spawn(|| compile_once(xml, mesh))
                 .join()
-                .unwrap_or_else(|_| Err(MjModelError::LoadFailed("MuJoCo's compiler panicked".into())))
+                .unwrap_or_else(|_| Err("MuJoCo's compiler panicked".into()))
         });
     }
     result
+}
+
+/// One attempt of [`compile`].
+fn compile_once(xml: &str, mesh: Option<&TriMesh>) -> Result<MjModel, String> {
+    if xml.contains('\0') {
+        return Err("the MJCF text holds a NUL character".into());
+    }
+    let mut spec = MjSpec::from_xml_string(xml).map_err(|e| edit_message(&e))?;
+    if let Some(mesh) = mesh {
+        let asset = spec
+            .mesh_mut(OBJECT_MESH)
+            .ok_or_else(|| format!("no mesh asset '{OBJECT_MESH}' for the object"))?;
+        asset.set_uservert(
+            &mesh
+                .vertices
+                .iter()
+                .flat_map(|v| v.to_array())
+                .map(as_read_f32)
+                .collect::<Vec<_>>(),
+        );
+        let face = mesh
+            .triangles
+            .iter()
+            .flatten()
+            .map(|&i| i32::try_from(i))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|_| format!("the object's mesh has more than {} vertices", i32::MAX))?;
+        asset.set_userface(&face);
+    }
+    spec.compile().map_err(|e| edit_message(&e))
+}
+
+/// The text of a MuJoCo parse or compile error.
+fn edit_message(e: &MjEditError) -> String {
+    match e {
+        MjEditError::ParseFailed(m) | MjEditError::CompileFailed(m) => m.clone(),
+        other => format!("{other:?}"),
+    }
 }
 
 /// Switches glibc's heap trimming off, once per process (see [`compile_xml`]).
@@ -168,14 +217,6 @@ fn keep_heap_top() {
         ONCE.call_once(|| unsafe {
             libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
         });
-    }
-}
-
-/// The text of a MuJoCo load error.
-pub fn mujoco_message(e: &MjModelError) -> String {
-    match e {
-        MjModelError::LoadFailed(m) => m.clone(),
-        other => format!("{other:?}"),
     }
 }
 
@@ -530,7 +571,7 @@ mod tests {
     fn ball() -> Scene {
         let xml = "<mujoco><worldbody><body pos=\"0 0 1\"><freejoint/><geom size=\"0.1\"/></body>\
                    </worldbody></mujoco>";
-        Scene::new(compile_xml(xml).unwrap(), None).unwrap()
+        Scene::new(compile(xml, None).unwrap(), None).unwrap()
     }
 
     #[test]
@@ -574,8 +615,8 @@ mod tests {
     #[test]
     fn a_real_fault_in_an_array_attribute_is_reported_not_retried_away() {
         let valid = "0 0 0  1 0 0  0 1 0  0 0 1";
-        assert!(compile_xml(&mesh_xml(valid)).is_ok());
-        let message = mujoco_message(&compile_xml(&mesh_xml("0 0 0  1 0 x  0 1 0  0 0 1")).unwrap_err());
+        assert!(compile(&mesh_xml(valid), None).is_ok());
+        let message = compile(&mesh_xml("0 0 0  1 0 x  0 1 0  0 0 1"), None).unwrap_err();
         assert!(message.contains("bad format in attribute 'vertex'"), "{message}");
         assert!(!message.starts_with(STRAY_ERRNO_MESSAGE), "{message}");
     }
