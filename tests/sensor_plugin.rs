@@ -458,3 +458,81 @@ fn row_zero_is_up_and_column_zero_is_left_seen_from_behind() {
         }
     }
 }
+
+/// A mesh above the object's large-mesh limit reaches MuJoCo as a coarse copy, and the sensor reads
+/// the exact surface the model carries beside it (issue 39): the images are the exact mesh's, not
+/// the copy's.
+#[test]
+fn a_large_mesh_is_sensed_through_its_exact_surface_not_mujocos_coarse_copy() {
+    let sphere = icosphere(DVec3::new(0.0, 0.0, 0.04), 0.04, 6);
+    let config = Valid::new(SensorConfig::default()).unwrap();
+    let exact = || ObjectSpec::new("sphere", sphere.clone());
+    let mut whole = FreePad::new(exact(), &config).unwrap();
+    let mut beside = FreePad::new(
+        ObjectSpec {
+            large_mesh_triangles: 10_000,
+            ..exact()
+        },
+        &config,
+    )
+    .unwrap();
+    let drawn = taction::mesh::cluster_vertices(&sphere, taction::sim::DRAWN_MESH_TRIANGLES);
+    assert!(drawn.triangles.len() * 3 < sphere.triangles.len());
+    let mut copy = FreePad::new(ObjectSpec::new("copy", drawn), &config).unwrap();
+    let (mut largest, mut copy_largest) = (0.0f64, 0.0f64);
+    for (k, normal) in [
+        DVec3::NEG_Z,
+        DVec3::new(0.3, 0.1, -1.0),
+        DVec3::new(-1.0, 0.2, -0.4),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let normal = normal.normalize();
+        // The pad's face 0.6 mm inside the sphere, a little off the pole each time.
+        let centre =
+            DVec3::new(0.0, 0.0, 0.04) - normal * (0.04 - 0.0006) + DVec3::new(0.0005 * k as f64, 0.0, 0.0);
+        let up = (DVec3::Y - normal * normal.dot(DVec3::Y)).normalize();
+        let pose = PadPose::new(centre, normal, up).unwrap();
+        let (a, b, c) = (
+            whole.read_at(&pose).unwrap(),
+            beside.read_at(&pose).unwrap(),
+            copy.read_at(&pose).unwrap(),
+        );
+        assert!(a.max() > 0.1, "the pad presses the sphere: {a}");
+        for ((x, y), z) in a.values().iter().zip(b.values()).zip(c.values()) {
+            largest = largest.max((x - y).abs());
+            copy_largest = copy_largest.max((x - z).abs());
+        }
+    }
+    assert!(
+        largest < 1e-5,
+        "exact surface beside the copy reads {largest} off the whole mesh"
+    );
+    assert!(
+        copy_largest > 10.0 * largest.max(1e-4),
+        "the copy alone reads {copy_largest} off"
+    );
+}
+
+/// A model whose mesh carries half of an exact surface is refused at compile time, naming the mesh
+/// and the missing field.
+#[test]
+fn half_an_exact_surface_is_refused_naming_the_mesh_and_the_missing_field() {
+    let config = Valid::new(SensorConfig::default()).unwrap();
+    let spec = ObjectSpec::new("box", taction::mesh::TriMesh::cuboid(DVec3::splat(0.02)));
+    let (vertex_name, face_name) = taction::sim::sensed_surface_names("object");
+    let error = taction::tactile::free_floating_builder(spec, &config)
+        .add(
+            taction::sim::Section::Custom,
+            format!("<numeric name=\"{vertex_name}\" data=\"0 0 0\"/>"),
+        )
+        .build()
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.contains("mesh 'object'") && error.contains(&face_name),
+        "{error}"
+    );
+}

@@ -2,7 +2,8 @@
 //!
 //! - loading OBJ, OFF and STL with validation ([`load()`], [`ValidationReport`]), writing OBJ;
 //! - geometry: bounds, area, signed volume, normalisation to a common size ([`normalise_to_diagonal`]),
-//!   and the edge topology behind watertightness and orientation checks ([`EdgeTopology`]);
+//!   the edge topology behind watertightness and orientation checks ([`EdgeTopology`]), and a
+//!   coarse copy of a large mesh for MuJoCo to draw ([`cluster_vertices`]);
 //! - the objects: ten real meshes fetched from Debian ([`CgalMesh`]), chess pieces as surfaces of
 //!   revolution ([`ChessPiece`], [`Profile`]), raised letters from a font ([`raised_letter`], [`Font`]);
 //! - one object, loaded, checked and plausible ([`Object::from_file`]);
@@ -11,6 +12,7 @@
 pub(crate) mod cgal;
 pub(crate) mod checksum;
 pub(crate) mod chess;
+pub(crate) mod decimate;
 pub(crate) mod error;
 pub(crate) mod glyph;
 pub(crate) mod glyph_overlap;
@@ -37,6 +39,7 @@ pub use plausible::{Implausible, SizeLimit, check_plausible};
 pub use validate::ValidationReport;
 
 // The mesh and its geometry: normalisation, orientation, topology, writing OBJ.
+pub use decimate::cluster_vertices;
 pub use normalise::{UpAxis, normalise_to_diagonal, orient_outward, rotate_up_to_z};
 pub use obj::{to_obj_string, write_obj};
 pub use topology::{EdgeTopology, connected_components};

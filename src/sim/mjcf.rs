@@ -18,6 +18,14 @@ pub const TABLE_TOP_Z_M: f64 = 0.0;
 /// default): they take part in contacts, and the tactile sensor does not see them.
 pub const COLLISION_GROUP: i32 = 3;
 
+/// The names of the two `<numeric>` fields that carry the exact surface of mesh asset `mesh` when
+/// the asset itself is a coarse copy (a large scan: `mesh::cluster_vertices`): its vertices
+/// (x, y, z, in the coordinates the asset was given in) and its faces (three vertex indices each).
+/// The covering sensor reads such a mesh through these instead of MuJoCo's copy.
+pub fn sensed_surface_names(mesh: &str) -> (String, String) {
+    (format!("{mesh}:sensed_vertex"), format!("{mesh}:sensed_face"))
+}
+
 /// The children of the root `<mujoco>` element of `xml` (what `<include>` would insert).
 pub fn inner(xml: &str, origin: &str) -> Result<String, SimError> {
     let missing = |what: &str| SimError::Mjcf {
@@ -49,6 +57,7 @@ pub enum Section {
     Sensor,
     Contact,
     Keyframe,
+    Custom,
 }
 
 impl Section {
@@ -60,6 +69,7 @@ impl Section {
             Self::Sensor => "sensor",
             Self::Contact => "contact",
             Self::Keyframe => "keyframe",
+            Self::Custom => "custom",
         }
     }
 }

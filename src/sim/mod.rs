@@ -10,7 +10,7 @@ pub(crate) mod perturb;
 pub(crate) mod scene;
 
 // The world: built from objects and the arm, stepped, saved and restored.
-pub use object::{ObjectMount, ObjectSpec};
+pub use object::{DRAWN_MESH_TRIANGLES, LARGE_MESH_TRIANGLES, ObjectMount, ObjectSpec, ObjectSurfaces};
 pub use scene::{Scene, SceneBuilder, SceneObject, SceneState};
 
 // The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.
@@ -23,7 +23,7 @@ pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 pub use perturb::{Perturbation, PerturbationBounds};
 
 // MJCF text for code that adds bodies to the world: its sections, the collision group, numbers.
-pub use mjcf::{COLLISION_GROUP, Section, comment, numbers};
+pub use mjcf::{COLLISION_GROUP, Section, comment, numbers, sensed_surface_names};
 
 /// Errors of the simulated world; each says which part and what is wrong.
 #[derive(Debug, thiserror::Error)]

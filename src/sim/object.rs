@@ -4,11 +4,15 @@
 //! the mesh's own frame (vertices are written as given, metres), so the object's pose in MuJoCo is
 //! the pose that maps mesh coordinates to the world, and perturbations (Sec. V-B4) act on it.
 
-use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh};
+use std::borrow::Cow;
+
+use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh, cluster_vertices};
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
-use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, space_separated};
+use crate::sim::mjcf::{
+    COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, sensed_surface_names, space_separated,
+};
 
 use crate::bodies::OBJECT_BODY;
 
@@ -30,19 +34,44 @@ pub enum ObjectMount {
     Free,
 }
 
-/// Where the `<mesh>` asset of the object's exact surface (the one the sensor reads) gets its
-/// vertices and faces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MeshData<'a> {
-    /// Inline `vertex` and `face` attributes: the text compiles alone.
-    Inline,
-    /// A file, relative to the MJCF file, which the caller writes beside it: a scene exported for
-    /// MuJoCo's own tools.
+/// Meshes of more triangles than this reach MuJoCo as a coarse copy of at most
+/// [`DRAWN_MESH_TRIANGLES`] (`mesh::cluster_vertices`), with the exact surface beside it for the
+/// sensor (see [`ObjectSurfaces`]). Every built-in object is below it (the bunny, the largest, has
+/// about 70,000).
+pub const LARGE_MESH_TRIANGLES: usize = 100_000;
+/// The most triangles of the copy MuJoCo compiles and draws of a large mesh.
+pub const DRAWN_MESH_TRIANGLES: usize = 20_000;
+
+/// The object's surface as a scene holds it.
+///
+/// MuJoCo compiles every mesh asset in full (normals, inertia, a BVH of every face), although the
+/// object's geom takes part in no contact (its collision shell does) and the sensor reads its own
+/// BVH: for a 1.3M-triangle scan that was a 256 MB model, 1.2 GB at the peak of the compile, and
+/// most of the time to its first reading (issue 39). A large mesh's asset is therefore a coarse
+/// copy, and the model carries the exact surface as two `<numeric>` fields, plain numbers MuJoCo
+/// copies without processing, from which the sensor builds its BVH
+/// ([`sensed_surface_names`]); the model stays the one source of what the sensor reads.
+#[derive(Debug, Clone)]
+pub struct ObjectSurfaces<'a> {
+    /// The mesh asset MuJoCo compiles: the mesh itself, or a coarse copy of a large one.
+    pub drawn: Cow<'a, TriMesh>,
+    /// The exact surface, when `drawn` is a copy.
+    pub sensed: Option<&'a TriMesh>,
+}
+
+/// Where the `<mesh>` asset of the object gets its vertices and faces.
+#[derive(Debug, Clone, Copy)]
+pub enum MeshAsset<'a> {
+    /// Inline attributes (a large mesh: its copy, and the exact surface as `<numeric>` text): the
+    /// text compiles alone.
+    Inline(&'a ObjectSurfaces<'a>),
+    /// A file holding the whole mesh, relative to the MJCF file, which the caller writes beside
+    /// it: a scene exported for MuJoCo's own tools, which compile what they are given.
     File(&'a str),
-    /// None in the text: the compiler of the scene sets them on the parsed specification
-    /// ([`SceneBuilder::build`](crate::sim::SceneBuilder::build)), sparing a scanned mesh's
-    /// millions of numbers their printing and MuJoCo's parsing (issue 39, large meshes).
-    Spec,
+    /// None in the text: the compiler of the scene sets them, and the exact surface's fields, on
+    /// the parsed specification ([`SceneBuilder::build`](crate::sim::SceneBuilder::build)),
+    /// sparing a scanned mesh's millions of numbers their printing and MuJoCo's parsing.
+    Spec(&'a ObjectSurfaces<'a>),
 }
 
 /// An object to place in the scene.
@@ -57,6 +86,10 @@ pub struct ObjectSpec {
     pub mount: ObjectMount,
     /// Mass of the object (free mount only), kilograms.
     pub mass_kg: f64,
+    /// Triangles above which MuJoCo is given a coarse copy of the mesh and the sensor the exact
+    /// surface beside it ([`ObjectSurfaces`]; [`LARGE_MESH_TRIANGLES`] by default); `usize::MAX`
+    /// gives MuJoCo the whole mesh whatever its size.
+    pub large_mesh_triangles: usize,
 }
 
 /// A checked object, resting at the origin as it was built.
@@ -75,6 +108,7 @@ impl ObjectSpec {
             pose: Pose::IDENTITY,
             mount: ObjectMount::Mocap,
             mass_kg: 0.2,
+            large_mesh_triangles: LARGE_MESH_TRIANGLES,
         }
     }
 
@@ -88,13 +122,30 @@ impl ObjectSpec {
         Ok(built.into_iter().map(Self::from).collect())
     }
 
-    /// Adds the mesh asset (its vertices and faces from `mesh_data`) and the object body to `doc`.
+    /// How a scene holds this object's surface: as it is, or, for a mesh of more than
+    /// [`large_mesh_triangles`](Self::large_mesh_triangles), a coarse copy for MuJoCo and the exact
+    /// surface beside it.
+    pub fn surfaces(&self) -> ObjectSurfaces<'_> {
+        if self.mesh.triangles.len() > self.large_mesh_triangles {
+            ObjectSurfaces {
+                drawn: Cow::Owned(cluster_vertices(&self.mesh, DRAWN_MESH_TRIANGLES)),
+                sensed: Some(&self.mesh),
+            }
+        } else {
+            ObjectSurfaces {
+                drawn: Cow::Borrowed(&self.mesh),
+                sensed: None,
+            }
+        }
+    }
+
+    /// Adds the mesh asset (its vertices and faces from `asset`) and the object body to `doc`.
     ///
     /// The geom collides with the arm and the table (MuJoCo uses the mesh's convex hull for these
     /// contacts; the tactile sensor raycasts the exact triangles). The body gets an explicit inertia (a
     /// solid sphere of the mesh's bounding radius), so that open or thin user meshes, whose volume
     /// MuJoCo cannot compute, still load.
-    pub fn add_to(&self, doc: &mut Document, mesh_data: MeshData) -> Result<(), SimError> {
+    pub fn add_to(&self, doc: &mut Document, asset: MeshAsset) -> Result<(), SimError> {
         let (lo, hi) = self.mesh.bounds().ok_or_else(|| SimError::Object {
             name: self.name.clone(),
             message: "the mesh has no vertices".into(),
@@ -105,7 +156,13 @@ impl ObjectSpec {
                 message: "the mesh has no triangles".into(),
             });
         }
-        doc.add(Section::Asset, self.mesh_asset(mesh_data));
+        doc.add(Section::Asset, mesh_asset(asset));
+        if let MeshAsset::Inline(ObjectSurfaces {
+            sensed: Some(sensed), ..
+        }) = asset
+        {
+            doc.add(Section::Custom, sensed_surface_xml(sensed));
+        }
         let shell = self.add_collision_shell(doc);
 
         let center = (lo + hi) * 0.5;
@@ -133,24 +190,6 @@ impl ObjectSpec {
         Ok(())
     }
 
-    /// The `<mesh>` asset of the exact surface the sensor reads.
-    fn mesh_asset(&self, mesh_data: MeshData) -> String {
-        match mesh_data {
-            MeshData::File(file) => format!(
-                "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" file=\"{}\"/>",
-                escape_attr(file)
-            ),
-            MeshData::Spec => format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\"/>"),
-            MeshData::Inline => {
-                let vertex = numbers(self.mesh.vertices.iter().flat_map(|v| v.to_array()));
-                let face = indices(self.mesh.triangles.iter().flatten());
-                format!(
-                    "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>"
-                )
-            }
-        }
-    }
-
     /// Adds the convex pieces of the collision shell as assets and returns their geoms for the
     /// object's body: contacts go through the shell (see `collision_shell`), the sensor reads the
     /// exact mesh.
@@ -172,6 +211,33 @@ impl ObjectSpec {
         }
         shell
     }
+}
+
+/// The object's `<mesh>` asset.
+fn mesh_asset(asset: MeshAsset) -> String {
+    match asset {
+        MeshAsset::File(file) => format!(
+            "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" file=\"{}\"/>",
+            escape_attr(file)
+        ),
+        MeshAsset::Spec(_) => format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\"/>"),
+        MeshAsset::Inline(surfaces) => {
+            let mesh = &surfaces.drawn;
+            let vertex = numbers(mesh.vertices.iter().flat_map(|v| v.to_array()));
+            let face = indices(mesh.triangles.iter().flatten());
+            format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
+        }
+    }
+}
+
+/// The exact surface of the object's mesh as the `<numeric>` fields the sensor reads.
+fn sensed_surface_xml(sensed: &TriMesh) -> String {
+    let (vertex_name, face_name) = sensed_surface_names(OBJECT_MESH);
+    let vertex = numbers(sensed.vertices.iter().flat_map(|v| v.to_array()));
+    let face = indices(sensed.triangles.iter().flatten());
+    format!(
+        "<numeric name=\"{vertex_name}\" data=\"{vertex}\"/>\n<numeric name=\"{face_name}\" data=\"{face}\"/>"
+    )
 }
 
 /// Space-separated vertex indices.

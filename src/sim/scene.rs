@@ -10,8 +10,8 @@ use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::arm::Arm;
-use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML, as_read_f32};
-use crate::sim::object::{MeshData, OBJECT_MESH, ObjectMount, ObjectSpec};
+use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML, as_read_f32, sensed_surface_names};
+use crate::sim::object::{MeshAsset, OBJECT_MESH, ObjectMount, ObjectSpec, ObjectSurfaces};
 
 /// What goes into a scene. The arm and table come from `mjcf/`; the object and any extra parts (a
 /// sensor plugin, a free-floating pad) are added by the caller.
@@ -72,17 +72,19 @@ impl SceneBuilder {
         self
     }
 
-    /// The MJCF document this builder compiles, complete: the object's mesh inline, or in the
+    /// The MJCF document this builder compiles, complete: the object's mesh inline (a large one as
+    /// [`ObjectSurfaces`] says), or the whole mesh in the
     /// [`object_mesh_file`](Self::object_mesh_file).
     pub fn to_xml(&self) -> Result<String, SimError> {
-        self.document(match &self.object_mesh_file {
-            Some(file) => MeshData::File(file),
-            None => MeshData::Inline,
-        })
+        match (&self.object_mesh_file, &self.object) {
+            (Some(file), _) => self.document(Some(MeshAsset::File(file))),
+            (None, Some(object)) => self.document(Some(MeshAsset::Inline(&object.surfaces()))),
+            (None, None) => self.document(None),
+        }
     }
 
-    /// The MJCF document with the object's mesh data from `mesh_data`.
-    fn document(&self, mesh_data: MeshData) -> Result<String, SimError> {
+    /// The MJCF document with the object's mesh asset from `asset`.
+    fn document(&self, asset: Option<MeshAsset>) -> Result<String, SimError> {
         let mut doc = Document::default();
         if self.arm {
             doc.include(ARM_XML, "mjcf/arm.xml")?;
@@ -98,8 +100,8 @@ impl SceneBuilder {
         if self.table {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
-        if let Some(object) = &self.object {
-            object.add_to(&mut doc, mesh_data)?;
+        if let (Some(object), Some(asset)) = (&self.object, asset) {
+            object.add_to(&mut doc, asset)?;
         }
         for (section, xml) in &self.extra {
             doc.add(*section, xml.clone());
@@ -111,12 +113,12 @@ impl SceneBuilder {
     /// compiles to, bit for bit, with the object's mesh handed to MuJoCo as numbers rather than
     /// text (a scanned mesh's millions of them, issue 39).
     pub fn build(&self) -> Result<Scene, SimError> {
-        let xml = self.document(MeshData::Spec)?;
-        let model =
-            compile(&xml, self.object.as_ref().map(|o| &o.mesh)).map_err(|message| SimError::Mjcf {
-                origin: "assembled scene".into(),
-                message,
-            })?;
+        let surfaces = self.object.as_ref().map(ObjectSpec::surfaces);
+        let xml = self.document(surfaces.as_ref().map(MeshAsset::Spec))?;
+        let model = compile(&xml, surfaces.as_ref()).map_err(|message| SimError::Mjcf {
+            origin: "assembled scene".into(),
+            message,
+        })?;
         Scene::new(model, self.object.as_ref())
     }
 }
@@ -152,16 +154,16 @@ const COMPILE_ATTEMPTS: usize = 4;
 /// `mmap` and the allocation succeeds with `errno` left at `ENOMEM`, however the top moves. A
 /// thread other than the main one allocates from its own `mmap`ed arena and never calls `sbrk`,
 /// so each retry compiles on a fresh thread.
-fn compile(xml: &str, mesh: Option<&TriMesh>) -> Result<MjModel, String> {
+fn compile(xml: &str, surfaces: Option<&ObjectSurfaces>) -> Result<MjModel, String> {
     keep_heap_top();
     let mut attempt = 1;
     let mut ballast: Vec<Vec<u8>> = Vec::new();
-    let mut result = compile_once(xml, mesh);
+    let mut result = compile_once(xml, surfaces);
     while attempt < COMPILE_ATTEMPTS && matches!(&result, Err(m) if m.starts_with(STRAY_ERRNO_MESSAGE)) {
         ballast.push(vec![1u8; 4096 << attempt]);
         attempt += 1;
         result = std::thread::scope(|s| {
-            s.spawn(|| compile_once(xml, mesh))
+            s.spawn(|| compile_once(xml, surfaces))
                 .join()
                 .unwrap_or_else(|_| Err("MuJoCo's compiler panicked".into()))
         });
@@ -170,33 +172,54 @@ fn compile(xml: &str, mesh: Option<&TriMesh>) -> Result<MjModel, String> {
 }
 
 /// One attempt of [`compile`].
-fn compile_once(xml: &str, mesh: Option<&TriMesh>) -> Result<MjModel, String> {
+fn compile_once(xml: &str, surfaces: Option<&ObjectSurfaces>) -> Result<MjModel, String> {
     if xml.contains('\0') {
         return Err("the MJCF text holds a NUL character".into());
     }
     let mut spec = MjSpec::from_xml_string(xml).map_err(|e| edit_message(&e))?;
-    if let Some(mesh) = mesh {
-        let asset = spec
-            .mesh_mut(OBJECT_MESH)
-            .ok_or_else(|| format!("no mesh asset '{OBJECT_MESH}' for the object"))?;
-        asset.set_uservert(
-            &mesh
-                .vertices
-                .iter()
-                .flat_map(|v| v.to_array())
-                .map(as_read_f32)
-                .collect::<Vec<_>>(),
-        );
-        let face = mesh
-            .triangles
-            .iter()
-            .flatten()
-            .map(|&i| i32::try_from(i))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|_| format!("the object's mesh has more than {} vertices", i32::MAX))?;
-        asset.set_userface(&face);
+    if let Some(surfaces) = surfaces {
+        set_object_surfaces(&mut spec, surfaces)?;
     }
     spec.compile().map_err(|e| edit_message(&e))
+}
+
+/// Sets the object's mesh asset and, for a large mesh, its exact surface's `<numeric>` fields on
+/// the parsed specification ([`MeshAsset::Spec`]).
+fn set_object_surfaces(spec: &mut MjSpec, surfaces: &ObjectSurfaces) -> Result<(), String> {
+    let too_many = || format!("the object's mesh has more than {} vertices", i32::MAX);
+    let asset = spec
+        .mesh_mut(OBJECT_MESH)
+        .ok_or_else(|| format!("no mesh asset '{OBJECT_MESH}' for the object"))?;
+    let drawn = &surfaces.drawn;
+    asset.set_uservert(
+        &drawn
+            .vertices
+            .iter()
+            .flat_map(|v| v.to_array())
+            .map(as_read_f32)
+            .collect::<Vec<_>>(),
+    );
+    let face = drawn
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| i32::try_from(i))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| too_many())?;
+    asset.set_userface(&face);
+    if let Some(sensed) = surfaces.sensed {
+        let (vertex_name, face_name) = sensed_surface_names(OBJECT_MESH);
+        let vertex: Vec<f64> = sensed.vertices.iter().flat_map(|v| v.to_array()).collect();
+        let face: Vec<f64> = sensed.triangles.iter().flatten().map(|&i| f64::from(i)).collect();
+        for (name, data) in [(vertex_name, vertex), (face_name, face)] {
+            let size = i32::try_from(data.len()).map_err(|_| too_many())?;
+            let numeric = spec.add_numeric();
+            numeric.set_name(&name).map_err(|e| edit_message(&e))?;
+            numeric.set_data(&data);
+            numeric.set_size(size).map_err(|e| edit_message(&e))?;
+        }
+    }
+    Ok(())
 }
 
 /// The text of a MuJoCo parse or compile error.

@@ -18,13 +18,15 @@
 //! site's own body are skipped). Meshes are rasterised from the faces of their BVH leaves over the
 //! sample rays ([`query_region`]), and a second, small query checks the pad's rigid back; each
 //! mesh's own bounding radius skips meshes out of reach and keeps both queries off empty space.
-//! Primitives are cut analytically ([`crate::tactile::primitive`]).
+//! Primitives are cut analytically ([`crate::tactile::primitive`]). A mesh asset that is a coarse
+//! copy of a large scan comes with the exact surface as two `<numeric>` fields
+//! (`sim::sensed_surface_names`); its BVH is built from those.
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
 
 use crate::pose::rotation_from_xmat;
-use crate::sim::mjcf::COLLISION_GROUP;
+use crate::sim::mjcf::{COLLISION_GROUP, sensed_surface_names};
 use crate::tactile::SensorConfig;
 use crate::tactile::back_contact::triangle_overlaps_box;
 use crate::tactile::config::ConfigError;
@@ -54,6 +56,8 @@ pub enum CoveringError {
     UnsupportedGeom { geom: String, kind: &'static str },
     #[error("taction.covering: mesh '{mesh}': {source}")]
     Mesh { mesh: String, source: MeshBvhError },
+    #[error("taction.covering: mesh '{mesh}': sensed surface: {what}")]
+    SensedSurface { mesh: String, what: String },
 }
 
 /// How one sensed geom is cut by the rays.
@@ -219,28 +223,70 @@ impl MeshCache {
         if let Some(slot) = self.slot[mesh] {
             return Ok(slot);
         }
-        let (va, vn) = (
-            model.mesh_vertadr[mesh] as usize,
-            model.mesh_vertnum[mesh] as usize,
-        );
-        let (fa, fnum) = (
-            model.mesh_faceadr[mesh] as usize,
-            model.mesh_facenum[mesh] as usize,
-        );
-        let bvh = MeshBvh::new(
-            &model.mesh_vert[3 * va..3 * (va + vn)],
-            &model.mesh_face[3 * fa..3 * (fa + fnum)],
-        )
-        .map_err(|source| CoveringError::Mesh {
-            mesh: model.name(mjtObj::mjOBJ_MESH, mesh),
-            source,
-        })?;
+        let name = model.name(mjtObj::mjOBJ_MESH, mesh);
+        let bvh = match sensed_surface(model, mesh, &name)? {
+            Some((vertex_xyz, face)) => MeshBvh::new(&vertex_xyz, &face),
+            None => {
+                let (va, vn) = (
+                    model.mesh_vertadr[mesh] as usize,
+                    model.mesh_vertnum[mesh] as usize,
+                );
+                let (fa, fnum) = (
+                    model.mesh_faceadr[mesh] as usize,
+                    model.mesh_facenum[mesh] as usize,
+                );
+                MeshBvh::new(
+                    &model.mesh_vert[3 * va..3 * (va + vn)],
+                    &model.mesh_face[3 * fa..3 * (fa + fnum)],
+                )
+            }
+        }
+        .map_err(|source| CoveringError::Mesh { mesh: name, source })?;
         self.stats.bvh_builds += 1;
         self.stats.bvh_triangles += bvh.triangle_count();
         self.meshes.push(bvh);
         self.slot[mesh] = Some(self.meshes.len() - 1);
         Ok(self.meshes.len() - 1)
     }
+}
+
+/// A surface as [`MeshBvh::new`] takes it: flat `xyz` vertex coordinates and vertex-index triples.
+type FlatMesh = (Vec<f32>, Vec<i32>);
+
+/// The exact surface of model mesh `mesh` (named `name`) when the model carries it beside a coarse
+/// asset (`sim::ObjectSurfaces`, issue 39): its vertices in the geom frame, as MuJoCo placed the
+/// asset's (`mesh_quat^-1 (v - mesh_pos)`), and its faces; none when the mesh has no such fields.
+fn sensed_surface(model: &ModelView, mesh: usize, name: &str) -> Result<Option<FlatMesh>, CoveringError> {
+    let (vertex_name, face_name) = sensed_surface_names(name);
+    let fault = |what: String| CoveringError::SensedSurface {
+        mesh: name.to_string(),
+        what,
+    };
+    let (vertex, face) = match (model.numeric(&vertex_name), model.numeric(&face_name)) {
+        (None, None) => return Ok(None),
+        (Some(vertex), Some(face)) => (vertex, face),
+        (Some(_), None) => return Err(fault(format!("'{vertex_name}' without '{face_name}'"))),
+        (None, Some(_)) => return Err(fault(format!("'{face_name}' without '{vertex_name}'"))),
+    };
+    if vertex.len() % 3 != 0 || face.len() % 3 != 0 {
+        return Err(fault("a field's size is not a multiple of 3".into()));
+    }
+    let face = face
+        .iter()
+        .map(|&i| {
+            (i.fract() == 0.0 && (0.0..=f64::from(i32::MAX)).contains(&i))
+                .then_some(i as i32)
+                .ok_or_else(|| fault(format!("face index {i} is not a vertex index")))
+        })
+        .collect::<Result<Vec<i32>, _>>()?;
+    let offset = DVec3::from_slice(&model.mesh_pos[3 * mesh..3 * mesh + 3]);
+    let [w, x, y, z] = [0, 1, 2, 3].map(|k| model.mesh_quat[4 * mesh + k]);
+    let to_geom = glam::DQuat::from_xyzw(x, y, z, w).normalize().inverse();
+    let vertex_xyz = vertex
+        .chunks_exact(3)
+        .flat_map(|v| (to_geom * (DVec3::from_slice(v) - offset)).as_vec3().to_array())
+        .collect();
+    Ok(Some((vertex_xyz, face)))
 }
 
 /// Checks that `sensor` is on a site and has one value per taxel; returns its site.

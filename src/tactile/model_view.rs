@@ -38,6 +38,14 @@ pub struct ModelView<'a> {
     pub mesh_vert: &'a [f32],
     /// 3 per face.
     pub mesh_face: &'a [i32],
+    /// 3 per mesh: the translation MuJoCo took off the asset's vertices (its centre of mass).
+    pub mesh_pos: &'a [f64],
+    /// 4 per mesh (w, x, y, z): the rotation MuJoCo took off them (its principal axes), so that a
+    /// vertex `v` of the asset is `mesh_quat^-1 (v - mesh_pos)` in the geom frame.
+    pub mesh_quat: &'a [f64],
+    pub numeric_adr: &'a [i32],
+    pub numeric_size: &'a [i32],
+    pub numeric_data: &'a [f64],
     pub sensor_type: &'a [i32],
     pub sensor_objtype: &'a [i32],
     pub sensor_objid: &'a [i32],
@@ -72,6 +80,11 @@ impl<'a> ModelView<'a> {
                 mesh_facenum: slice(m.mesh_facenum, m.nmesh),
                 mesh_vert: slice(m.mesh_vert, 3 * m.nmeshvert),
                 mesh_face: slice(m.mesh_face, 3 * m.nmeshface),
+                mesh_pos: slice(m.mesh_pos, 3 * m.nmesh),
+                mesh_quat: slice(m.mesh_quat, 4 * m.nmesh),
+                numeric_adr: slice(m.numeric_adr, m.nnumeric),
+                numeric_size: slice(m.numeric_size, m.nnumeric),
+                numeric_data: slice(m.numeric_data, m.nnumericdata),
                 sensor_type: slice(m.sensor_type, m.nsensor),
                 sensor_objtype: slice(m.sensor_objtype, m.nsensor),
                 sensor_objid: slice(m.sensor_objid, m.nsensor),
@@ -98,6 +111,7 @@ impl<'a> ModelView<'a> {
             mjtObj::mjOBJ_SENSOR => (m.name_sensoradr, "sensor", m.nsensor),
             mjtObj::mjOBJ_MESH => (m.name_meshadr, "mesh", m.nmesh),
             mjtObj::mjOBJ_PLUGIN => (m.name_pluginadr, "plugin", m.nplugin),
+            mjtObj::mjOBJ_NUMERIC => (m.name_numericadr, "numeric", m.nnumeric),
             _ => return format!("object {id}"),
         };
         // SAFETY: the name address arrays have one entry per object; names holds nnames bytes of
@@ -112,6 +126,17 @@ impl<'a> ModelView<'a> {
             Some(n) if !n.is_empty() => n,
             _ => format!("{kind} {id}"),
         }
+    }
+}
+
+impl ModelView<'_> {
+    /// The values of the `<numeric>` field named `name`, if the model has one (its whole `size`;
+    /// none when MuJoCo's arrays disagree with its addresses).
+    pub fn numeric(&self, name: &str) -> Option<&[f64]> {
+        let id = (0..self.numeric_adr.len()).find(|&id| self.name(mjtObj::mjOBJ_NUMERIC, id) == name)?;
+        let adr = usize::try_from(self.numeric_adr[id]).ok()?;
+        let size = usize::try_from(self.numeric_size[id]).ok()?;
+        self.numeric_data.get(adr..adr.checked_add(size)?)
     }
 }
 
