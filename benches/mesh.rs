@@ -1,8 +1,9 @@
 //! Object preparation costs: parsing and validating a real mesh (the 10k-vertex dragon OFF, fetched
 //! on first use), normalising it, generating a chess piece and a raised letter; and a scanned
 //! object's size (issue 39): the free pad's first reading of spheres 8 cm across of 20k and 200k
-//! triangles (and 1.3M with `TACTION_BENCH_LARGE_MESH=1`: about half a minute an iteration),
-//! generated in memory: the scene's MJCF, MuJoCo's compile, the sensor's BVH, the reading.
+//! triangles (and 1.3M with `TACTION_BENCH_LARGE_MESH=1`: about two seconds an iteration),
+//! generated in memory: the scene's MJCF, MuJoCo's compile (of a coarse copy above 100,000
+//! triangles, the exact surface beside it), the sensor's BVH, the reading.
 
 use std::hint::black_box;
 use std::path::Path;
