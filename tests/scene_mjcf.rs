@@ -408,11 +408,15 @@ fn a_built_scene_is_the_model_its_mjcf_text_compiles_to_bit_for_bit() {
         "the mesh must hold ties the cast rounds otherwise"
     );
     let config = taction::valid::Valid::new(SensorConfig::default()).unwrap();
-    for builder in [
-        taction::sim::SceneBuilder::with_arm_and_table(),
-        taction::tactile::free_floating_builder(taction::sim::ObjectSpec::new("tied", mesh.clone()), &config),
+    let tied = taction::sim::ObjectSpec::new("tied", mesh.clone());
+    for (builder, object) in [
+        (taction::sim::SceneBuilder::with_arm_and_table(), &tied),
+        (
+            taction::tactile::free_floating_builder(tied.clone(), &config),
+            &tied,
+        ),
     ] {
-        let builder = builder.object(taction::sim::ObjectSpec::new("tied", mesh.clone()));
+        let builder = builder.object(object.clone());
         let built = builder.build().unwrap();
         let from_text = MjModel::from_xml_string(&builder.to_xml().unwrap()).unwrap();
         let bytes = |model: &MjModel| {
@@ -427,4 +431,37 @@ fn a_built_scene_is_the_model_its_mjcf_text_compiles_to_bit_for_bit() {
         assert_eq!(differing, 0, "mesh coordinates differ");
         assert!(bytes(built.model()) == bytes(&from_text), "the MJB files differ");
     }
+}
+
+/// A large mesh: `build` gives MuJoCo a coarse copy and carries the exact surface as two numeric
+/// fields; `to_xml`, whose text cannot carry them (MuJoCo refuses a `<numeric>` of more than a few
+/// hundred values), writes the whole mesh, and its text compiles.
+#[test]
+fn a_large_mesh_is_a_copy_with_its_surface_when_built_and_whole_in_the_text() {
+    ensure_registered();
+    let sphere = sensor_support::icosphere(DVec3::new(0.0, 0.0, 0.04), 0.04, 5);
+    let triangles = sphere.triangles.len();
+    let config = taction::valid::Valid::new(SensorConfig::default()).unwrap();
+    let large = taction::sim::ObjectSpec {
+        large_mesh_triangles: 1_000,
+        ..taction::sim::ObjectSpec::new("large", sphere)
+    };
+    let builder = taction::tactile::free_floating_builder(large, &config);
+    let built = builder.build().unwrap();
+    let from_text = MjModel::from_xml_string(&builder.to_xml().unwrap()).unwrap();
+    let object_faces = |model: &MjModel| {
+        let mesh = model.name_to_id(MjtObjBase::mjOBJ_MESH, "object").unwrap();
+        model.mesh_facenum()[mesh] as usize
+    };
+    let (vertex_name, face_name) = taction::sim::sensed_surface_names("object");
+    let numeric_size = |model: &MjModel, name: &str| {
+        model
+            .name_to_id(MjtObjBase::mjOBJ_NUMERIC, name)
+            .map(|id| model.numeric_size()[id] as usize)
+    };
+    assert!(object_faces(built.model()) <= taction::sim::DRAWN_MESH_TRIANGLES);
+    assert_eq!(numeric_size(built.model(), &face_name), Some(3 * triangles));
+    assert!(numeric_size(built.model(), &vertex_name).is_some());
+    assert_eq!(object_faces(&from_text), triangles);
+    assert_eq!(numeric_size(&from_text, &face_name), None);
 }

@@ -10,9 +10,7 @@ use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh, cluster_v
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
-use crate::sim::mjcf::{
-    COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, sensed_surface_names, space_separated,
-};
+use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, space_separated};
 
 use crate::bodies::OBJECT_BODY;
 
@@ -50,7 +48,7 @@ pub const DRAWN_MESH_TRIANGLES: usize = 20_000;
 /// most of the time to its first reading (issue 39). A large mesh's asset is therefore a coarse
 /// copy, and the model carries the exact surface as two `<numeric>` fields, plain numbers MuJoCo
 /// copies without processing, from which the sensor builds its BVH
-/// ([`sensed_surface_names`]); the model stays the one source of what the sensor reads.
+/// ([`sensed_surface_names`](crate::sim::sensed_surface_names)); the model stays the one source of what the sensor reads.
 #[derive(Debug, Clone)]
 pub struct ObjectSurfaces<'a> {
     /// The mesh asset MuJoCo compiles: the mesh itself, or a coarse copy of a large one.
@@ -62,15 +60,17 @@ pub struct ObjectSurfaces<'a> {
 /// Where the `<mesh>` asset of the object gets its vertices and faces.
 #[derive(Debug, Clone, Copy)]
 pub enum MeshAsset<'a> {
-    /// Inline attributes (a large mesh: its copy, and the exact surface as `<numeric>` text): the
-    /// text compiles alone.
-    Inline(&'a ObjectSurfaces<'a>),
-    /// A file holding the whole mesh, relative to the MJCF file, which the caller writes beside
-    /// it: a scene exported for MuJoCo's own tools, which compile what they are given.
+    /// The whole mesh as inline attributes: the text compiles alone. A large mesh too: MJCF text
+    /// cannot carry its exact surface beside a copy (MuJoCo 3.17 refuses a `<numeric>` of more
+    /// than a few hundred values, and crashes on one whose `size` is larger).
+    Inline,
+    /// The whole mesh in a file, relative to the MJCF file, which the caller writes beside it: a
+    /// scene exported for MuJoCo's own tools.
     File(&'a str),
-    /// None in the text: the compiler of the scene sets them, and the exact surface's fields, on
-    /// the parsed specification ([`SceneBuilder::build`](crate::sim::SceneBuilder::build)),
-    /// sparing a scanned mesh's millions of numbers their printing and MuJoCo's parsing.
+    /// None in the text: the compiler of the scene sets them on the parsed specification, with a
+    /// large mesh's exact surface beside its copy ([`ObjectSurfaces`];
+    /// [`SceneBuilder::build`](crate::sim::SceneBuilder::build)), sparing a scanned mesh's
+    /// millions of numbers their printing and MuJoCo's parsing.
     Spec(&'a ObjectSurfaces<'a>),
 }
 
@@ -156,19 +156,13 @@ impl ObjectSpec {
                 message: "the mesh has no triangles".into(),
             });
         }
-        doc.add(Section::Asset, mesh_asset(asset));
-        if let MeshAsset::Inline(ObjectSurfaces {
-            sensed: Some(sensed), ..
-        }) = asset
-        {
-            doc.add(Section::Custom, sensed_surface_xml(sensed));
-        }
+        doc.add(Section::Asset, mesh_asset(asset, &self.mesh));
         // A large mesh's shell is made from the copy MuJoCo draws: its cells (about 1.4 mm for a
         // 1.3M-triangle sphere 8 cm across) are finer than the shell's own 2 mm tolerance, and the
         // pieces of the whole scan were thinned to 1 mm cells anyway.
         let shell_of = match asset {
-            MeshAsset::Inline(surfaces) | MeshAsset::Spec(surfaces) => surfaces.drawn.as_ref(),
-            MeshAsset::File(_) => &self.mesh,
+            MeshAsset::Spec(surfaces) => surfaces.drawn.as_ref(),
+            MeshAsset::Inline | MeshAsset::File(_) => &self.mesh,
         };
         let shell = add_collision_shell(doc, shell_of);
 
@@ -217,31 +211,20 @@ fn add_collision_shell(doc: &mut Document, mesh: &TriMesh) -> String {
     shell
 }
 
-/// The object's `<mesh>` asset.
-fn mesh_asset(asset: MeshAsset) -> String {
+/// The object's `<mesh>` asset (`mesh` the whole mesh).
+fn mesh_asset(asset: MeshAsset, mesh: &TriMesh) -> String {
     match asset {
         MeshAsset::File(file) => format!(
             "<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" file=\"{}\"/>",
             escape_attr(file)
         ),
         MeshAsset::Spec(_) => format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\"/>"),
-        MeshAsset::Inline(surfaces) => {
-            let mesh = &surfaces.drawn;
+        MeshAsset::Inline => {
             let vertex = numbers(mesh.vertices.iter().flat_map(|v| v.to_array()));
             let face = indices(mesh.triangles.iter().flatten());
             format!("<mesh name=\"{OBJECT_MESH}\" inertia=\"shell\" vertex=\"{vertex}\" face=\"{face}\"/>")
         }
     }
-}
-
-/// The exact surface of the object's mesh as the `<numeric>` fields the sensor reads.
-fn sensed_surface_xml(sensed: &TriMesh) -> String {
-    let (vertex_name, face_name) = sensed_surface_names(OBJECT_MESH);
-    let vertex = numbers(sensed.vertices.iter().flat_map(|v| v.to_array()));
-    let face = indices(sensed.triangles.iter().flatten());
-    format!(
-        "<numeric name=\"{vertex_name}\" data=\"{vertex}\"/>\n<numeric name=\"{face_name}\" data=\"{face}\"/>"
-    )
 }
 
 /// Space-separated vertex indices.

@@ -72,19 +72,20 @@ impl SceneBuilder {
         self
     }
 
-    /// The MJCF document this builder compiles, complete: the object's mesh inline (a large one as
-    /// [`ObjectSurfaces`] says), or the whole mesh in the
-    /// [`object_mesh_file`](Self::object_mesh_file).
+    /// The MJCF document of this builder's scene, complete, with the object's whole mesh inline or
+    /// in the [`object_mesh_file`](Self::object_mesh_file). It compiles to the model
+    /// [`build`](Self::build) makes, bit for bit, unless the mesh is large: `build` then gives
+    /// MuJoCo a coarse copy and the sensor the exact surface ([`ObjectSurfaces`]), which MJCF text
+    /// cannot carry, and the two read the same images to `f32` rounding.
     pub fn to_xml(&self) -> Result<String, SimError> {
-        match (&self.object_mesh_file, &self.object) {
-            (Some(file), _) => self.document(Some(MeshAsset::File(file))),
-            (None, Some(object)) => self.document(Some(MeshAsset::Inline(&object.surfaces()))),
-            (None, None) => self.document(None),
-        }
+        self.document(match &self.object_mesh_file {
+            Some(file) => MeshAsset::File(file),
+            None => MeshAsset::Inline,
+        })
     }
 
     /// The MJCF document with the object's mesh asset from `asset`.
-    fn document(&self, asset: Option<MeshAsset>) -> Result<String, SimError> {
+    fn document(&self, asset: MeshAsset) -> Result<String, SimError> {
         let mut doc = Document::default();
         if self.arm {
             doc.include(ARM_XML, "mjcf/arm.xml")?;
@@ -100,7 +101,7 @@ impl SceneBuilder {
         if self.table {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
-        if let (Some(object), Some(asset)) = (&self.object, asset) {
+        if let Some(object) = &self.object {
             object.add_to(&mut doc, asset)?;
         }
         for (section, xml) in &self.extra {
@@ -109,12 +110,12 @@ impl SceneBuilder {
         Ok(doc.to_xml("taction scene"))
     }
 
-    /// Compiles the scene and runs `mj_forward` once: the model [`to_xml`](Self::to_xml)'s text
-    /// compiles to, bit for bit, with the object's mesh handed to MuJoCo as numbers rather than
-    /// text (a scanned mesh's millions of them, issue 39).
+    /// Compiles the scene and runs `mj_forward` once, the object's mesh handed to MuJoCo as numbers
+    /// rather than text (a scanned mesh's millions of them, issue 39); a large mesh as
+    /// [`ObjectSurfaces`] says.
     pub fn build(&self) -> Result<Scene, SimError> {
         let surfaces = self.object.as_ref().map(ObjectSpec::surfaces);
-        let xml = self.document(surfaces.as_ref().map(MeshAsset::Spec))?;
+        let xml = self.document(surfaces.as_ref().map_or(MeshAsset::Inline, MeshAsset::Spec))?;
         let model = compile(&xml, surfaces.as_ref()).map_err(|message| SimError::Mjcf {
             origin: "assembled scene".into(),
             message,
