@@ -48,7 +48,8 @@ pub const DRAWN_MESH_TRIANGLES: usize = 20_000;
 /// most of the time to its first reading (issue 39). A large mesh's asset is therefore a coarse
 /// copy, and the model carries the exact surface as two `<numeric>` fields, plain numbers MuJoCo
 /// copies without processing, from which the sensor builds its BVH
-/// ([`sensed_surface_names`](crate::sim::sensed_surface_names)); the model stays the one source of what the sensor reads.
+/// ([`sensed_surface_names`](crate::sim::sensed_surface_names)); the model stays the one source of
+/// what the sensor reads.
 #[derive(Debug, Clone)]
 pub struct ObjectSurfaces<'a> {
     /// The mesh asset MuJoCo compiles: the mesh itself, or a coarse copy of a large one.
