@@ -8,7 +8,7 @@
 //! mesh and keeps the shape within a cell of the grid: each vertex moves to the mean of the
 //! vertices in its cell, and triangles whose corners fall in fewer than three cells vanish.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
 
@@ -66,7 +66,7 @@ fn clustered(mesh: &TriMesh, origin: DVec3, cell_m: f64) -> TriMesh {
         })
         .collect();
     let vertices: Vec<DVec3> = sums.iter().map(|&(sum, count)| sum / f64::from(count)).collect();
-    let mut seen: HashMap<[u32; 3], ()> = HashMap::new();
+    let mut seen: HashSet<[u32; 3]> = HashSet::new();
     let mut triangles = Vec::new();
     for &[a, b, c] in &mesh.triangles {
         let t = [cluster[a as usize], cluster[b as usize], cluster[c as usize]];
@@ -75,7 +75,7 @@ fn clustered(mesh: &TriMesh, origin: DVec3, cell_m: f64) -> TriMesh {
         }
         let mut key = t;
         key.sort_unstable();
-        if seen.insert(key, ()).is_none() {
+        if seen.insert(key) {
             triangles.push(t);
         }
     }

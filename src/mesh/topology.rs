@@ -67,6 +67,11 @@ impl EdgeTopology {
         }
     }
 
+    /// Each edge's (uses as low -> high, uses as high -> low).
+    fn use_counts(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.uses.iter().map(|&(_, counts)| counts)
+    }
+
     /// Number of distinct undirected edges.
     pub fn edge_count(&self) -> usize {
         self.uses.len()
@@ -79,21 +84,13 @@ impl EdgeTopology {
 
     /// Number of edges used by more than two triangles.
     pub fn non_manifold_edge_count(&self) -> usize {
-        self.uses
-            .iter()
-            .map(|(_, u)| u)
-            .filter(|(f, b)| f + b > 2)
-            .count()
+        self.use_counts().filter(|(f, b)| f + b > 2).count()
     }
 
     /// Number of two-triangle edges traversed twice in the same direction: their triangles have
     /// opposite orientations.
     pub fn misoriented_edge_count(&self) -> usize {
-        self.uses
-            .iter()
-            .map(|(_, u)| u)
-            .filter(|&&(f, b)| f + b == 2 && f != 1)
-            .count()
+        self.use_counts().filter(|&(f, b)| f + b == 2 && f != 1).count()
     }
 
     /// Number of closed loops the boundary edges form (connected components of the boundary graph).
@@ -133,13 +130,13 @@ impl EdgeTopology {
 
     /// True when every edge is shared by exactly two triangles (closed, manifold at edges).
     pub fn is_closed(&self) -> bool {
-        self.uses.iter().map(|(_, u)| u).all(|(f, b)| f + b == 2)
+        self.use_counts().all(|(f, b)| f + b == 2)
     }
 
     /// True when the mesh is closed and each edge is traversed once in each direction, i.e. all
     /// triangles of each connected shell wind the same way.
     pub fn is_consistently_oriented(&self) -> bool {
-        self.uses.iter().map(|(_, u)| u).all(|&(f, b)| f == 1 && b == 1)
+        self.use_counts().all(|(f, b)| f == 1 && b == 1)
     }
 
     /// Euler characteristic chi = V - E + F, counting only vertices that some triangle uses. For a

@@ -131,8 +131,8 @@ const STRAY_ERRNO_MESSAGE: &str = "XML Error: unknown error in attribute";
 /// Compiles the assembled scene: at most this many attempts when MuJoCo reports a stray `errno`.
 const COMPILE_ATTEMPTS: usize = 4;
 
-/// Parses `xml`, sets the object's mesh on the specification when there is one ([`MeshData::Spec`]),
-/// and compiles; tried again when the failure is MuJoCo's stray-`errno` report.
+/// Parses `xml`, sets the object's surfaces on the specification when there is one
+/// ([`MeshAsset::Spec`]), and compiles; tried again when the failure is MuJoCo's stray-`errno` report.
 ///
 /// MuJoCo 3.17 reads an array attribute (a mesh's `vertex` and `face`) with `StringToVector`,
 /// which zeroes `errno`, reserves, parses and shrinks the vector; its caller then takes any
@@ -231,7 +231,7 @@ fn edit_message(e: &MjEditError) -> String {
     }
 }
 
-/// Switches glibc's heap trimming off, once per process (see [`compile_xml`]).
+/// Switches glibc's heap trimming off, once per process (see [`compile`]).
 fn keep_heap_top() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {

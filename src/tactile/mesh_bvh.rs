@@ -9,8 +9,9 @@
 //! once, not once for each of the (about six) faces that share it.
 //!
 //! Vertices are read from the compiled model's `mesh_vert` (MuJoCo re-centres and re-orients them
-//! into the mesh's inertial frame, which is the geom frame), so together with `geom_xpos` and
-//! `geom_xmat` they give world positions with no further bookkeeping.
+//! into the mesh's inertial frame, which is the geom frame), or, for a large scan whose asset is a
+//! coarse copy, from its exact surface placed the same way (`covering::sensed_surface`), so
+//! together with `geom_xpos` and `geom_xmat` they give world positions with no further bookkeeping.
 
 use std::time::Duration;
 

@@ -127,9 +127,7 @@ impl<'a> ModelView<'a> {
             _ => format!("{kind} {id}"),
         }
     }
-}
 
-impl ModelView<'_> {
     /// The values of the `<numeric>` field named `name`, if the model has one (its whole `size`;
     /// none when MuJoCo's arrays disagree with its addresses).
     pub fn numeric(&self, name: &str) -> Option<&[f64]> {
