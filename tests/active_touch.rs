@@ -9,7 +9,10 @@ use std::sync::Arc;
 use glam::DVec3;
 use taction::active_touch::{EpisodeConfig, Touch, TouchEpisode, TouchError};
 use taction::describe::DescriptorKind;
-use taction::explore::{Collect, CollectMode, CollectPlan, ExplorationReport, PlannerConfig};
+use taction::explore::{
+    ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, PlannerConfig,
+    TouchScorer,
+};
 use taction::recognize::{Recognizer, TrainConfig, TrainedModel};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
@@ -214,4 +217,79 @@ fn touching_toward_the_planners_own_proposals_is_exploring() {
     assert_eq!(touched, explored);
     assert_eq!(stepped.tree().vertices().len(), explorer.tree().vertices().len());
     assert_eq!(stepped.grid().cells(), explorer.grid().cells());
+}
+
+/// A curiosity score: a target's distance from the nearest reading so far. What the information
+/// gain tends to when explored places have shown only what every likely object shares: the
+/// unexplored scores highest, and most of the unexplored is empty space.
+struct Novelty(Vec<DVec3>);
+
+impl TouchScorer for Novelty {
+    fn score(&self, candidates_m: &[DVec3]) -> Vec<f64> {
+        candidates_m
+            .iter()
+            .map(|c| {
+                self.0
+                    .iter()
+                    .map(|r| r.distance(*c))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .map(|d| if d.is_finite() { d } else { 0.0 })
+            .collect()
+    }
+}
+
+/// The active strategy ranks its candidates by what a touch would teach times the chance that the
+/// iteration touches at all, so a scorer that prefers empty space still touches about as often per
+/// iteration as the blind planner. Ranked by the score alone, the planner chased empty space: on
+/// the 3D set, 99% global iterations and 170x the blind planner's iterations per reading.
+#[test]
+fn active_exploration_touches_about_as_often_as_blind_exploration() {
+    const TOUCHES: usize = 12;
+    const ITERATIONS: usize = 3000;
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(planner(ITERATIONS)),
+        sensor: sensor(),
+        control: Valid::default(),
+        perturbation: PerturbationBounds::NONE,
+        readings_per_object: TOUCHES,
+        seed: 5,
+    };
+    let object = &objects()[1];
+    let (mut scene, mut blind) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
+    let blind = blind.explore(&mut scene, "ball", TOUCHES).unwrap();
+    assert_eq!(blind.converged(), TOUCHES);
+
+    let (mut scene, mut active) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
+    let (mut read, mut iterations) = (Vec::new(), 0);
+    while read.len() < TOUCHES && iterations < ITERATIONS {
+        let scorer = Novelty(read.clone());
+        let guidance = ActiveGuidance {
+            scorer: &scorer,
+            candidates: DEFAULT_CANDIDATES,
+        };
+        let report = active
+            .explore_guided(&mut scene, "ball", 1, Some(guidance), &mut || {})
+            .unwrap();
+        iterations += report.iterations;
+        read.extend(
+            report
+                .readings
+                .iter()
+                .filter(|r| r.is_converged())
+                .filter_map(|r| r.image.pose().map(|p| p.center_m)),
+        );
+    }
+    let per_reading = |iterations: usize| iterations as f64 / TOUCHES as f64;
+    eprintln!(
+        "iterations per converged reading: blind {:.1}, active {:.1}",
+        per_reading(blind.iterations),
+        per_reading(iterations)
+    );
+    assert_eq!(read.len(), TOUCHES, "{iterations} iterations");
+    assert!(
+        per_reading(iterations) <= 2.0 * per_reading(blind.iterations),
+        "active {iterations} iterations, blind {} for {TOUCHES} readings",
+        blind.iterations
+    );
 }

@@ -107,7 +107,8 @@ impl TouchEpisode {
         array::from_f64(py, &values, &[targets.len(), 3], "float64")
     }
 
-    /// The expected information gain of a touch toward each candidate, nats.
+    /// The expected information gain of a touch toward each candidate, nats: what a touch there
+    /// would teach times the chance it touches at all.
     fn gains<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let mut episode = self.episode()?;
         let episode = &mut *episode;

@@ -158,8 +158,9 @@ class ActiveTouchEnv(gymnasium.Env):
         }
 
     def gains(self) -> np.ndarray:
-        """The expected information gain (nats) of a touch toward each of the K candidates: what
-        the information-gain policy maximises (``taction.active_touch``)."""
+        """The expected information gain (nats) of a touch toward each of the K candidates: what a
+        touch there would teach times the chance it touches at all, judged from the episode's
+        earlier touches; what the information-gain policy maximises (``taction.active_touch``)."""
         offered = self._episode.gains()
         return offered[np.arange(self.k) % len(offered)]
 

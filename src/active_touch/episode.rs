@@ -206,15 +206,24 @@ impl TouchEpisode {
         &self.targets
     }
 
-    /// The expected information gain of a touch toward each candidate, nats
-    /// ([`InformationGain`](super::InformationGain)'s score given the readings so far).
+    /// The expected information gain of an iteration toward each candidate, nats: what a touch
+    /// there would teach ([`InformationGain`](super::InformationGain)'s score given the readings
+    /// so far) times the chance the iteration touches at all ([`touch_chances`](Self::touch_chances));
+    /// the quantity the planner's active strategy maximises ([`crate::explore::expected_gains`]).
     pub fn gains(&self) -> Result<Vec<f64>, TouchError> {
         use crate::explore::TouchScorer;
-        Ok(self.recognition()?.scorer().score(&self.targets))
+        let scores = self.recognition()?.scorer().score(&self.targets);
+        Ok(crate::explore::expected_gains(&scores, &self.touch_chances()))
     }
 
-    /// The information-gain policy's choice: the candidate of the largest gain (the first of equal
-    /// ones, [`best_candidate`](crate::explore::best_candidate)); `None` with no candidate.
+    /// The chance that a touch toward each candidate ends in a converged reading, judged from this
+    /// episode's earlier touches ([`Planner::touch_chances`]).
+    pub fn touch_chances(&self) -> Vec<f64> {
+        self.planner.touch_chances(&self.proposals)
+    }
+
+    /// The information-gain policy's choice: the candidate of the largest expected gain (the first
+    /// of equal ones, [`best_candidate`](crate::explore::best_candidate)); `None` with no candidate.
     pub fn most_informative(&self) -> Result<Option<usize>, TouchError> {
         Ok(crate::explore::best_candidate(&self.gains()?))
     }

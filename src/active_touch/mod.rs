@@ -26,10 +26,12 @@
 //! explored one by what it showed, so candidates near readings whose clusters tell the still
 //! likely objects apart score high (touch there again), candidates near readings of clusters all
 //! likely objects share (a flat face) score low, and unexplored places sit in between at the
-//! mutual information. The assumptions: a touch lands near its target (a global target in empty
-//! space may yield no touch, or one far away), nearby readings predict the next (the surface does
-//! not change within a neighbourhood, which a perturbation of the object breaks), and readings are
-//! independent given the object, as Eq. 15 already assumes.
+//! mutual information. The assumptions: a touch lands near its target, nearby readings predict the
+//! next (the surface does not change within a neighbourhood, which a perturbation of the object
+//! breaks), and readings are independent given the object, as Eq. 15 already assumes. Whether an
+//! iteration touches at all is the planner's to judge: it ranks candidates by this score times its
+//! own estimate of that chance (`explore::active`, [`TouchOdds`](crate::explore::TouchOdds)), so
+//! unexplored empty space, which scores the mutual information, does not win over the surface.
 //!
 //! Cost per planner iteration: `H(pi | c)` for every cluster once, `O(k J)` for `k` clusters and
 //! `J` objects, then per candidate `O(r + k)` for `r` readings so far; no MuJoCo, no descriptor.
@@ -457,6 +459,8 @@ pub struct TouchRun {
     pub touches: Vec<Touch>,
     /// Reading attempts, converged or not.
     pub attempts: usize,
+    /// Planner iterations spent, with or without a reading.
+    pub iterations: usize,
     /// Whether the confidence stop ended the run (else the budget was spent, or the planner ran
     /// out of iterations before a touch).
     pub stopped_confident: bool,
@@ -501,6 +505,7 @@ where
     let mut run = TouchRun {
         touches: Vec::new(),
         attempts: 0,
+        iterations: 0,
         stopped_confident: false,
     };
     while run.touches.len() < plan.budget {
@@ -510,6 +515,7 @@ where
         });
         let report = planner.explore_guided(scene, object, 1, guidance, &mut || {})?;
         run.attempts += report.readings.len();
+        run.iterations += report.iterations;
         let mut converged = report
             .readings
             .into_iter()

@@ -30,4 +30,7 @@ pub use report::ExplorationReport;
 pub use tree::{ExplorationTree, Vertex};
 
 // Active touch: the next touch chosen by the posterior.
-pub use active::{ActiveGuidance, DEFAULT_CANDIDATES, Probability, TouchScorer, best_candidate};
+pub use active::{
+    ActiveGuidance, DEFAULT_CANDIDATES, ODDS_PRIOR_ITERATIONS, Probability, TouchOdds, TouchScorer,
+    best_candidate, expected_gains,
+};

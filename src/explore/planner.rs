@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use crate::control::arm_pad::ArmPad;
 use crate::control::{ControlError, ReadTactile, settle};
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
-use crate::explore::active::{ActiveGuidance, best_candidate};
+use crate::explore::active::{ActiveGuidance, TouchOdds, best_candidate, expected_gains};
 use crate::explore::grid::ReadingGrid;
 use crate::explore::report::{ExplorationReport, aborted_reading, attempt_reading};
 use crate::explore::setup::TouchSetup;
@@ -300,6 +300,9 @@ pub struct Planner<R> {
     covering_reach_m: f64,
     tree: ExplorationTree,
     grid: ReadingGrid,
+    /// Where guided iterations touched and where they did not (the active strategy's
+    /// `P(reading | target)`, `explore/active.rs`).
+    odds: TouchOdds,
     rng: Rng,
     reader: R,
     /// The covering sensor on the pad, which tells the planner whether a stopped expansion step
@@ -392,6 +395,7 @@ where
             covering_reach_m,
             tree: ExplorationTree::new(q, pad.center_m, pad.normal),
             grid: ReadingGrid::new(config.workspace_min_m, config.grid_cell_m),
+            odds: TouchOdds::default(),
             rng,
             reader,
             covering: CoveringSensor::on_site(scene.model(), PAD_SITE).ok(),
@@ -460,7 +464,12 @@ where
             } else {
                 strategy
             };
+            let converged = record.report.converged();
             self.iterate_toward(scene, &arm, object, (strategy, target), label, &mut record)?;
+            if guidance.is_some() {
+                let touched = record.report.converged() > converged;
+                self.odds.record(strategy, target, touched);
+            }
         }
         Ok(record.report)
     }
@@ -502,6 +511,8 @@ where
             on_converged: &mut || {},
         };
         self.iterate_toward(scene, &arm, object, candidate, candidate.0, &mut record)?;
+        self.odds
+            .record(candidate.0, candidate.1, record.report.converged() > 0);
         Ok(record.report)
     }
 
@@ -556,8 +567,20 @@ where
             .filter_map(|_| self.propose())
             .collect();
         let targets: Vec<DVec3> = proposals.iter().map(|p| p.1).collect();
-        let best = best_candidate(&guide.scorer.score(&targets))?;
+        let gains = expected_gains(&guide.scorer.score(&targets), &self.touch_chances(&proposals));
+        let best = best_candidate(&gains)?;
         Some(proposals[best])
+    }
+
+    /// For each candidate (its kind, its target), the chance that an iteration toward it ends in a
+    /// converged reading, judged from this planner's earlier guided iterations (and
+    /// [`touch_toward`](Self::touch_toward)'s) whose targets lay within the local radius
+    /// ([`TouchOdds::chance`]).
+    pub fn touch_chances(&self, candidates: &[(Strategy, DVec3)]) -> Vec<f64> {
+        candidates
+            .iter()
+            .map(|&(strategy, target)| self.odds.chance(strategy, target, self.config.local_radius_m))
+            .collect()
     }
 
     /// Resets the arm to tree vertex `vertex` (Sec. III-A; the module docs say why it is not
