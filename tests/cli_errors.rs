@@ -286,6 +286,35 @@ fn an_experiment_refuses_a_folder_of_another_scale_before_it_starts() {
     assert!(!dir.path().join("data").exists(), "no dataset collected");
 }
 
+/// Without `--codebook`, the experiments on the arm's own touches train with the product's
+/// neighbour codebook and the paper's figures with its GMM: a folder of an earlier `active` run
+/// with the GMM (the default before) is refused, and so is a figure's folder of a kNN run, each
+/// naming both codebooks, before any data is collected.
+#[test]
+fn the_experiments_on_the_arms_touches_default_to_the_neighbour_codebook() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().display().to_string();
+    for (experiment, theirs, ours) in [("active", "gmm", "knn"), ("strategy", "knn", "gmm")] {
+        let earlier = dir.path().join(experiment);
+        std::fs::create_dir(&earlier).unwrap();
+        std::fs::write(
+            earlier.join("config.json"),
+            format!(r#"{{"scale": 0.1, "seed": 1, "training": {{"codebook": "{theirs}"}}}}"#),
+        )
+        .unwrap();
+        let line = fails_with(
+            &taction(&["experiment", experiment, "--scale", "0.1", "--out", &out]),
+            1,
+        );
+        assert!(
+            line.contains(&format!("scale 0.1, seed 1, codebook {theirs}"))
+                && line.contains(&format!("scale 0.1, seed 1, codebook {ours}")),
+            "{experiment}: {line}"
+        );
+    }
+    assert!(!dir.path().join("data").exists(), "no dataset collected");
+}
+
 #[test]
 fn an_obj_index_out_of_range_is_quoted_as_the_file_writes_it() {
     let dir = tempfile::tempdir().unwrap();

@@ -65,10 +65,12 @@ pub struct PaperArgs {
     #[arg(long)]
     pub allow_short: bool,
     /// The codebook of every model: gmm (the paper's) | kmeans | knn (beyond the paper: the
-    /// objects' shares of a feature's nearest training features, PCA keeping 99%). A run with
-    /// another codebook needs its own `--out`.
-    #[arg(long, value_name = "KIND", default_value = "gmm", value_parser = parse_codebook)]
-    pub codebook: CodebookKind,
+    /// objects' shares of a feature's nearest training features, PCA keeping 99%). Without it the
+    /// paper's figures and training-size use gmm, and the experiments on the arm's own touches
+    /// (end-to-end, active) the product's recipe, knn. A run with another codebook needs its own
+    /// `--out`.
+    #[arg(long, value_name = "KIND", value_parser = parse_codebook)]
+    pub codebook: Option<CodebookKind>,
     #[command(flatten)]
     pub posterior: PosteriorArg,
 }
@@ -152,7 +154,7 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
     let experiment = parse_experiment(&args.name)?;
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
-    check_earlier_runs(&[experiment.name()], &context)?;
+    check_earlier_runs(&[experiment], &context)?;
     announce_estimate(&[experiment.name()], &context);
     let (report, times) = experiment.run_timed(&context).map_err(|e| e.to_string())?;
     println!("{report}");
@@ -204,18 +206,21 @@ fn check_shortfalls(
 
 /// Refuses, before any estimate or data collection, to resume an experiment whose folder holds a
 /// run of another scale, seed or codebook (its `config.json`): the runner would refuse it only
-/// after collecting this run's data, and the shipped `results/` (scale 1.0, seed 1, gmm) is the
-/// default output folder.
-fn check_earlier_runs(names: &[&str], context: &PaperContext) -> Result<(), Box<dyn std::error::Error>> {
-    let ours = RunSettings {
-        scale: context.scale.fraction(),
-        seed: context.seed,
-        codebook: serde_json::to_value(context.codebook)?
-            .as_str()
-            .map(str::to_owned),
-    };
-    for name in names {
-        let path = context.options.out.join(name).join("config.json");
+/// after collecting this run's data, and the shipped `results/` (scale 1.0, seed 1, each
+/// experiment's own codebook) is the default output folder.
+fn check_earlier_runs(
+    experiments: &[PaperExperiment],
+    context: &PaperContext,
+) -> Result<(), Box<dyn std::error::Error>> {
+    for &experiment in experiments {
+        let ours = RunSettings {
+            scale: context.scale.fraction(),
+            seed: context.seed,
+            codebook: serde_json::to_value(context.codebook_for(experiment))?
+                .as_str()
+                .map(str::to_owned),
+        };
+        let path = context.options.out.join(experiment.name()).join("config.json");
         let Ok(text) = std::fs::read_to_string(&path) else {
             continue;
         };
@@ -291,7 +296,7 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
     let names: Vec<&str> = experiments.iter().map(|e| e.name()).collect();
-    check_earlier_runs(&names, &context)?;
+    check_earlier_runs(&experiments, &context)?;
     let started = Instant::now();
     let mut estimate = announce_estimate(&names, &context);
     let mut timings = Vec::new();

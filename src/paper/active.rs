@@ -49,7 +49,8 @@ use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confide
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
-    Evaluation, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
+    CodebookKind, Evaluation, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel,
+    Trial, evaluate,
 };
 use crate::sim::PerturbationBounds;
 
@@ -212,11 +213,11 @@ struct ActiveConfig<'a> {
 }
 
 /// Runs the experiment in `context` (one unit: the model, the L curves and the active curves).
-pub fn run_active(context: &PaperContext) -> Result<RunReport, BoxError> {
+pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
     let sweep = sweep();
     let objects = context.objects(Family::Shapes)?;
     let counts = sweep.settings[0].counts(context.scale.counts());
-    let training = training_config(context, counts, objects.specs.len());
+    let training = training_config(context, codebook, counts, objects.specs.len());
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let key = SafeName::builder(DESCRIPTOR.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);

@@ -4,6 +4,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, PoisonError};
 
+use super::PaperExperiment;
 use super::data::{DataStore, Objects};
 use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
@@ -74,8 +75,9 @@ pub struct PaperContext {
     pub real: RealRecording,
     /// Fig. 16b's settings ([`RealFramesOptions`](super::RealFramesOptions)).
     pub real_frames: RealFramesOptions,
-    /// The codebook every model is trained with: the paper's GMM unless `--codebook` says otherwise.
-    pub codebook: CodebookKind,
+    /// `--codebook`: the codebook of every model when given; else each experiment's own
+    /// ([`codebook_for`](Self::codebook_for)).
+    pub codebook: Option<CodebookKind>,
     pub(crate) store: DataStore,
     built: Mutex<HashMap<String, Arc<Objects>>>,
 }
@@ -99,7 +101,7 @@ impl PaperContext {
             letters,
             real,
             real_frames: RealFramesOptions::default(),
-            codebook: CodebookKind::Gmm,
+            codebook: None,
             built: Mutex::new(HashMap::new()),
         }
     }
@@ -130,10 +132,16 @@ impl PaperContext {
         self
     }
 
-    /// Trains every model with `codebook` instead of the paper's GMM.
-    pub fn with_codebook(mut self, codebook: CodebookKind) -> Self {
+    /// Trains every model of every experiment with `codebook` (`None`: each experiment's own).
+    pub fn with_codebook(mut self, codebook: Option<CodebookKind>) -> Self {
         self.codebook = codebook;
         self
+    }
+
+    /// The codebook of `experiment`'s models: `--codebook` when given, else the experiment's own
+    /// ([`PaperExperiment::default_codebook`]).
+    pub fn codebook_for(&self, experiment: PaperExperiment) -> CodebookKind {
+        self.codebook.unwrap_or(experiment.default_codebook())
     }
 
     /// Recognises with the posterior `rule` (the calibrated one unless `--posterior eq15`).

@@ -74,6 +74,7 @@ pub use sim_to_real::{GaussianBlur, SimToRealPreprocess, square_root};
 
 use crate::experiment::runner::{RunReport, run};
 use crate::experiment::unit::BoxError;
+use crate::recognize::CodebookKind;
 
 /// One experiment of the paper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -136,6 +137,20 @@ impl PaperExperiment {
         })
     }
 
+    /// The codebook of the experiment's models when `--codebook` does not say: the paper's GMM
+    /// (Sec. IV-C) for the paper's figures and the training-size study of its recipe; for the two
+    /// experiments on the arm's own touches, `end-to-end` and `active`, the codebook of the recipe
+    /// the product recognises them with (the demo's, [`ArmTrainingRecipe::CODEBOOK`]: the
+    /// neighbour codebook), so that what they measure is what a user of the product gets.
+    ///
+    /// [`ArmTrainingRecipe::CODEBOOK`]: crate::active_touch::ArmTrainingRecipe::CODEBOOK
+    pub fn default_codebook(self) -> CodebookKind {
+        match self {
+            Self::Active | Self::EndToEnd => crate::active_touch::ArmTrainingRecipe::CODEBOOK,
+            _ => CodebookKind::Gmm,
+        }
+    }
+
     /// Whether the experiment's rows are recognition curves ([`crate::experiment::AccuracyRow`]'s
     /// columns; `active` adds the confidence stop's); Fig. 14's are convergence statistics and
     /// Fig. 1's the placements it draws.
@@ -172,13 +187,16 @@ impl PaperExperiment {
 
     /// Runs the experiment in `context`.
     pub fn run(self, context: &PaperContext) -> Result<PaperOutput, BoxError> {
+        let codebook = context.codebook_for(self);
         Ok(match self.sweep() {
-            Some(sweep) => PaperOutput::Run(Box::new(sweep.run(context)?)),
+            Some(sweep) => PaperOutput::Run(Box::new(sweep.run(context, codebook)?)),
             None if self == Self::Exploration => PaperOutput::Picture(figure1::run_figure1(context)?),
             None if self == Self::RealFrames => {
-                PaperOutput::Run(Box::new(real_frames::run_real_frames(context)?))
+                PaperOutput::Run(Box::new(real_frames::run_real_frames(context, codebook)?))
             }
-            None if self == Self::Active => PaperOutput::Run(Box::new(active::run_active(context)?)),
+            None if self == Self::Active => {
+                PaperOutput::Run(Box::new(active::run_active(context, codebook)?))
+            }
             None => PaperOutput::Run(Box::new(run_convergence(context)?)),
         })
     }

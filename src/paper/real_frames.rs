@@ -39,8 +39,8 @@ use crate::experiment::unit::{BoxError, Unit};
 use crate::paper::sim_to_real::{GaussianBlur, square_root};
 use crate::paper::split::{SplitSizes, split_per_label};
 use crate::recognize::{
-    Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, Trial,
-    evaluate, train,
+    CodebookKind, Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig,
+    Trial, evaluate, train,
 };
 use crate::rng;
 use crate::tactile::TactileImage;
@@ -195,8 +195,9 @@ struct SplitPerLabel {
 /// Fig. 16b's description in `experiment list`.
 pub const DESCRIPTION: &str = "Fig. 16b: trained and tested on recorded frames (--real), pruned of non-contacts, split per letter 200/50/100, 7 trials, six descriptors";
 
-/// Runs Fig. 16b on the context's recording: one unit per descriptor, each running every trial.
-pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
+/// Runs Fig. 16b on the context's recording, every model with `codebook`: one unit per
+/// descriptor, each running every trial.
+pub fn run_real_frames(context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
     let options = &context.real_frames;
     options.check()?;
     let real = context.real_data()?;
@@ -204,7 +205,7 @@ pub fn run_real_frames(context: &PaperContext) -> Result<RunReport, BoxError> {
     let labels: Vec<String> = pruning.keys().cloned().collect();
     let sizes = split_sizes(context, &pruning)?;
     let training = selection_config(
-        context.codebook,
+        codebook,
         rng::substream(context.seed, MODEL_STREAM),
         sizes.train,
         sizes.validation,

@@ -183,9 +183,9 @@ impl RecognitionSweep {
         }
     }
 
-    /// Runs the sweep in `context`: prepares the datasets its pending units need, then runs the
-    /// units on the experiment framework (resumable, sharded, parallel).
-    pub fn run(&self, context: &PaperContext) -> Result<RunReport, BoxError> {
+    /// Runs the sweep in `context`, every model with `codebook`: prepares the datasets its pending
+    /// units need, then runs the units on the experiment framework (resumable, sharded, parallel).
+    pub fn run(&self, context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
         let objects = context.objects(self.family)?;
         let counts = context.scale.counts();
         let plans = self.unit_plans()?;
@@ -200,7 +200,7 @@ impl RecognitionSweep {
             objects: objects.names(),
             control: ControlConfig::default(),
             planner: PlannerConfig::default(),
-            training: training_config(context, counts, objects.specs.len()),
+            training: training_config(context, codebook, counts, objects.specs.len()),
         };
         check_resumable(&context.options, &name, &config)?;
         let dir = ExperimentDir::new(&context.options.out, &name);
@@ -223,7 +223,7 @@ impl RecognitionSweep {
                 ],
             },
             config,
-            units: self.units(context, &objects, counts, &plans, real),
+            units: self.units(context, &objects, counts, &plans, real, codebook),
         };
         Ok(run(&experiment, &context.options)?)
     }
@@ -236,13 +236,14 @@ impl RecognitionSweep {
         counts: DataCounts,
         plans: &[UnitPlan<'a>],
         real: Option<Arc<RealData>>,
+        codebook: CodebookKind,
     ) -> Vec<Unit<'a, AccuracyRow, RecognitionDetail>> {
         plans
             .iter()
             .map(|plan| {
                 let objects = Arc::clone(objects);
                 let setting_counts = plan.setting.counts(counts);
-                let training = training_config(context, setting_counts, objects.specs.len());
+                let training = training_config(context, codebook, setting_counts, objects.specs.len());
                 let real = real.clone();
                 let (setting, descriptor) = (plan.setting, plan.descriptor);
                 Unit::with_detail(plan.key.clone(), move || {
@@ -582,10 +583,15 @@ impl<'a> SettingData<'a> {
 
 /// Model selection as in Sec. V-B1 (3 seeded restarts) over the cluster counts sized to the
 /// problem ([`TrainConfig::with_grid_for`]: the planned training readings, since the grid is part of
-/// the run's `config.json`, written before any data is collected), with the run's codebook.
-pub(super) fn training_config(context: &PaperContext, counts: DataCounts, objects: usize) -> TrainConfig {
+/// the run's `config.json`, written before any data is collected), with `codebook`.
+pub(super) fn training_config(
+    context: &PaperContext,
+    codebook: CodebookKind,
+    counts: DataCounts,
+    objects: usize,
+) -> TrainConfig {
     selection_config(
-        context.codebook,
+        codebook,
         rng::substream(context.seed, MODEL_STREAM),
         counts.training_per_object,
         counts.validation_per_object,
