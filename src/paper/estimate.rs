@@ -2,8 +2,7 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scales 0.2 and 1.0 (the paper's, the default; together 24 minutes without `active`, whose
-//! explorations take 79 minutes more, and 10 estimated for `end-to-end`); at any other
+//! scales 0.2 and 1.0 (the paper's, the default: 26 minutes for all fifteen); at any other
 //! scale it is the power law through the 1.0 timing, `t(s) = t_1 s^p`, with the exponent the two
 //! timings give, `p = ln(t_1 / t_0.2) / ln 5`, held in [1, 3]: data collection grows linearly with
 //! the scale and codebook fitting faster, so a smaller `p` only says that the 0.2 timing was
@@ -23,30 +22,25 @@ pub const PACE_AFTER_S: f64 = 30.0;
 pub const REFERENCE_THREADS: usize = 2;
 
 /// Wall seconds of each experiment at scale 0.2 and 1.0 on the reference machine (seed 1, the
-/// built-in sets; `reproduce` one experiment after another into an empty folder, so datasets
-/// shared between experiments were collected by the first one that needed them; the phases of
-/// both runs are in docs/benchmarks.md). Measured 2026-11-26, except where noted.
+/// built-in sets, each experiment's own codebook; `reproduce` one experiment after another into an
+/// empty folder, so datasets shared between experiments were collected by the first one that
+/// needed them; the phases of both runs are in docs/benchmarks.md). Measured 2026-11-27.
 const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
-    ("exploration", 1.9, 0.6),
-    ("descriptors", 13.7, 76.3),
-    ("strategy", 19.4, 65.0),
-    ("validation", 15.2, 54.6),
-    ("perturbation", 5.6, 35.6),
-    ("thickness", 32.7, 145.4),
-    ("resolution", 22.2, 105.3),
-    ("noise", 33.1, 132.6),
-    ("convergence", 0.9, 1.1),
-    ("letters", 87.4, 505.3),
+    ("exploration", 0.6, 0.5),
+    ("descriptors", 14.0, 74.2),
+    ("strategy", 19.4, 65.2),
+    ("validation", 15.4, 54.0),
+    ("perturbation", 5.5, 35.2),
+    ("thickness", 33.3, 144.2),
+    ("resolution", 22.8, 104.8),
+    ("noise", 33.6, 130.7),
+    ("convergence", 0.9, 1.0),
+    ("letters", 92.3, 510.8),
     ("real-frames", 0.2, 0.2),
     ("sim-to-real", 1.2, 7.8),
-    ("training-size", 52.6, 286.0),
-    // Scale 1.0: its units alone (datasets and model cached) took 79 minutes on 2026-11-25 beside
-    // a CI run, which shared the two cores; alone it takes less.
-    ("active", 389.9, 4740.0),
-    // Not a timed run: its datasets' collection and models' training timed alone in the session
-    // that added it (test explorations 4 x 3 x 12 x 100 planner readings, about 60 s per 3600 on
-    // 2 cores; 36,000 reachable sampler readings 58 s; four neighbour models).
-    ("end-to-end", 120.0, 600.0),
+    ("training-size", 56.4, 282.1),
+    ("active", 24.3, 115.0),
+    ("end-to-end", 1.7, 21.2),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
@@ -180,7 +174,7 @@ mod tests {
             .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
             .sum();
         assert!(
-            (112.0 * 60.0..113.0 * 60.0).contains(&whole_run),
+            (25.5 * 60.0..26.0 * 60.0).contains(&whole_run),
             "{whole_run} s at scale 1.0"
         );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);
