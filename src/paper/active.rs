@@ -35,6 +35,7 @@ use super::recognition::{
 };
 use super::scale::DataCounts;
 use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
+use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
 use crate::experiment::factor::{Factor, Factors};
@@ -200,9 +201,10 @@ struct ActiveConfig<'a> {
     active_candidates: usize,
     neighbourhood_m: f64,
     stops: [f64; 3],
-    /// The posterior: `calibrated` on the arm's explorations (`calibration_trial_readings` per
-    /// trial), or the paper's `eq15`.
+    /// The posterior: `calibrated` on the arm's explorations (`calibration_explorations` of each
+    /// object, `calibration_trial_readings` per trial), or the paper's `eq15`.
     posterior: PosteriorRule,
+    calibration_explorations: usize,
     calibration_trial_readings: usize,
     scale: f64,
     counts: DataCounts,
@@ -224,7 +226,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
         let data = SettingData::new(context, &objects, &sweep.settings[0], counts);
         let mut requests = data.requests()?;
-        requests.push(data.calibration_request()?);
+        requests.extend(data.calibration_requests()?);
         context.store.prepare(&requests, dir.root())?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
@@ -263,6 +265,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             neighbourhood_m,
             stops: STOPS,
             posterior: context.posterior(),
+            calibration_explorations: counts.trials,
             calibration_trial_readings: counts.test_per_object,
             scale: context.scale.fraction(),
             counts,
@@ -307,8 +310,13 @@ impl ActiveUnit<'_> {
         )?;
         let model = match self.context.posterior() {
             PosteriorRule::Calibrated => {
-                let arm = self.context.store.dataset(&data.calibration_request()?)?;
-                let calibrate = || model.calibrate_on(&arm, self.counts.test_per_object);
+                let explorations = data
+                    .calibration_requests()?
+                    .iter()
+                    .map(|request| self.context.store.dataset(request))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let explorations: Vec<&Dataset> = explorations.iter().map(AsRef::as_ref).collect();
+                let calibrate = || model.calibrate_on_all(&explorations, self.counts.test_per_object);
                 self.context.store.clock.training(calibrate)?
             }
             PosteriorRule::Eq15 => model,

@@ -2,7 +2,7 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scales 0.2 and 1.0 (the paper's, the default: 26 minutes for all fifteen); at any other
+//! scales 0.2 and 1.0 (the paper's, the default: 27 minutes for all fifteen); at any other
 //! scale it is the power law through the 1.0 timing, `t(s) = t_1 s^p`, with the exponent the two
 //! timings give, `p = ln(t_1 / t_0.2) / ln 5`, held in [1, 3]: data collection grows linearly with
 //! the scale and codebook fitting faster, so a smaller `p` only says that the 0.2 timing was
@@ -39,7 +39,9 @@ const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
     ("real-frames", 0.2, 0.2),
     ("sim-to-real", 1.2, 7.8),
     ("training-size", 56.4, 282.1),
-    ("active", 24.3, 115.0),
+    // Scale 1.0: the run's 115 s, plus the 18 s and 62 s more of units its re-run with three
+    // calibration explorations per object took (datasets otherwise cached).
+    ("active", 24.3, 195.0),
     ("end-to-end", 1.7, 21.2),
 ];
 
@@ -174,7 +176,7 @@ mod tests {
             .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
             .sum();
         assert!(
-            (25.5 * 60.0..26.0 * 60.0).contains(&whole_run),
+            (27.0 * 60.0..27.5 * 60.0).contains(&whole_run),
             "{whole_run} s at scale 1.0"
         );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);

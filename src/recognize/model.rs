@@ -211,8 +211,17 @@ impl TrainedModel {
     /// recognise (`usize::MAX`: each object's readings as one trial), since the tempering is only
     /// fitted at the reading counts the trials reach.
     pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
-        let paths = self
-            .trials(data, trial_readings)?
+        self.calibrate_on_all(&[data], trial_readings)
+    }
+
+    /// [`calibrate_on`](Self::calibrate_on) the trials of every dataset of `data` together (several
+    /// explorations of each object: more paths to fit the tempering on).
+    pub fn calibrate_on_all(self, data: &[&Dataset], trial_readings: usize) -> Result<Self, RecognizeError> {
+        let mut trials = Vec::new();
+        for dataset in data {
+            trials.extend(self.trials(dataset, trial_readings)?);
+        }
+        let paths = trials
             .iter()
             .map(|trial| {
                 let mut posterior = self.bag.posterior();
