@@ -464,10 +464,11 @@ where
             } else {
                 strategy
             };
-            let converged = record.report.converged();
+            // Only guided iterations feed the odds; a blind run does not count its readings here.
+            let converged_before = guidance.map(|_| record.report.converged());
             self.iterate_toward(scene, &arm, object, (strategy, target), label, &mut record)?;
-            if guidance.is_some() {
-                let touched = record.report.converged() > converged;
+            if let Some(before) = converged_before {
+                let touched = record.report.converged() > before;
                 self.odds.record(strategy, target, touched);
             }
         }

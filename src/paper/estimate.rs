@@ -39,8 +39,8 @@ const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
     ("real-frames", 0.2, 0.2),
     ("sim-to-real", 1.2, 7.8),
     ("training-size", 56.4, 282.1),
-    // Scale 1.0: the run's 115 s, plus the 18 s and 62 s more of units its re-run with three
-    // calibration explorations per object took (datasets otherwise cached).
+    // Scale 1.0: the run's 115 s, plus what its re-run with three calibration explorations per
+    // object took more (18 s of data, 62 s of units; the other datasets cached).
     ("active", 24.3, 195.0),
     ("end-to-end", 1.7, 21.2),
 ];

@@ -516,15 +516,25 @@ impl<'a> SettingData<'a> {
     /// runs it judged (a stop at 0.99 never fired; docs/measurements.md, "More than one
     /// calibration exploration").
     pub(super) fn calibration_requests(&self) -> Result<Vec<DataRequest>, RangeError> {
+        self.planner_trials(
+            0.5,
+            PerturbationBounds::NONE,
+            self.counts.validation_per_object,
+            CALIBRATION_STREAM,
+        )
+    }
+
+    /// One planner dataset per trial, `readings` per object, trial `t` on stream
+    /// `first_stream + t`.
+    fn planner_trials(
+        &self,
+        local_probability: f64,
+        perturbation: PerturbationBounds,
+        readings: usize,
+        first_stream: u64,
+    ) -> Result<Vec<DataRequest>, RangeError> {
         (0..self.counts.trials)
-            .map(|t| {
-                self.planner_request(
-                    0.5,
-                    PerturbationBounds::NONE,
-                    self.counts.validation_per_object,
-                    CALIBRATION_STREAM + t as u64,
-                )
-            })
+            .map(|t| self.planner_request(local_probability, perturbation, readings, first_stream + t as u64))
             .collect()
     }
 
@@ -539,16 +549,12 @@ impl<'a> SettingData<'a> {
             TestData::Planner {
                 local_probability,
                 perturbation,
-            } => (0..self.counts.trials)
-                .map(|t| {
-                    self.planner_request(
-                        local_probability,
-                        perturbation,
-                        self.counts.test_per_object,
-                        trial_stream(t),
-                    )
-                })
-                .collect(),
+            } => self.planner_trials(
+                local_probability,
+                perturbation,
+                self.counts.test_per_object,
+                TEST_STREAM,
+            ),
             TestData::Real => Ok(Vec::new()),
         }
     }
