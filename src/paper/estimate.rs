@@ -2,7 +2,7 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scales 0.2 and 1.0 (the paper's, the default: 27 minutes for all fifteen); at any other
+//! scales 0.2 and 1.0 (the paper's, the default: 25 minutes for all fifteen); at any other
 //! scale it is the power law through the 1.0 timing, `t(s) = t_1 s^p`, with the exponent the two
 //! timings give, `p = ln(t_1 / t_0.2) / ln 5`, held in [1, 3]: data collection grows linearly with
 //! the scale and codebook fitting faster, so a smaller `p` only says that the 0.2 timing was
@@ -27,22 +27,20 @@ pub const REFERENCE_THREADS: usize = 2;
 /// needed them; the phases of both runs are in docs/benchmarks.md). Measured 2026-11-27.
 const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
     ("exploration", 0.6, 0.5),
-    ("descriptors", 14.0, 74.2),
-    ("strategy", 19.4, 65.2),
-    ("validation", 15.4, 54.0),
-    ("perturbation", 5.5, 35.2),
-    ("thickness", 33.3, 144.2),
-    ("resolution", 22.8, 104.8),
-    ("noise", 33.6, 130.7),
-    ("convergence", 0.9, 1.0),
-    ("letters", 92.3, 510.8),
-    ("real-frames", 0.2, 0.2),
-    ("sim-to-real", 1.2, 7.8),
-    ("training-size", 56.4, 282.1),
-    // Scale 1.0: the run's 115 s, plus what its re-run with three calibration explorations per
-    // object took more (18 s of data, 62 s of units; the other datasets cached).
-    ("active", 24.3, 195.0),
-    ("end-to-end", 1.7, 21.2),
+    ("descriptors", 12.4, 66.8),
+    ("strategy", 19.2, 65.0),
+    ("validation", 14.3, 51.7),
+    ("perturbation", 5.3, 35.5),
+    ("thickness", 29.7, 135.3),
+    ("resolution", 20.8, 96.7),
+    ("noise", 30.6, 120.5),
+    ("convergence", 0.9, 1.1),
+    ("letters", 74.6, 446.5),
+    ("real-frames", 0.1, 0.2),
+    ("sim-to-real", 1.0, 7.3),
+    ("training-size", 49.4, 263.0),
+    ("active", 25.2, 188.4),
+    ("end-to-end", 1.5, 20.8),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
@@ -176,7 +174,7 @@ mod tests {
             .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
             .sum();
         assert!(
-            (27.0 * 60.0..27.5 * 60.0).contains(&whole_run),
+            (24.75 * 60.0..25.25 * 60.0).contains(&whole_run),
             "{whole_run} s at scale 1.0"
         );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);

@@ -34,10 +34,12 @@
 //! 144 planner test runs at L = 1 and 0.5, fixed and perturbed: ECE 0.193, a stop at 0.95 right
 //! 78% of the time); fitted on the whole 100-touch explorations, ECE 0.074 and 98%.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
 use crate::recognize::evaluate::Trial;
+use crate::recognize::exp::exp;
 use crate::recognize::gmm::log_sum_exp;
 
 /// `w(n) = tau n^(beta - 1)`, the weight of the log-likelihood after `n` readings (module docs).
@@ -148,14 +150,31 @@ impl Tempering {
     /// `p(O_j | r_1..r_n)` for every object from the untempered log-likelihoods `ln p(r_1..r_n | O_j)`
     /// after `readings` readings: `(1 - epsilon) softmax(w(n) l) + epsilon / J`.
     pub fn probabilities(self, log_likelihood: &[f64], readings: usize) -> Vec<f64> {
+        let (weighted, lse) = self.tempered(log_likelihood, readings);
+        weighted
+            .iter()
+            .map(|&l| self.probability(l, lse, weighted.len()))
+            .collect()
+    }
+
+    /// [`probabilities`](Self::probabilities)`[object]` alone, the same bits.
+    fn probability_of(self, log_likelihood: &[f64], readings: usize, object: usize) -> f64 {
+        let (weighted, lse) = self.tempered(log_likelihood, readings);
+        self.probability(weighted[object], lse, weighted.len())
+    }
+
+    /// `w(n) l` and its log-sum-exp.
+    fn tempered(self, log_likelihood: &[f64], readings: usize) -> (Vec<f64>, f64) {
         let w = self.weight(readings);
         let weighted: Vec<f64> = log_likelihood.iter().map(|l| w * l).collect();
         let lse = log_sum_exp(&weighted);
-        let uniform = self.floor / log_likelihood.len().max(1) as f64;
-        weighted
-            .iter()
-            .map(|l| (1.0 - self.floor) * (l - lse).exp() + uniform)
-            .collect()
+        (weighted, lse)
+    }
+
+    /// One object's probability from its tempered log-likelihood `weighted`, their log-sum-exp
+    /// `lse` over `objects` objects.
+    fn probability(self, weighted: f64, lse: f64, objects: usize) -> f64 {
+        (1.0 - self.floor) * exp(weighted - lse) + self.floor / objects.max(1) as f64
     }
 
     /// `tau`: the codebook's sharpness correction.
@@ -190,18 +209,28 @@ impl Tempering {
         if trials.iter().all(|t| t.log_likelihoods.is_empty()) {
             return Self::EQ15;
         }
-        let mut best = (f64::INFINITY, Self::EQ15);
-        for floor in FLOOR_GRID {
-            for beta in BETA_GRID {
+        // Each grid point's search is independent: they run in parallel, and the best is taken
+        // in grid order, as a loop over the grid would (the same model for any thread count).
+        let grid: Vec<(f64, f64)> = FLOOR_GRID
+            .iter()
+            .flat_map(|&floor| BETA_GRID.iter().map(move |&beta| (floor, beta)))
+            .collect();
+        let searched: Vec<(f64, Self)> = grid
+            .par_iter()
+            .map(|&(floor, beta)| {
                 let at = |ln_tau: f64| Self {
                     tau: ln_tau.exp(),
                     beta,
                     floor,
                 };
                 let (ln_tau, loss) = golden_minimum(LN_TAU_RANGE, |t| mean_log_loss(trials, at(t)));
-                if loss < best.0 {
-                    best = (loss, at(ln_tau));
-                }
+                (loss, at(ln_tau))
+            })
+            .collect();
+        let mut best = (f64::INFINITY, Self::EQ15);
+        for (loss, tempering) in searched {
+            if loss < best.0 {
+                best = (loss, tempering);
             }
         }
         best.1
@@ -240,7 +269,7 @@ fn mean_log_loss(trials: &[EvidencePath], tempering: Tempering) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
     for trial in trials {
         for (i, l) in trial.log_likelihoods.iter().enumerate() {
-            sum -= tempering.probabilities(l, i + 1)[trial.object].ln();
+            sum -= tempering.probability_of(l, i + 1, trial.object).ln();
             count += 1;
         }
     }

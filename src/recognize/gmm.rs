@@ -16,8 +16,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
+use crate::recognize::exp::exp;
 use crate::recognize::features::FeatureMatrix;
-use crate::recognize::gmm_products::{weighted_scatter, whitened_distances};
+use crate::recognize::gmm_products::{weighted_column_sums, weighted_scatter, whitened_distances};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
 use crate::rng::Rng;
 
@@ -388,9 +389,9 @@ impl Component {
     /// same data row-major); `None` when its covariance is not positive definite.
     fn estimate(x: &DMatrix<f64>, x_rows: &[f64], resp: &[f64], reg_covar: f64) -> Option<Self> {
         let d = x.ncols();
-        let r = DVector::from_column_slice(resp);
-        let n = r.sum() + 10.0 * f64::EPSILON;
-        let mean = x.tr_mul(&r) / n;
+        // nalgebra's `sum`, a fold from +0 in order.
+        let n = resp.iter().fold(0.0, |sum, &r| sum + r) + 10.0 * f64::EPSILON;
+        let mean = DVector::from_vec(weighted_column_sums(x, resp)) / n;
         // The scatter's lower triangle; the general product fills the whole square.
         let scatter = match weighted_scatter(x_rows, mean.as_slice(), resp) {
             Some(lower) => DMatrix::from_row_slice(d, d, &lower),
@@ -444,17 +445,6 @@ fn precision_cholesky(sigma: DMatrix<f64>) -> Option<(DMatrix<f64>, f64)> {
     let p = l.transpose().solve_upper_triangular(&DMatrix::identity(d, d))?;
     let log_det = (0..d).map(|j| p[(j, j)].ln()).sum::<f64>();
     log_det.is_finite().then_some((p, log_det))
-}
-
-/// Below this `f64::exp` returns exactly 0: the smallest subnormal is `e^-744.4`, and anything
-/// under half of it (`e^-745.1`) rounds to zero.
-const EXP_UNDERFLOW: f64 = -746.0;
-
-/// `e^x`, the arguments far below the smallest subnormal answered 0 without calling `exp` (the
-/// same bits; its underflow path is slow, and with many components most of a feature's
-/// responsibilities underflow).
-fn exp(x: f64) -> f64 {
-    if x < EXP_UNDERFLOW { 0.0 } else { x.exp() }
 }
 
 /// `ln sum_i exp(v_i)`, stable for any magnitudes; `-inf` for an empty slice.
@@ -544,9 +534,62 @@ mod tests {
         DMatrix::from_fn(rows, cols, |_, _| rng.random_range(-3.0..3.0))
     }
 
+    /// Responsibilities as after k-means (0 and 1) and in between, or mostly exactly 0 (a whole
+    /// block of 256 and a whole pass of 64 among them) as for most components of a large mixture.
+    fn responsibilities(n: usize, sparse: bool, rng: &mut crate::rng::Rng) -> Vec<f64> {
+        use rand::RngExt;
+        (0..n)
+            .map(|r| match (sparse, r % 7) {
+                (true, _) if (256..512).contains(&r) || r % 11 != 3 => 0.0,
+                (true, _) => rng.random_range(1e-300..1.0),
+                (false, 0) => 0.0,
+                (false, 1) => 1.0,
+                (false, _) => rng.random_range(0.0..1.0),
+            })
+            .collect()
+    }
+
+    /// [`whitened_distances`] against the general product on `n` random features of `d` values,
+    /// bit for bit.
+    fn assert_distances_are_the_general_products(n: usize, d: usize, rng: &mut crate::rng::Rng) {
+        use rand::RngExt;
+        let x = random_matrix(rng, n, d);
+        let a = random_matrix(rng, d, d);
+        let sigma = &a * a.transpose() + DMatrix::identity(d, d) * 0.1;
+        let (p, _) = precision_cholesky(sigma).expect("a random SPD matrix has a Cholesky factor");
+        let mu = DVector::from_fn(d, |_, _| rng.random_range(-1.0..1.0));
+        let shift = p.tr_mul(&mu);
+        let fast = whitened_distances(&x, &p, shift.as_slice()).expect("a repeated product applies");
+        let general = whitened_distances_general(&x, &p, shift.as_slice());
+        for (r, (a, b)) in fast.iter().zip(&general).enumerate() {
+            assert_eq!(a.to_bits(), b.to_bits(), "n {n}, d {d}, row {r}: {a} vs {b}");
+        }
+    }
+
+    /// [`weighted_scatter`] against the general product on `n` random features of `d` values,
+    /// bit for bit.
+    fn assert_scatter_is_the_general_products(n: usize, d: usize, sparse: bool, rng: &mut crate::rng::Rng) {
+        use rand::RngExt;
+        let x = random_matrix(rng, n, d);
+        let x_rows: Vec<f64> = x.transpose().as_slice().to_vec();
+        let resp = responsibilities(n, sparse, rng);
+        let mean: Vec<f64> = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let lower = weighted_scatter(&x_rows, &mean, &resp).expect("a repeated product applies");
+        let general = weighted_scatter_general(&x, &x_rows, &mean, &resp);
+        for a in 0..d {
+            for b in 0..=a {
+                let (got, want) = (lower[a * d + b], general[(a, b)]);
+                assert_eq!(
+                    got.to_bits(),
+                    want.to_bits(),
+                    "n {n}, d {d}, sparse {sparse}, ({a}, {b}): {got} vs {want}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn the_triangular_distances_give_the_general_products_bits() {
-        use rand::RngExt;
         if !has_avx2_fma() {
             return;
         }
@@ -554,95 +597,98 @@ mod tests {
         // Row counts with and without a partial group of eight; d from nalgebra's smallest
         // product size to beyond one group, with and without a partial group of four.
         for (n, d) in [(1003, 6), (517, 7), (2000, 20), (64, 23), (300, 33)] {
-            let x = random_matrix(&mut rng, n, d);
-            let a = random_matrix(&mut rng, d, d);
-            let sigma = &a * a.transpose() + DMatrix::identity(d, d) * 0.1;
-            let (p, _) = precision_cholesky(sigma).expect("a random SPD matrix has a Cholesky factor");
-            let mu = DVector::from_fn(d, |_, _| rng.random_range(-1.0..1.0));
-            let shift = p.tr_mul(&mu);
-            let fast = whitened_distances(&x, &p, shift.as_slice()).expect("the fast path applies");
-            let general = whitened_distances_general(&x, &p, shift.as_slice());
-            for (r, (a, b)) in fast.iter().zip(&general).enumerate() {
-                assert_eq!(a.to_bits(), b.to_bits(), "n {n}, d {d}, row {r}: {a} vs {b}");
-            }
+            assert_distances_are_the_general_products(n, d, &mut rng);
         }
     }
 
     #[test]
     fn the_triangular_scatter_gives_the_general_products_bits() {
-        use rand::RngExt;
         if !has_avx2_fma() {
             return;
         }
         let mut rng = crate::rng::rng(43);
         // Feature counts within one block of the product's KC and across several (with a partial
-        // pass); d with partial tiles in both directions. Responsibilities in [0, 1], some exactly
-        // 0 and some exactly 1 as after k-means; or mostly 0 as for most components of a large
-        // mixture (the skipped features), a whole block of the KC and a whole pass among them.
-        let dense = |r: usize, rng: &mut crate::rng::Rng| match r % 7 {
-            0 => 0.0,
-            1 => 1.0,
-            _ => rng.random_range(0.0..1.0),
-        };
-        let sparse = |r: usize, rng: &mut crate::rng::Rng| {
-            if (256..512).contains(&r) || r % 11 != 3 {
-                0.0
-            } else {
-                rng.random_range(1e-300..1.0)
-            }
-        };
+        // pass); d with partial tiles in both directions; dense and sparse responsibilities.
         let cases = [
-            (200, 6, dense as fn(usize, &mut crate::rng::Rng) -> f64),
-            (600, 20, dense),
-            (1000, 13, dense),
-            (257, 23, dense),
-            (1000, 20, sparse),
-            (3000, 7, sparse),
+            (200, 6, false),
+            (600, 20, false),
+            (1000, 13, false),
+            (257, 23, false),
+            (1000, 20, true),
+            (3000, 7, true),
         ];
-        for (n, d, weight) in cases {
-            let x = random_matrix(&mut rng, n, d);
-            let x_rows: Vec<f64> = x.transpose().as_slice().to_vec();
-            let resp: Vec<f64> = (0..n).map(|r| weight(r, &mut rng)).collect();
-            let mean: Vec<f64> = (0..d).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let lower = weighted_scatter(&x_rows, &mean, &resp).expect("the fast path applies");
-            let general = weighted_scatter_general(&x, &x_rows, &mean, &resp);
-            for a in 0..d {
-                for b in 0..=a {
-                    let (got, want) = (lower[a * d + b], general[(a, b)]);
-                    assert_eq!(
-                        got.to_bits(),
-                        want.to_bits(),
-                        "n {n}, d {d}, ({a}, {b}): {got} vs {want}"
-                    );
-                }
+        for (n, d, sparse) in cases {
+            assert_scatter_is_the_general_products(n, d, sparse, &mut rng);
+        }
+    }
+
+    #[test]
+    fn the_small_products_give_nalgebras_bits() {
+        let mut rng = crate::rng::rng(47);
+        // A dimension of at most 5 on either side: nalgebra's own chains, on every machine.
+        for (n, d) in [(1003, 4), (517, 1), (2000, 5), (4, 20), (5, 6), (1, 3)] {
+            assert_distances_are_the_general_products(n, d, &mut rng);
+            for sparse in [false, true] {
+                assert_scatter_is_the_general_products(n, d, sparse, &mut rng);
             }
         }
     }
 
     #[test]
-    fn the_underflow_shortcut_gives_the_bits_of_exp() {
-        // Across the threshold (every representable step near it), through the subnormal range
-        // and far below, and on the special values.
-        let near = (-4000..4000).map(|i| EXP_UNDERFLOW + f64::from(i) * 1e-3);
-        let wide = (0..2000).map(|i| -f64::from(i) * 0.75);
-        let special = [
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NAN,
-            -1e300,
-            0.0,
-            -0.0,
-            709.0,
+    fn a_small_scatter_that_sums_to_zero_keeps_the_sign_of_nalgebras_zero() {
+        let mean = [0.5, 0.5];
+        // The first coordinate above the mean, the second below: with every responsibility 0
+        // nalgebra chains -0 terms ((x_1 - m_1) 0 = -0, times a positive residual) into -0 at
+        // (1, 0), where the skipping sum has nothing. Then residuals of exactly 0 (the second
+        // coordinate at its mean) under non-zero responsibilities.
+        let below = [1.0, -2.0, 3.0, -0.25, 2.0, -1.0, 1.5, -3.0, 4.0, -0.5, 0.75, -1.5];
+        let at_mean = [1.0, 0.5, 3.0, -0.25, 2.0, 0.5, 1.5, -3.0, 4.0, 0.5, 0.75, -1.5];
+        let cases = [
+            (below, [0.0; 6]),
+            (at_mean, [0.0, 0.0, 0.7, 0.0, 0.2, 0.0]),
+            (at_mean, [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
         ];
-        let mut zeros = 0;
-        for x in near.chain(wide).chain(special) {
-            assert_eq!(exp(x).to_bits(), x.exp().to_bits(), "exp({x})");
-            zeros += usize::from(x < EXP_UNDERFLOW);
+        let mut negative_zeros = 0;
+        for (rows, resp) in cases {
+            let x = DMatrix::from_row_slice(6, 2, &rows);
+            let lower = weighted_scatter(&rows, &mean, &resp).expect("the small path applies");
+            let general = weighted_scatter_general(&x, &rows, &mean, &resp);
+            for a in 0..2 {
+                for b in 0..=a {
+                    let (got, want) = (lower[a * 2 + b], general[(a, b)]);
+                    assert_eq!(
+                        got.to_bits(),
+                        want.to_bits(),
+                        "{resp:?} ({a}, {b}): {got} vs {want}"
+                    );
+                    negative_zeros += usize::from(want.to_bits() == (-0.0f64).to_bits());
+                }
+            }
         }
-        // Not vacuous: the shortcut answered many of them.
-        assert!(zeros > 3000, "{zeros}");
-        // The threshold is not too low to matter: the last subnormals are just above it.
-        assert!((EXP_UNDERFLOW + 2.0).exp() > 0.0);
+        // Not vacuous: some of nalgebra's sums are -0.
+        assert!(negative_zeros > 0);
+    }
+
+    #[test]
+    fn the_weighted_column_sums_give_nalgebras_bits() {
+        let mut rng = crate::rng::rng(53);
+        // Row counts with every remainder modulo the dot product's eight chains, and fewer rows
+        // than chains.
+        for (n, d) in [(1000, 3), (1001, 4), (1007, 2), (7, 5), (3000, 10), (1, 1)] {
+            let x = random_matrix(&mut rng, n, d);
+            for sparse in [false, true] {
+                let resp = responsibilities(n, sparse, &mut rng);
+                let got = weighted_column_sums(&x, &resp);
+                let want = x.tr_mul(&DVector::from_column_slice(&resp));
+                for (j, (a, b)) in got.iter().zip(want.iter()).enumerate() {
+                    assert_eq!(
+                        a.to_bits(),
+                        b.to_bits(),
+                        "n {n}, d {d}, sparse {sparse}, column {j}: {a} vs {b}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -16,9 +16,22 @@
 //! +0), so a fused multiply-add by a structural zero leaves it unchanged and skipping those terms
 //! changes no bit; the tests in `gmm` compare with nalgebra's product bit for bit. Where
 //! `matrixmultiply` would sum another way (a processor without FMA runs its plain AVX kernel;
-//! nalgebra multiplies dimensions of at most [`NALGEBRA_SMALL_DIM`] without it; `d` beyond one
-//! block) the functions return `None` and the mixture keeps the general product, so a fit gives
-//! the same bits as before on every machine.
+//! `d` beyond one block) the functions return `None` and the mixture keeps the general product, so
+//! a fit gives the same bits as before on every machine.
+//!
+//! A product with a dimension of at most [`NALGEBRA_SMALL_DIM`] (the Polar-Fourier features of the
+//! letters keep 4 components) nalgebra forms without `matrixmultiply`: column by column, each
+//! value a chain of separately rounded products and sums in the order of the summed index,
+//! starting from its first term. Those chains are repeated here on every machine, without the
+//! `n x d` intermediates, and the scatter again skips the features of zero responsibility: each
+//! adds a signed zero, which changes a chain only while it is zero and only in the sign of that
+//! zero, so an entry that ends at zero is summed again over every feature.
+//!
+//! The mean `sum_r p_r x_r` is nalgebra's dot product of each column with the responsibilities:
+//! eight chains over the rows by their index modulo eight, while eight remain, added pairwise in a
+//! fixed order, then the rest in order. [`weighted_column_sums`] forms the same chains, skipping
+//! the groups of eight features whose responsibilities are all zero (a chain starts at +0 and so
+//! never holds -0: a zero term leaves it unchanged).
 
 use nalgebra::DMatrix;
 
@@ -46,7 +59,13 @@ const PASS: usize = 64;
 /// Whether the triangular sums repeat nalgebra's products for `n` features of `d` values on this
 /// processor.
 fn repeats_the_general_product(n: usize, d: usize) -> bool {
-    has_avx2_fma() && n > NALGEBRA_SMALL_DIM && d > NALGEBRA_SMALL_DIM && d <= KC
+    has_avx2_fma() && !is_small_product(n, d) && d <= KC
+}
+
+/// Whether nalgebra forms the products of `n` features of `d` values by its own chains (a
+/// dimension of at most [`NALGEBRA_SMALL_DIM`]) rather than with `matrixmultiply`.
+fn is_small_product(n: usize, d: usize) -> bool {
+    n <= NALGEBRA_SMALL_DIM || d <= NALGEBRA_SMALL_DIM
 }
 
 /// `q_r = sum_j ((X P)_rj - shift_j)^2` for every row `r` of `x` (`n x d`, column-major), the
@@ -55,7 +74,13 @@ fn repeats_the_general_product(n: usize, d: usize) -> bool {
 /// triangular precision factor. `None` where the general product would sum another way.
 pub(super) fn whitened_distances(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Option<Vec<f64>> {
     let (n, d) = x.shape();
-    if !repeats_the_general_product(n, d) || p.shape() != (d, d) || shift.len() != d {
+    if d == 0 || p.shape() != (d, d) || shift.len() != d {
+        return None;
+    }
+    if is_small_product(n, d) {
+        return Some(small_distances(x, p, shift));
+    }
+    if !repeats_the_general_product(n, d) {
         return None;
     }
     let rows = PaddedRows::upper(p);
@@ -141,13 +166,121 @@ fn distances_of_rows<const R: usize>(
 /// `None` where the general product would sum another way.
 pub(super) fn weighted_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Option<Vec<f64>> {
     let (n, d) = (resp.len(), mean.len());
-    if !repeats_the_general_product(n, d) || x_rows.len() != n * d {
+    if n == 0 || d == 0 || x_rows.len() != n * d {
+        return None;
+    }
+    if is_small_product(n, d) {
+        return Some(small_scatter(x_rows, mean, resp));
+    }
+    if !repeats_the_general_product(n, d) {
         return None;
     }
     let mut lower = vec![0.0; d * d];
     // SAFETY: `repeats_the_general_product` checked that the processor has AVX2 and FMA.
     unsafe { scatter_fma(x_rows, mean, resp, &mut lower) };
     Some(lower)
+}
+
+/// [`whitened_distances`] for a small product: `(X P)_rj` as nalgebra's chain over `i` (every
+/// term, the structural zeros too), then the squares added in column order.
+fn small_distances(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Vec<f64> {
+    let (n, d) = x.shape();
+    let x = x.as_slice();
+    (0..n)
+        .map(|r| {
+            let mut q = 0.0;
+            for (column, &s) in p.as_slice().chunks_exact(d).zip(shift) {
+                let mut y = x[r] * column[0];
+                for (i, &pij) in column.iter().enumerate().skip(1) {
+                    y += x[i * n + r] * pij;
+                }
+                let t = y - s;
+                q += t * t;
+            }
+            q
+        })
+        .collect()
+}
+
+/// [`weighted_scatter`] for a small product: `S_ab` as nalgebra's chain over the features of
+/// `((x_ra - mean_a) resp_r) (x_rb - mean_b)`, from the features of non-zero responsibility; an
+/// entry that ends at zero is chained again over every feature, for the sign of its zero.
+fn small_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Vec<f64> {
+    let d = mean.len();
+    let mut lower = vec![0.0; d * d];
+    let mut residual = vec![0.0; d];
+    let mut weighted = vec![0.0; d];
+    let mut started = false;
+    for (x, &weight) in x_rows.chunks_exact(d).zip(resp) {
+        if weight == 0.0 {
+            continue;
+        }
+        for (((res, w), &v), &m) in residual.iter_mut().zip(&mut weighted).zip(x).zip(mean) {
+            *res = v - m;
+            *w = *res * weight;
+        }
+        for (a, row) in lower.chunks_exact_mut(d).enumerate() {
+            for (s, &rb) in row[..=a].iter_mut().zip(&residual) {
+                let term = weighted[a] * rb;
+                *s = if started { term + *s } else { term };
+            }
+        }
+        started = true;
+    }
+    for a in 0..d {
+        for b in 0..=a {
+            if lower[a * d + b] == 0.0 {
+                lower[a * d + b] = small_scatter_entry(x_rows, mean, resp, a, b);
+            }
+        }
+    }
+    lower
+}
+
+/// One entry of [`small_scatter`] chained over every feature, as nalgebra chains it.
+fn small_scatter_entry(x_rows: &[f64], mean: &[f64], resp: &[f64], a: usize, b: usize) -> f64 {
+    let d = mean.len();
+    let term = |(x, &weight): (&[f64], &f64)| ((x[a] - mean[a]) * weight) * (x[b] - mean[b]);
+    let mut features = x_rows.chunks_exact(d).zip(resp);
+    let first = features.next().map_or(0.0, term);
+    features.fold(first, |s, feature| term(feature) + s)
+}
+
+/// `sum_r resp_r x_r` for every column of `x` (`n x d`, column-major): nalgebra's `x^T resp`
+/// ([`Matrix::tr_mul`](nalgebra::Matrix::tr_mul)) to the bit, skipping the groups of eight
+/// features (one term of each chain) whose responsibilities are all zero.
+pub(super) fn weighted_column_sums(x: &DMatrix<f64>, resp: &[f64]) -> Vec<f64> {
+    /// nalgebra's dot product keeps this many chains.
+    const CHAINS: usize = 8;
+    let (n, d) = x.shape();
+    if n == 0 {
+        return vec![0.0; d];
+    }
+    let chained = n - n % CHAINS;
+    let groups: Vec<usize> = (0..chained)
+        .step_by(CHAINS)
+        .filter(|&g| resp[g..g + CHAINS].iter().any(|&r| r != 0.0))
+        .collect();
+    x.as_slice()
+        .chunks_exact(n)
+        .map(|column| {
+            let mut chain = [0.0; CHAINS];
+            for &g in &groups {
+                let terms = column[g..g + CHAINS].iter().zip(&resp[g..g + CHAINS]);
+                for (c, (v, r)) in chain.iter_mut().zip(terms) {
+                    *c += v * r;
+                }
+            }
+            let mut sum = 0.0;
+            for (low, high) in chain[..CHAINS / 2].iter().zip(&chain[CHAINS / 2..]) {
+                sum += low + high;
+            }
+            for (v, r) in column[chained..].iter().zip(&resp[chained..]) {
+                sum += v * r;
+            }
+            sum
+        })
+        .collect()
 }
 
 /// The M-step's scatter, compiled with AVX2 and FMA where they exist (callers check the
@@ -269,11 +402,14 @@ mod tests {
 
     #[test]
     fn sizes_the_general_product_sums_another_way_are_left_to_it() {
+        // Beyond one block of the summed index `matrixmultiply` adds its chains another way.
+        let d = KC + 1;
+        let x = DMatrix::from_element(6, d, 1.0);
+        assert!(whitened_distances(&x, &DMatrix::identity(d, d), &vec![0.0; d]).is_none());
+        assert!(weighted_scatter(&vec![1.0; 6 * d], &vec![0.0; d], &[1.0; 6]).is_none());
+        // nalgebra's own chains (a dimension of at most 5) are repeated on every machine.
         let x = DMatrix::from_element(100, 5, 1.0);
-        let p = DMatrix::identity(5, 5);
-        assert!(whitened_distances(&x, &p, &[0.0; 5]).is_none());
-        assert!(weighted_scatter(&[1.0; 500], &[0.0; 5], &[1.0; 100]).is_none());
-        let x = DMatrix::from_element(5, 8, 1.0);
-        assert!(whitened_distances(&x, &DMatrix::identity(8, 8), &[0.0; 8]).is_none());
+        assert!(whitened_distances(&x, &DMatrix::identity(5, 5), &[0.0; 5]).is_some());
+        assert!(weighted_scatter(&[1.0; 500], &[0.0; 5], &[1.0; 100]).is_some());
     }
 }

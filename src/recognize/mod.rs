@@ -24,6 +24,7 @@ pub(crate) mod confusion;
 pub(crate) mod decision;
 pub(crate) mod error;
 pub(crate) mod evaluate;
+pub(crate) mod exp;
 pub(crate) mod features;
 pub(crate) mod fusion;
 pub(crate) mod gmm;
