@@ -27,6 +27,7 @@
 use glam::DVec3;
 
 use crate::dataset::Strategy;
+use crate::explore::cells::PointCells;
 
 /// Scores candidate touch targets by what a touch there is expected to tell about the object's
 /// identity, given the readings it has been shown so far.
@@ -130,17 +131,64 @@ pub const ODDS_PRIOR_ITERATIONS: f64 = 2.0;
 /// Where the planner's iterations have found the object: every guided iteration's target, the kind
 /// of move that carried the pad there and whether it ended in a converged reading. Only the
 /// planner's own outcomes, never the object's pose or shape.
-#[derive(Debug, Clone, Default)]
+///
+/// The targets are binned into cubes per kind, so that [`chance`](Self::chance), asked for every
+/// candidate of every iteration, looks at the targets near the candidate rather than at all of
+/// them (a scan of every target was half of an `active` experiment's time on the perturbed
+/// object, whose explorations run to thousands of iterations).
+#[derive(Debug, Clone)]
 pub struct TouchOdds {
-    /// Target, kind and outcome of each recorded iteration, in order.
-    attempts: Vec<(DVec3, Strategy, bool)>,
+    cell_m: f64,
+    kinds: Vec<KindOdds>,
+}
+
+/// The recorded iterations of one kind of move.
+#[derive(Debug, Clone)]
+struct KindOdds {
+    strategy: Strategy,
+    tried: usize,
+    touched: usize,
+    /// Each iteration's target and whether it touched.
+    targets: PointCells<(DVec3, bool)>,
+}
+
+impl Default for TouchOdds {
+    /// For chances asked within the planner's default local radius.
+    fn default() -> Self {
+        Self::new(crate::explore::PlannerConfig::default().local_radius_m)
+    }
 }
 
 impl TouchOdds {
+    /// No iteration yet, for chances asked within `radius_m` (any radius is answered exactly;
+    /// this one fastest): the targets are binned in cubes a little wider than it, so that a query
+    /// looks at the 27 cells around the candidate's.
+    pub fn new(radius_m: f64) -> Self {
+        Self {
+            cell_m: radius_m * 1.001,
+            kinds: Vec::new(),
+        }
+    }
+
     /// Records one iteration toward `target_m` of kind `strategy`; `touched` when it ended in a
     /// converged reading.
     pub fn record(&mut self, strategy: Strategy, target_m: DVec3, touched: bool) {
-        self.attempts.push((target_m, strategy, touched));
+        let kind = match self.kinds.iter().position(|k| k.strategy == strategy) {
+            Some(i) => &mut self.kinds[i],
+            None => {
+                self.kinds.push(KindOdds {
+                    strategy,
+                    tried: 0,
+                    touched: 0,
+                    targets: PointCells::new(self.cell_m),
+                });
+                let last = self.kinds.len() - 1;
+                &mut self.kinds[last]
+            }
+        };
+        kind.tried += 1;
+        kind.touched += usize::from(touched);
+        kind.targets.insert(target_m, (target_m, touched));
     }
 
     /// The chance that an iteration of kind `strategy` toward `target_m` ends in a converged
@@ -148,22 +196,19 @@ impl TouchOdds {
     /// 1/2 before any), refined by the iterations of that kind whose targets lay within
     /// `radius_m`: `(touched_near + a p0) / (near + a)`, `a` = [`ODDS_PRIOR_ITERATIONS`].
     pub fn chance(&self, strategy: Strategy, target_m: DVec3, radius_m: f64) -> f64 {
-        let (mut tried, mut touched, mut near, mut touched_near) = (0.0, 0.0, 0.0, 0.0);
-        let radius_sq = radius_m * radius_m;
-        for (target, kind, hit) in &self.attempts {
-            if *kind != strategy {
-                continue;
-            }
-            let hit = f64::from(u8::from(*hit));
-            tried += 1.0;
-            touched += hit;
-            if target.distance_squared(target_m) <= radius_sq {
-                near += 1.0;
-                touched_near += hit;
+        let (mut tried, mut touched, mut near, mut touched_near) = (0, 0, 0usize, 0usize);
+        if let Some(kind) = self.kinds.iter().find(|k| k.strategy == strategy) {
+            (tried, touched) = (kind.tried, kind.touched);
+            let radius_sq = radius_m * radius_m;
+            for (target, hit) in kind.targets.near(target_m, radius_m) {
+                if target.distance_squared(target_m) <= radius_sq {
+                    near += 1;
+                    touched_near += usize::from(*hit);
+                }
             }
         }
-        let overall = (touched + 1.0) / (tried + 2.0);
-        (touched_near + ODDS_PRIOR_ITERATIONS * overall) / (near + ODDS_PRIOR_ITERATIONS)
+        let overall = (touched as f64 + 1.0) / (tried as f64 + 2.0);
+        (touched_near as f64 + ODDS_PRIOR_ITERATIONS * overall) / (near as f64 + ODDS_PRIOR_ITERATIONS)
     }
 }
 
@@ -239,6 +284,63 @@ mod tests {
         // Global: 0 of 4, p0 = 1/6; near `far` 2 p0 / 6, at `here` p0.
         assert!((odds.chance(Strategy::Global, far, 0.02) - 2.0 / 36.0).abs() < 1e-12);
         assert!((odds.chance(Strategy::Global, here, 0.02) - 1.0 / 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn touch_odds_are_the_scan_of_every_recorded_iteration() {
+        use rand::RngExt;
+        let mut rng = crate::rng::rng(17);
+        let mut odds = TouchOdds::new(0.025);
+        let mut recorded = Vec::new();
+        // What `chance` computed by scanning every iteration before the targets were binned.
+        let scan = |recorded: &[(Strategy, DVec3, bool)], strategy: Strategy, at: DVec3, radius_m: f64| {
+            let (mut tried, mut touched, mut near, mut touched_near) = (0.0, 0.0, 0.0, 0.0);
+            for (kind, target, hit) in recorded {
+                if *kind != strategy {
+                    continue;
+                }
+                let hit = f64::from(u8::from(*hit));
+                tried += 1.0;
+                touched += hit;
+                if target.distance_squared(at) <= radius_m * radius_m {
+                    near += 1.0;
+                    touched_near += hit;
+                }
+            }
+            let overall = (touched + 1.0) / (tried + 2.0);
+            (touched_near + ODDS_PRIOR_ITERATIONS * overall) / (near + ODDS_PRIOR_ITERATIONS)
+        };
+        let point = |rng: &mut crate::rng::Rng| {
+            DVec3::new(
+                rng.random_range(-0.1..0.1),
+                rng.random_range(-0.1..0.1),
+                rng.random_range(0.0..0.1),
+            )
+        };
+        for i in 0..3000 {
+            let strategy = if i % 3 == 0 {
+                Strategy::Global
+            } else {
+                Strategy::Local
+            };
+            let target = point(&mut rng);
+            let touched = rng.random_range(0.0..1.0) < 0.3;
+            odds.record(strategy, target, touched);
+            recorded.push((strategy, target, touched));
+            if i % 97 == 0 {
+                for radius_m in [0.01, 0.025, 0.06] {
+                    for strategy in [Strategy::Local, Strategy::Global, Strategy::Active] {
+                        let at = point(&mut rng);
+                        let want = scan(&recorded, strategy, at, radius_m);
+                        assert_eq!(
+                            odds.chance(strategy, at, radius_m).to_bits(),
+                            want.to_bits(),
+                            "{i}, {radius_m}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Exploration (Sec. III-A) and training-data collection (Sec. V-A3).
 
 pub(crate) mod active;
+pub(crate) mod cells;
 pub(crate) mod collect;
 pub(crate) mod grid;
 pub(crate) mod planner;

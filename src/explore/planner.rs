@@ -395,7 +395,7 @@ where
             covering_reach_m,
             tree: ExplorationTree::new(q, pad.center_m, pad.normal),
             grid: ReadingGrid::new(config.workspace_min_m, config.grid_cell_m),
-            odds: TouchOdds::default(),
+            odds: TouchOdds::new(config.local_radius_m),
             rng,
             reader,
             covering: CoveringSensor::on_site(scene.model(), PAD_SITE).ok(),

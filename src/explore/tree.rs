@@ -2,9 +2,13 @@
 //! vertices consist of collision-free configurations, while edges indicate collision-free motions
 //! between the configurations that they connect."
 
-use std::collections::HashMap;
+use glam::DVec3;
 
-use glam::{DVec3, IVec3};
+use crate::explore::cells::PointCells;
+
+/// The side of the cells the vertices are binned in, about the pad's own size: a tree near the
+/// object holds a few vertices a cell.
+const VERTEX_CELL_M: f64 = 0.01;
 
 /// One vertex: a configuration and where it puts the pad.
 #[derive(Debug, Clone, PartialEq)]
@@ -26,13 +30,13 @@ pub struct Vertex {
 pub struct ExplorationTree {
     vertices: Vec<Vertex>,
     /// The vertices' pad positions binned into cubes, for [`nearest`](Self::nearest).
-    cells: PadCells,
+    cells: PointCells<usize>,
 }
 
 impl ExplorationTree {
     pub fn new(root_q: Vec<f64>, pad_m: DVec3, pad_normal: DVec3) -> Self {
-        let mut cells = PadCells::default();
-        cells.insert(0, pad_m);
+        let mut cells = PointCells::new(VERTEX_CELL_M);
+        cells.insert(pad_m, 0);
         Self {
             vertices: vec![Vertex {
                 q: root_q,
@@ -67,7 +71,7 @@ impl ExplorationTree {
             blocked: false,
         });
         let i = self.vertices.len() - 1;
-        self.cells.insert(i, pad_m);
+        self.cells.insert(pad_m, i);
         i
     }
 
@@ -83,7 +87,7 @@ impl ExplorationTree {
     /// it searches the cells around `p` ring by ring instead of every vertex (a linear scan was 62%
     /// of an active-touch run's time); the answer is the scan's, ties included.
     pub fn nearest(&self, p: DVec3) -> usize {
-        let Some(centre) = PadCells::cell(p) else {
+        let Some(centre) = self.cells.cell(p) else {
             return self.nearest_by_scan(p);
         };
         let mut best = Nearest::default();
@@ -93,14 +97,14 @@ impl ExplorationTree {
                 best.offer(i, v.pad_m.distance_squared(p));
             }
         };
-        self.cells.strays.iter().for_each(|&i| offer(&mut best, i));
+        self.cells.strays().iter().for_each(|&i| offer(&mut best, i));
         for ring in 0..=self.cells.rings_to_cover(centre) {
             for cell in self.cells.ring(centre, ring) {
                 self.cells.members(cell).iter().for_each(|&i| offer(&mut best, i));
             }
             // Vertices outside rings 0..=ring are at least `ring` cells from `p` (less a margin
-            // far above the rounding of `p / CELL_M`).
-            let reach_m = (ring as f64 * PadCells::CELL_M - 1e-9).max(0.0);
+            // far above the rounding of `p / cell_m`).
+            let reach_m = (ring as f64 * self.cells.cell_m() - 1e-9).max(0.0);
             if best.distance_sq < reach_m * reach_m {
                 break;
             }
@@ -138,78 +142,6 @@ impl Nearest {
             self.index = index;
             self.distance_sq = distance_sq;
         }
-    }
-}
-
-/// Vertex indices binned by pad position into cubes of [`CELL_M`](Self::CELL_M), with the bounds
-/// of the occupied cells (a ring beyond them holds nothing).
-#[derive(Debug, Clone)]
-struct PadCells {
-    members: HashMap<IVec3, Vec<usize>>,
-    /// Vertices with no cell (a non-finite pad position): offered to every search.
-    strays: Vec<usize>,
-    low: IVec3,
-    high: IVec3,
-}
-
-impl Default for PadCells {
-    fn default() -> Self {
-        Self {
-            members: HashMap::new(),
-            strays: Vec::new(),
-            low: IVec3::MAX,
-            high: IVec3::MIN,
-        }
-    }
-}
-
-impl PadCells {
-    /// About the pad's own size: a tree near the object holds a few vertices a cell.
-    const CELL_M: f64 = 0.01;
-
-    /// `p`'s cell; `None` beyond 10 km (or NaN), where the search scans every cell.
-    fn cell(p: DVec3) -> Option<IVec3> {
-        let c = (p / Self::CELL_M).floor();
-        (c.abs().max_element() <= 1e6).then(|| c.as_ivec3())
-    }
-
-    fn insert(&mut self, i: usize, p: DVec3) {
-        let Some(c) = Self::cell(p) else {
-            self.strays.push(i);
-            return;
-        };
-        self.members.entry(c).or_default().push(i);
-        self.low = self.low.min(c);
-        self.high = self.high.max(c);
-    }
-
-    fn members(&self, c: IVec3) -> &[usize] {
-        self.members.get(&c).map_or(&[], Vec::as_slice)
-    }
-
-    /// The ring whose cube around `centre` contains every occupied cell.
-    fn rings_to_cover(&self, centre: IVec3) -> i32 {
-        let far = (centre - self.low).abs().max((self.high - centre).abs());
-        far.max_element().max(0)
-    }
-
-    /// The occupied-bounds cells at Chebyshev distance exactly `ring` from `centre`.
-    fn ring(&self, centre: IVec3, ring: i32) -> impl Iterator<Item = IVec3> + '_ {
-        let lo = (centre - IVec3::splat(ring)).max(self.low);
-        let hi = (centre + IVec3::splat(ring)).min(self.high);
-        (lo.x..=hi.x).flat_map(move |x| {
-            (lo.y..=hi.y).flat_map(move |y| {
-                let on_side = (x - centre.x).abs() == ring || (y - centre.y).abs() == ring;
-                let clip = |z: i32| z.max(lo.z)..=z.min(hi.z);
-                // On the ring's sides every z; inside them only its top and bottom faces.
-                let (first, second) = if on_side {
-                    (lo.z..=hi.z, hi.z + 1..=hi.z)
-                } else {
-                    (clip(centre.z - ring), clip(centre.z + ring))
-                };
-                first.chain(second).map(move |z| IVec3::new(x, y, z))
-            })
-        })
     }
 }
 

@@ -608,7 +608,8 @@ mod tests {
         }
         let mut rng = crate::rng::rng(43);
         // Feature counts within one block of the product's KC and across several (with a partial
-        // pass); d with partial tiles in both directions; dense and sparse responsibilities.
+        // pass); d with every remainder modulo eight, so every tile shape; dense and sparse
+        // responsibilities.
         let cases = [
             (200, 6, false),
             (600, 20, false),
@@ -616,6 +617,13 @@ mod tests {
             (257, 23, false),
             (1000, 20, true),
             (3000, 7, true),
+            (800, 10, true),
+            (400, 9, false),
+            (400, 12, false),
+            (400, 16, true),
+            (400, 17, false),
+            (400, 14, false),
+            (300, 8, false),
         ];
         for (n, d, sparse) in cases {
             assert_scatter_is_the_general_products(n, d, sparse, &mut rng);
