@@ -93,23 +93,23 @@ impl<T> PointCells<T> {
     /// items of every cell within `radius_m` (plus a margin far above the rounding of `p /
     /// cell_m`) of `p`'s cell; every item when `p` has no cell. The caller tests the distance.
     pub(crate) fn near(&self, p: DVec3, radius_m: f64) -> impl Iterator<Item = &T> + '_ {
-        let cells: Vec<IVec3> = match self.cell(p) {
-            Some(centre) => {
-                let reach = radius_m / self.cell_m + 1e-6;
-                let rings = if reach.is_finite() {
-                    (reach.floor() as i32)
-                        .saturating_add(1)
-                        .min(self.rings_to_cover(centre))
-                } else {
-                    self.rings_to_cover(centre)
-                };
-                (0..=rings).flat_map(|ring| self.ring(centre, ring)).collect()
-            }
-            None => self.members.keys().copied().collect(),
-        };
+        let centre = self.cell(p);
+        let around = centre.into_iter().flat_map(move |centre| {
+            let reach = radius_m / self.cell_m + 1e-6;
+            let rings = if reach.is_finite() {
+                (reach.floor() as i32)
+                    .saturating_add(1)
+                    .min(self.rings_to_cover(centre))
+            } else {
+                self.rings_to_cover(centre)
+            };
+            (0..=rings).flat_map(move |ring| self.ring(centre, ring))
+        });
+        let everywhere = centre.is_none().then(|| self.members.values().flatten());
         self.strays
             .iter()
-            .chain(cells.into_iter().flat_map(|c| self.members(c).iter()))
+            .chain(around.flat_map(|c| self.members(c).iter()))
+            .chain(everywhere.into_iter().flatten())
     }
 }
 

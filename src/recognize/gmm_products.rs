@@ -49,11 +49,14 @@ const NALGEBRA_SMALL_DIM: usize = 5;
 const COLS: usize = 4;
 /// Feature rows per pass of the E-step: two lanes of four.
 const ROWS: usize = 8;
-/// Rows `a` of the scatter per tile (broadcast); the last rows of an odd `d` go in tiles of two.
+/// Rows `a` of the scatter per tile (broadcast).
 const TILE_A: usize = 4;
-/// Columns `b` of the scatter per tile: two lanes of four, or one where the triangle ends within
-/// four columns.
+/// Rows of the last tiles where at most two rows remain after the groups of [`TILE_A`].
+const SHORT_TILE_A: usize = 2;
+/// Columns `b` of the scatter per tile: two lanes of four.
 const TILE_B: usize = 8;
+/// Columns of the last tile of a row group where the triangle ends within one lane of four.
+const NARROW_TILE_B: usize = 4;
 /// Features per pass of the scatter, so that the pass's residuals stay in the first-level cache.
 const PASS: usize = 64;
 
@@ -216,10 +219,7 @@ fn small_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Vec<f64> {
         if weight == 0.0 {
             continue;
         }
-        for (((res, w), &v), &m) in residual.iter_mut().zip(&mut weighted).zip(x).zip(mean) {
-            *res = v - m;
-            *w = *res * weight;
-        }
+        residual_into(x, mean, weight, &mut residual, &mut weighted);
         for (a, row) in lower.chunks_exact_mut(d).enumerate() {
             for (s, &rb) in row[..=a].iter_mut().zip(&residual) {
                 let term = weighted[a] * rb;
@@ -236,6 +236,16 @@ fn small_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Vec<f64> {
         }
     }
     lower
+}
+
+/// A feature's residual `x - mean` and its weighted residual `(x - mean) weight`, the two factors of
+/// its term in the scatter.
+#[inline(always)]
+fn residual_into(x: &[f64], mean: &[f64], weight: f64, residual: &mut [f64], weighted: &mut [f64]) {
+    for (((res, w), &v), &m) in residual.iter_mut().zip(weighted).zip(x).zip(mean) {
+        *res = v - m;
+        *w = *res * weight;
+    }
 }
 
 /// One entry of [`small_scatter`] chained over every feature, as nalgebra chains it.
@@ -296,12 +306,26 @@ unsafe fn scatter_fma(x_rows: &[f64], mean: &[f64], resp: &[f64], lower: &mut [f
 enum TileShape {
     /// [`TILE_A`] x [`TILE_B`].
     Full,
-    /// [`TILE_A`] x 4: the triangle's last columns of a row group.
+    /// [`TILE_A`] x [`NARROW_TILE_B`]: the triangle's last columns of a row group.
     Narrow,
-    /// 2 x [`TILE_B`]: the last two rows of a `d` that leaves two (or one) after the groups of four.
+    /// [`SHORT_TILE_A`] x [`TILE_B`]: the last rows of a `d` that leaves two (or one) after the
+    /// groups of four.
     Short,
-    /// 2 x 4.
+    /// [`SHORT_TILE_A`] x [`NARROW_TILE_B`].
     ShortNarrow,
+}
+
+impl TileShape {
+    /// Rows and columns.
+    #[cfg(test)]
+    fn size(self) -> (usize, usize) {
+        match self {
+            Self::Full => (TILE_A, TILE_B),
+            Self::Narrow => (TILE_A, NARROW_TILE_B),
+            Self::Short => (SHORT_TILE_A, TILE_B),
+            Self::ShortNarrow => (SHORT_TILE_A, NARROW_TILE_B),
+        }
+    }
 }
 
 /// One tile of the scatter: its first row `a0`, first column `b0` and shape.
@@ -320,10 +344,10 @@ struct Tile {
 fn lower_tiles(d: usize) -> Vec<Tile> {
     let mut tiles = Vec::new();
     for a0 in (0..d).step_by(TILE_A) {
-        let short = d - a0 <= 2;
+        let short = d - a0 <= SHORT_TILE_A;
         let columns = d.min(a0 + TILE_A);
         for b0 in (0..columns).step_by(TILE_B) {
-            let narrow = columns - b0 <= 4;
+            let narrow = columns - b0 <= NARROW_TILE_B;
             let shape = match (short, narrow) {
                 (false, false) => TileShape::Full,
                 (false, true) => TileShape::Narrow,
@@ -403,10 +427,7 @@ impl Scatter {
         let x = &x_rows[r * d..][..d];
         let residual = &mut self.residuals[t * stride..][..d];
         let weighted = &mut self.weighted[t * stride..][..d];
-        for (((res, w), &v), &m) in residual.iter_mut().zip(weighted).zip(x).zip(mean) {
-            *res = v - m;
-            *w = *res * weight;
-        }
+        residual_into(x, mean, weight, residual, weighted);
     }
 
     /// Continues every tile's chains over the pass's `count` features.
@@ -416,9 +437,9 @@ impl Scatter {
             let Tile { a0, b0, shape } = self.tiles[i];
             match shape {
                 TileShape::Full => self.chain_tile::<TILE_A, TILE_B>(a0, b0, count),
-                TileShape::Narrow => self.chain_tile::<TILE_A, 4>(a0, b0, count),
-                TileShape::Short => self.chain_tile::<2, TILE_B>(a0, b0, count),
-                TileShape::ShortNarrow => self.chain_tile::<2, 4>(a0, b0, count),
+                TileShape::Narrow => self.chain_tile::<TILE_A, NARROW_TILE_B>(a0, b0, count),
+                TileShape::Short => self.chain_tile::<SHORT_TILE_A, TILE_B>(a0, b0, count),
+                TileShape::ShortNarrow => self.chain_tile::<SHORT_TILE_A, NARROW_TILE_B>(a0, b0, count),
             }
         }
     }
@@ -457,12 +478,7 @@ mod tests {
             let rows = d.next_multiple_of(TILE_A);
             let mut covered = vec![0; rows * stride];
             for Tile { a0, b0, shape } in lower_tiles(d) {
-                let (height, width) = match shape {
-                    TileShape::Full => (TILE_A, TILE_B),
-                    TileShape::Narrow => (TILE_A, 4),
-                    TileShape::Short => (2, TILE_B),
-                    TileShape::ShortNarrow => (2, 4),
-                };
+                let (height, width) = shape.size();
                 assert!(
                     a0 + height <= rows && b0 + width <= stride,
                     "d {d}: tile at ({a0}, {b0}) leaves the padding"
@@ -483,11 +499,9 @@ mod tests {
         // vectors of four per feature.
         let lanes: usize = lower_tiles(10)
             .iter()
-            .map(|t| match t.shape {
-                TileShape::Full => TILE_A * TILE_B,
-                TileShape::Narrow => TILE_A * 4,
-                TileShape::Short => 2 * TILE_B,
-                TileShape::ShortNarrow => 2 * 4,
+            .map(|t| {
+                let (height, width) = t.shape.size();
+                height * width
             })
             .sum();
         assert_eq!(lanes / 4, 18);
