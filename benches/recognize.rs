@@ -1,6 +1,6 @@
 //! Recognition speed (issue 7): the GMM codebook fit at the paper's training-set size (10 objects x
 //! 1000 readings of ~20-dimensional PCA'd features, Sec. V-B), the per-touch cost of the online
-//! posterior, and the neighbour codebook's training histograms.
+//! posterior, the neighbour codebook's training histograms, and the posterior's tempering fit.
 //!
 //! Two GMM groups: `gmm_fit_10x1000x20` runs exactly 100 EM iterations (tolerance 0, the same work
 //! for every implementation) and `gmm_fit_10x1000x20_tol1e-3` runs with the default settings (stop
@@ -26,7 +26,9 @@ use taction::describe::Feature;
 use taction::recognize::pipeline::{
     FeatureMatrix, GaussianMixture, GmmConfig, GmmFit, LeaveOneReadingOut, TrainingFeatures,
 };
-use taction::recognize::{CodebookConfig, CodebookKind, LabelledFeatures, TrainConfig, train};
+use taction::recognize::{
+    CodebookConfig, CodebookKind, EvidencePath, LabelledFeatures, Tempering, TrainConfig, train,
+};
 use taction::rng::{Rng, stream};
 use taction::units::round_trip;
 use taction::valid::Valid;
@@ -244,5 +246,41 @@ fn knn_training(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, gmm_fit, per_touch, knn_training);
+/// The posterior's tempering fit (`Tempering::fit`, 192 golden-section searches over every prefix
+/// of every validation trial) at the shapes of its two heavy uses: the 52 letters' validation
+/// trials (520 of 10 readings) and the `active` experiment's calibration explorations (12 objects,
+/// 36 whole explorations of 100 readings). Log-likelihoods as a codebook gives them: per reading,
+/// the true object a little likelier on average.
+fn tempering_fit(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tempering_fit");
+    group.sample_size(10);
+    for (objects, trials, readings) in [(52, 520, 10), (12, 36, 100)] {
+        let mut rng = stream(53, objects as u64);
+        let paths: Vec<EvidencePath> = (0..trials)
+            .map(|t| {
+                let object = t % objects;
+                let mut sums = vec![0.0; objects];
+                let log_likelihoods = (0..readings)
+                    .map(|_| {
+                        for (j, s) in sums.iter_mut().enumerate() {
+                            let mean = if j == object { -3.0 } else { -4.0 };
+                            *s += mean + 2.0 * normal(&mut rng);
+                        }
+                        sums.clone()
+                    })
+                    .collect();
+                EvidencePath {
+                    object,
+                    log_likelihoods,
+                }
+            })
+            .collect();
+        group.bench_function(format!("{objects}objects_{trials}x{readings}"), |b| {
+            b.iter(|| black_box(Tempering::fit(black_box(&paths))))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, gmm_fit, per_touch, knn_training, tempering_fit);
 criterion_main!(benches);

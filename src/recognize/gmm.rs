@@ -16,7 +16,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
-use crate::recognize::exp::exp;
+use crate::recognize::exp::{
+    Shift, add_exp_of_differences, exp_of_differences_in_place, sum_exp_of_differences,
+};
 use crate::recognize::features::FeatureMatrix;
 use crate::recognize::gmm_products::{weighted_column_sums, weighted_scatter, whitened_distances};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
@@ -259,7 +261,7 @@ impl GaussianMixture {
     pub fn responsibilities(&self, x: &[f64], out: &mut [f64]) -> f64 {
         self.weighted_log_densities(x, out);
         let lse = log_sum_exp(out);
-        out.iter_mut().for_each(|v| *v = exp(*v - lse));
+        exp_of_differences_in_place(out, Shift::All(lse));
         lse
     }
 
@@ -297,10 +299,7 @@ impl GaussianMixture {
     fn e_step(&self, x: &DMatrix<f64>) -> (f64, Vec<Vec<f64>>) {
         let n = x.nrows();
         let mut columns = self.weighted_log_prob_columns(x);
-        let norms = log_sum_exp_rows(&columns);
-        columns
-            .par_iter_mut()
-            .for_each(|c| c.iter_mut().zip(&norms).for_each(|(v, lse)| *v = exp(*v - lse)));
+        let norms = normalise_rows(&mut columns);
         (norms.iter().sum::<f64>() / n as f64, columns)
     }
 }
@@ -389,9 +388,9 @@ impl Component {
     /// same data row-major); `None` when its covariance is not positive definite.
     fn estimate(x: &DMatrix<f64>, x_rows: &[f64], resp: &[f64], reg_covar: f64) -> Option<Self> {
         let d = x.ncols();
-        // nalgebra's `sum`, a fold from +0 in order.
-        let n = resp.iter().fold(0.0, |sum, &r| sum + r) + 10.0 * f64::EPSILON;
-        let mean = DVector::from_vec(weighted_column_sums(x, resp)) / n;
+        let (sums, total) = weighted_column_sums(x, resp);
+        let n = total + 10.0 * f64::EPSILON;
+        let mean = DVector::from_vec(sums) / n;
         // The scatter's lower triangle; the general product fills the whole square.
         let scatter = match weighted_scatter(x_rows, mean.as_slice(), resp) {
             Some(lower) => DMatrix::from_row_slice(d, d, &lower),
@@ -453,36 +452,69 @@ pub fn log_sum_exp(v: &[f64]) -> f64 {
     if !max.is_finite() {
         return max;
     }
-    max + v.iter().map(|x| exp(x - max)).sum::<f64>().ln()
+    max + sum_exp_of_differences(v, max).ln()
 }
+
+/// Rows per block of [`log_sum_exp_rows`] and [`normalise_rows`]: a block's values in every
+/// column, its maxima and sums stay in the cache between the passes over them.
+const ROW_BLOCK: usize = 512;
 
 /// `ln sum_i exp(columns[i][r])` for every row `r`: the same arithmetic as [`log_sum_exp`] on each
 /// row (the exponentials summed in component order), computed a block of rows at a time so every
 /// pass reads contiguous memory, the blocks in parallel.
 fn log_sum_exp_rows(columns: &[Vec<f64>]) -> Vec<f64> {
-    /// Rows per block: the block's maxima and sums stay in the first-level cache.
-    const BLOCK: usize = 512;
     let n = columns.first().map_or(0, Vec::len);
     let mut out = vec![0.0; n];
-    out.par_chunks_mut(BLOCK).enumerate().for_each(|(b, out)| {
-        let rows = b * BLOCK..b * BLOCK + out.len();
-        let mut max = vec![f64::NEG_INFINITY; out.len()];
-        for column in columns {
-            for (m, &v) in max.iter_mut().zip(&column[rows.clone()]) {
-                *m = m.max(v);
-            }
-        }
-        let mut sum = vec![0.0; out.len()];
-        for column in columns {
-            for ((s, &v), &m) in sum.iter_mut().zip(&column[rows.clone()]).zip(&max) {
-                *s += exp(v - m);
-            }
-        }
-        for ((o, &m), &s) in out.iter_mut().zip(&max).zip(&sum) {
-            *o = if m.is_finite() { m + s.ln() } else { m };
-        }
+    out.par_chunks_mut(ROW_BLOCK).enumerate().for_each(|(b, out)| {
+        let block: Vec<&[f64]> = columns.iter().map(|c| &c[b * ROW_BLOCK..][..out.len()]).collect();
+        log_sum_exp_of_block(&block, out);
     });
     out
+}
+
+/// [`log_sum_exp_rows`] of one block of rows (`block[i]` is component `i`'s values there) into
+/// `out`.
+fn log_sum_exp_of_block(block: &[&[f64]], out: &mut [f64]) {
+    let mut max = vec![f64::NEG_INFINITY; out.len()];
+    for column in block {
+        for (m, &v) in max.iter_mut().zip(*column) {
+            *m = m.max(v);
+        }
+    }
+    let mut sum = vec![0.0; out.len()];
+    for column in block {
+        add_exp_of_differences(&mut sum, column, Shift::Rows(&max));
+    }
+    for ((o, &m), &s) in out.iter_mut().zip(&max).zip(&sum) {
+        *o = if m.is_finite() { m + s.ln() } else { m };
+    }
+}
+
+/// The responsibilities from the weighted log-densities: every row `r` of `columns` replaced by
+/// `exp(columns[i][r] - ln sum_m exp(columns[m][r]))`, the row's log-sum-exp returned. One block of
+/// rows at a time, as [`log_sum_exp_rows`] forms it, its exponentials taken while the block is in
+/// the cache: the same bits as the log-sum-exp of every row and then the exponentials.
+fn normalise_rows(columns: &mut [Vec<f64>]) -> Vec<f64> {
+    let n = columns.first().map_or(0, Vec::len);
+    // Per block, its rows of every column.
+    let mut blocks: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(ROW_BLOCK)).map(|_| Vec::new()).collect();
+    for column in columns.iter_mut() {
+        for (block, rows) in blocks.iter_mut().zip(column.chunks_mut(ROW_BLOCK)) {
+            block.push(rows);
+        }
+    }
+    let mut norms = vec![0.0; n];
+    norms
+        .par_chunks_mut(ROW_BLOCK)
+        .zip(blocks.par_iter_mut())
+        .for_each(|(norms, block)| {
+            let values: Vec<&[f64]> = block.iter().map(|rows| &**rows).collect();
+            log_sum_exp_of_block(&values, norms);
+            for rows in block.iter_mut() {
+                exp_of_differences_in_place(rows, Shift::Rows(norms));
+            }
+        });
+    norms
 }
 
 #[cfg(test)]
@@ -678,7 +710,7 @@ mod tests {
     }
 
     #[test]
-    fn the_weighted_column_sums_give_nalgebras_bits() {
+    fn the_weighted_column_sums_and_their_total_give_nalgebras_bits() {
         let mut rng = crate::rng::rng(53);
         // Row counts with every remainder modulo the dot product's eight chains, and fewer rows
         // than chains.
@@ -686,8 +718,10 @@ mod tests {
             let x = random_matrix(&mut rng, n, d);
             for sparse in [false, true] {
                 let resp = responsibilities(n, sparse, &mut rng);
-                let got = weighted_column_sums(&x, &resp);
+                let (got, total) = weighted_column_sums(&x, &resp);
                 let want = x.tr_mul(&DVector::from_column_slice(&resp));
+                let want_total = DVector::from_column_slice(&resp).sum();
+                assert_eq!(total.to_bits(), want_total.to_bits(), "n {n}, sparse {sparse}");
                 for (j, (a, b)) in got.iter().zip(want.iter()).enumerate() {
                     assert_eq!(
                         a.to_bits(),

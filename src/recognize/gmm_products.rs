@@ -259,20 +259,28 @@ fn small_scatter_entry(x_rows: &[f64], mean: &[f64], resp: &[f64], a: usize, b: 
 
 /// `sum_r resp_r x_r` for every column of `x` (`n x d`, column-major): nalgebra's `x^T resp`
 /// ([`Matrix::tr_mul`](nalgebra::Matrix::tr_mul)) to the bit, skipping the groups of eight
-/// features (one term of each chain) whose responsibilities are all zero.
-pub(super) fn weighted_column_sums(x: &DMatrix<f64>, resp: &[f64]) -> Vec<f64> {
+/// features (one term of each chain) whose responsibilities are all zero; and `sum_r resp_r`
+/// added in feature order from +0 (nalgebra's `sum`), which skips the same groups: a zero added
+/// to a sum from +0 changes no bit. With hundreds of components most groups are zero.
+pub(super) fn weighted_column_sums(x: &DMatrix<f64>, resp: &[f64]) -> (Vec<f64>, f64) {
     /// nalgebra's dot product keeps this many chains.
     const CHAINS: usize = 8;
     let (n, d) = x.shape();
     if n == 0 {
-        return vec![0.0; d];
+        return (vec![0.0; d], 0.0);
     }
     let chained = n - n % CHAINS;
     let groups: Vec<usize> = (0..chained)
         .step_by(CHAINS)
         .filter(|&g| resp[g..g + CHAINS].iter().any(|&r| r != 0.0))
         .collect();
-    x.as_slice()
+    let total = groups
+        .iter()
+        .flat_map(|&g| &resp[g..g + CHAINS])
+        .chain(&resp[chained..])
+        .fold(0.0, |sum, &r| sum + r);
+    let sums = x
+        .as_slice()
         .chunks_exact(n)
         .map(|column| {
             let mut chain = [0.0; CHAINS];
@@ -291,7 +299,8 @@ pub(super) fn weighted_column_sums(x: &DMatrix<f64>, resp: &[f64]) -> Vec<f64> {
             }
             sum
         })
-        .collect()
+        .collect();
+    (sums, total)
 }
 
 /// The M-step's scatter, compiled with AVX2 and FMA where they exist (callers check the
