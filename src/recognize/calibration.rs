@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 use crate::recognize::RecognizeError;
 use crate::recognize::evaluate::Trial;
 use crate::recognize::exp::{Lanes, exp};
-use crate::recognize::gmm::log_sum_exp;
+use crate::recognize::gmm::{log_sum_exp, log_sum_exp_of_parts};
 
 /// `w(n) = tau n^(beta - 1)`, the weight of the log-likelihood after `n` readings (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -295,9 +295,7 @@ impl<'a> Prefixes<'a> {
         let objects = each.first().map_or(0, |p| p.2.len());
         let lanes = each.iter().all(|p| p.2.len() == objects).then(|| {
             each.chunks(4)
-                .flat_map(|group| {
-                    (0..objects).map(move |j| std::array::from_fn(|l| group[l.min(group.len() - 1)].2[j]))
-                })
+                .flat_map(|group| (0..objects).map(move |j| std::array::from_fn(|l| lane(group, l).2[j])))
                 .collect()
         });
         Self {
@@ -315,7 +313,7 @@ impl<'a> Prefixes<'a> {
         let weights: Vec<f64> = (0..=self.readings).map(|n| tempering.weight(n)).collect();
         let mut sum = 0.0;
         for (g, group) in self.each.chunks(4).enumerate() {
-            let weight: [f64; 4] = std::array::from_fn(|l| weights[group[l.min(group.len() - 1)].0]);
+            let weight: [f64; 4] = std::array::from_fn(|l| weights[lane(group, l).0]);
             let rows = g * self.objects..(g + 1) * self.objects;
             let lanes = self
                 .lanes
@@ -324,12 +322,7 @@ impl<'a> Prefixes<'a> {
             for (l, &(readings, object, log_likelihood)) in group.iter().enumerate() {
                 let p = match lanes {
                     Some((max, sums)) => {
-                        // `log_sum_exp`'s result from its maximum and sum.
-                        let lse = if max[l].is_finite() {
-                            max[l] + sums[l].ln()
-                        } else {
-                            max[l]
-                        };
+                        let lse = log_sum_exp_of_parts(max[l], sums[l]);
                         tempering.probability(weight[l] * log_likelihood[object], lse, self.objects)
                     }
                     None => tempering.probability_of(log_likelihood, readings, object),
@@ -339,6 +332,12 @@ impl<'a> Prefixes<'a> {
         }
         sum / self.each.len().max(1) as f64
     }
+}
+
+/// Lane `l` of a group of up to four prefixes: a short last group repeats its last prefix in the
+/// lanes it lacks (their results are not used).
+fn lane<'g, 'a>(group: &'g [(usize, usize, &'a [f64])], l: usize) -> &'g (usize, usize, &'a [f64]) {
+    &group[l.min(group.len() - 1)]
 }
 
 /// The minimum of a function convex on `[a, b]` by golden-section search: its argument and value.
@@ -510,14 +509,10 @@ mod tests {
         }
         let fitted = Tempering::fit(&trials);
         let truth = Tempering::new(1.0 / sharpness, 1.0).unwrap();
-        assert!(
-            Prefixes::of(&trials).mean_log_loss(fitted) <= Prefixes::of(&trials).mean_log_loss(truth) + 1e-9,
-            "{fitted:?}"
-        );
-        assert!(
-            Prefixes::of(&trials).mean_log_loss(fitted)
-                < Prefixes::of(&trials).mean_log_loss(Tempering::EQ15)
-        );
+        let prefixes = Prefixes::of(&trials);
+        let loss = |tempering| prefixes.mean_log_loss(tempering);
+        assert!(loss(fitted) <= loss(truth) + 1e-9, "{fitted:?}");
+        assert!(loss(fitted) < loss(Tempering::EQ15));
         assert!(fitted.tau() < 0.5, "{fitted:?}");
     }
 

@@ -452,7 +452,13 @@ pub fn log_sum_exp(v: &[f64]) -> f64 {
     if !max.is_finite() {
         return max;
     }
-    max + sum_exp_of_differences(v, max).ln()
+    log_sum_exp_of_parts(max, sum_exp_of_differences(v, max))
+}
+
+/// [`log_sum_exp`]'s result from its parts, where they are formed elsewhere with its bits: the
+/// largest value `max` and `sum = sum_i exp(v_i - max)`; `max` itself where it is not finite.
+pub(crate) fn log_sum_exp_of_parts(max: f64, sum: f64) -> f64 {
+    if max.is_finite() { max + sum.ln() } else { max }
 }
 
 /// Rows per block of [`log_sum_exp_rows`] and [`normalise_rows`]: a block's values in every
@@ -486,7 +492,7 @@ fn log_sum_exp_of_block(block: &[&[f64]], out: &mut [f64]) {
         add_exp_of_differences(&mut sum, column, Shift::Rows(&max));
     }
     for ((o, &m), &s) in out.iter_mut().zip(&max).zip(&sum) {
-        *o = if m.is_finite() { m + s.ln() } else { m };
+        *o = log_sum_exp_of_parts(m, s);
     }
 }
 
