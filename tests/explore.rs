@@ -16,6 +16,17 @@ fn box_object() -> ObjectSpec {
     ObjectSpec::new("box", common::box_mesh(DVec3::new(0.10, 0.08, 0.10)))
 }
 
+/// Two objects of different shapes, each collected in its own scene.
+fn box_and_sphere() -> [ObjectSpec; 2] {
+    [
+        box_object(),
+        ObjectSpec::new(
+            "sphere",
+            common::sphere_mesh(0.04, DVec3::new(0.0, 0.0, 0.04), 12),
+        ),
+    ]
+}
+
 fn plan(mode: CollectMode, readings: usize, perturbation: PerturbationBounds) -> CollectPlan {
     CollectPlan {
         mode,
@@ -227,13 +238,7 @@ fn reachable_sampler_reads_every_face_but_the_one_on_the_table() {
 fn datasets_are_identical_for_one_and_two_threads() {
     use taction::dataset::{Dataset, DatasetHeader};
     let dir = tempfile::tempdir().unwrap();
-    let objects = [
-        box_object(),
-        ObjectSpec::new(
-            "sphere",
-            common::sphere_mesh(0.04, DVec3::new(0.0, 0.0, 0.04), 12),
-        ),
-    ];
+    let objects = box_and_sphere();
     let perturbation = PerturbationBounds::new(5.0, 0.05).unwrap();
     let write = |mode: CollectMode, seed: u64, threads: usize, name: &str| {
         let mut plan = plan(mode, 3, perturbation);
@@ -281,6 +286,102 @@ fn datasets_are_identical_for_one_and_two_threads() {
             "{name}: seed 6 wrote the same dataset as seed 5"
         );
     }
+}
+
+/// A batch of datasets collected on one pool gives each dataset the bytes its own collection gives,
+/// on one thread and on two, hands each over exactly once (a dataset of no objects too), counts
+/// every converged reading, and stops at the first error of the caller's hand-over, returning it.
+#[test]
+fn a_batch_of_datasets_gives_each_the_bytes_of_its_own_collection() {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use taction::dataset::Dataset;
+    use taction::explore::{BatchDataset, collect_datasets};
+    let dir = tempfile::tempdir().unwrap();
+    let objects = box_and_sphere();
+    let perturbation = PerturbationBounds::new(5.0, 0.05).unwrap();
+    let sampler = plan(CollectMode::Sampler(Valid::default()), 3, perturbation);
+    let planner = plan(CollectMode::Planner(Valid::default()), 2, perturbation);
+    let bytes = |dataset: &Dataset, name: &str| {
+        let path = dir.path().join(name);
+        dataset.write(&path).unwrap();
+        std::fs::read(&path).unwrap()
+    };
+    let alone: Vec<Vec<u8>> = [sampler, planner]
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            bytes(
+                &p.collect_dataset("test", &objects, 1, &|| {}).unwrap(),
+                &format!("alone-{i}.csv"),
+            )
+        })
+        .collect();
+    let batch = [
+        BatchDataset {
+            plan: sampler,
+            object_set: "test",
+            objects: &objects,
+        },
+        BatchDataset {
+            plan: planner,
+            object_set: "test",
+            objects: &objects,
+        },
+        BatchDataset {
+            plan: sampler,
+            object_set: "test",
+            objects: &[],
+        },
+    ];
+    for threads in [1, 2] {
+        let handed: Mutex<Vec<(usize, Vec<u8>, usize)>> = Mutex::new(Vec::new());
+        let converged = AtomicUsize::new(0);
+        collect_datasets(
+            &batch,
+            threads,
+            &|| {
+                converged.fetch_add(1, Ordering::Relaxed);
+            },
+            &|n, dataset| -> Result<(), taction::explore::CollectError> {
+                let file = bytes(&dataset, &format!("batch-{threads}-{n}.csv"));
+                handed.lock().unwrap().push((n, file, dataset.len()));
+                Ok(())
+            },
+        )
+        .unwrap();
+        let mut handed = handed.into_inner().unwrap();
+        handed.sort_by_key(|(n, ..)| *n);
+        assert_eq!(
+            handed.iter().map(|(n, ..)| *n).collect::<Vec<_>>(),
+            [0, 1, 2],
+            "{threads} threads"
+        );
+        assert!(
+            handed[0].1 == alone[0],
+            "{threads} threads: the batch's sampler dataset differs"
+        );
+        assert!(
+            handed[1].1 == alone[1],
+            "{threads} threads: the batch's planner dataset differs"
+        );
+        assert_eq!(handed[2].2, 0, "the dataset of no objects has readings");
+        assert_eq!(
+            converged.into_inner(),
+            2 * (3 + 2),
+            "{threads} threads: converged readings counted"
+        );
+    }
+    let handed = Mutex::new(Vec::new());
+    type BoxError = Box<dyn std::error::Error + Send + Sync>;
+    let error = collect_datasets(&batch[..2], 1, &|| {}, &|n, _| -> Result<(), BoxError> {
+        handed.lock().unwrap().push(n);
+        Err(format!("dataset {n} refused").into())
+    })
+    .unwrap_err();
+    let handed = handed.into_inner().unwrap();
+    assert_eq!(handed.len(), 1, "the batch went on after an error: {handed:?}");
+    assert_eq!(error.to_string(), format!("dataset {} refused", handed[0]));
 }
 
 /// With L = 0 (global strategy only) the tree grows toward uniform targets from the nearest vertex

@@ -536,3 +536,69 @@ fn half_an_exact_surface_is_refused_naming_the_mesh_and_the_missing_field() {
         "{error}"
     );
 }
+
+/// The free pad's scene leaves out the object's collision shell (nothing there collides with the
+/// object) and reads what the same scene with the shell reads, bit for bit, at 40 seeded poses
+/// around an object whose shell has several pieces (a ball with a post beside it), the object
+/// where it was built and moved.
+#[test]
+fn the_free_pad_reads_the_same_without_the_objects_collision_shell() {
+    use rand::RngExt;
+    use taction::control::FreePad;
+    use taction::pose::{PadPose, Pose};
+    use taction::sim::{COLLISION_GROUP, ObjectSpec, SceneBuilder, Section};
+    use taction::tactile::{add_sensor, free_pad_body_xml};
+    use taction::valid::Valid;
+    let mut mesh = icosphere(DVec3::new(0.0, 0.0, 0.03), 0.03, 2);
+    mesh.append(&box_between(
+        DVec3::new(0.035, -0.01, 0.0),
+        DVec3::new(0.06, 0.01, 0.05),
+    ));
+    let object = ObjectSpec::new("ball and post", mesh);
+    let config = Valid::new(SensorConfig::default()).unwrap();
+    let mut without = FreePad::new(object.clone(), &config).unwrap();
+    let shell_geoms = |pad: &FreePad| {
+        let model = pad.scene().model();
+        model
+            .geom_group()
+            .iter()
+            .filter(|&&g| g == COLLISION_GROUP)
+            .count()
+    };
+    assert_eq!(
+        shell_geoms(&without),
+        0,
+        "the free pad's object has a collision shell"
+    );
+    let builder = SceneBuilder::new()
+        .table(false)
+        .object(object)
+        .add(Section::Worldbody, free_pad_body_xml(&config));
+    let mut with =
+        FreePad::from_scene(add_sensor(builder, &config, "covering", "pad").build().unwrap()).unwrap();
+    assert!(shell_geoms(&with) > 1, "the comparison scene has no shell");
+    let mut r = taction::rng::rng(3);
+    let mut touched = 0;
+    for k in 0..40 {
+        if k == 20 {
+            let moved = Pose::new(DVec3::new(0.01, -0.02, 0.0), glam::DQuat::from_rotation_z(0.4));
+            without.scene_mut().set_object_pose(moved).unwrap();
+            with.scene_mut().set_object_pose(moved).unwrap();
+        }
+        let direction = DVec3::new(
+            r.random_range(-1.0..1.0),
+            r.random_range(-1.0..1.0),
+            r.random_range(0.1..1.0),
+        )
+        .normalize();
+        let center = DVec3::new(0.01, 0.0, 0.03) + direction * r.random_range(0.025..0.04);
+        let pose = PadPose::new(center, -direction, DVec3::Z.cross(direction).normalize()).unwrap();
+        let (a, b) = (without.read_at(&pose).unwrap(), with.read_at(&pose).unwrap());
+        let bits = |image: &taction::tactile::TactileImage| {
+            image.values().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&a), bits(&b), "pose {k}");
+        touched += usize::from(a.values().iter().any(|&v| v > 0.0));
+    }
+    assert!(touched >= 10, "only {touched} of 40 poses touched the object");
+}

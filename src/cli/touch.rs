@@ -137,7 +137,7 @@ pub fn touch_arm(
     let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
     let (ik_options, motion) = precise_motion();
-    let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
+    let mut ik = InverseKinematics::for_scene(&scene, ik_options)?;
     let home = arm.q(scene.data());
     let q = ik
         .solve(

@@ -13,7 +13,9 @@ pub(crate) mod surface_sampling;
 pub(crate) mod tree;
 
 // Collecting a dataset: the sampler or the exploring arm, over a set of objects.
-pub use collect::{Collect, CollectError, CollectMode, CollectPlan, SensorReader};
+pub use collect::{
+    BatchDataset, Collect, CollectError, CollectMode, CollectPlan, SensorReader, collect_datasets,
+};
 pub use grid::ReadingGrid;
 pub use setup::TouchSetup;
 

@@ -377,8 +377,8 @@ where
                 (ik, motion, MoveOptions::default().kinematic())
             }
         };
-        let ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
-        let expansion_ik = InverseKinematics::new(scene.model_arc(), arm.clone(), IkOptions::default());
+        let ik = InverseKinematics::for_scene(scene, ik_options)?;
+        let expansion_ik = InverseKinematics::for_scene(scene, IkOptions::default())?;
         let covering_reach_m = match arm.back_geom() {
             Some(g) => covering_reach_m(&setup.sensor, scene.model().geom_size()[g]),
             None => f64::INFINITY,

@@ -29,7 +29,7 @@ impl ArmReach {
         let scene = SceneBuilder::with_arm_and_table().object(object).build()?;
         let arm = scene.arm().cloned().ok_or(SimError::NoArm)?;
         let (ik_options, _) = precise_motion();
-        let ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);
+        let ik = InverseKinematics::for_scene(&scene, ik_options)?;
         let home = arm.q(scene.data());
         Ok(Self { scene, arm, ik, home })
     }

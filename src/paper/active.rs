@@ -19,9 +19,9 @@
 //! stopped by then (`confident`, the cumulative distribution of touches-to-confidence) and the
 //! fraction stopped with the right guess (`correct_at_stop`).
 
-use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
-use rayon::prelude::*;
 use serde::de::{self, Deserializer};
 use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
@@ -329,9 +329,9 @@ impl ActiveUnit<'_> {
             per_object.extend(curve_objects);
             reliability.extend(curve_reliability);
         }
-        for (state, perturbation) in object_states() {
-            let (curve_rows, (curve_objects, curve_reliability)) =
-                self.active_curve(state, perturbation, &model, descriptor.as_ref())?;
+        for (curve_rows, (curve_objects, curve_reliability)) in
+            self.active_curves(&model, descriptor.as_ref())?
+        {
             rows.extend(curve_rows);
             per_object.extend(curve_objects);
             reliability.extend(curve_reliability);
@@ -359,61 +359,93 @@ impl ActiveUnit<'_> {
         )
     }
 
-    /// The active curve with the object `state` (`perturbation`): every trial's objects explored
-    /// with `model` in the loop, in parallel, under the plans of the L = 0.5 datasets.
-    fn active_curve(
+    /// The active curves with the object fixed and perturbed ([`object_states`]): every trial's
+    /// objects explored with `model` in the loop under the plans of the L = 0.5 datasets with the
+    /// same perturbation (same sensor, seeds, objects). Both curves' explorations share one pass
+    /// over the pool, the perturbed ones (the longer) first, so that the pool stays busy to the
+    /// end instead of idling at the end of each curve while its slowest exploration finishes.
+    fn active_curves(
         &self,
-        state: &str,
-        perturbation: PerturbationBounds,
         model: &TrainedModel,
         descriptor: &dyn Descriptor,
-    ) -> Result<Rows, BoxError> {
+    ) -> Result<Vec<Rows>, BoxError> {
         let objects = &self.objects;
-        // The plans of the L = 0.5 datasets with this perturbation: same sensor, seeds, objects.
-        let base = self.data().test_requests(TestData::Planner {
-            local_probability: ACTIVE_LOCAL_PROBABILITY,
-            perturbation,
-        })?;
-        let jobs: Vec<(usize, usize)> = (0..base.len())
-            .flat_map(|t| (0..objects.specs.len()).map(move |o| (t, o)))
+        let states = object_states();
+        let bases = states
+            .iter()
+            .map(|&(_, perturbation)| {
+                self.data().test_requests(TestData::Planner {
+                    local_probability: ACTIVE_LOCAL_PROBABILITY,
+                    perturbation,
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let jobs: Vec<(usize, usize, usize)> = (0..states.len())
+            .rev()
+            .flat_map(|s| {
+                (0..bases[s].len()).flat_map(move |t| (0..objects.specs.len()).map(move |o| (s, t, o)))
+            })
             .collect();
-        // The curve is one unit of the run, saved when whole: the bar says how far it is.
-        let progress = Progress::new(
-            &format!("active touch, object {state}"),
-            jobs.len(),
-            "objects explored",
-        );
-        let explored: Vec<Trial> = jobs
-            .par_iter()
-            .map(|&(t, o)| {
-                let trial = active_trial(
-                    &base[t].plan,
-                    objects,
-                    o,
-                    model,
-                    descriptor,
-                    self.counts.test_per_object,
-                    self.neighbourhood_m,
-                );
-                progress.inc();
-                trial
+        // The curves are one unit of the run, saved when whole: the bar says how far they are.
+        let progress = Progress::new("active touch", jobs.len(), "objects explored");
+        // Each worker takes the next exploration in order, so the pass ends on fixed ones.
+        let next = AtomicUsize::new(0);
+        let slots: Vec<Mutex<Option<Result<Trial, BoxError>>>> =
+            jobs.iter().map(|_| Mutex::new(None)).collect();
+        rayon::scope(|scope| {
+            for _ in 0..rayon::current_num_threads() {
+                scope.spawn(|_| {
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(&(s, t, o)) = jobs.get(i) else {
+                            break;
+                        };
+                        let trial = active_trial(
+                            &bases[s][t].plan,
+                            objects,
+                            o,
+                            model,
+                            descriptor,
+                            self.counts.test_per_object,
+                            self.neighbourhood_m,
+                        );
+                        progress.inc();
+                        *slots[i].lock().unwrap_or_else(PoisonError::into_inner) = Some(trial);
+                    }
+                });
+            }
+        });
+        let explored: Vec<Trial> = slots
+            .into_iter()
+            .map(|slot| {
+                slot.into_inner()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .unwrap_or_else(|| Err("internal: an active exploration did not run".into()))
             })
             .collect::<Result<_, BoxError>>()?;
         progress.finish(explored.len());
         let objects_per_trial = objects.specs.len().max(1);
-        let trials: Vec<(u64, Vec<Trial>)> = base
+        states
             .iter()
-            .zip(explored.chunks(objects_per_trial))
-            .map(|(request, chunk)| (request.plan.seed, chunk.to_vec()))
-            .collect();
-        curve_rows(
-            self.sweep,
-            model,
-            &levels("active", ACTIVE_LOCAL_PROBABILITY, state),
-            &trials,
-            self.counts,
-            self.context.seed,
-        )
+            .enumerate()
+            .map(|(s, &(state, _))| {
+                let of_state = jobs.iter().zip(&explored).filter(|((js, ..), _)| *js == s);
+                let trials_of_state: Vec<Trial> = of_state.map(|(_, trial)| trial.clone()).collect();
+                let trials: Vec<(u64, Vec<Trial>)> = bases[s]
+                    .iter()
+                    .zip(trials_of_state.chunks(objects_per_trial))
+                    .map(|(request, chunk)| (request.plan.seed, chunk.to_vec()))
+                    .collect();
+                curve_rows(
+                    self.sweep,
+                    model,
+                    &levels("active", ACTIVE_LOCAL_PROBABILITY, state),
+                    &trials,
+                    self.counts,
+                    self.context.seed,
+                )
+            })
+            .collect()
     }
 }
 

@@ -13,12 +13,13 @@
 //! Files are written atomically; a corrupt one is an error naming it.
 //!
 //! Datasets are collected in a preparation step before an experiment's units run ([`DataStore::
-//! prepare`]), each one in parallel over its objects; units then only read them. Collecting inside
-//! the units instead would make units that share a dataset wait on each other inside the thread
-//! pool.
+//! prepare`]), all those an experiment lacks as one batch of object tasks on the pool
+//! ([`collect_datasets`]); units then only read them. Collecting inside the units instead would
+//! make units that share a dataset wait on each other inside the thread pool.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Instant;
 
@@ -29,7 +30,7 @@ use crate::dataset::{Dataset, Shortfall, describe_shortfalls};
 use crate::describe::Descriptor;
 use crate::experiment::progress::Progress;
 use crate::experiment::unit::{BoxError, rows_to_csv};
-use crate::explore::{Collect, CollectPlan};
+use crate::explore::{BatchDataset, CollectPlan, collect_datasets};
 use crate::mesh::ObjectSet;
 use crate::mesh::checksum::sha256_hex;
 use crate::recognize::{PosteriorRule, TrainConfig, TrainedModel};
@@ -180,9 +181,9 @@ impl DataStore {
     }
 
     /// Makes every requested dataset available: read from disk when an earlier run wrote it,
-    /// otherwise collected now (in parallel over its objects) and written. Requests are taken in
-    /// order, each distinct dataset once. The short ones among them are recorded in
-    /// `experiment_dir`'s [`SHORTFALLS_FILE`].
+    /// otherwise collected now (all the missing ones as one batch, each written when whole), each
+    /// distinct dataset once. The short ones among them are recorded in `experiment_dir`'s
+    /// [`SHORTFALLS_FILE`].
     pub fn prepare(&self, requests: &[DataRequest], experiment_dir: &Path) -> Result<(), BoxError> {
         self.clock
             .datasets(|| self.prepare_timed(requests, experiment_dir))
@@ -193,31 +194,22 @@ impl DataStore {
         for r in requests {
             distinct.entry(r.key()).or_insert(r);
         }
-        let total = distinct.len();
-        for (i, (key, request)) in distinct.into_iter().enumerate() {
+        let mut missing = Vec::new();
+        for (key, request) in distinct {
             if self.lock().contains_key(&key) {
                 continue;
             }
             let path = self.dataset_path(request);
-            let dataset = if path.exists() {
-                Dataset::read(&path).map_err(|e| {
+            if path.exists() {
+                let dataset = Dataset::read(&path).map_err(|e| {
                     format!("{e} (a dataset cached by an earlier run; delete the file to collect it again)")
-                })?
+                })?;
+                self.keep(key, request, &path, dataset);
             } else {
-                self.collect(request, &path, (i + 1, total))?
-            };
-            let short = dataset.shortfalls(request.plan.readings_per_object);
-            if !short.is_empty() {
-                // Accuracy counts an object read fewer times as `recognize::AccuracyPoint` defines
-                // it; the user must still know it happened, now and when the run ends.
-                eprintln!("  warning: {} ({})", describe_shortfalls(&short), path.display());
-                self.shortfalls
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .insert(key.clone(), short);
+                missing.push((key, request, path));
             }
-            self.lock().insert(key, Arc::new(dataset));
         }
+        self.collect(&missing)?;
         let short: Vec<ShortObject> = {
             let known = self.shortfalls.lock().unwrap_or_else(PoisonError::into_inner);
             requests
@@ -239,40 +231,83 @@ impl DataStore {
         Ok(())
     }
 
-    /// Collects `request`'s dataset (number `nth.0` of `nth.1` to prepare), in parallel over its
-    /// objects, and writes it to `path`.
-    fn collect(&self, request: &DataRequest, path: &Path, nth: (usize, usize)) -> Result<Dataset, BoxError> {
-        let (n, total) = nth;
-        let started = Instant::now();
-        eprintln!(
-            "collecting dataset {n}/{total}: {} readings of each of {} objects ({}), {}x{} taxels",
-            request.plan.readings_per_object,
-            request.objects.specs.len(),
-            request.plan.mode.generator_name(),
-            request.plan.sensor.rows,
-            request.plan.sensor.cols,
-        );
-        let progress = Progress::collection(
-            &format!("  dataset {n}/{total}"),
-            request.objects.specs.len(),
-            request.plan.readings_per_object,
-        );
-        let dataset = Collect::from_plan(request.plan)
-            .threads(self.threads)
-            .progress(&|| progress.inc())
-            .dataset(&request.object_set, &request.objects.specs)?;
-        progress.finish(dataset.converged().count());
-        crate::experiment::files::create_dir_all(&self.root.join("data"))?;
-        dataset.write(path)?;
+    /// Makes `dataset` (of `request`, read from or written to `path`) available under `key`,
+    /// recording its short objects.
+    fn keep(&self, key: String, request: &DataRequest, path: &Path, dataset: Dataset) {
+        let short = dataset.shortfalls(request.plan.readings_per_object);
+        if !short.is_empty() {
+            // Accuracy counts an object read fewer times as `recognize::AccuracyPoint` defines
+            // it; the user must still know it happened, now and when the run ends.
+            eprintln!("  warning: {} ({})", describe_shortfalls(&short), path.display());
+            self.shortfalls
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .insert(key.clone(), short);
+        }
+        self.lock().insert(key, Arc::new(dataset));
+    }
 
-        eprintln!(
-            "  {} readings ({} converged) in {:.1} s -> {}",
-            dataset.len(),
-            dataset.converged().count(),
-            started.elapsed().as_secs_f64(),
-            path.display()
-        );
-        Ok(dataset)
+    /// Collects the `missing` datasets (key, request, file) as one batch over the store's threads
+    /// ([`collect_datasets`]: the pool stays busy from one dataset to the next), writing each to its
+    /// file as soon as it is whole.
+    fn collect(&self, missing: &[(String, &DataRequest, PathBuf)]) -> Result<(), BoxError> {
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let started = Instant::now();
+        let total = missing.len();
+        for (n, (_, request, _)) in missing.iter().enumerate() {
+            eprintln!(
+                "collecting dataset {}/{total}: {} readings of each of {} objects ({}), {}x{} taxels",
+                n + 1,
+                request.plan.readings_per_object,
+                request.objects.specs.len(),
+                request.plan.mode.generator_name(),
+                request.plan.sensor.rows,
+                request.plan.sensor.cols,
+            );
+        }
+        let asked: usize = missing
+            .iter()
+            .map(|(_, r, _)| r.objects.specs.len().saturating_mul(r.plan.readings_per_object))
+            .sum();
+        let name = match total {
+            1 => "  dataset 1/1".to_string(),
+            _ => format!("  datasets 1-{total}/{total}"),
+        };
+        let progress = Progress::new(&name, asked, "converged readings");
+        let batch: Vec<BatchDataset> = missing
+            .iter()
+            .map(|(_, request, _)| BatchDataset {
+                plan: request.plan,
+                object_set: &request.object_set,
+                objects: &request.objects.specs,
+            })
+            .collect();
+        let converged = AtomicUsize::new(0);
+        crate::experiment::files::create_dir_all(&self.root.join("data"))?;
+        collect_datasets(&batch, self.threads, &|| progress.inc(), &|n,
+                                                                     dataset|
+         -> Result<
+            (),
+            BoxError,
+        > {
+            let (key, request, path) = &missing[n];
+            dataset.write(path)?;
+            converged.fetch_add(dataset.converged().count(), Ordering::Relaxed);
+            eprintln!(
+                "  dataset {}/{total}: {} readings ({} converged) in {:.1} s -> {}",
+                n + 1,
+                dataset.len(),
+                dataset.converged().count(),
+                started.elapsed().as_secs_f64(),
+                path.display()
+            );
+            self.keep(key.clone(), request, path, dataset);
+            Ok(())
+        })?;
+        progress.finish(converged.into_inner());
+        Ok(())
     }
 
     /// A dataset made available by [`prepare`](Self::prepare).

@@ -534,20 +534,20 @@ impl Arm {
     }
 
     /// Advances `sample` along `path` by at most `max_step_rad` on any joint and at most
-    /// `limit_m` of pad travel (the increment shrinks until it does: kinematics are cheap, and
-    /// the rigid back's bounding radius turns the pad's rotation into travel); the scene's
-    /// kinematics are left at the new sample.
+    /// `limit_m` of pad travel (the increment shrinks until it does: the pad's pose at a trial
+    /// increment comes from the arm's twin, without placing the object's shell, and the rigid
+    /// back's bounding radius turns the pad's rotation into travel); the scene's kinematics are
+    /// left at the new sample.
     fn next_sample(&self, scene: &mut Scene, path: &JointPath<'_>, sample: &mut PathSample, limit_m: f64) {
         let mut ds = (1.0 - sample.s).min(path.max_step_rad / path.span.max(1e-12));
         loop {
             let next = (sample.s + ds).min(1.0);
             path.at(next, &mut sample.q);
-            self.set_q(scene.data_mut(), &sample.q);
-            scene.data_mut().kinematics();
-            let pad = self.site_pose(scene.data());
+            let pad = scene.pad_pose_at(self, &sample.q);
             let travel = (pad.position_m - sample.pad.position_m).length()
                 + pad.rotation.angle_between(sample.pad.rotation) * path.reach_m;
             if travel <= limit_m || ds * path.span <= 1e-7 {
+                scene.arm_moved_to(self, &sample.q);
                 sample.pad = pad;
                 sample.s = next;
                 return;

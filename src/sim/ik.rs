@@ -23,6 +23,7 @@ use rand::RngExt;
 
 use crate::rng;
 use crate::sim::arm::Arm;
+use crate::sim::{Scene, SimError};
 
 /// A pad placement to reach: the pad centre and the direction its normal should point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,6 +95,19 @@ impl InverseKinematics {
             data: MjData::new(model),
             options,
             calls: 0,
+        }
+    }
+
+    /// The solver for the arm of `scene`, on the arm's twin where the scene has one (the same
+    /// frames and Jacobian bit for bit, without placing the rest of the world at every iteration:
+    /// [`ArmTwin`](crate::sim::ArmTwin)).
+    pub fn for_scene(scene: &Scene, options: IkOptions) -> Result<Self, SimError> {
+        match scene.arm_twin() {
+            Some(twin) => Ok(Self::new(twin.model_arc(), twin.arm().clone(), options)),
+            None => {
+                let arm = scene.arm().cloned().ok_or(SimError::NoArm)?;
+                Ok(Self::new(scene.model_arc(), arm, options))
+            }
         }
     }
 

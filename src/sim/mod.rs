@@ -8,6 +8,7 @@ pub(crate) mod mjcf;
 pub(crate) mod object;
 pub(crate) mod perturb;
 pub(crate) mod scene;
+pub(crate) mod twin;
 
 // The world: built from objects and the arm, stepped, saved and restored.
 pub use object::{DRAWN_MESH_TRIANGLES, LARGE_MESH_TRIANGLES, ObjectMount, ObjectSpec, ObjectSurfaces};
@@ -18,6 +19,7 @@ pub use arm::{
     ARM_JOINTS, Arm, Collision, Execution, MoveOptions, MoveOutcome, PAD_BACK_GEOM, PAD_SITE, Watch,
 };
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
+pub use twin::ArmTwin;
 
 // The object perturbed between readings (Sec. V-B4).
 pub use perturb::{Perturbation, PerturbationBounds};

@@ -140,13 +140,15 @@ impl ObjectSpec {
         }
     }
 
-    /// Adds the mesh asset (its vertices and faces from `asset`) and the object body to `doc`.
+    /// Adds the mesh asset (its vertices and faces from `asset`) and the object body to `doc`, with
+    /// the collision shell (`collision_shell.rs`) when `with_shell` says so.
     ///
-    /// The geom collides with the arm and the table (MuJoCo uses the mesh's convex hull for these
-    /// contacts; the tactile sensor raycasts the exact triangles). The body gets an explicit inertia (a
-    /// solid sphere of the mesh's bounding radius), so that open or thin user meshes, whose volume
-    /// MuJoCo cannot compute, still load.
-    pub fn add_to(&self, doc: &mut Document, asset: MeshAsset) -> Result<(), SimError> {
+    /// The shell collides with the arm and the table (the tactile sensor raycasts the exact
+    /// triangles of the object's own geom, which takes part in no contact). The body gets an
+    /// explicit inertia (a solid sphere of the mesh's bounding radius), so that open or thin user
+    /// meshes, whose volume MuJoCo cannot compute, still load, and so that the body's frames do not
+    /// depend on whether it has a shell.
+    pub fn add_to(&self, doc: &mut Document, asset: MeshAsset, with_shell: bool) -> Result<(), SimError> {
         let (lo, hi) = self.mesh.bounds().ok_or_else(|| SimError::Object {
             name: self.name.clone(),
             message: "the mesh has no vertices".into(),
@@ -165,7 +167,10 @@ impl ObjectSpec {
             MeshAsset::Spec(surfaces) => surfaces.drawn.as_ref(),
             MeshAsset::Inline | MeshAsset::File(_) => &self.mesh,
         };
-        let shell = add_collision_shell(doc, shell_of);
+        let shell = match with_shell {
+            true => add_collision_shell(doc, shell_of),
+            false => String::new(),
+        };
 
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-3);

@@ -1,6 +1,6 @@
 //! A compiled MuJoCo world and its state: the one place that owns `MjModel` and `MjData`.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use mujoco_rs::prelude::*;
@@ -12,6 +12,7 @@ use crate::sim::SimError;
 use crate::sim::arm::Arm;
 use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML, as_read_f32, sensed_surface_names};
 use crate::sim::object::{MeshAsset, OBJECT_MESH, ObjectMount, ObjectSpec, ObjectSurfaces};
+use crate::sim::twin::ArmTwin;
 
 /// What goes into a scene. The arm and table come from `mjcf/`; the object and any extra parts (a
 /// sensor plugin, a free-floating pad) are added by the caller.
@@ -24,6 +25,8 @@ pub struct SceneBuilder {
     object_mesh_file: Option<String>,
     extra: Vec<(Section, String)>,
     timestep_s: Option<f64>,
+    /// The object without its collision shell: a world where nothing collides with it.
+    without_collision_shell: bool,
 }
 
 impl SceneBuilder {
@@ -48,6 +51,16 @@ impl SceneBuilder {
 
     pub fn object(mut self, object: ObjectSpec) -> Self {
         self.object = Some(object);
+        self
+    }
+
+    /// Leaves out the object's collision shell (`collision_shell.rs`): for a world where nothing
+    /// can collide with the object (the free-floating pad's: its plate takes part in no contact,
+    /// and there is neither arm nor table), where the shell's 40-200 convex pieces would only be
+    /// compiled by MuJoCo and placed again at every kinematics call. The sensor never reads the
+    /// shell, and the object's body has an explicit inertia, so its readings are the same.
+    pub fn without_collision_shell(mut self) -> Self {
+        self.without_collision_shell = true;
         self
     }
 
@@ -102,7 +115,7 @@ impl SceneBuilder {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
         if let Some(object) = &self.object {
-            object.add_to(&mut doc, asset)?;
+            object.add_to(&mut doc, asset, !self.without_collision_shell)?;
         }
         for (section, xml) in &self.extra {
             doc.add(*section, xml.clone());
@@ -289,12 +302,31 @@ pub struct SceneObject {
     pub mesh: TriMesh,
 }
 
+/// `mjcf/arm.xml` compiled alone (the arm's [`ArmTwin`]), once per process; `None` if it did not
+/// compile (scenes then place the whole world for the arm's kinematics, only slower).
+fn arm_alone() -> Option<Arc<MjModel>> {
+    static MODEL: OnceLock<Option<Arc<MjModel>>> = OnceLock::new();
+    MODEL
+        .get_or_init(|| {
+            let builder = SceneBuilder {
+                arm: true,
+                ..SceneBuilder::default()
+            };
+            let xml = builder.document(MeshAsset::Inline).ok()?;
+            compile(&xml, None).ok().map(Arc::new)
+        })
+        .clone()
+}
+
 /// A compiled world and its simulation state.
 pub struct Scene {
     model: Arc<MjModel>,
     data: MjData<Arc<MjModel>>,
     object: Option<SceneObject>,
     arm: Option<Arm>,
+    /// The arm compiled alone, where it is bit for bit the scene's: the pad's pose at a
+    /// configuration without placing the rest of the world.
+    twin: Option<ArmTwin>,
 }
 
 impl Scene {
@@ -320,11 +352,15 @@ impl Scene {
             _ => None,
         };
         let arm = Arm::find(&model)?;
+        let twin = arm
+            .as_ref()
+            .and_then(|arm| ArmTwin::of(arm_alone()?, &model, arm));
         let mut scene = Self {
             model,
             data,
             object,
             arm,
+            twin,
         };
         scene.data.forward();
         Ok(scene)
@@ -353,6 +389,37 @@ impl Scene {
 
     pub fn object(&self) -> Option<&SceneObject> {
         self.object.as_ref()
+    }
+
+    /// The arm compiled alone ([`ArmTwin`]), when the scene's arm is `mjcf/arm.xml`'s.
+    pub fn arm_twin(&self) -> Option<&ArmTwin> {
+        self.twin.as_ref()
+    }
+
+    /// The pad's pose with `arm` (the scene's) at `q`, the rest of the world where it is: from the
+    /// arm's twin when the scene has one, leaving the scene's state alone; otherwise by the scene's
+    /// own kinematics, left at `q`.
+    pub fn pad_pose_at(&mut self, arm: &Arm, q: &[f64]) -> Pose {
+        match self.twin.as_mut() {
+            Some(twin) => twin.pad_pose(q),
+            None => {
+                arm.set_q(&mut self.data, q);
+                self.data.kinematics();
+                arm.site_pose(&self.data)
+            }
+        }
+    }
+
+    /// Moves `arm` (the scene's) to `q` with the scene's kinematics current, where only the arm
+    /// moved since the scene's last `mj_kinematics` (a kinematic motion): the arm's frames from its
+    /// twin, the rest of the world's as they are, the bits `mj_kinematics` would give without
+    /// placing the object's collision shell again. Without a twin, [`pad_pose_at`](Self::pad_pose_at)
+    /// of the same `q` already computed them.
+    pub(crate) fn arm_moved_to(&mut self, arm: &Arm, q: &[f64]) {
+        if let Some(twin) = self.twin.as_mut() {
+            arm.set_q(&mut self.data, q);
+            twin.write_arm_kinematics(q, &mut self.data);
+        }
     }
 
     /// Recomputes everything derived from the state (kinematics, contacts, sensors) without advancing time.

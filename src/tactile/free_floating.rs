@@ -30,11 +30,13 @@ pub fn free_pad_body_xml(config: &SensorConfig) -> String {
 }
 
 /// The scene builder of a free-floating sensor looking at `object` (no arm, no table unless the
-/// caller adds one), with the covering sensor registered and configured.
+/// caller adds one), with the covering sensor registered and configured. Nothing in it collides
+/// with the object, so the object has no collision shell.
 pub fn free_floating_builder(object: ObjectSpec, config: &Valid<SensorConfig>) -> SceneBuilder {
     let builder = SceneBuilder::new()
         .table(false)
         .object(object)
+        .without_collision_shell()
         .add(Section::Worldbody, free_pad_body_xml(config));
     add_sensor(builder, config, FREE_PAD_SENSOR, FREE_PAD_SITE)
 }
