@@ -39,7 +39,8 @@ struct ArmElements {
 
 impl ArmTwin {
     /// The twin of `arm` in `scene_model` on `model`, the arm compiled alone, if that has, bit for
-    /// bit, the numbers the arm's kinematics and Jacobian read ([`same_arm`]).
+    /// bit, the numbers the arm's kinematics and Jacobian read (its bodies, joints, geoms and
+    /// sites; see `same_arm`).
     pub fn of(model: Arc<MjModel>, scene_model: &MjModel, arm: &Arm) -> Option<Self> {
         let twin_arm = Arm::find(&model).ok().flatten()?;
         let elements = same_arm(&model, &twin_arm, scene_model, arm)?;
