@@ -286,26 +286,22 @@ impl DataStore {
             .collect();
         let converged = AtomicUsize::new(0);
         crate::experiment::files::create_dir_all(&self.root.join("data"))?;
-        collect_datasets(&batch, self.threads, &|| progress.inc(), &|n,
-                                                                     dataset|
-         -> Result<
-            (),
-            BoxError,
-        > {
+        let write = |n: usize, dataset: Dataset| -> Result<(), BoxError> {
             let (key, request, path) = &missing[n];
             dataset.write(path)?;
-            converged.fetch_add(dataset.converged().count(), Ordering::Relaxed);
+            let converged_here = dataset.converged().count();
+            converged.fetch_add(converged_here, Ordering::Relaxed);
             eprintln!(
-                "  dataset {}/{total}: {} readings ({} converged) in {:.1} s -> {}",
+                "  dataset {}/{total}: {} readings ({converged_here} converged) in {:.1} s -> {}",
                 n + 1,
                 dataset.len(),
-                dataset.converged().count(),
                 started.elapsed().as_secs_f64(),
                 path.display()
             );
             self.keep(key.clone(), request, path, dataset);
             Ok(())
-        })?;
+        };
+        collect_datasets(&batch, self.threads, &|| progress.inc(), &write)?;
         progress.finish(converged.into_inner());
         Ok(())
     }
