@@ -117,6 +117,8 @@ fn stages(
         })
     });
     let mut depth = DepthBuffer::new(&grid);
+    // The depths the form stage reads, also when a filter skips the rasterise stage.
+    depth.draw_mesh(&grid, &bvh, &leaves, (&to_pad, o), t);
     group.bench_function(BenchmarkId::new("stage", "rasterise"), |b| {
         b.iter(|| {
             depth.nearest_m.fill(f64::INFINITY);
