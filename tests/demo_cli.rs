@@ -185,14 +185,17 @@ fn active_demo(out: &Path, extra: &[&str]) -> (String, Vec<Vec<String>>) {
     (stdout, touch_rows(out))
 }
 
-/// The confidence stop fires at the first touch whose best guess reaches the threshold, and the
-/// stopped run is the run without the stop cut short there (the stop changes no random draw).
+/// The confidence stop fires once one guess has held the threshold over the last
+/// `--stop-held-readings` touches (two by default; one: the first touch whose best guess reaches
+/// it), and the stopped run is the run without the stop cut short there (the stop changes no
+/// random draw).
 #[test]
 fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
     let dir = tempfile::tempdir().expect("a temporary folder");
     let out = dir.path().join("demo");
     let (stdout, full) = active_demo(&out, &[]);
     assert_eq!(full.len(), 8, "no stop: the whole budget\n{stdout}");
+    let guess: Vec<&str> = full.iter().map(|r| r[2].as_str()).collect();
     let p_guess: Vec<f64> = full.iter().map(|r| r[3].parse().expect("p_guess")).collect();
     // A threshold strictly between two touches' confidences, crossed after the first touch.
     let crossing = (1..p_guess.len())
@@ -200,22 +203,40 @@ fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
         .unwrap_or_else(|| panic!("confidence never rises after touch 1: {p_guess:?}"));
     let below = p_guess[..crossing].iter().cloned().fold(0.0, f64::max);
     let threshold = 0.5 * (below + p_guess[crossing]);
-    let (stdout, stopped) = active_demo(&out, &["--stop-at-confidence", &threshold.to_string()]);
-    assert_eq!(
-        stopped.len(),
-        crossing + 1,
-        "threshold {threshold}, {p_guess:?}\n{stdout}"
-    );
-    assert_eq!(
-        stopped[..],
-        full[..=crossing],
-        "the stopped run is a prefix of the full run"
-    );
-    assert!(stdout.contains("stopped: confident"), "{stdout}");
+    // Held over two touches: the first touch after the crossing that, with the one before it,
+    // names one object at or above the threshold (or no stop within the budget).
+    let held_twice = (crossing + 1..p_guess.len())
+        .find(|&i| guess[i] == guess[i - 1] && p_guess[i] >= threshold && p_guess[i - 1] >= threshold);
     assert!(
-        stdout.contains(&format!("after {} touches", crossing + 1)),
-        "the touches used are reported:\n{stdout}"
+        held_twice.is_some(),
+        "the run holds the threshold over two touches after the crossing: {guess:?} {p_guess:?}"
     );
+    let expected = [("1", Some(crossing)), ("2", held_twice)];
+    for (held, stop) in expected {
+        let args = [
+            "--stop-at-confidence",
+            &threshold.to_string(),
+            "--stop-held-readings",
+            held,
+        ];
+        let (stdout, stopped) = active_demo(&out, &args);
+        let used = stop.map_or(full.len(), |i| i + 1);
+        assert_eq!(
+            stopped.len(),
+            used,
+            "held over {held}: threshold {threshold}, {guess:?} {p_guess:?}\n{stdout}"
+        );
+        assert_eq!(
+            stopped[..],
+            full[..used],
+            "the stopped run is a prefix of the full run"
+        );
+        assert_eq!(stdout.contains("stopped: confident"), stop.is_some(), "{stdout}");
+        assert!(
+            stdout.contains(&format!("after {used} touches")),
+            "the touches used are reported:\n{stdout}"
+        );
+    }
     let (_, _, stderr) = taction_demo(dir.path(), &["--stop-at-confidence", "1.5"]);
     assert!(stderr.contains("--stop-at-confidence"), "{stderr}");
 }

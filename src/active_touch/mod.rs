@@ -53,7 +53,7 @@ use glam::DVec3;
 use crate::control::ControlError;
 use crate::dataset::{Dataset, Reading};
 use crate::describe::DescriptorKind;
-use crate::explore::active::{ActiveGuidance, Probability, TouchScorer};
+use crate::explore::active::{ActiveGuidance, ConfidenceStop, TouchScorer};
 use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{Planner, PlannerConfig, SamplerConfig};
 use crate::recognize::bag::BagOfFeatures;
@@ -442,9 +442,9 @@ pub struct TouchPlan {
     /// `Some(n)`: the active strategy with `n` candidates per iteration; `None`: the planner's
     /// local/global rule.
     pub active_candidates: Option<usize>,
-    /// The confidence stop: end at the first touch after which the posterior's largest
-    /// probability reaches this.
-    pub stop_at_confidence: Option<Probability>,
+    /// The confidence stop: end once one guess has held its probability at the stop's threshold
+    /// over its last touches.
+    pub stop_at_confidence: Option<ConfidenceStop>,
 }
 
 /// One converged touch and the belief after it.
@@ -508,6 +508,8 @@ where
         iterations: 0,
         stopped_confident: false,
     };
+    // Each touch's guess and its probability, what the confidence stop watches.
+    let mut trace = Vec::new();
     while run.touches.len() < plan.budget {
         let guidance = plan.active_candidates.map(|candidates| ActiveGuidance {
             scorer: recognition.scorer(),
@@ -528,9 +530,8 @@ where
             let belief = recognition.observe(&reading.image)?;
             let touch = Touch { reading, belief };
             on_touch(&touch);
-            let confident = plan
-                .stop_at_confidence
-                .is_some_and(|p| max_probability(&touch.belief) >= p.get());
+            trace.push((touch.belief.guess(), max_probability(&touch.belief)));
+            let confident = plan.stop_at_confidence.is_some_and(|stop| stop.fires(&trace));
             run.touches.push(touch);
             if confident {
                 run.stopped_confident = true;

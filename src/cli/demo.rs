@@ -9,9 +9,11 @@
 //! the posterior over touches, a contact sheet of the tactile images and the paper's Fig. 1: the object
 //! with a patch at every converged touch, the images beside it. `--strategy active` chooses
 //! each touch by expected information gain (`active_touch`); `--stop-at-confidence P` ends the
-//! exploration once the best guess has probability P.
+//! exploration once one guess has held probability P over the last `--stop-held-readings` touches
+//! (two unless told otherwise: `explore::active::ConfidenceStop`).
 
 use std::io::Write;
+use std::num::NonZeroUsize;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -22,7 +24,7 @@ use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::experiment::{Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
-use taction::explore::Probability;
+use taction::explore::{ConfidenceStop, Probability};
 use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
@@ -73,10 +75,15 @@ pub struct DemoArgs {
     /// candidate touch with the largest expected information gain about the object's identity.
     #[arg(long, value_enum, default_value_t = DemoStrategy::Blind)]
     pub strategy: DemoStrategy,
-    /// Stop exploring once the best guess's probability reaches P, a probability in (0, 1]
-    /// (e.g. 0.95) [default: spend all --touches].
+    /// Stop exploring once one guess has held probability P or more over the last
+    /// --stop-held-readings touches, P in (0, 1] (e.g. 0.95) [default: spend all --touches].
     #[arg(long, value_name = "P")]
     pub stop_at_confidence: Option<Probability>,
+    /// Touches the guess must hold --stop-at-confidence over before the stop fires: 1 stops at the
+    /// first touch that reaches it, which is right less often than P promises (the first crossing
+    /// is selected for being high).
+    #[arg(long, value_name = "N", default_value_t = ConfidenceStop::DEFAULT_HELD_READINGS, requires = "stop_at_confidence")]
+    pub stop_held_readings: NonZeroUsize,
     #[command(flatten)]
     pub posterior: PosteriorArg,
 }
@@ -312,7 +319,9 @@ fn explore_unknown(
         TouchPlan {
             budget: args.touches,
             active_candidates: (args.strategy == DemoStrategy::Active).then_some(DEFAULT_CANDIDATES),
-            stop_at_confidence: args.stop_at_confidence,
+            stop_at_confidence: args
+                .stop_at_confidence
+                .map(|p| ConfidenceStop::new(p).held_over(args.stop_held_readings)),
         },
         &mut |touch| shown.add(&touch.belief),
     )?;

@@ -34,6 +34,6 @@ pub use tree::{ExplorationTree, Vertex};
 
 // Active touch: the next touch chosen by the posterior.
 pub use active::{
-    ActiveGuidance, DEFAULT_CANDIDATES, ODDS_PRIOR_ITERATIONS, Probability, TouchOdds, TouchScorer,
-    best_candidate, expected_gains,
+    ActiveGuidance, ConfidenceStop, DEFAULT_CANDIDATES, ODDS_PRIOR_ITERATIONS, Probability, TouchOdds,
+    TouchScorer, best_candidate, expected_gains,
 };

@@ -14,10 +14,11 @@
 //! L = 0.5 datasets (common random numbers) and no stop, `test_per_object` touches per object.
 //!
 //! The confidence stop needs no second run: the planner's draws do not depend on it, so a run with
-//! the stop is the run without it cut at the first touch whose posterior's largest probability
-//! reaches the threshold. Each row adds, for each threshold of [`STOPS`], the fraction of objects
-//! stopped by then (`confident`, the cumulative distribution of touches-to-confidence) and the
-//! fraction stopped with the right guess (`correct_at_stop`).
+//! the stop is the run without it cut at the touch where the stop fires ([`ConfidenceStop`], the
+//! product's default: one guess held at the threshold over the last two touches). Each row adds,
+//! for each threshold of [`STOPS`], the fraction of objects stopped by then (`confident`, the
+//! cumulative distribution of touches-to-confidence) and the fraction stopped with the right guess
+//! (`correct_at_stop`).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -46,7 +47,7 @@ use crate::experiment::progress::Progress;
 use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
-use crate::explore::active::{DEFAULT_CANDIDATES, Probability, touches_to_confidence};
+use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES, Probability};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
@@ -79,7 +80,7 @@ const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 /// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) |
 /// | `local_probability` | L of the planner's moves, or of the active strategy's proposals (0.5) |
 /// | `object_motion` | `fixed` or `perturbed` after every reading |
-/// | `confident` | fraction of objects whose posterior's largest probability reached the stop threshold within `n_readings` readings |
+/// | `confident` | fraction of objects whose confidence stop ([`ConfidenceStop`]: one guess held at the threshold over the last `stop_held_readings` touches) fired within `n_readings` readings |
 /// | `correct_at_stop` | fraction of objects stopped within `n_readings` readings whose guess at the stop was right |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActiveRow {
@@ -201,6 +202,8 @@ struct ActiveConfig<'a> {
     active_candidates: usize,
     neighbourhood_m: f64,
     stops: [f64; 3],
+    /// Touches a guess must hold a stop's threshold over for the stop to fire.
+    stop_held_readings: usize,
     /// The posterior: `calibrated` on the arm's explorations (`calibration_explorations` of each
     /// object, `calibration_trial_readings` per trial), or the paper's `eq15`.
     posterior: PosteriorRule,
@@ -264,6 +267,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             active_candidates: DEFAULT_CANDIDATES,
             neighbourhood_m,
             stops: STOPS,
+            stop_held_readings: ConfidenceStop::DEFAULT_HELD_READINGS.get(),
             posterior: context.posterior(),
             calibration_explorations: counts.trials,
             calibration_trial_readings: counts.test_per_object,
@@ -504,7 +508,7 @@ fn curve_rows(
 ) -> Result<Rows, BoxError> {
     let thresholds = STOPS
         .iter()
-        .map(|p| Probability::new(*p))
+        .map(|p| Probability::new(*p).map(ConfidenceStop::new))
         .collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     let (mut table, mut curve) = (ReliabilityTable::default(), None);
@@ -561,13 +565,14 @@ fn curve_rows(
 fn stops(
     evaluation: &Evaluation,
     trials: usize,
-    threshold: Probability,
+    stop: ConfidenceStop,
     budget: usize,
 ) -> Vec<Option<(usize, bool)>> {
     (0..trials)
         .map(|t| {
             let touches: Vec<_> = evaluation.touches.iter().filter(|r| r.trial == t).collect();
-            touches_to_confidence(touches.iter().map(|r| r.p_guess()), threshold, budget).map(|k| {
+            let trace: Vec<(usize, f64)> = touches.iter().map(|r| (r.object_guess, r.p_guess())).collect();
+            stop.touches_used(&trace, budget).map(|k| {
                 let at = touches[k - 1];
                 (k, at.object_guess == at.object_true)
             })
