@@ -20,6 +20,7 @@
 pub mod atomic;
 pub mod bodies;
 pub mod pose;
+pub mod queue;
 pub mod rng;
 pub(crate) mod simd;
 pub mod units;

@@ -8,7 +8,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Modules every module may use: no domain, no MuJoCo.
-const LEAVES: [&str; 7] = ["atomic", "bodies", "pose", "rng", "simd", "units", "valid"];
+const LEAVES: [&str; 8] = [
+    "atomic", "bodies", "pose", "queue", "rng", "simd", "units", "valid",
+];
 
 /// The paper's modules in the order of the flow: world -> sensor -> hand-off -> control/explore ->
 /// descriptors -> recognizer.
@@ -29,6 +31,7 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
         ("atomic", vec![]),
         ("bodies", vec![]),
         ("pose", vec![]),
+        ("queue", vec![]),
         ("rng", vec![]),
         ("simd", vec![]),
         ("units", vec![]),

@@ -5,7 +5,6 @@
 //! of the requested size and come back in object order, so the readings do not depend on the number of
 //! threads or on scheduling.
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
@@ -302,28 +301,9 @@ where
         .flat_map(|(d, b)| (0..b.objects.len()).map(move |o| (d, o)))
         .collect();
     tasks.sort_by_key(|&(d, _)| std::cmp::Reverse(relative_cost(&batch[d].plan)));
-    let next = AtomicUsize::new(0);
-    let failure: Mutex<Option<E>> = Mutex::new(None);
-    let stop = AtomicBool::new(false);
     let pool = worker_pool(threads).map_err(CollectError::from)?;
-    pool.broadcast(|_| {
-        while !stop.load(Ordering::Relaxed) {
-            let Some(&(d, o)) = tasks.get(next.fetch_add(1, Ordering::Relaxed)) else {
-                break;
-            };
-            if let Err(e) = run(d, o) {
-                stop.store(true, Ordering::Relaxed);
-                failure
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .get_or_insert(e);
-            }
-        }
-    });
-    match failure.into_inner().unwrap_or_else(PoisonError::into_inner) {
-        Some(e) => Err(e),
-        None => Ok(()),
-    }
+    pool.install(|| crate::queue::run_in_order(tasks.len(), |i| run(tasks[i].0, tasks[i].1)))?;
+    Ok(())
 }
 
 /// What one object of `plan` costs against the others of a batch, roughly: a planner reading (a

@@ -20,8 +20,7 @@
 //! cumulative distribution of touches-to-confidence) and the fraction stopped with the right guess
 //! (`correct_at_stop`).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 
 use serde::de::{self, Deserializer};
 use serde::ser::{SerializeStruct, Serializer};
@@ -366,8 +365,9 @@ impl ActiveUnit<'_> {
     /// The active curves with the object fixed and perturbed ([`object_states`]): every trial's
     /// objects explored with `model` in the loop under the plans of the L = 0.5 datasets with the
     /// same perturbation (same sensor, seeds, objects). Both curves' explorations share one pass
-    /// over the pool, the perturbed ones (the longer) first, so that the pool stays busy to the
-    /// end instead of idling at the end of each curve while its slowest exploration finishes.
+    /// over the pool ([`crate::queue`]), the perturbed ones (the longer) first, so that the pool
+    /// stays busy to the end instead of idling at the end of each curve while its slowest
+    /// exploration finishes.
     fn active_curves(
         &self,
         model: &TrainedModel,
@@ -392,41 +392,22 @@ impl ActiveUnit<'_> {
             .collect();
         // The curves are one unit of the run, saved when whole: the bar says how far they are.
         let progress = Progress::new("active touch", jobs.len(), "objects explored");
-        // Each worker takes the next exploration in order, so the pass ends on fixed ones.
-        let next = AtomicUsize::new(0);
-        let slots: Vec<Mutex<Option<Result<Trial, BoxError>>>> =
-            jobs.iter().map(|_| Mutex::new(None)).collect();
-        rayon::scope(|scope| {
-            for _ in 0..rayon::current_num_threads() {
-                scope.spawn(|_| {
-                    loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        let Some(&(s, t, o)) = jobs.get(i) else {
-                            break;
-                        };
-                        let trial = active_trial(
-                            &bases[s][t].plan,
-                            objects,
-                            o,
-                            model,
-                            descriptor,
-                            self.counts.test_per_object,
-                            self.neighbourhood_m,
-                        );
-                        progress.inc();
-                        *slots[i].lock().unwrap_or_else(PoisonError::into_inner) = Some(trial);
-                    }
-                });
-            }
-        });
-        let explored: Vec<Trial> = slots
-            .into_iter()
-            .map(|slot| {
-                slot.into_inner()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .unwrap_or_else(|| Err("internal: an active exploration did not run".into()))
-            })
-            .collect::<Result<_, BoxError>>()?;
+        // The workers take the explorations in order, so the pass ends on fixed ones; the first
+        // failed exploration stops the pass.
+        let explored: Vec<Trial> = crate::queue::run_in_order(jobs.len(), |i| {
+            let (s, t, o) = jobs[i];
+            let trial = active_trial(
+                &bases[s][t].plan,
+                objects,
+                o,
+                model,
+                descriptor,
+                self.counts.test_per_object,
+                self.neighbourhood_m,
+            );
+            progress.inc();
+            trial
+        })?;
         progress.finish(explored.len());
         let objects_per_trial = objects.specs.len().max(1);
         states
