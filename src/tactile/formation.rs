@@ -269,44 +269,51 @@ mod four_lanes {
 
     use super::TaxelPass;
 
-    /// `K_x` applied to one sample row: the taxel columns four at a time, each with its own four
-    /// partial sums in one register (lane `l` is [`dot`](super::dot)'s `acc[l]`), so that four
-    /// independent chains of additions are in flight where one taxel's sum waits on its last
-    /// addition; the columns left over one at a time.
+    /// `K_x` applied to one sample row: the taxel columns four at a time ([`sums`] of four bands),
+    /// so that four independent chains of additions are in flight where one taxel's sum waits on
+    /// its last addition; the columns left over one at a time.
     ///
     /// # Safety
     /// The processor must have AVX2.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn row_pass(along_x: &TaxelPass, row: &[f64], reduced: &mut [f64]) {
-        let len = along_x.len;
-        let whole = len - len % 4;
         let bands = |c: usize| {
             let (start, w) = along_x.band(c);
-            (w, &row[start..start + len])
+            (w, &row[start..start + w.len()])
         };
         let done = reduced.len() - reduced.len() % 4;
         for (q, out) in reduced.chunks_exact_mut(4).enumerate() {
-            let pairs = [0, 1, 2, 3].map(|i| bands(4 * q + i));
-            let mut acc = [_mm256_setzero_pd(); 4];
-            for m in (0..whole).step_by(4) {
-                for (acc, (w, p)) in acc.iter_mut().zip(&pairs) {
-                    // SAFETY: `m + 4 <= whole <= len`, the length of both slices.
-                    *acc = unsafe { add_product(*acc, w.as_ptr().add(m), p.as_ptr().add(m)) };
-                }
-            }
-            for ((o, acc), (w, p)) in out.iter_mut().zip(acc).zip(&pairs) {
-                *o = finish(acc, &w[whole..], &p[whole..]);
-            }
+            // SAFETY: the processor has AVX2 (this function's contract).
+            out.copy_from_slice(&unsafe { sums([0, 1, 2, 3].map(|i| bands(4 * q + i))) });
         }
         for (c, o) in reduced.iter_mut().enumerate().skip(done) {
-            let (w, p) = bands(c);
-            let mut acc = _mm256_setzero_pd();
-            for m in (0..whole).step_by(4) {
-                // SAFETY: as above.
-                acc = unsafe { add_product(acc, w.as_ptr().add(m), p.as_ptr().add(m)) };
+            // SAFETY: as above.
+            [*o] = unsafe { sums([bands(c)]) };
+        }
+    }
+
+    /// [`dot`](super::dot) of `N` pairs of bands of one length at once, each pair's four partial
+    /// sums in a register of its own (lane `l` is `dot`'s `acc[l]`).
+    ///
+    /// # Safety
+    /// The processor must have AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn sums<const N: usize>(pairs: [(&[f64], &[f64]); N]) -> [f64; N] {
+        let len = pairs.first().map_or(0, |(w, _)| w.len());
+        let whole = len - len % 4;
+        let mut acc = [_mm256_setzero_pd(); N];
+        for m in (0..whole).step_by(4) {
+            for (acc, (w, p)) in acc.iter_mut().zip(&pairs) {
+                // SAFETY: `m + 4 <= whole <= len`, the length of both slices of every pair.
+                *acc = unsafe { add_product(*acc, w.as_ptr().add(m), p.as_ptr().add(m)) };
             }
+        }
+        let mut out = [0.0; N];
+        for ((o, acc), (w, p)) in out.iter_mut().zip(acc).zip(&pairs) {
             *o = finish(acc, &w[whole..], &p[whole..]);
         }
+        out
     }
 
     /// `acc + a[0..4] * b[0..4]`, lane by lane (never fused).
