@@ -57,6 +57,8 @@ enum Command {
 
 fn main() -> ExitCode {
     quiet_on_closed_stdout();
+    // SAFETY: no thread has been started and nothing has used MuJoCo yet.
+    unsafe { taction::sim::keep_mujoco_log_off_disk() };
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Collect(args) => cli::collect::run(args),

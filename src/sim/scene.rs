@@ -257,6 +257,20 @@ fn keep_heap_top() {
     }
 }
 
+/// Stops MuJoCo from appending its messages to `MUJOCO_LOG.TXT` in the working directory; it
+/// still prints them on stderr. A run reports the faults those warnings announce itself
+/// ([`Scene::fault`]; `physics_fault` among a dataset's causes), so the file only left a stray
+/// log in the user's folder. For a program that owns its process (the `taction` command): the log
+/// configuration is MuJoCo's, global, so a library call would change a host program's log.
+///
+/// # Safety
+/// No other thread may use MuJoCo while this runs: call it at the start of the program.
+pub unsafe fn keep_mujoco_log_off_disk() {
+    let config = mujoco_rs::wrappers::mj_logging::log_config().with_logto_file(false);
+    // SAFETY: the caller holds every thread that could read MuJoCo's log configuration.
+    unsafe { mujoco_rs::wrappers::mj_logging::set_log_config(config) };
+}
+
 /// MuJoCo's warnings of a state gone bad, and what each says.
 const FAULT_WARNINGS: [(MjtWarning, &str); 3] = [
     (
