@@ -283,7 +283,8 @@ mod four_lanes {
         };
         let done = reduced.len() - reduced.len() % 4;
         for (q, out) in reduced.chunks_exact_mut(4).enumerate() {
-            // SAFETY: the processor has AVX2 (this function's contract).
+            // SAFETY: the processor has AVX2 (this function's contract), and every band of
+            // `along_x` and its slice of `row` have the pass's length.
             out.copy_from_slice(&unsafe { sums([0, 1, 2, 3].map(|i| bands(4 * q + i))) });
         }
         for (c, o) in reduced.iter_mut().enumerate().skip(done) {
@@ -296,11 +297,14 @@ mod four_lanes {
     /// sums in a register of its own (lane `l` is `dot`'s `acc[l]`).
     ///
     /// # Safety
-    /// The processor must have AVX2.
+    /// The processor must have AVX2, and every slice of `pairs` must be as long as the first
+    /// (the bands of one [`TaxelPass`] all have its length): the loads read that many values of
+    /// each.
     #[inline]
     #[target_feature(enable = "avx2")]
     unsafe fn sums<const N: usize>(pairs: [(&[f64], &[f64]); N]) -> [f64; N] {
         let len = pairs.first().map_or(0, |(w, _)| w.len());
+        debug_assert!(pairs.iter().all(|(w, p)| w.len() == len && p.len() == len));
         let whole = len - len % 4;
         let mut acc = [_mm256_setzero_pd(); N];
         for m in (0..whole).step_by(4) {
