@@ -9,8 +9,8 @@ use criterion::{BatchSize, BenchmarkId, Criterion, criterion_group, criterion_ma
 use rand::RngExt;
 use taction::dataset::{RealImport, import_real_csv};
 use taction::experiment::ACCURACY_LABEL;
+use taction::experiment::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 use taction::experiment::{Experiment, ExperimentSpec, RunOptions, SafeName, Unit, run};
-use taction::experiment::{Figure, Panel, ReferenceLine, Series};
 use taction::paper::SimToRealPreprocess;
 use taction::tactile::TactileImage;
 
@@ -111,6 +111,7 @@ fn figure(c: &mut Criterion) {
             y: 1.0 / 12.0,
             label: "chance (1/12)".into(),
         }),
+        band_label: BAND_LABEL,
     };
     let figure = Figure {
         title: "bench".into(),

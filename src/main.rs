@@ -31,6 +31,9 @@ enum Command {
     Reproduce(cli::experiment::ReproduceArgs),
     /// Combine the output directories of sharded experiment runs (`--shard k/n`) into one.
     Merge(cli::merge::MergeArgs),
+    /// Pool the runs of one experiment with different seeds (`--seed`): curves over every seed with
+    /// a 90% interval that resamples seeds, summed reliability tables, plots.
+    Pool(cli::pool::PoolArgs),
     /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
     Objects(cli::objects::ObjectsArgs),
     /// Print the absolute path of the taction.covering MuJoCo plugin library (for mj_loadPluginLibrary).
@@ -67,6 +70,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => cli::experiment::run_experiment(args),
         Command::Reproduce(args) => cli::experiment::run_reproduce(args),
         Command::Merge(args) => cli::merge::run(args),
+        Command::Pool(args) => cli::pool::run(args),
         Command::Objects(args) => cli::objects::run(args),
         Command::PluginPath(args) => cli::plugin_path::run(args),
         Command::Scene(args) => cli::scene::run(args),

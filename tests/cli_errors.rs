@@ -538,6 +538,7 @@ fn no_help_text_points_to_rust_code() {
         vec!["experiment"],
         vec!["reproduce"],
         vec!["merge"],
+        vec!["pool"],
         vec!["objects", "export"],
         vec!["objects", "letters"],
         vec!["sense"],

@@ -655,3 +655,85 @@ fn an_experiment_runs_with_the_neighbour_codebook_and_keeps_it_apart() {
     assert!(!gmm.status.success(), "a GMM run reused the kNN folder");
     assert!(stderr.contains("config.json"), "{stderr}");
 }
+
+#[test]
+fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    run_experiment("descriptors", &one, &["--seed", "1"]);
+    run_experiment("descriptors", &two, &["--seed", "2"]);
+    let pooled = dir.path().join("pooled");
+    let arg = |p: &Path| p.display().to_string();
+    let out = taction(&["pool", &arg(&one), &arg(&two), "--out", &arg(&pooled)]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(stdout.contains("descriptors: 2 seeds pooled (1, 2)"), "{stdout}");
+    assert!(stdout.contains("calibration: "), "{stdout}");
+
+    // Every seed's rows, then per point the mean over all of them and an interval around it.
+    let union = rows(&pooled.join("descriptors/descriptors.csv"));
+    let single = |root: &Path| rows(&root.join("descriptors/descriptors.csv"));
+    assert_eq!(union, [single(&one), single(&two)].concat());
+    let mut reader = csv::Reader::from_path(pooled.join("descriptors/descriptors_pooled.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    assert_eq!(
+        header.iter().collect::<Vec<_>>(),
+        [
+            "experiment",
+            "descriptor",
+            "n_readings",
+            "seeds",
+            "trials",
+            "accuracy",
+            "accuracy_low",
+            "accuracy_high",
+            "reliability"
+        ]
+    );
+    let mut points = 0;
+    for record in reader.records() {
+        let record = record.unwrap();
+        let (descriptor, n): (&str, u32) = (&record[1], record[2].parse().unwrap());
+        let number = |i: usize| record[i].parse::<f64>().unwrap();
+        let at: Vec<&AccuracyRow> = union
+            .iter()
+            .filter(|r| r.descriptor == descriptor && r.n_readings == n)
+            .collect();
+        assert_eq!(record[4].parse::<usize>().unwrap(), at.len());
+        let mean = at.iter().map(|r| r.accuracy).sum::<f64>() / at.len() as f64;
+        assert!((number(5) - mean).abs() < 1e-12, "{descriptor} {n}");
+        assert!(number(6) <= number(5) + 1e-12 && number(5) <= number(7) + 1e-12);
+        points += 1;
+    }
+    assert_eq!(
+        points,
+        union.len() / 2 / union.iter().map(|r| r.trial).max().map_or(1, |t| t as usize + 1)
+    );
+    valid_svg_and_png(&pooled.join("descriptors/descriptors"));
+    assert!(pooled.join("descriptors/descriptors_reliability.csv").is_file());
+
+    // One seed twice is not two seeds; the output may not be one of the runs.
+    let again = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "pool",
+            &arg(&one),
+            &arg(&one),
+            "--out",
+            &arg(&dir.path().join("x")),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(
+        !again.status.success() && stderr.contains("seed 1 in both"),
+        "{stderr}"
+    );
+    let into_run = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["pool", &arg(&one), &arg(&two), "--out", &arg(&two)])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&into_run.stderr);
+    assert!(
+        !into_run.status.success() && stderr.contains("is one of the runs"),
+        "{stderr}"
+    );
+}

@@ -22,7 +22,7 @@ use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, Tou
 use taction::control::sensor_reader;
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
-use taction::experiment::{Figure, Panel, ReferenceLine, Series};
+use taction::experiment::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
 use taction::explore::{ConfidenceStop, Probability};
 use taction::explore::{Planner, PlannerConfig};
@@ -484,6 +484,7 @@ fn posterior_figure(truth: &str, p_true: Vec<(f64, f64)>, touches: usize, object
                 y: 1.0 / objects as f64,
                 label: format!("chance (1/{objects})"),
             }),
+            band_label: BAND_LABEL,
         }],
     }
 }

@@ -10,6 +10,7 @@ pub mod merge;
 pub mod objects;
 pub mod plausible;
 pub mod plugin_path;
+pub mod pool;
 pub mod recognize;
 pub mod scene;
 pub mod sense;

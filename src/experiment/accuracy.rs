@@ -96,6 +96,38 @@ pub struct ReliabilityRow {
     pub ece: Option<f64>,
 }
 
+impl ReliabilityRow {
+    /// The rows of one curve's `table`, one per bin, each with the table's ECE.
+    pub fn of_table(
+        experiment: &str,
+        descriptor: &str,
+        factors: &Factors,
+        table: &ReliabilityTable,
+    ) -> Vec<ReliabilityRow> {
+        let ece = table.ece();
+        table
+            .bins()
+            .iter()
+            .enumerate()
+            .map(|(b, bin)| {
+                let (low, high) = ReliabilityTable::bounds(b);
+                ReliabilityRow {
+                    experiment: experiment.to_string(),
+                    descriptor: descriptor.to_string(),
+                    factors: factors.clone(),
+                    bin: b as u32,
+                    confidence_low: low,
+                    confidence_high: high,
+                    count: bin.count as u64,
+                    mean_confidence: bin.mean_confidence(),
+                    accuracy: bin.accuracy(),
+                    ece,
+                }
+            })
+            .collect()
+    }
+}
+
 impl DetailRow for ReliabilityRow {
     const TABLE: Option<&'static str> = Some("reliability");
 }
@@ -186,27 +218,7 @@ impl AccuracyCurve {
     /// The curve's reliability rows: `table` pooled over all its trials (so `trial` and the seeds
     /// are not columns), one row per bin, each with the table's ECE.
     pub fn reliability_rows(&self, table: &ReliabilityTable) -> Vec<ReliabilityRow> {
-        let ece = table.ece();
-        table
-            .bins()
-            .iter()
-            .enumerate()
-            .map(|(b, bin)| {
-                let (low, high) = ReliabilityTable::bounds(b);
-                ReliabilityRow {
-                    experiment: self.experiment.clone(),
-                    descriptor: self.descriptor.clone(),
-                    factors: self.factors.clone(),
-                    bin: b as u32,
-                    confidence_low: low,
-                    confidence_high: high,
-                    count: bin.count as u64,
-                    mean_confidence: bin.mean_confidence(),
-                    accuracy: bin.accuracy(),
-                    ece,
-                }
-            })
-            .collect()
+        ReliabilityRow::of_table(&self.experiment, &self.descriptor, &self.factors, table)
     }
 
     /// The per-object rows of `evaluation`: at every point, each trial's outcome (the outcomes the

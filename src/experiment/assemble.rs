@@ -165,7 +165,7 @@ pub(crate) fn plot_source(dir: &ExperimentDir, spec: &PlotSpec) -> PathBuf {
 
 /// The unit files `paths` as one table: the first one's header, then every file's rows in order;
 /// every file must have the same header.
-fn concatenate(paths: &[PathBuf]) -> Result<Vec<u8>, ExperimentError> {
+pub(crate) fn concatenate(paths: &[PathBuf]) -> Result<Vec<u8>, ExperimentError> {
     let mut out: Vec<u8> = Vec::new();
     let mut first: Option<(UnitTable, &PathBuf)> = None;
     for path in paths {

@@ -90,6 +90,42 @@ pub enum ExperimentError {
     },
     #[error("{}: no experiment output here (no <experiment>/manifest.json)", dir.display())]
     NoExperiments { dir: PathBuf },
+    #[error("pooling needs the output roots of at least two runs with different seeds, got {given}")]
+    PoolNeedsSeeds { given: usize },
+    #[error(
+        "experiment '{experiment}' differs between {} and {}: {what}; only runs that differ in their \
+         seeds pool",
+        first.display(),
+        second.display()
+    )]
+    SeedRunMismatch {
+        experiment: String,
+        first: PathBuf,
+        second: PathBuf,
+        what: String,
+    },
+    #[error(
+        "experiment '{experiment}': seed {seed} in both {} and {}; pooled runs need different seeds",
+        first.display(),
+        second.display()
+    )]
+    RepeatedSeed {
+        experiment: String,
+        seed: u64,
+        first: PathBuf,
+        second: PathBuf,
+    },
+    #[error(
+        "{}: experiment '{experiment}' is not finished (no {}); finish the run, or merge its shards, \
+         before pooling",
+        dir.display(),
+        csv.display()
+    )]
+    NotFinished {
+        experiment: String,
+        dir: PathBuf,
+        csv: PathBuf,
+    },
 }
 
 impl ExperimentError {

@@ -21,7 +21,7 @@ pub struct Series {
     pub band: Vec<(f64, f64, f64)>,
 }
 
-/// The legend entry of the shaded bands (see [`Series::band`]).
+/// The legend entry of the shaded bands of an experiment's trials (see [`Series::band`]).
 pub const BAND_LABEL: &str = "band: lowest to highest trial";
 
 /// A horizontal reference line drawn dashed, e.g. chance level (1 / number of objects).
@@ -48,6 +48,8 @@ pub struct Panel {
     /// Label the x axis at integers only (counts, such as the number of readings).
     pub integer_x: bool,
     pub reference: Option<ReferenceLine>,
+    /// The legend entry of the bands: what they span ([`BAND_LABEL`] for the trials' spread).
+    pub band_label: &'static str,
 }
 
 /// A titled figure of one or more panels, laid out two per row.
@@ -228,7 +230,7 @@ fn panel_chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
-/// Each series' band (lowest to highest trial), shaded in its colour; one legend entry for all.
+/// Each series' band, shaded in its colour; one legend entry for all ([`Panel::band_label`]).
 fn draw_bands<DB: DrawingBackend>(panel: &Panel, chart: &mut PanelChart<'_, DB>) -> DrawResult<DB> {
     let mut band_explained = false;
     for (i, series) in panel.series.iter().enumerate() {
@@ -246,7 +248,7 @@ fn draw_bands<DB: DrawingBackend>(panel: &Panel, chart: &mut PanelChart<'_, DB>)
         // One legend entry says what every band is.
         if !band_explained {
             band_explained = true;
-            drawn.label(BAND_LABEL).legend(|(x, y)| {
+            drawn.label(panel.band_label).legend(|(x, y)| {
                 Rectangle::new(
                     [(x, y - 5), (x + 22, y + 5)],
                     RGBColor(90, 90, 90).mix(0.2).filled(),

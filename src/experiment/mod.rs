@@ -9,7 +9,8 @@
 //! stopped and never duplicates a row; once every unit is present it assembles `<experiment>.csv`
 //! (and `<experiment>_<table>.csv`), draws the
 //! experiment's plots and rewrites the index `<out>/README.md`. [`merge()`] combines the outputs of
-//! separate shards into exactly the files of one unsharded run. The on-disk layout is in
+//! separate shards into exactly the files of one unsharded run; [`pool()`] combines finished runs of
+//! different seeds into curves over every seed with an interval that resamples seeds. The on-disk layout is in
 //! `layout.rs`.
 //!
 //! The framework knows nothing of MuJoCo, the paper or recognition beyond the accuracy row it
@@ -27,6 +28,7 @@ pub(crate) mod layout;
 pub(crate) mod merge;
 pub(crate) mod name;
 pub(crate) mod plot;
+pub(crate) mod pool;
 pub(crate) mod progress;
 pub(crate) mod runner;
 pub(crate) mod shard;
@@ -38,6 +40,10 @@ pub use error::{ExperimentError, UnitFailure};
 pub use factor::{Factor, FactorError, Factors};
 pub use merge::{MergeReport, merge};
 pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
+pub use pool::{
+    BySeedRow, INTERVAL_BAND_LABEL, INTERVAL_LEVEL, PoolRecord, PoolReport, PooledExperiment, PooledRow,
+    PooledRun, RESAMPLES, pool,
+};
 pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};
@@ -52,7 +58,7 @@ pub use index::write_index;
 pub use layout::ExperimentDir;
 
 // Plots: the spec of a plot, the figure it builds, its panels and series.
-pub use figure::{Figure, Panel, ReferenceLine, Series};
+pub use figure::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 pub use plot::{
     ACCURACY_LABEL, Axis, PERFECT_CALIBRATION, PlotKind, PlotSpec, build_figure, reliability_figure,
 };

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::accuracy::{AccuracyRow, ReliabilityRow};
 use super::error::ExperimentError;
 use super::factor::Factors;
-use super::figure::{Figure, Panel, ReferenceLine, Series};
+use super::figure::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 use super::layout::ExperimentDir;
 use super::name::SafeName;
 use super::unit::DetailRow;
@@ -234,7 +234,7 @@ impl<K: PartialEq, V: Default> Ordered<K, V> {
 /// The y axis of accuracy plots: the CSVs' `accuracy` column as it is.
 pub const ACCURACY_LABEL: &str = "accuracy (fraction correct)";
 
-fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
+pub(crate) fn csv_error(path: &Path, e: impl std::fmt::Display) -> ExperimentError {
     ExperimentError::Csv {
         path: path.to_path_buf(),
         what: e.to_string(),
@@ -269,6 +269,21 @@ fn accuracy_panels(
     legend: Option<&str>,
 ) -> Result<Vec<Panel>, ExperimentError> {
     let (curves, max_n) = read_accuracy_curves(csv)?;
+    arrange_accuracy_panels(csv, &curves, max_n, objects, legend, Means::series)
+}
+
+/// The panels of accuracy curves, whatever summarises each (`series` makes a curve's line and band
+/// under its label): when both the descriptor and the factor levels vary, one panel per descriptor
+/// with one line per levels (the layout of Fig. 11-13); otherwise one panel. `csv` names the
+/// source in errors of the `legend` template.
+fn arrange_accuracy_panels<V>(
+    csv: &Path,
+    curves: &Ordered<(String, Factors), V>,
+    max_n: u32,
+    objects: Option<usize>,
+    legend: Option<&str>,
+    series: impl Fn(&V, String) -> Series,
+) -> Result<Vec<Panel>, ExperimentError> {
     let mut descriptors: Vec<&str> = Vec::new();
     let mut settings: Vec<&Factors> = Vec::new();
     for ((d, f), _) in &curves.items {
@@ -285,29 +300,82 @@ fn accuracy_panels(
         descriptors
             .iter()
             .map(|&descriptor| {
-                let series = curves
+                let lines = curves
                     .items
                     .iter()
                     .filter(|((d, _), _)| d == descriptor)
-                    .map(|((d, f), m)| Ok(m.series(setting(d, f)?)))
+                    .map(|((d, f), v)| Ok(series(v, setting(d, f)?)))
                     .collect::<Result<_, ExperimentError>>()?;
-                Ok(panel(descriptor.to_string(), series))
+                Ok(panel(descriptor.to_string(), lines))
             })
             .collect()
     } else {
-        let series = curves
+        let lines = curves
             .items
             .iter()
-            .map(|((d, f), m)| {
-                Ok(m.series(if settings.len() > 1 {
-                    setting(d, f)?
-                } else {
-                    d.clone()
-                }))
+            .map(|((d, f), v)| {
+                Ok(series(
+                    v,
+                    if settings.len() > 1 {
+                        setting(d, f)?
+                    } else {
+                        d.clone()
+                    },
+                ))
             })
             .collect::<Result<_, ExperimentError>>()?;
-        Ok(vec![panel(String::new(), series)])
+        Ok(vec![panel(String::new(), lines)])
     }
+}
+
+/// One accuracy curve summarised elsewhere (`pool`): its points `(n_readings, accuracy)` and its
+/// band `(n_readings, low, high)`, both sorted by the number of readings.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SummarisedCurve {
+    pub descriptor: String,
+    pub factors: Factors,
+    pub points: Vec<(f64, f64)>,
+    pub band: Vec<(f64, f64, f64)>,
+}
+
+/// The accuracy figure of `spec` (its title, legend template and chance level) drawn from curves
+/// already summarised, laid out as [`PlotKind::Accuracy`] lays out an experiment's curves;
+/// `band_label` says what the bands are, `csv` names the source in errors.
+pub(crate) fn summarised_accuracy_figure(
+    spec: &PlotSpec,
+    csv: &Path,
+    curves: Vec<SummarisedCurve>,
+    band_label: &'static str,
+) -> Result<Figure, ExperimentError> {
+    let max_n = curves
+        .iter()
+        .flat_map(|curve| curve.points.iter().map(|&(n, _)| n as u32))
+        .max()
+        .unwrap_or(1);
+    let mut ordered = Ordered::new();
+    for curve in curves {
+        let key = (curve.descriptor.clone(), curve.factors.clone());
+        *ordered.entry(key) = Some(curve);
+    }
+    let mut panels = arrange_accuracy_panels(
+        csv,
+        &ordered,
+        max_n,
+        spec.objects,
+        spec.legend.as_deref(),
+        |curve: &Option<SummarisedCurve>, label| Series {
+            label,
+            points: curve.as_ref().map(|c| c.points.clone()).unwrap_or_default(),
+            band: curve.as_ref().map(|c| c.band.clone()).unwrap_or_default(),
+        },
+    )?;
+    for panel in &mut panels {
+        panel.band_label = band_label;
+    }
+    Ok(Figure {
+        title: spec.title.clone(),
+        panels,
+    })
 }
 
 /// Reads `csv`'s accuracy rows, each checked (fractions in [0, 1], at least one reading).
@@ -477,6 +545,7 @@ fn reliability_panel(curves: Vec<Series>) -> Panel {
         legend: true,
         integer_x: false,
         reference: None,
+        band_label: BAND_LABEL,
     }
 }
 
@@ -500,6 +569,7 @@ fn accuracy_panel(title: String, series: Vec<Series>, max_n: u32, objects: Optio
             y: 1.0 / n as f64,
             label: format!("chance (1/{n})"),
         }),
+        band_label: BAND_LABEL,
     }
 }
 
@@ -667,6 +737,7 @@ fn line_panel(x: &Axis, y: &Axis, y_count: usize, acc: Ordered<String, Means>, b
         legend,
         integer_x: false,
         reference: None,
+        band_label: BAND_LABEL,
     }
 }
 

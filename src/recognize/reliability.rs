@@ -71,6 +71,11 @@ impl ReliabilityTable {
         table
     }
 
+    /// The table of these bins (sums pooled elsewhere, e.g. read back from a reliability CSV).
+    pub fn from_bins(bins: [ReliabilityBin; CONFIDENCE_BINS]) -> Self {
+        Self { bins }
+    }
+
     /// Bin `b`'s bounds, `[b/10, (b+1)/10)` (the last one closed), as written in the CSVs.
     pub fn bounds(bin: usize) -> (f64, f64) {
         let width = CONFIDENCE_BINS as f64;

@@ -1,0 +1,1095 @@
+//! Pooling runs of several seeds: `taction pool RUNS... --out DIR` gives a recognition experiment's
+//! curves over every seed, with an interval that resamples whole seeds.
+//!
+//! One seed is one draw of everything random in a run: the datasets, the codebook's restarts, the
+//! calibration explorations, every exploration's poses. A curve of one seed therefore carries the
+//! noise of its models as well as of its test runs, and the seeds of one configuration differ by
+//! more than its trials' spread suggests (docs/measurements.md, "Nine seeds": the `active`
+//! experiment's ECE ranged 0.02-0.10 per seed and curve, 0.013-0.031 over the nine seeds pooled).
+//! A claim about a strategy needs several seeds, and its interval must resample seeds, not runs:
+//! runs of one seed share their model, so an interval over runs would be too narrow.
+//!
+//! The runs must be finished (`<experiment>.csv` assembled; merge a sharded run first) and must
+//! differ in nothing but their seeds: `manifest.json` byte for byte, `config.json` apart from its
+//! `seed` and `*_seed` fields. What is written, per experiment with recognition curves (one
+//! [`PlotKind::Accuracy`] plot of its main table), in `<out>/<experiment>/`:
+//!
+//! | file | what |
+//! |---|---|
+//! | `<experiment>.csv` | every run's accuracy rows, in the order the runs were given (each row names its seed) |
+//! | `<experiment>_pooled.csv` | one row per curve and number of readings ([`PooledRow`]) |
+//! | `<experiment>_by_seed.csv` | one row per curve, seed and number of readings ([`BySeedRow`]) |
+//! | `<experiment>_reliability.csv` | the reliability table of each curve, every seed's predictions summed ([`ReliabilityRow`]), when the runs have one |
+//! | `<stem>.svg`, `.png` | the experiment's plots over every seed: accuracy with the interval as band, reliability diagrams, and line plots of the main table's own columns (their mean over every seed's rows) |
+//! | `pool.json` | the runs and seeds pooled, the resampling, and the configuration they share |
+//!
+//! Experiments without recognition curves (`convergence`, `exploration`) are reported as skipped.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use rand::RngExt;
+use serde::ser::{SerializeStruct, Serializer};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+use super::accuracy::{AccuracyRow, ReliabilityRow, TidyRecord};
+use super::assemble::concatenate;
+use super::error::ExperimentError;
+use super::factor::Factors;
+use super::files::{create_dir_all, read};
+use super::layout::{ExperimentDir, experiments_in};
+use super::name::ExperimentName;
+use super::plot::{
+    PERFECT_CALIBRATION, PlotKind, PlotSpec, SummarisedCurve, csv_error, render_plot,
+    summarised_accuracy_figure,
+};
+use super::spec::{Manifest, to_json};
+use crate::atomic::{remove_stale_temporaries, write_if_changed};
+use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
+
+/// Resamples of the seeds behind each interval: enough that the 5th and 95th percentiles move by
+/// well under a point between resamplings.
+pub const RESAMPLES: usize = 2000;
+
+/// The interval's coverage: the 5th to the 95th percentile of the resampled pooled accuracy.
+pub const INTERVAL_LEVEL: f64 = 0.9;
+
+/// The resampling's own seed: the same runs always give the same interval.
+const RESAMPLE_SEED: u64 = 1;
+
+/// What the bands of a pooled accuracy plot are.
+pub const INTERVAL_BAND_LABEL: &str = "band: 90% interval, seeds resampled";
+
+/// One experiment pooled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledExperiment {
+    pub name: ExperimentName,
+    /// The runs' seeds, in the order the runs were given.
+    pub seeds: Vec<u64>,
+    /// Every file written, tables first.
+    pub files: Vec<PathBuf>,
+    /// Each curve of the pooled reliability diagrams, named with its pooled ECE.
+    pub calibration: Vec<String>,
+}
+
+/// What a pool produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoolReport {
+    pub pooled: Vec<PooledExperiment>,
+    /// Experiments found in every run but not pooled, with the reason.
+    pub skipped: Vec<(ExperimentName, String)>,
+}
+
+/// One point of one curve over every seed.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment`, `descriptor`, factor columns, `n_readings` | as in [`AccuracyRow`] |
+/// | `seeds` | runs pooled at this point |
+/// | `trials` | trials pooled (every seed's) |
+/// | `accuracy` | the mean of every trial's accuracy, all seeds together |
+/// | `accuracy_low`, `accuracy_high` | the [`INTERVAL_LEVEL`] percentile interval of that mean over [`RESAMPLES`] resamples of whole seeds (with replacement, each resample as many seeds as were given) |
+/// | `reliability` | the mean of every trial's reliability |
+/// | the experiment's own columns | each the mean of that column over every trial (`active`: the share of objects stopped, and stopped right, by each threshold) |
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub factors: Factors,
+    pub n_readings: u32,
+    pub seeds: usize,
+    pub trials: usize,
+    pub accuracy: f64,
+    pub accuracy_low: f64,
+    pub accuracy_high: f64,
+    pub reliability: f64,
+    pub extras: Vec<(String, f64)>,
+}
+
+impl Serialize for PooledRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let width = 9 + self.factors.len() + self.extras.len();
+        let mut row = serializer.serialize_struct("PooledRow", width)?;
+        row.serialize_field("experiment", &self.experiment)?;
+        row.serialize_field("descriptor", &self.descriptor)?;
+        self.factors.serialize_columns(&mut row)?;
+        row.serialize_field("n_readings", &self.n_readings)?;
+        row.serialize_field("seeds", &self.seeds)?;
+        row.serialize_field("trials", &self.trials)?;
+        row.serialize_field("accuracy", &self.accuracy)?;
+        row.serialize_field("accuracy_low", &self.accuracy_low)?;
+        row.serialize_field("accuracy_high", &self.accuracy_high)?;
+        row.serialize_field("reliability", &self.reliability)?;
+        for (column, value) in &self.extras {
+            // Columns named at run time: serde's struct fields want static names, so each is
+            // leaked once per distinct name (a handful per process).
+            row.serialize_field(static_name(column), value)?;
+        }
+        row.end()
+    }
+}
+
+/// One point of one curve of one seed: its trials' mean.
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] |
+/// | `seed` | the run's seed |
+/// | `n_readings` | as in [`AccuracyRow`] |
+/// | `trials` | the run's trials at this point |
+/// | `accuracy`, `reliability` | the mean over those trials |
+#[derive(Debug, Clone, PartialEq)]
+pub struct BySeedRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub factors: Factors,
+    pub seed: u64,
+    pub n_readings: u32,
+    pub trials: usize,
+    pub accuracy: f64,
+    pub reliability: f64,
+}
+
+impl Serialize for BySeedRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("BySeedRow", 7 + self.factors.len())?;
+        row.serialize_field("experiment", &self.experiment)?;
+        row.serialize_field("descriptor", &self.descriptor)?;
+        self.factors.serialize_columns(&mut row)?;
+        row.serialize_field("seed", &self.seed)?;
+        row.serialize_field("n_readings", &self.n_readings)?;
+        row.serialize_field("trials", &self.trials)?;
+        row.serialize_field("accuracy", &self.accuracy)?;
+        row.serialize_field("reliability", &self.reliability)?;
+        row.end()
+    }
+}
+
+/// A column name as the `&'static str` serde's struct fields take.
+fn static_name(column: &str) -> &'static str {
+    use std::collections::BTreeSet;
+    use std::sync::Mutex;
+    static NAMES: Mutex<BTreeSet<&'static str>> = Mutex::new(BTreeSet::new());
+    let mut names = NAMES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some(&name) = names.get(column) {
+        return name;
+    }
+    let name: &'static str = Box::leak(column.to_string().into_boxed_str());
+    names.insert(name);
+    name
+}
+
+/// `pool.json`: what was pooled and how.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoolRecord {
+    pub experiment: ExperimentName,
+    /// Each run's experiment directory and seed, in the order given.
+    pub runs: Vec<PooledRun>,
+    pub resamples: usize,
+    pub interval_level: f64,
+    pub resample_seed: u64,
+    /// The configuration every run shares: the first run's `config.json` without its seeds.
+    pub config: Value,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PooledRun {
+    pub dir: PathBuf,
+    pub seed: u64,
+}
+
+/// Pools the runs `inputs` into `out`, experiment by experiment: each input the output root of
+/// one finished run (its `--out`) or one experiment's folder in it (`results/active`). Every input
+/// must hold the same experiments.
+pub fn pool(inputs: &[PathBuf], out: &Path) -> Result<PoolReport, ExperimentError> {
+    if inputs.len() < 2 {
+        return Err(ExperimentError::PoolNeedsSeeds { given: inputs.len() });
+    }
+    let mut found: Vec<Vec<ExperimentDir>> = Vec::new();
+    for input in inputs {
+        let dirs = experiment_dirs(input)?;
+        if dirs.is_empty() {
+            return Err(ExperimentError::NoExperiments { dir: input.clone() });
+        }
+        found.push(dirs);
+    }
+    let names: Vec<&ExperimentName> = found[0].iter().map(ExperimentDir::name).collect();
+    for (input, dirs) in inputs.iter().zip(&found).skip(1) {
+        let here: Vec<&ExperimentName> = dirs.iter().map(ExperimentDir::name).collect();
+        if let Some(missing) = names.iter().find(|n| !here.contains(n)) {
+            return Err(not_in_both(missing, &inputs[0], input));
+        }
+        if let Some(extra) = here.iter().find(|n| !names.contains(n)) {
+            return Err(not_in_both(extra, input, &inputs[0]));
+        }
+    }
+    let mut report = PoolReport {
+        pooled: Vec::new(),
+        skipped: Vec::new(),
+    };
+    for (i, name) in names.iter().enumerate() {
+        let runs: Vec<&ExperimentDir> = found.iter().map(|dirs| &dirs[i]).collect();
+        match pool_experiment(&runs, out)? {
+            Ok(pooled) => report.pooled.push(pooled),
+            Err(why) => report.skipped.push(((*name).clone(), why)),
+        }
+    }
+    Ok(report)
+}
+
+/// The experiments of `input`: the one it is (a folder holding `manifest.json`, such as
+/// `results/active`), or those of the output root it is.
+fn experiment_dirs(input: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
+    if input.join("manifest.json").is_file() {
+        let name =
+            input
+                .file_name()
+                .and_then(|n| n.to_str())
+                .ok_or_else(|| ExperimentError::NoExperiments {
+                    dir: input.to_path_buf(),
+                })?;
+        let parent = input.parent().unwrap_or_else(|| Path::new("."));
+        return Ok(vec![ExperimentDir::new(parent, &ExperimentName::new(name)?)]);
+    }
+    experiments_in(input)
+}
+
+fn not_in_both(name: &ExperimentName, has: &Path, lacks: &Path) -> ExperimentError {
+    ExperimentError::SeedRunMismatch {
+        experiment: name.to_string(),
+        first: has.to_path_buf(),
+        second: lacks.to_path_buf(),
+        what: "the first holds it, the second does not".to_string(),
+    }
+}
+
+/// One run of the experiment: its directory, seed, and assembled accuracy rows with the
+/// experiment's own columns.
+struct SeedRun<'a> {
+    dir: &'a ExperimentDir,
+    seed: u64,
+    rows: Vec<(AccuracyRow, Vec<f64>)>,
+}
+
+/// Pools one experiment's `runs`; `Ok(Err(why))` when it has no recognition curves to pool.
+fn pool_experiment(
+    runs: &[&ExperimentDir],
+    out: &Path,
+) -> Result<Result<PooledExperiment, String>, ExperimentError> {
+    let first = runs[0];
+    let name = first.name();
+    let manifest_bytes = read(&first.manifest())?;
+    for other in &runs[1..] {
+        if read(&other.manifest())? != manifest_bytes {
+            return Err(mismatch(name, first, other, "manifest.json differs"));
+        }
+    }
+    let manifest = Manifest::read(&first.manifest())?;
+    let Some(accuracy_plot) = manifest
+        .spec
+        .plots
+        .iter()
+        .find(|p| p.kind == PlotKind::Accuracy && p.table.is_none())
+    else {
+        return Ok(Err(
+            "no recognition curves (no accuracy plot of its main table)".to_string()
+        ));
+    };
+    let (config, seeds) = shared_config(runs)?;
+    let columns = shared_columns(runs)?;
+    let extras: Vec<String> = match columns.iter().position(|c| c == "stream_seed") {
+        Some(last) => columns[last + 1..].to_vec(),
+        None => Vec::new(),
+    };
+    let runs: Vec<SeedRun> = runs
+        .iter()
+        .zip(&seeds)
+        .map(|(&dir, &seed)| read_run(dir, seed, &extras))
+        .collect::<Result<_, _>>()?;
+
+    let target = ExperimentDir::new(out, name);
+    for folder in [out, target.root()] {
+        create_dir_all(folder)?;
+        remove_stale_temporaries(folder)?;
+    }
+    let mut files = Vec::new();
+    let union = target.csv();
+    let sources: Vec<PathBuf> = runs.iter().map(|r| r.dir.csv()).collect();
+    write_if_changed(&union, &concatenate(&sources)?)?;
+    files.push(union.clone());
+
+    let curves = Curves::of(&runs, &extras)?;
+    let pooled = curves.pooled(name, &extras);
+    let pooled_csv = target.root().join(format!("{name}_pooled.csv"));
+    write_if_changed(&pooled_csv, &csv_bytes(&pooled, &pooled_csv)?)?;
+    files.push(pooled_csv.clone());
+    let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
+    write_if_changed(
+        &by_seed_csv,
+        &csv_bytes(&curves.by_seed(name, &seeds), &by_seed_csv)?,
+    )?;
+    files.push(by_seed_csv);
+
+    let reliability = pool_reliability(&runs, &manifest, &target)?;
+    files.extend(reliability.clone());
+
+    let title = |spec: &PlotSpec| format!("{} ({} seeds pooled)", spec.title, seeds.len());
+    let mut calibration = Vec::new();
+    let mut plots = Vec::new();
+    for spec in &manifest.spec.plots {
+        let titled = PlotSpec {
+            title: title(spec),
+            ..spec.clone()
+        };
+        match (&spec.kind, &spec.table) {
+            (PlotKind::Accuracy, None) if spec == accuracy_plot => {
+                let figure = summarised_accuracy_figure(
+                    &titled,
+                    &pooled_csv,
+                    pooled_curves(&pooled),
+                    INTERVAL_BAND_LABEL,
+                )?;
+                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
+                figure.write_svg(&svg)?;
+                figure.write_png(&png)?;
+                plots.extend([svg, png]);
+            }
+            (PlotKind::Reliability, Some(_)) => {
+                if let Some(table) = &reliability {
+                    let (figure, paths) = render_plot(&titled, table, &target)?;
+                    calibration.extend(figure.panels.iter().flat_map(|panel| {
+                        let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
+                        curves.map(|s| s.label.clone())
+                    }));
+                    plots.extend(paths);
+                }
+            }
+            (PlotKind::Lines { .. }, None) => plots.extend(render_plot(&titled, &union, &target)?.1),
+            // Other plots read tables that are not pooled (per-object rows).
+            _ => {}
+        }
+    }
+    files.extend(plots);
+
+    let record = PoolRecord {
+        experiment: name.clone(),
+        runs: runs
+            .iter()
+            .map(|r| PooledRun {
+                dir: r.dir.root().to_path_buf(),
+                seed: r.seed,
+            })
+            .collect(),
+        resamples: RESAMPLES,
+        interval_level: INTERVAL_LEVEL,
+        resample_seed: RESAMPLE_SEED,
+        config,
+    };
+    let record_path = target.root().join("pool.json");
+    write_if_changed(&record_path, &to_json(&record, &record_path)?)?;
+    files.push(record_path);
+    Ok(Ok(PooledExperiment {
+        name: name.clone(),
+        seeds,
+        files,
+        calibration,
+    }))
+}
+
+fn mismatch(
+    name: &ExperimentName,
+    first: &ExperimentDir,
+    second: &ExperimentDir,
+    what: impl Into<String>,
+) -> ExperimentError {
+    ExperimentError::SeedRunMismatch {
+        experiment: name.to_string(),
+        first: first.root().to_path_buf(),
+        second: second.root().to_path_buf(),
+        what: what.into(),
+    }
+}
+
+/// Whether a configuration field is a seed (the run's `seed`, a derived `training.seed`, a sensor's
+/// `noise_seed`): the one thing pooled runs may differ in.
+fn is_seed_field(key: &str) -> bool {
+    key == "seed" || key.ends_with("_seed")
+}
+
+/// `value` without its seed fields, at any depth.
+fn without_seeds(value: &Value) -> Value {
+    match value {
+        Value::Object(map) => Value::Object(
+            map.iter()
+                .filter(|(k, _)| !is_seed_field(k))
+                .map(|(k, v)| (k.clone(), without_seeds(v)))
+                .collect(),
+        ),
+        Value::Array(items) => Value::Array(items.iter().map(without_seeds).collect()),
+        other => other.clone(),
+    }
+}
+
+/// The first place where `a` and `b` differ, as a path of keys and indices with both values.
+fn first_difference(a: &Value, b: &Value, at: &str) -> Option<String> {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let here = format!("{at}/{k}");
+                match (x.get(k), y.get(k)) {
+                    (Some(u), Some(v)) => first_difference(u, v, &here),
+                    (u, v) => Some(format!("{here}: {} vs {}", shown(u), shown(v))),
+                }
+            })
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (u, v))| first_difference(u, v, &format!("{at}/{i}"))),
+        _ if a == b => None,
+        _ => Some(format!(
+            "{}: {} vs {}",
+            if at.is_empty() { "/" } else { at },
+            shown(Some(a)),
+            shown(Some(b))
+        )),
+    }
+}
+
+fn shown(value: Option<&Value>) -> String {
+    let text = value.map_or_else(|| "absent".to_string(), Value::to_string);
+    match text.char_indices().nth(60) {
+        Some((cut, _)) => format!("{}...", &text[..cut]),
+        None => text,
+    }
+}
+
+/// The configuration the runs share (the first's without its seeds) and each run's seed; an error
+/// when they differ in more than their seeds or share a seed.
+fn shared_config(runs: &[&ExperimentDir]) -> Result<(Value, Vec<u64>), ExperimentError> {
+    let name = runs[0].name();
+    let mut configs = Vec::new();
+    let mut seeds: Vec<u64> = Vec::new();
+    for &run in runs {
+        let path = run.config();
+        let value: Value = serde_json::from_slice(&read(&path)?).map_err(|e| ExperimentError::Json {
+            path: path.clone(),
+            what: e.to_string(),
+        })?;
+        let seed = value
+            .get("seed")
+            .and_then(Value::as_u64)
+            .ok_or_else(|| ExperimentError::Json {
+                path: path.clone(),
+                what: "no top-level 'seed' (a run's seed) to tell the pooled runs apart".to_string(),
+            })?;
+        if let Some(i) = seeds.iter().position(|&s| s == seed) {
+            return Err(ExperimentError::RepeatedSeed {
+                experiment: name.to_string(),
+                seed,
+                first: runs[i].root().to_path_buf(),
+                second: run.root().to_path_buf(),
+            });
+        }
+        seeds.push(seed);
+        configs.push(without_seeds(&value));
+    }
+    for (run, config) in runs.iter().zip(&configs).skip(1) {
+        if let Some(what) = first_difference(&configs[0], config, "") {
+            return Err(mismatch(name, runs[0], run, format!("config.json {what}")));
+        }
+    }
+    Ok((configs.swap_remove(0), seeds))
+}
+
+/// The header every run's `<experiment>.csv` shares.
+fn shared_columns(runs: &[&ExperimentDir]) -> Result<Vec<String>, ExperimentError> {
+    let mut columns: Option<Vec<String>> = None;
+    for &run in runs {
+        let path = run.csv();
+        if !path.is_file() {
+            return Err(ExperimentError::NotFinished {
+                experiment: run.name().to_string(),
+                dir: run.root().to_path_buf(),
+                csv: path,
+            });
+        }
+        let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
+        let header: Vec<String> = reader
+            .headers()
+            .map_err(|e| csv_error(&path, e))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        match &columns {
+            None => columns = Some(header),
+            Some(first) if *first != header => {
+                return Err(mismatch(
+                    run.name(),
+                    runs[0],
+                    run,
+                    format!(
+                        "the columns of {}.csv differ ('{}' vs '{}')",
+                        run.name(),
+                        first.join(","),
+                        header.join(",")
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(columns.unwrap_or_default())
+}
+
+/// The accuracy rows of one run with its `extras` columns; every row must carry the run's seed.
+fn read_run<'a>(
+    dir: &'a ExperimentDir,
+    seed: u64,
+    extras: &[String],
+) -> Result<SeedRun<'a>, ExperimentError> {
+    let path = dir.csv();
+    let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
+    let mut rows = Vec::new();
+    for (i, record) in reader.deserialize::<TidyRecord>().enumerate() {
+        let line = i + 2;
+        let at_line = |what: String| csv_error(&path, format!("line {line}: {what}"));
+        let record = record.map_err(|e| csv_error(&path, e))?;
+        let row = AccuracyRow::from_record(&record).map_err(at_line)?;
+        if row.seed != seed {
+            return Err(at_line(format!(
+                "a row of seed {} in a run whose config.json says seed {seed}",
+                row.seed
+            )));
+        }
+        let values = extras
+            .iter()
+            .map(|column| {
+                let value: f64 = record.number(column)?;
+                if value.is_finite() {
+                    Ok(value)
+                } else {
+                    Err(format!("column '{column}': {value} is not finite"))
+                }
+            })
+            .collect::<Result<Vec<f64>, String>>()
+            .map_err(at_line)?;
+        rows.push((row, values));
+    }
+    if rows.is_empty() {
+        return Err(csv_error(&path, "no rows"));
+    }
+    Ok(SeedRun { dir, seed, rows })
+}
+
+/// One seed's trials at one point of one curve, summed.
+#[derive(Debug, Clone, Default)]
+struct SeedSums {
+    trials: usize,
+    accuracy: f64,
+    reliability: f64,
+    extras: Vec<f64>,
+}
+
+/// A curve: its descriptor and factor levels.
+type CurveKey = (String, Factors);
+
+/// Per number of readings, each seed's sums in the order the runs were given.
+type PointSums = BTreeMap<u32, Vec<SeedSums>>;
+
+/// Every curve (descriptor and factor levels, in order of first appearance) with, per number of
+/// readings, each seed's sums in the order the runs were given.
+struct Curves {
+    items: Vec<(CurveKey, PointSums)>,
+    seeds: usize,
+}
+
+impl Curves {
+    /// Sums every run's rows; every seed must have every point some seed has.
+    fn of(runs: &[SeedRun], extras: &[String]) -> Result<Self, ExperimentError> {
+        let mut items: Vec<(CurveKey, PointSums)> = Vec::new();
+        let blank = SeedSums {
+            extras: vec![0.0; extras.len()],
+            ..SeedSums::default()
+        };
+        for (s, run) in runs.iter().enumerate() {
+            for (row, values) in &run.rows {
+                let key = (row.descriptor.clone(), row.factors.clone());
+                let i = match items.iter().position(|(k, _)| *k == key) {
+                    Some(i) => i,
+                    None => {
+                        items.push((key, BTreeMap::new()));
+                        items.len() - 1
+                    }
+                };
+                let point = items[i]
+                    .1
+                    .entry(row.n_readings)
+                    .or_insert_with(|| vec![blank.clone(); runs.len()]);
+                let sums = &mut point[s];
+                sums.trials += 1;
+                sums.accuracy += row.accuracy;
+                sums.reliability += row.reliability;
+                for (total, value) in sums.extras.iter_mut().zip(values) {
+                    *total += value;
+                }
+            }
+        }
+        for ((descriptor, factors), points) in &items {
+            for (n, sums) in points {
+                if let Some(s) = sums.iter().position(|sum| sum.trials == 0) {
+                    return Err(csv_error(
+                        &runs[s].dir.csv(),
+                        format!(
+                            "no rows for {descriptor} {factors} at {n} readings, which seed {} has",
+                            runs[sums.iter().position(|sum| sum.trials > 0).unwrap_or(0)].seed
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(Self {
+            items,
+            seeds: runs.len(),
+        })
+    }
+
+    /// The pooled rows, curve by curve, each point's interval from one shared set of resamples.
+    fn pooled(&self, experiment: &ExperimentName, extras: &[String]) -> Vec<PooledRow> {
+        let draws = resamples(self.seeds);
+        let mut rows = Vec::new();
+        for ((descriptor, factors), points) in &self.items {
+            for (&n, sums) in points {
+                let trials: usize = sums.iter().map(|s| s.trials).sum();
+                let mean = |part: fn(&SeedSums) -> f64| sums.iter().map(part).sum::<f64>() / trials as f64;
+                let (accuracy_low, accuracy_high) = interval(sums, &draws);
+                rows.push(PooledRow {
+                    experiment: experiment.to_string(),
+                    descriptor: descriptor.clone(),
+                    factors: factors.clone(),
+                    n_readings: n,
+                    seeds: sums.len(),
+                    trials,
+                    accuracy: mean(|s| s.accuracy),
+                    accuracy_low,
+                    accuracy_high,
+                    reliability: mean(|s| s.reliability),
+                    extras: extras
+                        .iter()
+                        .enumerate()
+                        .map(|(e, column)| {
+                            let total: f64 = sums.iter().map(|s| s.extras[e]).sum();
+                            (column.clone(), total / trials as f64)
+                        })
+                        .collect(),
+                });
+            }
+        }
+        rows
+    }
+
+    fn by_seed(&self, experiment: &ExperimentName, seeds: &[u64]) -> Vec<BySeedRow> {
+        let mut rows = Vec::new();
+        for ((descriptor, factors), points) in &self.items {
+            for (s, &seed) in seeds.iter().enumerate() {
+                for (&n, sums) in points {
+                    let sum = &sums[s];
+                    rows.push(BySeedRow {
+                        experiment: experiment.to_string(),
+                        descriptor: descriptor.clone(),
+                        factors: factors.clone(),
+                        seed,
+                        n_readings: n,
+                        trials: sum.trials,
+                        accuracy: sum.accuracy / sum.trials as f64,
+                        reliability: sum.reliability / sum.trials as f64,
+                    });
+                }
+            }
+        }
+        rows
+    }
+}
+
+/// [`RESAMPLES`] draws of `seeds` seed indices each, with replacement.
+fn resamples(seeds: usize) -> Vec<Vec<usize>> {
+    let mut rng = crate::rng::rng(RESAMPLE_SEED);
+    (0..RESAMPLES)
+        .map(|_| (0..seeds).map(|_| rng.random_range(0..seeds)).collect())
+        .collect()
+}
+
+/// The [`INTERVAL_LEVEL`] percentile interval of the pooled accuracy over `draws` (linear
+/// interpolation between order statistics, numpy's default).
+fn interval(sums: &[SeedSums], draws: &[Vec<usize>]) -> (f64, f64) {
+    let mut means: Vec<f64> = draws
+        .iter()
+        .map(|draw| {
+            let (correct, trials) = draw.iter().fold((0.0, 0usize), |(c, t), &s| {
+                (c + sums[s].accuracy, t + sums[s].trials)
+            });
+            correct / trials as f64
+        })
+        .collect();
+    means.sort_by(f64::total_cmp);
+    let tail = (1.0 - INTERVAL_LEVEL) / 2.0;
+    (percentile(&means, tail), percentile(&means, 1.0 - tail))
+}
+
+/// The `q` quantile of `sorted` (non-empty), interpolating linearly between order statistics.
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let h = q * (sorted.len() - 1) as f64;
+    let (below, fraction) = (h.floor() as usize, h - h.floor());
+    match sorted.get(below + 1) {
+        Some(&above) => sorted[below] + fraction * (above - sorted[below]),
+        None => sorted[below],
+    }
+}
+
+/// The curves of the pooled rows, as the accuracy figure draws them.
+fn pooled_curves(rows: &[PooledRow]) -> Vec<SummarisedCurve> {
+    let mut curves: Vec<SummarisedCurve> = Vec::new();
+    for row in rows {
+        let i = match curves
+            .iter()
+            .position(|c| c.descriptor == row.descriptor && c.factors == row.factors)
+        {
+            Some(i) => i,
+            None => {
+                curves.push(SummarisedCurve {
+                    descriptor: row.descriptor.clone(),
+                    factors: row.factors.clone(),
+                    points: Vec::new(),
+                    band: Vec::new(),
+                });
+                curves.len() - 1
+            }
+        };
+        let n = f64::from(row.n_readings);
+        curves[i].points.push((n, row.accuracy));
+        curves[i].band.push((n, row.accuracy_low, row.accuracy_high));
+    }
+    curves
+}
+
+/// The reliability tables of the runs summed curve by curve into `<experiment>_reliability.csv`,
+/// when the manifest has the table and every run assembled it; the file written.
+fn pool_reliability(
+    runs: &[SeedRun],
+    manifest: &Manifest,
+    target: &ExperimentDir,
+) -> Result<Option<PathBuf>, ExperimentError> {
+    let Some(table) = manifest.details.iter().find(|t| t.as_str() == "reliability") else {
+        return Ok(None);
+    };
+    let mut curves: Vec<((String, String, Factors), ReliabilityTable)> = Vec::new();
+    for run in runs {
+        let path = run.dir.detail_csv(table);
+        if !path.is_file() {
+            return Err(ExperimentError::NotFinished {
+                experiment: run.dir.name().to_string(),
+                dir: run.dir.root().to_path_buf(),
+                csv: path,
+            });
+        }
+        let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
+        let mut bins: Vec<((String, String, Factors), [ReliabilityBin; 10])> = Vec::new();
+        for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
+            let row = row.map_err(|e| csv_error(&path, e))?;
+            let bin = usize::try_from(row.bin)
+                .ok()
+                .filter(|&b| b < CONFIDENCE_BINS)
+                .ok_or_else(|| csv_error(&path, format!("line {}: bin {} is not 0-9", i + 2, row.bin)))?;
+            let key = (
+                row.experiment.clone(),
+                row.descriptor.clone(),
+                row.factors.clone(),
+            );
+            let j = match bins.iter().position(|(k, _)| *k == key) {
+                Some(j) => j,
+                None => {
+                    bins.push((key, [ReliabilityBin::default(); CONFIDENCE_BINS]));
+                    bins.len() - 1
+                }
+            };
+            let count = usize::try_from(row.count).unwrap_or(usize::MAX);
+            bins[j].1[bin] = ReliabilityBin {
+                count,
+                // The bin's sums back from its means: the count of right guesses exactly (a ratio
+                // of integers far below 2^52), the summed confidence to rounding.
+                confidence_sum: row.mean_confidence.unwrap_or(0.0) * count as f64,
+                correct: (row.accuracy.unwrap_or(0.0) * count as f64).round() as usize,
+            };
+        }
+        for (key, bins) in bins {
+            let table = ReliabilityTable::from_bins(bins);
+            match curves.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, pooled)) => pooled.merge(&table),
+                None => curves.push((key, table)),
+            }
+        }
+    }
+    let rows: Vec<ReliabilityRow> = curves
+        .iter()
+        .flat_map(|((experiment, descriptor, factors), table)| {
+            ReliabilityRow::of_table(experiment, descriptor, factors, table)
+        })
+        .collect();
+    let path = target.detail_csv(table);
+    write_if_changed(&path, &csv_bytes(&rows, &path)?)?;
+    Ok(Some(path))
+}
+
+/// `rows` as CSV with a header; `path` names the destination in errors.
+fn csv_bytes<R: Serialize>(rows: &[R], path: &Path) -> Result<Vec<u8>, ExperimentError> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for row in rows {
+        writer.serialize(row).map_err(|e| csv_error(path, e))?;
+    }
+    writer.into_inner().map_err(|e| csv_error(path, e.error()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes a finished run of the toy experiment under `root`: its manifest (an accuracy plot
+    /// and a reliability table), `config` with `seed`, and the accuracy rows `trials[t][n - 1]`
+    /// with an extra column `stopped` equal to the accuracy halved.
+    fn write_run(root: &Path, seed: u64, config: &str, trials: &[&[f64]], reliability: Option<&str>) {
+        let dir = root.join("toy");
+        std::fs::create_dir_all(&dir).unwrap();
+        let manifest = r#"{"name":"toy","description":"a toy","plots":[{"stem":"toy","title":"Toy","kind":"accuracy","objects":4},{"stem":"toy-reliability","title":"Calibration","kind":"reliability","objects":null,"table":"reliability"}],"details":["reliability"],"units":["all"]}"#;
+        std::fs::write(dir.join("manifest.json"), manifest).unwrap();
+        std::fs::write(
+            dir.join("config.json"),
+            format!(
+                r#"{{"seed": {seed}, "training": {{"seed": {}}}, {config}}}"#,
+                seed * 7919
+            ),
+        )
+        .unwrap();
+        let mut csv = String::from(
+            "experiment,descriptor,noise_fraction,trial,n_readings,accuracy,reliability,seed,stream_seed,stopped\n",
+        );
+        for (t, points) in trials.iter().enumerate() {
+            for (i, a) in points.iter().enumerate() {
+                csv += &format!(
+                    "toy,mnti,0.1,{t},{},{a},{},{seed},-5,{}\n",
+                    i + 1,
+                    a / 2.0,
+                    a / 2.0
+                );
+            }
+        }
+        std::fs::write(dir.join("toy.csv"), csv).unwrap();
+        if let Some(rows) = reliability {
+            let header = "experiment,descriptor,noise_fraction,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n";
+            std::fs::write(dir.join("toy_reliability.csv"), format!("{header}{rows}")).unwrap();
+        }
+    }
+
+    /// One bin of a toy reliability table, the other nine empty.
+    fn reliability(bin: u32, count: u64, mean_confidence: f64, accuracy: f64) -> String {
+        (0..10)
+            .map(|b| {
+                let (low, high) = ReliabilityTable::bounds(b);
+                if b == bin as usize {
+                    format!("toy,mnti,0.1,{b},{low:?},{high:?},{count},{mean_confidence},{accuracy},0.1\n")
+                } else {
+                    format!("toy,mnti,0.1,{b},{low:?},{high:?},0,,,0.1\n")
+                }
+            })
+            .collect()
+    }
+
+    const SCALE: &str = r#""scale": 1.0"#;
+
+    fn two_runs(root: &Path) -> Vec<PathBuf> {
+        let (a, b) = (root.join("a"), root.join("b"));
+        write_run(
+            &a,
+            1,
+            SCALE,
+            &[&[0.5, 1.0], &[1.0, 1.0]],
+            Some(&reliability(9, 4, 0.95, 0.75)),
+        );
+        write_run(
+            &b,
+            2,
+            SCALE,
+            &[&[0.25, 0.5], &[0.25, 0.5]],
+            Some(&reliability(9, 4, 0.95, 1.0)),
+        );
+        vec![a, b]
+    }
+
+    fn rows(path: &Path) -> Vec<csv::StringRecord> {
+        csv::Reader::from_path(path)
+            .unwrap()
+            .records()
+            .map(Result::unwrap)
+            .collect()
+    }
+
+    #[test]
+    fn pooled_curves_average_every_trial_of_every_seed_with_an_interval_between_the_seeds() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let out = root.path().join("pooled");
+        let report = pool(&runs, &out).unwrap();
+        assert_eq!(report.pooled.len(), 1);
+        assert_eq!(report.pooled[0].seeds, vec![1, 2]);
+        let pooled = rows(&out.join("toy/toy_pooled.csv"));
+        // experiment,descriptor,noise_fraction,n_readings,seeds,trials,accuracy,low,high,reliability,stopped
+        let first: Vec<&str> = pooled[0].iter().collect();
+        assert_eq!(&first[..6], ["toy", "mnti", "0.1", "1", "2", "4"]);
+        let number = |r: &csv::StringRecord, i: usize| r[i].parse::<f64>().unwrap();
+        // (0.5 + 1 + 0.25 + 0.25) / 4; seed 1's mean 0.75, seed 2's 0.25.
+        assert_eq!(number(&pooled[0], 6), 0.5);
+        let (low, high) = (number(&pooled[0], 7), number(&pooled[0], 8));
+        assert!(
+            (0.25..0.5).contains(&low) && high > 0.5 && high <= 0.75,
+            "{low} {high}"
+        );
+        assert_eq!(number(&pooled[0], 9), 0.25);
+        assert_eq!(number(&pooled[0], 10), 0.25);
+        // n = 2: (1 + 1 + 0.5 + 0.5) / 4
+        assert_eq!(number(&pooled[1], 6), 0.75);
+        let by_seed = rows(&out.join("toy/toy_by_seed.csv"));
+        let means: Vec<(String, f64)> = by_seed.iter().map(|r| (r[3].to_string(), number(r, 6))).collect();
+        assert_eq!(
+            means,
+            [
+                ("1".into(), 0.75),
+                ("1".into(), 1.0),
+                ("2".into(), 0.25),
+                ("2".into(), 0.5)
+            ]
+        );
+        // Every seed's rows, as they were.
+        let union = std::fs::read_to_string(out.join("toy/toy.csv")).unwrap();
+        assert_eq!(union.lines().count(), 1 + 4 + 4);
+        assert!(out.join("toy/toy.svg").is_file() && out.join("toy/toy-reliability.png").is_file());
+        let record: PoolRecord =
+            serde_json::from_slice(&std::fs::read(out.join("toy/pool.json")).unwrap()).unwrap();
+        assert_eq!(record.runs.iter().map(|r| r.seed).collect::<Vec<_>>(), [1, 2]);
+        assert_eq!(record.config, serde_json::json!({"scale": 1.0, "training": {}}));
+    }
+
+    #[test]
+    fn the_same_runs_pool_to_the_same_bytes() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let (one, two) = (root.path().join("one"), root.path().join("two"));
+        pool(&runs, &one).unwrap();
+        pool(&runs, &two).unwrap();
+        for file in [
+            "toy.csv",
+            "toy_pooled.csv",
+            "toy_by_seed.csv",
+            "toy_reliability.csv",
+            "toy.svg",
+        ] {
+            assert_eq!(
+                std::fs::read(one.join("toy").join(file)).unwrap(),
+                std::fs::read(two.join("toy").join(file)).unwrap(),
+                "{file}"
+            );
+        }
+    }
+
+    #[test]
+    fn reliability_tables_sum_their_predictions() {
+        let root = tempfile::tempdir().unwrap();
+        let out = root.path().join("pooled");
+        let report = pool(&two_runs(root.path()), &out).unwrap();
+        let pooled = rows(&out.join("toy/toy_reliability.csv"));
+        assert_eq!(pooled.len(), 10);
+        // Eight predictions at mean confidence 0.95, seven right: ECE |7/8 - 0.95| = 0.075.
+        assert_eq!(&pooled[9][6], "8");
+        assert_eq!(pooled[9][8].parse::<f64>().unwrap(), 0.875);
+        let ece: f64 = pooled[9][9].parse().unwrap();
+        assert!((ece - 0.075).abs() < 1e-12, "{ece}");
+        assert!(
+            report.pooled[0].calibration[0].contains("ECE 0.075"),
+            "{:?}",
+            report.pooled[0].calibration
+        );
+    }
+
+    #[test]
+    fn runs_that_differ_in_more_than_their_seeds_are_refused_naming_the_field() {
+        let root = tempfile::tempdir().unwrap();
+        let (a, b) = (root.path().join("a"), root.path().join("b"));
+        write_run(&a, 1, SCALE, &[&[0.5]], None);
+        write_run(&b, 2, r#""scale": 0.3"#, &[&[0.5]], None);
+        let e = pool(&[a.clone(), b], &root.path().join("out"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("/scale: 1.0 vs 0.3"), "{e}");
+        let c = root.path().join("c");
+        write_run(&c, 1, SCALE, &[&[0.25]], None);
+        let e = pool(&[a, c], &root.path().join("out")).unwrap_err();
+        assert!(matches!(e, ExperimentError::RepeatedSeed { seed: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn one_run_an_unfinished_run_or_a_missing_experiment_is_refused() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let out = root.path().join("out");
+        assert!(matches!(
+            pool(&runs[..1], &out),
+            Err(ExperimentError::PoolNeedsSeeds { given: 1 })
+        ));
+        std::fs::remove_file(runs[1].join("toy/toy.csv")).unwrap();
+        assert!(matches!(
+            pool(&runs, &out),
+            Err(ExperimentError::NotFinished { .. })
+        ));
+        let empty = root.path().join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        assert!(matches!(
+            pool(&[runs[0].clone(), empty], &out),
+            Err(ExperimentError::NoExperiments { .. })
+        ));
+    }
+
+    #[test]
+    fn an_experiment_folder_pools_as_its_output_root_does() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let folders: Vec<PathBuf> = runs.iter().map(|r| r.join("toy")).collect();
+        let (by_root, by_folder) = (root.path().join("r"), root.path().join("f"));
+        pool(&runs, &by_root).unwrap();
+        pool(&folders, &by_folder).unwrap();
+        assert_eq!(
+            std::fs::read(by_root.join("toy/toy_pooled.csv")).unwrap(),
+            std::fs::read(by_folder.join("toy/toy_pooled.csv")).unwrap()
+        );
+    }
+
+    #[test]
+    fn percentiles_interpolate_between_order_statistics_as_numpy_does() {
+        let sorted = [1.0, 2.0, 3.0, 4.0];
+        // numpy.percentile([1, 2, 3, 4], [5, 50, 95]) = [1.15, 2.5, 3.85]
+        for (q, want) in [(0.05, 1.15), (0.5, 2.5), (0.95, 3.85), (0.0, 1.0), (1.0, 4.0)] {
+            assert!((percentile(&sorted, q) - want).abs() < 1e-12, "{q}");
+        }
+    }
+
+    #[test]
+    fn one_seed_resampled_is_its_own_interval() {
+        let sums = vec![SeedSums {
+            trials: 3,
+            accuracy: 2.0,
+            ..SeedSums::default()
+        }];
+        let (low, high) = interval(&sums, &resamples(1));
+        assert_eq!((low, high), (2.0 / 3.0, 2.0 / 3.0));
+    }
+}
