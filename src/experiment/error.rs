@@ -116,6 +116,11 @@ pub enum ExperimentError {
         second: PathBuf,
     },
     #[error(
+        "{}: the pooled files would go into one of the runs pooled; give another --out",
+        dir.display()
+    )]
+    PoolIntoRun { dir: PathBuf },
+    #[error(
         "{}: experiment '{experiment}' is not finished (no {}); finish the run, or merge its shards, \
          before pooling",
         dir.display(),

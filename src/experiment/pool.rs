@@ -309,6 +309,11 @@ fn pool_experiment(
         .collect::<Result<_, _>>()?;
 
     let target = ExperimentDir::new(out, name);
+    if runs.iter().any(|run| same_folder(run.dir.root(), target.root())) {
+        return Err(ExperimentError::PoolIntoRun {
+            dir: target.root().to_path_buf(),
+        });
+    }
     for folder in [out, target.root()] {
         create_dir_all(folder)?;
         remove_stale_temporaries(folder)?;
@@ -395,6 +400,14 @@ fn pool_experiment(
         files,
         calibration,
     }))
+}
+
+/// Whether `a` and `b` are one folder (both existing, the same after resolving links).
+fn same_folder(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }
 
 fn mismatch(
@@ -1057,6 +1070,19 @@ mod tests {
             pool(&[runs[0].clone(), empty], &out),
             Err(ExperimentError::NoExperiments { .. })
         ));
+    }
+
+    #[test]
+    fn pooled_files_never_go_into_a_run() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let before = std::fs::read(runs[0].join("toy/toy.csv")).unwrap();
+        let folders: Vec<PathBuf> = runs.iter().map(|r| r.join("toy")).collect();
+        for out in [&runs[0], &runs[1]] {
+            let e = pool(&folders, out).unwrap_err();
+            assert!(matches!(e, ExperimentError::PoolIntoRun { .. }), "{e}");
+        }
+        assert_eq!(std::fs::read(runs[0].join("toy/toy.csv")).unwrap(), before);
     }
 
     #[test]
