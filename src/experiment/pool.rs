@@ -23,7 +23,8 @@
 //! | `<stem>.svg`, `.png` | the experiment's plots over every seed: accuracy with the interval as band, reliability diagrams, and line plots of the main table's own columns (their mean over every seed's rows) |
 //! | `pool.json` | the runs and seeds pooled, the resampling, and the configuration they share |
 //!
-//! Experiments without recognition curves (`convergence`, `exploration`) are reported as skipped.
+//! Experiments without recognition curves (`convergence`) are reported as skipped; picture folders
+//! (`exploration`, Fig. 1's run) hold no manifest and are not experiments here.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
