@@ -573,6 +573,11 @@ fn read_run<'a>(
         let at_line = |what: String| csv_error(&path, format!("line {line}: {what}"));
         let record = record.map_err(|e| csv_error(&path, e))?;
         let row = AccuracyRow::from_record(&record).map_err(at_line)?;
+        for (column, value) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
+            if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
+                return Err(at_line(format!("{column} {value} is not a fraction in [0, 1]")));
+            }
+        }
         if row.seed != seed {
             return Err(at_line(format!(
                 "a row of seed {} in a run whose config.json says seed {seed}",
@@ -1071,6 +1076,19 @@ mod tests {
             pool(&[runs[0].clone(), empty], &out),
             Err(ExperimentError::NoExperiments { .. })
         ));
+    }
+
+    #[test]
+    fn a_run_with_an_accuracy_outside_0_1_is_refused_naming_its_line() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let csv = runs[1].join("toy/toy.csv");
+        let text = std::fs::read_to_string(&csv)
+            .unwrap()
+            .replace(",0.25,0.125,2,", ",NaN,0.125,2,");
+        std::fs::write(&csv, text).unwrap();
+        let e = pool(&runs, &root.path().join("out")).unwrap_err().to_string();
+        assert!(e.contains("toy.csv") && e.contains("line 2: accuracy NaN"), "{e}");
     }
 
     #[test]
