@@ -31,8 +31,8 @@ enum Command {
     Reproduce(cli::experiment::ReproduceArgs),
     /// Combine the output directories of sharded experiment runs (`--shard k/n`) into one.
     Merge(cli::merge::MergeArgs),
-    /// Pool the runs of one experiment with different seeds (`--seed`): curves over every seed with
-    /// a 90% interval that resamples seeds, summed reliability tables, plots.
+    /// Pool runs that differ only in `--seed`: each recognition experiment's curves over every seed
+    /// with a 90% interval that resamples seeds, summed reliability tables, plots.
     Pool(cli::pool::PoolArgs),
     /// Object sets: list them, fetch the 3D meshes, write the raised letters, export a set as OBJ.
     Objects(cli::objects::ObjectsArgs),

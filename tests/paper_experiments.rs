@@ -733,7 +733,7 @@ fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refu
         .unwrap();
     let stderr = String::from_utf8_lossy(&into_run.stderr);
     assert!(
-        !into_run.status.success() && stderr.contains("into one of the runs pooled"),
+        !into_run.status.success() && stderr.contains("holds an experiment's run"),
         "{stderr}"
     );
 }

@@ -1,5 +1,5 @@
-//! `taction pool RUNS... --out DIR`: one recognition experiment's curves over the runs of several
-//! seeds, with an interval that resamples whole seeds.
+//! `taction pool RUNS... --out DIR`: every recognition experiment of runs that differ only in their
+//! seeds, its curves over every seed with an interval that resamples whole seeds.
 
 use std::path::PathBuf;
 

@@ -90,7 +90,7 @@ pub enum ExperimentError {
     },
     #[error("{}: no experiment output here (no <experiment>/manifest.json)", dir.display())]
     NoExperiments { dir: PathBuf },
-    #[error("pooling needs the output roots of at least two runs with different seeds, got {given}")]
+    #[error("pooling needs at least two finished runs with different seeds, got {given}")]
     PoolNeedsSeeds { given: usize },
     #[error(
         "experiment '{experiment}' differs between {} and {}: {what}; only runs that differ in their \
@@ -116,7 +116,8 @@ pub enum ExperimentError {
         second: PathBuf,
     },
     #[error(
-        "{}: the pooled files would go into one of the runs pooled; give another --out",
+        "{}: holds an experiment's run (its manifest.json), which the pooled files would overwrite; \
+         give another --out",
         dir.display()
     )]
     PoolIntoRun { dir: PathBuf },

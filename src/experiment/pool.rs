@@ -40,12 +40,13 @@ use super::error::ExperimentError;
 use super::factor::Factors;
 use super::files::{create_dir_all, read};
 use super::layout::{ExperimentDir, experiments_in};
-use super::name::ExperimentName;
+use super::name::{ExperimentName, SafeName};
 use super::plot::{
     PERFECT_CALIBRATION, PlotKind, PlotSpec, SummarisedCurve, csv_error, render_plot,
     summarised_accuracy_figure,
 };
 use super::spec::{Manifest, to_json};
+use super::unit::DetailRow;
 use crate::atomic::{remove_stale_temporaries, write_if_changed};
 use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
 
@@ -229,31 +230,41 @@ pub fn pool(inputs: &[PathBuf], out: &Path) -> Result<PoolReport, ExperimentErro
         pooled: Vec::new(),
         skipped: Vec::new(),
     };
+    let mut prepared = Vec::new();
     for (i, name) in names.iter().enumerate() {
         let runs: Vec<&ExperimentDir> = found.iter().map(|dirs| &dirs[i]).collect();
-        match pool_experiment(&runs, out)? {
-            Ok(pooled) => report.pooled.push(pooled),
+        match prepare(&runs, out)? {
+            Ok(experiment) => prepared.push(experiment),
             Err(why) => report.skipped.push(((*name).clone(), why)),
         }
+    }
+    for experiment in prepared {
+        report.pooled.push(write(experiment, out)?);
     }
     Ok(report)
 }
 
 /// The experiments of `input`: the one it is (a folder holding `manifest.json`, such as
-/// `results/active`), or those of the output root it is.
+/// `results/active`), or those of the output root it is. An experiment's folder must carry its
+/// experiment's name, as a run writes it: its tables are named after the experiment.
 fn experiment_dirs(input: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
-    if input.join("manifest.json").is_file() {
-        let name =
-            input
-                .file_name()
-                .and_then(|n| n.to_str())
-                .ok_or_else(|| ExperimentError::NoExperiments {
-                    dir: input.to_path_buf(),
-                })?;
-        let parent = input.parent().unwrap_or_else(|| Path::new("."));
-        return Ok(vec![ExperimentDir::new(parent, &ExperimentName::new(name)?)]);
+    let manifest = input.join("manifest.json");
+    if !manifest.is_file() {
+        return experiments_in(input);
     }
-    experiments_in(input)
+    let name = Manifest::read(&manifest)?.spec.name;
+    let folder = input.canonicalize().map_err(ExperimentError::io(input))?;
+    let parent = folder.parent().unwrap_or(&folder);
+    if folder.file_name().and_then(|n| n.to_str()) != Some(name.as_str()) {
+        return Err(ExperimentError::Json {
+            path: manifest,
+            what: format!(
+                "names experiment '{name}', but its folder is not named so; give the folder its \
+                 experiment's name or pool its output root"
+            ),
+        });
+    }
+    Ok(vec![ExperimentDir::new(parent, &name)])
 }
 
 fn not_in_both(name: &ExperimentName, has: &Path, lacks: &Path) -> ExperimentError {
@@ -273,17 +284,30 @@ struct SeedRun<'a> {
     rows: Vec<(AccuracyRow, Vec<f64>)>,
 }
 
-/// Pools one experiment's `runs`; `Ok(Err(why))` when it has no recognition curves to pool.
-fn pool_experiment(
-    runs: &[&ExperimentDir],
-    out: &Path,
-) -> Result<Result<PooledExperiment, String>, ExperimentError> {
+/// One experiment read, checked and pooled, with nothing written yet: every run's files are read
+/// and checked before any output is written.
+struct Prepared {
+    name: ExperimentName,
+    target: ExperimentDir,
+    manifest: Manifest,
+    accuracy_plot: PlotSpec,
+    record: PoolRecord,
+    /// The union of the runs' accuracy tables.
+    union: Vec<u8>,
+    pooled: Vec<PooledRow>,
+    by_seed: Vec<BySeedRow>,
+    /// The summed reliability table's rows, when the runs have the table.
+    reliability: Option<Vec<ReliabilityRow>>,
+}
+
+/// Reads and pools one experiment's `runs`; `Ok(Err(why))` when it has no recognition curves.
+fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, String>, ExperimentError> {
     let first = runs[0];
     let name = first.name();
-    let manifest_bytes = read(&first.manifest())?;
+    let manifest_json = read_json(&first.manifest())?;
     for other in &runs[1..] {
-        if read(&other.manifest())? != manifest_bytes {
-            return Err(mismatch(name, first, other, "manifest.json differs"));
+        if let Some(what) = first_difference(&manifest_json, &read_json(&other.manifest())?, "") {
+            return Err(mismatch(name, first, other, format!("manifest.json {what}")));
         }
     }
     let manifest = Manifest::read(&first.manifest())?;
@@ -292,11 +316,18 @@ fn pool_experiment(
         .plots
         .iter()
         .find(|p| p.kind == PlotKind::Accuracy && p.table.is_none())
+        .cloned()
     else {
         return Ok(Err(
             "no recognition curves (no accuracy plot of its main table)".to_string()
         ));
     };
+    let target = ExperimentDir::new(out, name);
+    if target.manifest().is_file() {
+        return Err(ExperimentError::PoolIntoRun {
+            dir: target.root().to_path_buf(),
+        });
+    }
     let (config, seeds) = shared_config(runs)?;
     let columns = shared_columns(runs)?;
     let extras: Vec<String> = match columns.iter().position(|c| c == "stream_seed") {
@@ -308,76 +339,10 @@ fn pool_experiment(
         .zip(&seeds)
         .map(|(&dir, &seed)| read_run(dir, seed, &extras))
         .collect::<Result<_, _>>()?;
-
-    let target = ExperimentDir::new(out, name);
-    if runs.iter().any(|run| same_folder(run.dir.root(), target.root())) {
-        return Err(ExperimentError::PoolIntoRun {
-            dir: target.root().to_path_buf(),
-        });
-    }
-    for folder in [out, target.root()] {
-        create_dir_all(folder)?;
-        remove_stale_temporaries(folder)?;
-    }
-    let mut files = Vec::new();
-    let union = target.csv();
     let sources: Vec<PathBuf> = runs.iter().map(|r| r.dir.csv()).collect();
-    write_if_changed(&union, &concatenate(&sources)?)?;
-    files.push(union.clone());
-
+    let union = concatenate(&sources)?;
     let curves = Curves::of(&runs, &extras)?;
-    let pooled = curves.pooled(name, &extras);
-    let pooled_csv = target.root().join(format!("{name}_pooled.csv"));
-    write_if_changed(&pooled_csv, &csv_bytes(&pooled, &pooled_csv)?)?;
-    files.push(pooled_csv.clone());
-    let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
-    write_if_changed(
-        &by_seed_csv,
-        &csv_bytes(&curves.by_seed(name, &seeds), &by_seed_csv)?,
-    )?;
-    files.push(by_seed_csv);
-
-    let reliability = pool_reliability(&runs, &manifest, &target)?;
-    files.extend(reliability.clone());
-
-    let title = |spec: &PlotSpec| format!("{} ({} seeds pooled)", spec.title, seeds.len());
-    let mut calibration = Vec::new();
-    let mut plots = Vec::new();
-    for spec in &manifest.spec.plots {
-        let titled = PlotSpec {
-            title: title(spec),
-            ..spec.clone()
-        };
-        match (&spec.kind, &spec.table) {
-            (PlotKind::Accuracy, None) if spec == accuracy_plot => {
-                let figure = summarised_accuracy_figure(
-                    &titled,
-                    &pooled_csv,
-                    pooled_curves(&pooled),
-                    INTERVAL_BAND_LABEL,
-                )?;
-                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
-                figure.write_svg(&svg)?;
-                figure.write_png(&png)?;
-                plots.extend([svg, png]);
-            }
-            (PlotKind::Reliability, Some(_)) => {
-                if let Some(table) = &reliability {
-                    let (figure, paths) = render_plot(&titled, table, &target)?;
-                    calibration.extend(figure.panels.iter().flat_map(|panel| {
-                        let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
-                        curves.map(|s| s.label.clone())
-                    }));
-                    plots.extend(paths);
-                }
-            }
-            (PlotKind::Lines { .. }, None) => plots.extend(render_plot(&titled, &union, &target)?.1),
-            // Other plots read tables that are not pooled (per-object rows).
-            _ => {}
-        }
-    }
-    files.extend(plots);
-
+    let reliability = pool_reliability(&runs, &manifest)?;
     let record = PoolRecord {
         experiment: name.clone(),
         runs: runs
@@ -392,23 +357,106 @@ fn pool_experiment(
         resample_seed: RESAMPLE_SEED,
         config,
     };
-    let record_path = target.root().join("pool.json");
-    write_if_changed(&record_path, &to_json(&record, &record_path)?)?;
-    files.push(record_path);
-    Ok(Ok(PooledExperiment {
+    Ok(Ok(Prepared {
         name: name.clone(),
-        seeds,
-        files,
-        calibration,
+        pooled: curves.pooled(name, &extras),
+        by_seed: curves.by_seed(name, &seeds),
+        target,
+        manifest,
+        accuracy_plot,
+        record,
+        union,
+        reliability,
     }))
 }
 
-/// Whether `a` and `b` are one folder (both existing, the same after resolving links).
-fn same_folder(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
+/// Writes a prepared experiment's tables, plots and `pool.json`.
+fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentError> {
+    let Prepared {
+        name,
+        target,
+        manifest,
+        accuracy_plot,
+        record,
+        union,
+        pooled,
+        by_seed,
+        reliability,
+    } = prepared;
+    for folder in [out, target.root()] {
+        create_dir_all(folder)?;
+        remove_stale_temporaries(folder)?;
     }
+    let union_csv = target.csv();
+    write_if_changed(&union_csv, &union)?;
+    let pooled_csv = target.root().join(format!("{name}_pooled.csv"));
+    write_if_changed(&pooled_csv, &csv_bytes(&pooled, &pooled_csv)?)?;
+    let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
+    write_if_changed(&by_seed_csv, &csv_bytes(&by_seed, &by_seed_csv)?)?;
+    let mut files = vec![union_csv.clone(), pooled_csv.clone(), by_seed_csv];
+    let reliability_csv = match (&reliability, ReliabilityRow::TABLE) {
+        (Some(rows), Some(table)) => {
+            let path = target.detail_csv(&SafeName::new(table)?);
+            write_if_changed(&path, &csv_bytes(rows, &path)?)?;
+            files.push(path.clone());
+            Some(path)
+        }
+        _ => None,
+    };
+
+    let seeds = record.runs.len();
+    let mut calibration = Vec::new();
+    for spec in &manifest.spec.plots {
+        let titled = PlotSpec {
+            title: format!("{} ({seeds} seeds pooled)", spec.title),
+            ..spec.clone()
+        };
+        match (&spec.kind, &spec.table) {
+            (PlotKind::Accuracy, None) if *spec == accuracy_plot => {
+                let figure = summarised_accuracy_figure(
+                    &titled,
+                    &pooled_csv,
+                    pooled_curves(&pooled),
+                    INTERVAL_BAND_LABEL,
+                )?;
+                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
+                figure.write_svg(&svg)?;
+                figure.write_png(&png)?;
+                files.extend([svg, png]);
+            }
+            (PlotKind::Reliability, Some(_)) => {
+                if let Some(table) = &reliability_csv {
+                    let (figure, paths) = render_plot(&titled, table, &target)?;
+                    calibration.extend(figure.panels.iter().flat_map(|panel| {
+                        let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
+                        curves.map(|s| s.label.clone())
+                    }));
+                    files.extend(paths);
+                }
+            }
+            (PlotKind::Lines { .. }, None) => files.extend(render_plot(&titled, &union_csv, &target)?.1),
+            // Other plots read tables that are not pooled (per-object rows).
+            _ => {}
+        }
+    }
+
+    let record_path = target.root().join("pool.json");
+    write_if_changed(&record_path, &to_json(&record, &record_path)?)?;
+    files.push(record_path);
+    Ok(PooledExperiment {
+        name,
+        seeds: record.runs.iter().map(|r| r.seed).collect(),
+        files,
+        calibration,
+    })
+}
+
+/// The JSON in `path`.
+fn read_json(path: &Path) -> Result<Value, ExperimentError> {
+    serde_json::from_slice(&read(path)?).map_err(|e| ExperimentError::Json {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })
 }
 
 fn mismatch(
@@ -489,10 +537,7 @@ fn shared_config(runs: &[&ExperimentDir]) -> Result<(Value, Vec<u64>), Experimen
     let mut seeds: Vec<u64> = Vec::new();
     for &run in runs {
         let path = run.config();
-        let value: Value = serde_json::from_slice(&read(&path)?).map_err(|e| ExperimentError::Json {
-            path: path.clone(),
-            what: e.to_string(),
-        })?;
+        let value = read_json(&path)?;
         let seed = value
             .get("seed")
             .and_then(Value::as_u64)
@@ -568,11 +613,26 @@ fn read_run<'a>(
     let path = dir.csv();
     let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
     let mut rows = Vec::new();
+    let mut seen = std::collections::HashSet::new();
     for (i, record) in reader.deserialize::<TidyRecord>().enumerate() {
         let line = i + 2;
         let at_line = |what: String| csv_error(&path, format!("line {line}: {what}"));
         let record = record.map_err(|e| csv_error(&path, e))?;
         let row = AccuracyRow::from_record(&record).map_err(at_line)?;
+        if row.n_readings == 0 {
+            return Err(at_line("n_readings must be at least 1".to_string()));
+        }
+        if !seen.insert((
+            row.descriptor.clone(),
+            row.factors.clone(),
+            row.trial,
+            row.n_readings,
+        )) {
+            return Err(at_line(format!(
+                "{} {} trial {} at {} readings is given twice",
+                row.descriptor, row.factors, row.trial, row.n_readings
+            )));
+        }
         for (column, value) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
             if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
                 return Err(at_line(format!("{column} {value} is not a fraction in [0, 1]")));
@@ -794,18 +854,28 @@ fn pooled_curves(rows: &[PooledRow]) -> Vec<SummarisedCurve> {
     curves
 }
 
-/// The reliability tables of the runs summed curve by curve into `<experiment>_reliability.csv`,
-/// when the manifest has the table and every run assembled it; the file written.
+/// The largest bin count read back: far above any experiment's predictions, far below where sums
+/// of counts could overflow.
+const MAX_BIN_COUNT: u64 = 1 << 40;
+
+/// A curve of a reliability table: experiment, descriptor, factor levels.
+type ReliabilityKey = (String, String, Factors);
+
+/// The reliability tables of the runs summed curve by curve, when the manifest has the table
+/// (every run must then have assembled it, with the same curves); their rows.
 fn pool_reliability(
     runs: &[SeedRun],
     manifest: &Manifest,
-    target: &ExperimentDir,
-) -> Result<Option<PathBuf>, ExperimentError> {
-    let Some(table) = manifest.details.iter().find(|t| t.as_str() == "reliability") else {
+) -> Result<Option<Vec<ReliabilityRow>>, ExperimentError> {
+    let Some(table) = manifest
+        .details
+        .iter()
+        .find(|t| Some(t.as_str()) == ReliabilityRow::TABLE)
+    else {
         return Ok(None);
     };
-    let mut curves: Vec<((String, String, Factors), ReliabilityTable)> = Vec::new();
-    for run in runs {
+    let mut curves: Vec<(ReliabilityKey, ReliabilityTable)> = Vec::new();
+    for (r, run) in runs.iter().enumerate() {
         let path = run.dir.detail_csv(table);
         if !path.is_file() {
             return Err(ExperimentError::NotFinished {
@@ -814,52 +884,90 @@ fn pool_reliability(
                 csv: path,
             });
         }
-        let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
-        let mut bins: Vec<((String, String, Factors), [ReliabilityBin; 10])> = Vec::new();
-        for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
-            let row = row.map_err(|e| csv_error(&path, e))?;
-            let bin = usize::try_from(row.bin)
-                .ok()
-                .filter(|&b| b < CONFIDENCE_BINS)
-                .ok_or_else(|| csv_error(&path, format!("line {}: bin {} is not 0-9", i + 2, row.bin)))?;
-            let key = (
-                row.experiment.clone(),
-                row.descriptor.clone(),
-                row.factors.clone(),
-            );
-            let j = match bins.iter().position(|(k, _)| *k == key) {
-                Some(j) => j,
-                None => {
-                    bins.push((key, [ReliabilityBin::default(); CONFIDENCE_BINS]));
-                    bins.len() - 1
-                }
-            };
-            let count = usize::try_from(row.count).unwrap_or(usize::MAX);
-            bins[j].1[bin] = ReliabilityBin {
-                count,
-                // The bin's sums back from its means: the count of right guesses exactly (a ratio
-                // of integers far below 2^52), the summed confidence to rounding.
-                confidence_sum: row.mean_confidence.unwrap_or(0.0) * count as f64,
-                correct: (row.accuracy.unwrap_or(0.0) * count as f64).round() as usize,
-            };
+        let tables = read_reliability(&path)?;
+        let keys: Vec<&ReliabilityKey> = tables.iter().map(|(k, _)| k).collect();
+        let known: Vec<&ReliabilityKey> = curves.iter().map(|(k, _)| k).collect();
+        if r > 0 && keys != known {
+            return Err(mismatch(
+                run.dir.name(),
+                runs[0].dir,
+                run.dir,
+                format!("their {} tables hold different curves", table.as_str()),
+            ));
         }
-        for (key, bins) in bins {
-            let table = ReliabilityTable::from_bins(bins);
+        for (key, table) in tables {
             match curves.iter_mut().find(|(k, _)| *k == key) {
                 Some((_, pooled)) => pooled.merge(&table),
                 None => curves.push((key, table)),
             }
         }
     }
-    let rows: Vec<ReliabilityRow> = curves
-        .iter()
-        .flat_map(|((experiment, descriptor, factors), table)| {
-            ReliabilityRow::of_table(experiment, descriptor, factors, table)
+    Ok(Some(
+        curves
+            .iter()
+            .flat_map(|((experiment, descriptor, factors), table)| {
+                ReliabilityRow::of_table(experiment, descriptor, factors, table)
+            })
+            .collect(),
+    ))
+}
+
+/// The curves of one run's reliability table, in order, each bin given once, with its count,
+/// mean confidence and accuracy read back into sums: the number right exactly (a ratio of integers
+/// far below 2^52), the summed confidence to rounding.
+fn read_reliability(path: &Path) -> Result<Vec<(ReliabilityKey, ReliabilityTable)>, ExperimentError> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| csv_error(path, e))?;
+    let mut curves: Vec<(ReliabilityKey, [Option<ReliabilityBin>; CONFIDENCE_BINS])> = Vec::new();
+    for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
+        let row = row.map_err(|e| csv_error(path, e))?;
+        let at_line = |what: String| csv_error(path, format!("line {}: {what}", i + 2));
+        let b = usize::try_from(row.bin)
+            .ok()
+            .filter(|&b| b < CONFIDENCE_BINS)
+            .ok_or_else(|| at_line(format!("bin {} is not 0-9", row.bin)))?;
+        if row.count > MAX_BIN_COUNT {
+            return Err(at_line(format!("count {} is beyond {MAX_BIN_COUNT}", row.count)));
+        }
+        let fraction = |column: &str, value: Option<f64>| match value {
+            Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v),
+            Some(v) => Err(at_line(format!("{column} {v} is not a fraction in [0, 1]"))),
+            None if row.count == 0 => Ok(0.0),
+            None => Err(at_line(format!(
+                "{column} is empty in a bin of {} predictions",
+                row.count
+            ))),
+        };
+        let count = row.count as usize;
+        let bin = ReliabilityBin {
+            count,
+            confidence_sum: fraction("mean_confidence", row.mean_confidence)? * count as f64,
+            correct: (fraction("accuracy", row.accuracy)? * count as f64).round() as usize,
+        };
+        let key = (row.experiment, row.descriptor, row.factors);
+        let j = match curves.iter().position(|(k, _)| *k == key) {
+            Some(j) => j,
+            None => {
+                curves.push((key, [None; CONFIDENCE_BINS]));
+                curves.len() - 1
+            }
+        };
+        if curves[j].1[b].replace(bin).is_some() {
+            return Err(at_line(format!("bin {b} of this curve is given twice")));
+        }
+    }
+    curves
+        .into_iter()
+        .map(|(key, bins)| {
+            let missing = bins.iter().position(Option::is_none);
+            match missing {
+                Some(b) => Err(csv_error(path, format!("{} {}: no bin {b}", key.1, key.2))),
+                None => Ok((
+                    key,
+                    ReliabilityTable::from_bins(bins.map(Option::unwrap_or_default)),
+                )),
+            }
         })
-        .collect();
-    let path = target.detail_csv(table);
-    write_if_changed(&path, &csv_bytes(&rows, &path)?)?;
-    Ok(Some(path))
+        .collect()
 }
 
 /// `rows` as CSV with a header; `path` names the destination in errors.
@@ -1092,16 +1200,90 @@ mod tests {
     }
 
     #[test]
-    fn pooled_files_never_go_into_a_run() {
+    fn pooled_files_never_go_into_a_run_given_or_not() {
         let root = tempfile::tempdir().unwrap();
         let runs = two_runs(root.path());
+        let third = root.path().join("c");
+        write_run(&third, 3, SCALE, &[&[0.5, 0.5]], None);
         let before = std::fs::read(runs[0].join("toy/toy.csv")).unwrap();
         let folders: Vec<PathBuf> = runs.iter().map(|r| r.join("toy")).collect();
-        for out in [&runs[0], &runs[1]] {
+        for out in [&runs[0], &runs[1], &third] {
             let e = pool(&folders, out).unwrap_err();
             assert!(matches!(e, ExperimentError::PoolIntoRun { .. }), "{e}");
         }
         assert_eq!(std::fs::read(runs[0].join("toy/toy.csv")).unwrap(), before);
+        assert!(!third.join("toy/toy_pooled.csv").exists());
+    }
+
+    /// Pools `runs` into a fresh folder; the error's text, after checking nothing was written.
+    fn refused(runs: &[PathBuf], root: &Path) -> String {
+        let out = root.join("refused");
+        let e = pool(runs, &out).unwrap_err().to_string();
+        assert!(
+            !out.join("toy").exists(),
+            "nothing written before the refusal: {e}"
+        );
+        e
+    }
+
+    #[test]
+    fn broken_rows_are_refused_naming_file_and_line_before_anything_is_written() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let csv = runs[1].join("toy/toy.csv");
+        let good = std::fs::read_to_string(&csv).unwrap();
+        for (broken, want) in [
+            (
+                good.replace(",0,1,0.25,", ",0,0,0.25,"),
+                "line 2: n_readings must be at least 1",
+            ),
+            (
+                good.replace(",0.1,1,1,0.25,", ",0.1,0,1,0.25,"),
+                "trial 0 at 1 readings is given twice",
+            ),
+        ] {
+            std::fs::write(&csv, broken).unwrap();
+            let e = refused(&runs, root.path());
+            assert!(e.contains("toy.csv") && e.contains(want), "{e}");
+        }
+        std::fs::write(&csv, good).unwrap();
+        let table = runs[1].join("toy/toy_reliability.csv");
+        let good = std::fs::read_to_string(&table).unwrap();
+        let header = good.lines().next().unwrap();
+        let twice = good.replace("toy,mnti,0.1,1,", "toy,mnti,0.1,0,");
+        let empty = good.replace("0.95,1,0.1", ",,0.1");
+        let other = format!(
+            "{header}\n{}",
+            reliability(9, 4, 0.95, 1.0).replace("toy,mnti,", "toy,sift,")
+        );
+        for (broken, want) in [
+            (twice, "bin 0 of this curve is given twice"),
+            (empty, "mean_confidence is empty in a bin of 4 predictions"),
+            (other, "different curves"),
+        ] {
+            std::fs::write(&table, broken).unwrap();
+            let e = refused(&runs, root.path());
+            assert!(e.contains(want), "{e}");
+        }
+    }
+
+    #[test]
+    fn manifests_that_differ_are_refused_naming_the_field_and_folders_must_carry_their_name() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = two_runs(root.path());
+        let manifest = runs[1].join("toy/manifest.json");
+        let text = std::fs::read_to_string(&manifest).unwrap();
+        std::fs::write(&manifest, text.replace("a toy", "another toy")).unwrap();
+        let e = refused(&runs, root.path());
+        assert!(e.contains("manifest.json /description"), "{e}");
+        std::fs::write(&manifest, text).unwrap();
+        let renamed = root.path().join("toy-seed-2");
+        std::fs::rename(runs[1].join("toy"), &renamed).unwrap();
+        let e = refused(&[runs[0].join("toy"), renamed], root.path());
+        assert!(
+            e.contains("names experiment 'toy', but its folder is not named so"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -80,7 +80,7 @@ const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 /// | `local_probability` | L of the planner's moves, or of the active strategy's proposals (0.5) |
 /// | `object_motion` | `fixed` or `perturbed` after every reading |
 /// | `confident` | fraction of objects whose confidence stop ([`ConfidenceStop`]: one guess held at the threshold over the last `stop_held_readings` touches) fired within `n_readings` readings |
-/// | `correct_at_stop` | fraction of objects stopped within `n_readings` readings whose guess at the stop was right |
+/// | `correct_at_stop` | fraction of the objects (all of them, as in `confident`) that stopped within `n_readings` readings with the right guess at the stop; `correct_at_stop / confident` is the share of the stopped runs that were right |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActiveRow {
     pub accuracy: AccuracyRow,
