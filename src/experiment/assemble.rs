@@ -8,7 +8,7 @@ use super::files::read;
 use super::layout::ExperimentDir;
 use super::name::SafeName;
 use super::name::UnitKey;
-use super::plot::{PERFECT_CALIBRATION, PlotKind, PlotSpec, render_plot};
+use super::plot::{PlotKind, PlotSpec, calibration_labels, render_plot};
 use super::spec::Manifest;
 use crate::atomic::write_if_changed;
 
@@ -138,10 +138,7 @@ pub fn finish(dir: &ExperimentDir, manifest: &Manifest) -> Result<Finished, Expe
             let (figure, paths) = render_plot(spec, &source, dir)?;
             plots.extend(paths);
             if spec.kind == PlotKind::Reliability {
-                calibration.extend(figure.panels.iter().flat_map(|panel| {
-                    let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
-                    curves.map(|s| s.label.clone())
-                }));
+                calibration.extend(calibration_labels(&figure));
             }
         }
     }

@@ -14,3 +14,11 @@ pub fn create_dir_all(dir: &Path) -> Result<(), ExperimentError> {
 pub fn read(path: &Path) -> Result<Vec<u8>, ExperimentError> {
     std::fs::read(path).map_err(ExperimentError::io(path))
 }
+
+/// Reads a JSON file as `T`, naming it on failure.
+pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, ExperimentError> {
+    serde_json::from_slice(&read(path)?).map_err(|e| ExperimentError::Json {
+        path: path.to_path_buf(),
+        what: e.to_string(),
+    })
+}

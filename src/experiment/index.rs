@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use super::assemble::{missing_detail, missing_units, plot_source};
 use super::error::ExperimentError;
 use super::figure::{Panel, format_number as number};
-use super::files::read;
+use super::files::read_json;
 use super::layout::ExperimentDir;
 use super::layout::{experiments_in, folders_holding};
 use super::name::SafeName;
@@ -125,11 +125,7 @@ pub struct PictureSpec {
 fn picture_sections(text: &mut String, out: &Path) -> Result<(), ExperimentError> {
     for name in folders_holding(out, PICTURE_FILE)? {
         let spec_path = out.join(name.as_str()).join(PICTURE_FILE);
-        let spec: PictureSpec =
-            serde_json::from_slice(&read(&spec_path)?).map_err(|e| ExperimentError::Json {
-                path: spec_path.clone(),
-                what: e.to_string(),
-            })?;
+        let spec: PictureSpec = read_json(&spec_path)?;
         let _ = write!(
             text,
             "\n## {name}\n\n{}\n\nData: [{name}.csv]({name}/{name}.csv)\n\n![{}]({name}/{name}.png)\n",

@@ -210,16 +210,17 @@ impl Means {
 }
 
 /// Items in order of first appearance, each with its accumulator.
-struct Ordered<K, V> {
-    items: Vec<(K, V)>,
+pub(crate) struct Ordered<K, V> {
+    pub items: Vec<(K, V)>,
 }
 
 impl<K: PartialEq, V: Default> Ordered<K, V> {
-    fn new() -> Self {
+    pub fn new() -> Self {
         Self { items: Vec::new() }
     }
 
-    fn entry(&mut self, key: K) -> &mut V {
+    /// The accumulator of `key`, a default one appended when `key` is new.
+    pub fn entry(&mut self, key: K) -> &mut V {
         let i = match self.items.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
@@ -330,43 +331,38 @@ fn arrange_accuracy_panels<V>(
 
 /// One accuracy curve summarised elsewhere (`pool`): its points `(n_readings, accuracy)` and its
 /// band `(n_readings, low, high)`, both sorted by the number of readings.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct SummarisedCurve {
-    pub descriptor: String,
-    pub factors: Factors,
     pub points: Vec<(f64, f64)>,
     pub band: Vec<(f64, f64, f64)>,
 }
 
 /// The accuracy figure of `spec` (its title, legend template and chance level) drawn from curves
-/// already summarised, laid out as [`PlotKind::Accuracy`] lays out an experiment's curves;
-/// `band_label` says what the bands are, `csv` names the source in errors.
+/// already summarised, each under its descriptor and factor levels, laid out as
+/// [`PlotKind::Accuracy`] lays out an experiment's curves; `band_label` says what the bands are,
+/// `csv` names the source in errors.
 pub(crate) fn summarised_accuracy_figure(
     spec: &PlotSpec,
     csv: &Path,
-    curves: Vec<SummarisedCurve>,
+    curves: &Ordered<(String, Factors), SummarisedCurve>,
     band_label: &'static str,
 ) -> Result<Figure, ExperimentError> {
     let max_n = curves
+        .items
         .iter()
-        .flat_map(|curve| curve.points.iter().map(|&(n, _)| n as u32))
+        .flat_map(|(_, curve)| curve.points.iter().map(|&(n, _)| n as u32))
         .max()
         .unwrap_or(1);
-    let mut ordered = Ordered::new();
-    for curve in curves {
-        let key = (curve.descriptor.clone(), curve.factors.clone());
-        *ordered.entry(key) = Some(curve);
-    }
     let mut panels = arrange_accuracy_panels(
         csv,
-        &ordered,
+        curves,
         max_n,
         spec.objects,
         spec.legend.as_deref(),
-        |curve: &Option<SummarisedCurve>, label| Series {
+        |curve: &SummarisedCurve, label| Series {
             label,
-            points: curve.as_ref().map(|c| c.points.clone()).unwrap_or_default(),
-            band: curve.as_ref().map(|c| c.band.clone()).unwrap_or_default(),
+            points: curve.points.clone(),
+            band: curve.band.clone(),
         },
     )?;
     for panel in &mut panels {
@@ -443,6 +439,15 @@ fn setting_label(
 
 /// The label of a reliability diagram's diagonal.
 pub const PERFECT_CALIBRATION: &str = "perfect calibration";
+
+/// The curves of a reliability diagram, each named with its ECE (`pf (ECE 0.042)`): every series
+/// but the diagonal.
+pub(crate) fn calibration_labels(figure: &Figure) -> impl Iterator<Item = String> + '_ {
+    figure.panels.iter().flat_map(|panel| {
+        let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
+        curves.map(|s| s.label.clone())
+    })
+}
 
 /// A reliability diagram of `curves`, each a name and its table: what `taction recognize` draws
 /// (the experiments draw theirs from their `reliability` table, [`PlotKind::Reliability`]).

@@ -38,11 +38,11 @@ use super::accuracy::{AccuracyRow, ReliabilityRow, TidyRecord};
 use super::assemble::concatenate;
 use super::error::ExperimentError;
 use super::factor::Factors;
-use super::files::{create_dir_all, read};
+use super::files::{create_dir_all, read_json};
 use super::layout::{ExperimentDir, experiments_in};
 use super::name::{ExperimentName, SafeName};
 use super::plot::{
-    PERFECT_CALIBRATION, PlotKind, PlotSpec, SummarisedCurve, csv_error, render_plot,
+    Ordered, PlotKind, PlotSpec, SummarisedCurve, calibration_labels, csv_error, render_plot,
     summarised_accuracy_figure,
 };
 use super::spec::{Manifest, to_json};
@@ -296,17 +296,17 @@ struct Prepared {
     union: Vec<u8>,
     pooled: Vec<PooledRow>,
     by_seed: Vec<BySeedRow>,
-    /// The summed reliability table's rows, when the runs have the table.
-    reliability: Option<Vec<ReliabilityRow>>,
+    /// The summed reliability table's name and rows, when the runs have the table.
+    reliability: Option<(SafeName, Vec<ReliabilityRow>)>,
 }
 
 /// Reads and pools one experiment's `runs`; `Ok(Err(why))` when it has no recognition curves.
 fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, String>, ExperimentError> {
     let first = runs[0];
     let name = first.name();
-    let manifest_json = read_json(&first.manifest())?;
+    let manifest_json: Value = read_json(&first.manifest())?;
     for other in &runs[1..] {
-        if let Some(what) = first_difference(&manifest_json, &read_json(&other.manifest())?, "") {
+        if let Some(what) = first_difference(&manifest_json, &read_json::<Value>(&other.manifest())?, "") {
             return Err(mismatch(name, first, other, format!("manifest.json {what}")));
         }
     }
@@ -394,14 +394,14 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
     let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
     write_if_changed(&by_seed_csv, &csv_bytes(&by_seed, &by_seed_csv)?)?;
     let mut files = vec![union_csv.clone(), pooled_csv.clone(), by_seed_csv];
-    let reliability_csv = match (&reliability, ReliabilityRow::TABLE) {
-        (Some(rows), Some(table)) => {
-            let path = target.detail_csv(&SafeName::new(table)?);
+    let reliability_csv = match &reliability {
+        Some((table, rows)) => {
+            let path = target.detail_csv(table);
             write_if_changed(&path, &csv_bytes(rows, &path)?)?;
             files.push(path.clone());
             Some(path)
         }
-        _ => None,
+        None => None,
     };
 
     let seeds = record.runs.len();
@@ -416,7 +416,7 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
                 let figure = summarised_accuracy_figure(
                     &titled,
                     &pooled_csv,
-                    pooled_curves(&pooled),
+                    &pooled_curves(&pooled),
                     INTERVAL_BAND_LABEL,
                 )?;
                 let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
@@ -427,10 +427,7 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
             (PlotKind::Reliability, Some(_)) => {
                 if let Some(table) = &reliability_csv {
                     let (figure, paths) = render_plot(&titled, table, &target)?;
-                    calibration.extend(figure.panels.iter().flat_map(|panel| {
-                        let curves = panel.series.iter().filter(|s| s.label != PERFECT_CALIBRATION);
-                        curves.map(|s| s.label.clone())
-                    }));
+                    calibration.extend(calibration_labels(&figure));
                     files.extend(paths);
                 }
             }
@@ -448,14 +445,6 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
         seeds: record.runs.iter().map(|r| r.seed).collect(),
         files,
         calibration,
-    })
-}
-
-/// The JSON in `path`.
-fn read_json(path: &Path) -> Result<Value, ExperimentError> {
-    serde_json::from_slice(&read(path)?).map_err(|e| ExperimentError::Json {
-        path: path.to_path_buf(),
-        what: e.to_string(),
     })
 }
 
@@ -537,7 +526,7 @@ fn shared_config(runs: &[&ExperimentDir]) -> Result<(Value, Vec<u64>), Experimen
     let mut seeds: Vec<u64> = Vec::new();
     for &run in runs {
         let path = run.config();
-        let value = read_json(&path)?;
+        let value: Value = read_json(&path)?;
         let seed = value
             .get("seed")
             .and_then(Value::as_u64)
@@ -682,30 +671,22 @@ type PointSums = BTreeMap<u32, Vec<SeedSums>>;
 /// Every curve (descriptor and factor levels, in order of first appearance) with, per number of
 /// readings, each seed's sums in the order the runs were given.
 struct Curves {
-    items: Vec<(CurveKey, PointSums)>,
+    curves: Ordered<CurveKey, PointSums>,
     seeds: usize,
 }
 
 impl Curves {
     /// Sums every run's rows; every seed must have every point some seed has.
     fn of(runs: &[SeedRun], extras: &[String]) -> Result<Self, ExperimentError> {
-        let mut items: Vec<(CurveKey, PointSums)> = Vec::new();
+        let mut curves: Ordered<CurveKey, PointSums> = Ordered::new();
         let blank = SeedSums {
             extras: vec![0.0; extras.len()],
             ..SeedSums::default()
         };
         for (s, run) in runs.iter().enumerate() {
             for (row, values) in &run.rows {
-                let key = (row.descriptor.clone(), row.factors.clone());
-                let i = match items.iter().position(|(k, _)| *k == key) {
-                    Some(i) => i,
-                    None => {
-                        items.push((key, BTreeMap::new()));
-                        items.len() - 1
-                    }
-                };
-                let point = items[i]
-                    .1
+                let point = curves
+                    .entry((row.descriptor.clone(), row.factors.clone()))
                     .entry(row.n_readings)
                     .or_insert_with(|| vec![blank.clone(); runs.len()]);
                 let sums = &mut point[s];
@@ -717,7 +698,7 @@ impl Curves {
                 }
             }
         }
-        for ((descriptor, factors), points) in &items {
+        for ((descriptor, factors), points) in &curves.items {
             for (n, sums) in points {
                 if let Some(s) = sums.iter().position(|sum| sum.trials == 0) {
                     return Err(csv_error(
@@ -731,7 +712,7 @@ impl Curves {
             }
         }
         Ok(Self {
-            items,
+            curves,
             seeds: runs.len(),
         })
     }
@@ -740,7 +721,7 @@ impl Curves {
     fn pooled(&self, experiment: &ExperimentName, extras: &[String]) -> Vec<PooledRow> {
         let draws = resamples(self.seeds);
         let mut rows = Vec::new();
-        for ((descriptor, factors), points) in &self.items {
+        for ((descriptor, factors), points) in &self.curves.items {
             for (&n, sums) in points {
                 let trials: usize = sums.iter().map(|s| s.trials).sum();
                 let mean = |part: fn(&SeedSums) -> f64| sums.iter().map(part).sum::<f64>() / trials as f64;
@@ -772,7 +753,7 @@ impl Curves {
 
     fn by_seed(&self, experiment: &ExperimentName, seeds: &[u64]) -> Vec<BySeedRow> {
         let mut rows = Vec::new();
-        for ((descriptor, factors), points) in &self.items {
+        for ((descriptor, factors), points) in &self.curves.items {
             for (s, &seed) in seeds.iter().enumerate() {
                 for (&n, sums) in points {
                     let sum = &sums[s];
@@ -829,27 +810,13 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// The curves of the pooled rows, as the accuracy figure draws them.
-fn pooled_curves(rows: &[PooledRow]) -> Vec<SummarisedCurve> {
-    let mut curves: Vec<SummarisedCurve> = Vec::new();
+fn pooled_curves(rows: &[PooledRow]) -> Ordered<CurveKey, SummarisedCurve> {
+    let mut curves = Ordered::new();
     for row in rows {
-        let i = match curves
-            .iter()
-            .position(|c| c.descriptor == row.descriptor && c.factors == row.factors)
-        {
-            Some(i) => i,
-            None => {
-                curves.push(SummarisedCurve {
-                    descriptor: row.descriptor.clone(),
-                    factors: row.factors.clone(),
-                    points: Vec::new(),
-                    band: Vec::new(),
-                });
-                curves.len() - 1
-            }
-        };
+        let curve: &mut SummarisedCurve = curves.entry((row.descriptor.clone(), row.factors.clone()));
         let n = f64::from(row.n_readings);
-        curves[i].points.push((n, row.accuracy));
-        curves[i].band.push((n, row.accuracy_low, row.accuracy_high));
+        curve.points.push((n, row.accuracy));
+        curve.band.push((n, row.accuracy_low, row.accuracy_high));
     }
     curves
 }
@@ -862,11 +829,11 @@ const MAX_BIN_COUNT: u64 = 1 << 40;
 type ReliabilityKey = (String, String, Factors);
 
 /// The reliability tables of the runs summed curve by curve, when the manifest has the table
-/// (every run must then have assembled it, with the same curves); their rows.
+/// (every run must then have assembled it, with the same curves): the table's name and rows.
 fn pool_reliability(
     runs: &[SeedRun],
     manifest: &Manifest,
-) -> Result<Option<Vec<ReliabilityRow>>, ExperimentError> {
+) -> Result<Option<(SafeName, Vec<ReliabilityRow>)>, ExperimentError> {
     let Some(table) = manifest
         .details
         .iter()
@@ -874,7 +841,7 @@ fn pool_reliability(
     else {
         return Ok(None);
     };
-    let mut curves: Vec<(ReliabilityKey, ReliabilityTable)> = Vec::new();
+    let mut curves: Ordered<ReliabilityKey, ReliabilityTable> = Ordered::new();
     for (r, run) in runs.iter().enumerate() {
         let path = run.dir.detail_csv(table);
         if !path.is_file() {
@@ -886,7 +853,7 @@ fn pool_reliability(
         }
         let tables = read_reliability(&path)?;
         let keys: Vec<&ReliabilityKey> = tables.iter().map(|(k, _)| k).collect();
-        let known: Vec<&ReliabilityKey> = curves.iter().map(|(k, _)| k).collect();
+        let known: Vec<&ReliabilityKey> = curves.items.iter().map(|(k, _)| k).collect();
         if r > 0 && keys != known {
             return Err(mismatch(
                 run.dir.name(),
@@ -896,20 +863,17 @@ fn pool_reliability(
             ));
         }
         for (key, table) in tables {
-            match curves.iter_mut().find(|(k, _)| *k == key) {
-                Some((_, pooled)) => pooled.merge(&table),
-                None => curves.push((key, table)),
-            }
+            curves.entry(key).merge(&table);
         }
     }
-    Ok(Some(
-        curves
-            .iter()
-            .flat_map(|((experiment, descriptor, factors), table)| {
-                ReliabilityRow::of_table(experiment, descriptor, factors, table)
-            })
-            .collect(),
-    ))
+    let rows = curves
+        .items
+        .iter()
+        .flat_map(|((experiment, descriptor, factors), table)| {
+            ReliabilityRow::of_table(experiment, descriptor, factors, table)
+        })
+        .collect();
+    Ok(Some((table.clone(), rows)))
 }
 
 /// The curves of one run's reliability table, in order, each bin given once, with its count,
@@ -917,7 +881,7 @@ fn pool_reliability(
 /// far below 2^52), the summed confidence to rounding.
 fn read_reliability(path: &Path) -> Result<Vec<(ReliabilityKey, ReliabilityTable)>, ExperimentError> {
     let mut reader = csv::Reader::from_path(path).map_err(|e| csv_error(path, e))?;
-    let mut curves: Vec<(ReliabilityKey, [Option<ReliabilityBin>; CONFIDENCE_BINS])> = Vec::new();
+    let mut curves: Ordered<ReliabilityKey, [Option<ReliabilityBin>; CONFIDENCE_BINS]> = Ordered::new();
     for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
         let row = row.map_err(|e| csv_error(path, e))?;
         let at_line = |what: String| csv_error(path, format!("line {}: {what}", i + 2));
@@ -943,19 +907,13 @@ fn read_reliability(path: &Path) -> Result<Vec<(ReliabilityKey, ReliabilityTable
             confidence_sum: fraction("mean_confidence", row.mean_confidence)? * count as f64,
             correct: (fraction("accuracy", row.accuracy)? * count as f64).round() as usize,
         };
-        let key = (row.experiment, row.descriptor, row.factors);
-        let j = match curves.iter().position(|(k, _)| *k == key) {
-            Some(j) => j,
-            None => {
-                curves.push((key, [None; CONFIDENCE_BINS]));
-                curves.len() - 1
-            }
-        };
-        if curves[j].1[b].replace(bin).is_some() {
+        let bins = curves.entry((row.experiment, row.descriptor, row.factors));
+        if bins[b].replace(bin).is_some() {
             return Err(at_line(format!("bin {b} of this curve is given twice")));
         }
     }
     curves
+        .items
         .into_iter()
         .map(|(key, bins)| {
             let missing = bins.iter().position(Option::is_none);

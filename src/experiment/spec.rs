@@ -7,7 +7,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::error::ExperimentError;
-use super::files::read;
+use super::files::read_json;
 use super::name::{ExperimentName, SafeName, UnitKey};
 use super::plot::PlotSpec;
 use crate::atomic::{write_atomic, write_if_changed};
@@ -55,11 +55,7 @@ fn one_or_many<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<Vec<
 
 impl Manifest {
     pub fn read(path: &Path) -> Result<Self, ExperimentError> {
-        let bytes = read(path)?;
-        serde_json::from_slice(&bytes).map_err(|e| ExperimentError::Json {
-            path: path.to_path_buf(),
-            what: e.to_string(),
-        })
+        read_json(path)
     }
 
     /// Pretty JSON with a final newline; the same manifest always gives the same bytes.
