@@ -1,11 +1,13 @@
 //! MuJoCo's log stays off the user's disk (`sim::keep_mujoco_log_off_disk`, which the `taction`
 //! command calls first): a physics fault is still detected and reported, and no `MUJOCO_LOG.TXT`
 //! appears in the working directory. One test in a binary of its own, since it changes the
-//! process's working directory and MuJoCo's global log configuration.
+//! process's working directory and MuJoCo's global log configuration (which `common` switched
+//! off before `main`, as for every test binary: the test switches it back on first).
 
 mod common;
 
 use glam::DVec3;
+use mujoco_rs::wrappers::mj_logging;
 use taction::sim::{ObjectSpec, SceneBuilder, keep_mujoco_log_off_disk};
 
 /// A scene of a box whose velocities are made NaN before a step: MuJoCo warns of a bad velocity,
@@ -25,6 +27,9 @@ fn a_physics_fault_is_reported_without_a_log_file_in_the_working_directory() {
     let log = dir.path().join("MUJOCO_LOG.TXT");
 
     // MuJoCo's default writes the file, so the check below can tell.
+    let default = mj_logging::log_config().with_logto_file(true);
+    // SAFETY: this test is the only one of its binary: no other thread uses MuJoCo.
+    unsafe { mj_logging::set_log_config(default) };
     let fault = faulted_step().expect("the fault should be reported");
     assert!(fault.contains("bad velocity"), "{fault}");
     assert!(

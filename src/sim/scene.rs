@@ -665,6 +665,15 @@ impl Scene {
 mod tests {
     use super::*;
 
+    /// The library's unit tests provoke MuJoCo's warnings on purpose (a NaN velocity, an absurd
+    /// force): they leave no `MUJOCO_LOG.TXT` in the checkout. Before `main`, while no thread runs
+    /// MuJoCo, as [`keep_mujoco_log_off_disk`] requires.
+    #[ctor::ctor(unsafe)]
+    fn log_off_disk() {
+        // SAFETY: constructors run before `main`, on the one thread there is.
+        unsafe { keep_mujoco_log_off_disk() };
+    }
+
     fn mesh_xml(vertex: &str) -> String {
         format!(
             "<mujoco><asset><mesh name=\"m\" vertex=\"{vertex}\"/></asset>\

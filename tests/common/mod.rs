@@ -4,6 +4,15 @@
 use glam::DVec3;
 use taction::mesh::TriMesh;
 
+/// Tests that provoke MuJoCo's warnings on purpose (a state gone bad, a full geom buffer) leave no
+/// `MUJOCO_LOG.TXT` in the checkout: every test binary with these helpers switches the log file
+/// off before `main`, while no thread runs MuJoCo, as `keep_mujoco_log_off_disk` requires.
+#[ctor::ctor(unsafe)]
+fn log_off_disk() {
+    // SAFETY: constructors run before `main`, on the one thread there is.
+    unsafe { taction::sim::keep_mujoco_log_off_disk() };
+}
+
 /// A closed box mesh with its bottom face on z = 0, centred in x and y, outward-facing triangles.
 pub fn box_mesh(size_m: DVec3) -> TriMesh {
     let h = size_m * 0.5;
