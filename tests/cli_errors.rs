@@ -705,3 +705,29 @@ fn an_unknown_sim_to_real_label_is_named_with_its_line() {
         "{line}"
     );
 }
+
+#[test]
+fn a_reference_curve_that_is_not_column_equals_level_is_refused_before_any_run_is_read() {
+    for (against, says) in [
+        ("speed=3", "'speed' is neither 'descriptor' nor a factor"),
+        ("strategy", "'strategy' is not column=level"),
+        ("strategy=blind,strategy=active", "'strategy' is given twice"),
+    ] {
+        let line = fails_with(
+            &taction(&[
+                "pool",
+                "no-such-run",
+                "nor-this",
+                "--out",
+                "x",
+                "--against",
+                against,
+            ]),
+            2,
+        );
+        assert!(
+            line.contains("--against") && line.contains(says),
+            "{against}: {line}"
+        );
+    }
+}

@@ -736,4 +736,66 @@ fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refu
         !into_run.status.success() && stderr.contains("holds an experiment's run"),
         "{stderr}"
     );
+
+    // Every descriptor against the first, seed by seed: its difference at each point is the
+    // difference of the two pooled curves.
+    let first = union[0].descriptor.clone();
+    let against = dir.path().join("against");
+    let reference = format!("descriptor={first}");
+    let out = taction(&[
+        "pool",
+        &arg(&one),
+        &arg(&two),
+        "--out",
+        &arg(&against),
+        "--against",
+        &reference,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(stdout.contains(&format!("against {reference}: ")), "{stdout}");
+    let pooled_accuracy = |descriptor: &str, n: u32| {
+        let at: Vec<f64> = union
+            .iter()
+            .filter(|r| r.descriptor == descriptor && r.n_readings == n)
+            .map(|r| r.accuracy)
+            .collect();
+        at.iter().sum::<f64>() / at.len() as f64
+    };
+    let differences = csv::Reader::from_path(against.join("descriptors/descriptors_differences.csv"))
+        .unwrap()
+        .into_records()
+        .map(Result::unwrap)
+        .collect::<Vec<_>>();
+    let descriptors: std::collections::BTreeSet<&str> = union.iter().map(|r| r.descriptor.as_str()).collect();
+    assert_eq!(
+        differences.len(),
+        (descriptors.len() - 1) * (points / descriptors.len())
+    );
+    for record in &differences {
+        let (descriptor, n): (&str, u32) = (&record[1], record[3].parse().unwrap());
+        assert_ne!(descriptor, first);
+        let difference: f64 = record[7].parse().unwrap();
+        let want = pooled_accuracy(descriptor, n) - pooled_accuracy(&first, n);
+        assert!(
+            (difference - want).abs() < 1e-12,
+            "{descriptor} {n}: {difference} vs {want}"
+        );
+    }
+    let unknown = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "pool",
+            &arg(&one),
+            &arg(&two),
+            "--out",
+            &arg(&dir.path().join("y")),
+        ])
+        .args(["--against", "strategy=blind"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&unknown.stderr);
+    assert!(
+        !unknown.status.success() && stderr.contains("descriptors: its curves have no factor strategy"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("y/descriptors").exists());
 }

@@ -5,6 +5,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use taction::experiment::ReferenceCurve;
+
 use crate::cli::common::OutputLock;
 
 #[derive(Debug, Args)]
@@ -19,12 +21,19 @@ pub struct PoolArgs {
     /// tables, the plots and `pool.json`.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also compare every curve with a reference curve, seed by seed: `column=level` pairs joined by
+    /// commas, each column a factor or `descriptor` (e.g. `strategy=blind,local_probability=1`).
+    /// Each curve meets the curve of its own levels with these replaced; written per experiment
+    /// (`<experiment>_differences.csv`): the differences with their 90% interval over resampled
+    /// seeds, and the readings each curve needs to reach the reference's accuracy.
+    #[arg(long, value_name = "COLUMN=LEVEL,...")]
+    pub against: Option<ReferenceCurve>,
 }
 
 /// Pools every experiment the runs hold, then prints what it wrote and each curve's pooled ECE.
 pub fn run(args: &PoolArgs) -> Result<(), Box<dyn std::error::Error>> {
     let _lock = OutputLock::acquire(&args.out, "out")?;
-    let report = taction::experiment::pool(&args.runs, &args.out)?;
+    let report = taction::experiment::pool(&args.runs, &args.out, args.against.as_ref())?;
     for pooled in &report.pooled {
         let seeds: Vec<String> = pooled.seeds.iter().map(u64::to_string).collect();
         println!(
@@ -38,6 +47,24 @@ pub fn run(args: &PoolArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
         for curve in &pooled.calibration {
             println!("  calibration: {curve}");
+        }
+        match &pooled.compared {
+            Some(Ok(comparisons)) => {
+                let reference = args.against.as_ref().map(ToString::to_string).unwrap_or_default();
+                for c in comparisons {
+                    let (n, accuracy, reached) = c.last;
+                    let reached = match reached {
+                        Some(m) => format!("after {m} readings"),
+                        None => "never".to_string(),
+                    };
+                    println!(
+                        "  against {reference}: {} {}: level or ahead at {} of {} counts; reaches the reference's {accuracy:.3} at {n} readings {reached}",
+                        c.descriptor, c.factors, c.counts_level_or_ahead, c.counts
+                    );
+                }
+            }
+            Some(Err(why)) => eprintln!("{}: not compared: {why}", pooled.name),
+            None => {}
         }
     }
     for (name, why) in &report.skipped {

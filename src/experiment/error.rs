@@ -132,6 +132,8 @@ pub enum ExperimentError {
         dir: PathBuf,
         csv: PathBuf,
     },
+    #[error("--against {reference}: no experiment has curves to compare with it ({})", why.join("; "))]
+    NothingAgainst { reference: String, why: Vec<String> },
 }
 
 impl ExperimentError {

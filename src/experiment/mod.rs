@@ -30,6 +30,8 @@ pub(crate) mod name;
 pub(crate) mod plot;
 pub(crate) mod pool;
 pub(crate) mod progress;
+pub(crate) mod reference;
+pub(crate) mod resample;
 pub(crate) mod runner;
 pub(crate) mod shard;
 pub(crate) mod spec;
@@ -41,9 +43,10 @@ pub use factor::{Factor, FactorError, Factors};
 pub use merge::{MergeReport, merge};
 pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
 pub use pool::{
-    BySeedRow, INTERVAL_BAND_LABEL, INTERVAL_LEVEL, PoolRecord, PoolReport, PooledExperiment, PooledRow,
-    PooledRun, RESAMPLES, pool,
+    BySeedRow, INTERVAL_BAND_LABEL, PoolRecord, PoolReport, PooledExperiment, PooledRow, PooledRun, pool,
 };
+pub use reference::{Comparison, DifferenceRow, ReferenceCurve};
+pub use resample::{INTERVAL_LEVEL, RESAMPLES};
 pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};

@@ -23,13 +23,14 @@
 //! | `<stem>.svg`, `.png` | the experiment's plots over every seed: accuracy with the interval as band, reliability diagrams, and line plots of the main table's own columns (their mean over every seed's rows) |
 //! | `pool.json` | the runs and seeds pooled, the resampling, and the configuration they share |
 //!
+//! With `--against`, each curve is also compared with a reference curve, seed by seed
+//! ([`super::reference`]: `<experiment>_differences.csv`).
+//!
 //! Experiments without recognition curves (`convergence`) are reported as skipped; picture folders
 //! (`exploration`, Fig. 1's run) hold no manifest and are not experiments here.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use rand::RngExt;
 use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -45,20 +46,15 @@ use super::plot::{
     Ordered, PlotKind, PlotSpec, SummarisedCurve, calibration_labels, csv_error, render_plot,
     summarised_accuracy_figure,
 };
+use super::reference::{Compared, Comparison, ReferenceCurve, against};
+use super::resample::{
+    CurveKey, INTERVAL_LEVEL, PointSums, RESAMPLE_SEED, RESAMPLES, SeedSums, interval, pooled_accuracy,
+    resamples,
+};
 use super::spec::{Manifest, to_json};
 use super::unit::DetailRow;
 use crate::atomic::{remove_stale_temporaries, write_if_changed};
 use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
-
-/// Resamples of the seeds behind each interval: enough that the 5th and 95th percentiles move by
-/// well under a point between resamplings.
-pub const RESAMPLES: usize = 2000;
-
-/// The interval's coverage: the 5th to the 95th percentile of the resampled pooled accuracy.
-pub const INTERVAL_LEVEL: f64 = 0.9;
-
-/// The resampling's own seed: the same runs always give the same interval.
-const RESAMPLE_SEED: u64 = 1;
 
 /// What the bands of a pooled accuracy plot are.
 pub const INTERVAL_BAND_LABEL: &str = "band: 90% interval, seeds resampled";
@@ -73,6 +69,8 @@ pub struct PooledExperiment {
     pub files: Vec<PathBuf>,
     /// Each curve of the pooled reliability diagrams, named with its pooled ECE.
     pub calibration: Vec<String>,
+    /// With a reference curve: each curve compared with it, or why none was.
+    pub compared: Option<Result<Vec<Comparison>, String>>,
 }
 
 /// What a pool produced.
@@ -191,6 +189,9 @@ pub struct PoolRecord {
     pub resamples: usize,
     pub interval_level: f64,
     pub resample_seed: u64,
+    /// The reference curve the others were compared with (`--against`), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub against: Option<String>,
     /// The configuration every run shares: the first run's `config.json` without its seeds.
     pub config: Value,
 }
@@ -203,8 +204,13 @@ pub struct PooledRun {
 
 /// Pools the runs `inputs` into `out`, experiment by experiment: each input the output root of
 /// one finished run (its `--out`) or one experiment's folder in it (`results/active`). Every input
-/// must hold the same experiments.
-pub fn pool(inputs: &[PathBuf], out: &Path) -> Result<PoolReport, ExperimentError> {
+/// must hold the same experiments. With `reference`, every curve is also compared with its
+/// reference curve; at least one experiment must have curves to compare.
+pub fn pool(
+    inputs: &[PathBuf],
+    out: &Path,
+    reference: Option<&ReferenceCurve>,
+) -> Result<PoolReport, ExperimentError> {
     if inputs.len() < 2 {
         return Err(ExperimentError::PoolNeedsSeeds { given: inputs.len() });
     }
@@ -233,10 +239,25 @@ pub fn pool(inputs: &[PathBuf], out: &Path) -> Result<PoolReport, ExperimentErro
     let mut prepared = Vec::new();
     for (i, name) in names.iter().enumerate() {
         let runs: Vec<&ExperimentDir> = found.iter().map(|dirs| &dirs[i]).collect();
-        match prepare(&runs, out)? {
+        match prepare(&runs, out, reference)? {
             Ok(experiment) => prepared.push(experiment),
             Err(why) => report.skipped.push(((*name).clone(), why)),
         }
+    }
+    if let Some(reference) = reference
+        && !prepared.iter().any(|p| matches!(p.compared, Some(Ok(_))))
+    {
+        let why = prepared
+            .iter()
+            .filter_map(|p| match &p.compared {
+                Some(Err(why)) => Some(format!("{}: {why}", p.name)),
+                _ => None,
+            })
+            .collect();
+        return Err(ExperimentError::NothingAgainst {
+            reference: reference.to_string(),
+            why,
+        });
     }
     for experiment in prepared {
         report.pooled.push(write(experiment, out)?);
@@ -298,10 +319,16 @@ struct Prepared {
     by_seed: Vec<BySeedRow>,
     /// The summed reliability table's name and rows, when the runs have the table.
     reliability: Option<(SafeName, Vec<ReliabilityRow>)>,
+    /// With a reference curve: the curves' differences from it and their reach, or why none.
+    compared: Option<Compared>,
 }
 
 /// Reads and pools one experiment's `runs`; `Ok(Err(why))` when it has no recognition curves.
-fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, String>, ExperimentError> {
+fn prepare(
+    runs: &[&ExperimentDir],
+    out: &Path,
+    reference: Option<&ReferenceCurve>,
+) -> Result<Result<Prepared, String>, ExperimentError> {
     let first = runs[0];
     let name = first.name();
     let manifest_json: Value = read_json(&first.manifest())?;
@@ -342,6 +369,7 @@ fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, Strin
     let sources: Vec<PathBuf> = runs.iter().map(|r| r.dir.csv()).collect();
     let union = concatenate(&sources)?;
     let curves = Curves::of(&runs, &extras)?;
+    let compared = reference.map(|r| against(&curves.curves.items, r, name.as_str(), &resamples(runs.len())));
     let reliability = pool_reliability(&runs, &manifest)?;
     let record = PoolRecord {
         experiment: name.clone(),
@@ -355,6 +383,7 @@ fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, Strin
         resamples: RESAMPLES,
         interval_level: INTERVAL_LEVEL,
         resample_seed: RESAMPLE_SEED,
+        against: reference.map(ReferenceCurve::to_string),
         config,
     };
     Ok(Ok(Prepared {
@@ -367,6 +396,7 @@ fn prepare(runs: &[&ExperimentDir], out: &Path) -> Result<Result<Prepared, Strin
         record,
         union,
         reliability,
+        compared,
     }))
 }
 
@@ -382,6 +412,7 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
         pooled,
         by_seed,
         reliability,
+        compared,
     } = prepared;
     for folder in [out, target.root()] {
         create_dir_all(folder)?;
@@ -394,6 +425,16 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
     let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
     write_if_changed(&by_seed_csv, &csv_bytes(&by_seed, &by_seed_csv)?)?;
     let mut files = vec![union_csv.clone(), pooled_csv.clone(), by_seed_csv];
+    let compared = match compared {
+        Some(Ok((differences, comparisons))) => {
+            let differences_csv = target.root().join(format!("{name}_differences.csv"));
+            write_if_changed(&differences_csv, &csv_bytes(&differences, &differences_csv)?)?;
+            files.push(differences_csv);
+            Some(Ok(comparisons))
+        }
+        Some(Err(why)) => Some(Err(why)),
+        None => None,
+    };
     let reliability_csv = match &reliability {
         Some((table, rows)) => {
             let path = target.detail_csv(table);
@@ -445,6 +486,7 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
         seeds: record.runs.iter().map(|r| r.seed).collect(),
         files,
         calibration,
+        compared,
     })
 }
 
@@ -653,21 +695,6 @@ fn read_run<'a>(
     Ok(SeedRun { dir, seed, rows })
 }
 
-/// One seed's trials at one point of one curve, summed.
-#[derive(Debug, Clone, Default)]
-struct SeedSums {
-    trials: usize,
-    accuracy: f64,
-    reliability: f64,
-    extras: Vec<f64>,
-}
-
-/// A curve: its descriptor and factor levels.
-type CurveKey = (String, Factors);
-
-/// Per number of readings, each seed's sums in the order the runs were given.
-type PointSums = BTreeMap<u32, Vec<SeedSums>>;
-
 /// Every curve (descriptor and factor levels, in order of first appearance) with, per number of
 /// readings, each seed's sums in the order the runs were given.
 struct Curves {
@@ -733,7 +760,7 @@ impl Curves {
                     n_readings: n,
                     seeds: sums.len(),
                     trials,
-                    accuracy: mean(|s| s.accuracy),
+                    accuracy: pooled_accuracy(sums, None),
                     accuracy_low,
                     accuracy_high,
                     reliability: mean(|s| s.reliability),
@@ -764,48 +791,13 @@ impl Curves {
                         seed,
                         n_readings: n,
                         trials: sum.trials,
-                        accuracy: sum.accuracy / sum.trials as f64,
+                        accuracy: sum.mean_accuracy(),
                         reliability: sum.reliability / sum.trials as f64,
                     });
                 }
             }
         }
         rows
-    }
-}
-
-/// [`RESAMPLES`] draws of `seeds` seed indices each, with replacement.
-fn resamples(seeds: usize) -> Vec<Vec<usize>> {
-    let mut rng = crate::rng::rng(RESAMPLE_SEED);
-    (0..RESAMPLES)
-        .map(|_| (0..seeds).map(|_| rng.random_range(0..seeds)).collect())
-        .collect()
-}
-
-/// The [`INTERVAL_LEVEL`] percentile interval of the pooled accuracy over `draws` (linear
-/// interpolation between order statistics, numpy's default).
-fn interval(sums: &[SeedSums], draws: &[Vec<usize>]) -> (f64, f64) {
-    let mut means: Vec<f64> = draws
-        .iter()
-        .map(|draw| {
-            let (correct, trials) = draw.iter().fold((0.0, 0usize), |(c, t), &s| {
-                (c + sums[s].accuracy, t + sums[s].trials)
-            });
-            correct / trials as f64
-        })
-        .collect();
-    means.sort_by(f64::total_cmp);
-    let tail = (1.0 - INTERVAL_LEVEL) / 2.0;
-    (percentile(&means, tail), percentile(&means, 1.0 - tail))
-}
-
-/// The `q` quantile of `sorted` (non-empty), interpolating linearly between order statistics.
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    let h = q * (sorted.len() - 1) as f64;
-    let (below, fraction) = (h.floor() as usize, h - h.floor());
-    match sorted.get(below + 1) {
-        Some(&above) => sorted[below] + fraction * (above - sorted[below]),
-        None => sorted[below],
     }
 }
 
@@ -1025,7 +1017,7 @@ mod tests {
         let root = tempfile::tempdir().unwrap();
         let runs = two_runs(root.path());
         let out = root.path().join("pooled");
-        let report = pool(&runs, &out).unwrap();
+        let report = pool(&runs, &out, None).unwrap();
         assert_eq!(report.pooled.len(), 1);
         assert_eq!(report.pooled[0].seeds, vec![1, 2]);
         let pooled = rows(&out.join("toy/toy_pooled.csv"));
@@ -1070,8 +1062,8 @@ mod tests {
         let root = tempfile::tempdir().unwrap();
         let runs = two_runs(root.path());
         let (one, two) = (root.path().join("one"), root.path().join("two"));
-        pool(&runs, &one).unwrap();
-        pool(&runs, &two).unwrap();
+        pool(&runs, &one, None).unwrap();
+        pool(&runs, &two, None).unwrap();
         for file in [
             "toy.csv",
             "toy_pooled.csv",
@@ -1091,7 +1083,7 @@ mod tests {
     fn reliability_tables_sum_their_predictions() {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("pooled");
-        let report = pool(&two_runs(root.path()), &out).unwrap();
+        let report = pool(&two_runs(root.path()), &out, None).unwrap();
         let pooled = rows(&out.join("toy/toy_reliability.csv"));
         assert_eq!(pooled.len(), 10);
         // Eight predictions at mean confidence 0.95, seven right: ECE |7/8 - 0.95| = 0.075.
@@ -1112,13 +1104,13 @@ mod tests {
         let (a, b) = (root.path().join("a"), root.path().join("b"));
         write_run(&a, 1, SCALE, &[&[0.5]], None);
         write_run(&b, 2, r#""scale": 0.3"#, &[&[0.5]], None);
-        let e = pool(&[a.clone(), b], &root.path().join("out"))
+        let e = pool(&[a.clone(), b], &root.path().join("out"), None)
             .unwrap_err()
             .to_string();
         assert!(e.contains("/scale: 1.0 vs 0.3"), "{e}");
         let c = root.path().join("c");
         write_run(&c, 1, SCALE, &[&[0.25]], None);
-        let e = pool(&[a, c], &root.path().join("out")).unwrap_err();
+        let e = pool(&[a, c], &root.path().join("out"), None).unwrap_err();
         assert!(matches!(e, ExperimentError::RepeatedSeed { seed: 1, .. }), "{e}");
     }
 
@@ -1128,18 +1120,18 @@ mod tests {
         let runs = two_runs(root.path());
         let out = root.path().join("out");
         assert!(matches!(
-            pool(&runs[..1], &out),
+            pool(&runs[..1], &out, None),
             Err(ExperimentError::PoolNeedsSeeds { given: 1 })
         ));
         std::fs::remove_file(runs[1].join("toy/toy.csv")).unwrap();
         assert!(matches!(
-            pool(&runs, &out),
+            pool(&runs, &out, None),
             Err(ExperimentError::NotFinished { .. })
         ));
         let empty = root.path().join("empty");
         std::fs::create_dir_all(&empty).unwrap();
         assert!(matches!(
-            pool(&[runs[0].clone(), empty], &out),
+            pool(&[runs[0].clone(), empty], &out, None),
             Err(ExperimentError::NoExperiments { .. })
         ));
     }
@@ -1153,7 +1145,9 @@ mod tests {
             .unwrap()
             .replace(",0.25,0.125,2,", ",NaN,0.125,2,");
         std::fs::write(&csv, text).unwrap();
-        let e = pool(&runs, &root.path().join("out")).unwrap_err().to_string();
+        let e = pool(&runs, &root.path().join("out"), None)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("toy.csv") && e.contains("line 2: accuracy NaN"), "{e}");
     }
 
@@ -1166,7 +1160,7 @@ mod tests {
         let before = std::fs::read(runs[0].join("toy/toy.csv")).unwrap();
         let folders: Vec<PathBuf> = runs.iter().map(|r| r.join("toy")).collect();
         for out in [&runs[0], &runs[1], &third] {
-            let e = pool(&folders, out).unwrap_err();
+            let e = pool(&folders, out, None).unwrap_err();
             assert!(matches!(e, ExperimentError::PoolIntoRun { .. }), "{e}");
         }
         assert_eq!(std::fs::read(runs[0].join("toy/toy.csv")).unwrap(), before);
@@ -1176,7 +1170,7 @@ mod tests {
     /// Pools `runs` into a fresh folder; the error's text, after checking nothing was written.
     fn refused(runs: &[PathBuf], root: &Path) -> String {
         let out = root.join("refused");
-        let e = pool(runs, &out).unwrap_err().to_string();
+        let e = pool(runs, &out, None).unwrap_err().to_string();
         assert!(
             !out.join("toy").exists(),
             "nothing written before the refusal: {e}"
@@ -1250,31 +1244,11 @@ mod tests {
         let runs = two_runs(root.path());
         let folders: Vec<PathBuf> = runs.iter().map(|r| r.join("toy")).collect();
         let (by_root, by_folder) = (root.path().join("r"), root.path().join("f"));
-        pool(&runs, &by_root).unwrap();
-        pool(&folders, &by_folder).unwrap();
+        pool(&runs, &by_root, None).unwrap();
+        pool(&folders, &by_folder, None).unwrap();
         assert_eq!(
             std::fs::read(by_root.join("toy/toy_pooled.csv")).unwrap(),
             std::fs::read(by_folder.join("toy/toy_pooled.csv")).unwrap()
         );
-    }
-
-    #[test]
-    fn percentiles_interpolate_between_order_statistics_as_numpy_does() {
-        let sorted = [1.0, 2.0, 3.0, 4.0];
-        // numpy.percentile([1, 2, 3, 4], [5, 50, 95]) = [1.15, 2.5, 3.85]
-        for (q, want) in [(0.05, 1.15), (0.5, 2.5), (0.95, 3.85), (0.0, 1.0), (1.0, 4.0)] {
-            assert!((percentile(&sorted, q) - want).abs() < 1e-12, "{q}");
-        }
-    }
-
-    #[test]
-    fn one_seed_resampled_is_its_own_interval() {
-        let sums = vec![SeedSums {
-            trials: 3,
-            accuracy: 2.0,
-            ..SeedSums::default()
-        }];
-        let (low, high) = interval(&sums, &resamples(1));
-        assert_eq!((low, high), (2.0 / 3.0, 2.0 / 3.0));
     }
 }
