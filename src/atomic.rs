@@ -73,6 +73,16 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
 }
 
+/// Deletes `path` if it is there: an output an earlier run into the same folder wrote and this
+/// run does not, which would otherwise stand beside fresh files as if this run had written it.
+pub fn remove_if_present(path: &Path) -> Result<(), FileError> {
+    match std::fs::remove_file(path) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(source) => Err(FileError::at(path)(source)),
+    }
+}
+
 /// Deletes the temporaries of [`write_atomic`] in `dir` left by processes that no longer run (a
 /// killed run), judged by the process id in their name; returns how many. Temporaries of live
 /// processes, such as another shard writing into the same directory, are left alone. Where `/proc`

@@ -26,10 +26,11 @@ fn a_physics_fault_is_reported_without_a_log_file_in_the_working_directory() {
     std::env::set_current_dir(dir.path()).unwrap();
     let log = dir.path().join("MUJOCO_LOG.TXT");
 
-    // MuJoCo's default writes the file, so the check below can tell.
-    let default = mj_logging::log_config().with_logto_file(true);
+    // MuJoCo's default writes the file (which `common` switched off): on again, so the check
+    // below can tell.
+    let file_on = mj_logging::log_config().with_logto_file(true);
     // SAFETY: this test is the only one of its binary: no other thread uses MuJoCo.
-    unsafe { mj_logging::set_log_config(default) };
+    unsafe { mj_logging::set_log_config(file_on) };
     let fault = faulted_step().expect("the fault should be reported");
     assert!(fault.contains("bad velocity"), "{fault}");
     assert!(

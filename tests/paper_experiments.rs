@@ -752,7 +752,7 @@ fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refu
         &reference,
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(stdout.contains(&format!("against {reference}: ")), "{stdout}");
+    assert!(stdout.contains(&format!("against {reference} (")), "{stdout}");
     let pooled_accuracy = |descriptor: &str, n: u32| {
         let at: Vec<f64> = union
             .iter()

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use taction::experiment::ReferenceCurve;
+use taction::experiment::ReferenceLevels;
 
 use crate::cli::common::OutputLock;
 
@@ -23,14 +23,16 @@ pub struct PoolArgs {
     pub out: PathBuf,
     /// Also compare every curve with a reference curve, seed by seed: `column=level` pairs joined by
     /// commas, each column a factor or `descriptor` (e.g. `strategy=blind,local_probability=1`).
-    /// Each curve meets the curve of its own levels with these replaced; written per experiment
-    /// (`<experiment>_differences.csv`): the differences with their 90% interval over resampled
-    /// seeds, and the readings each curve needs to reach the reference's accuracy.
+    /// Each curve is compared with the curve of its own levels with these replaced; written per
+    /// experiment (`<experiment>_differences.csv`): the differences with their 90% interval over
+    /// resampled seeds, and the first number of readings at which each curve reaches the
+    /// reference's accuracy.
     #[arg(long, value_name = "COLUMN=LEVEL,...")]
-    pub against: Option<ReferenceCurve>,
+    pub against: Option<ReferenceLevels>,
 }
 
-/// Pools every experiment the runs hold, then prints what it wrote and each curve's pooled ECE.
+/// Pools every experiment the runs hold, then prints what it wrote, each curve's pooled ECE and,
+/// with `--against`, each curve against its reference.
 pub fn run(args: &PoolArgs) -> Result<(), Box<dyn std::error::Error>> {
     let _lock = OutputLock::acquire(&args.out, "out")?;
     let report = taction::experiment::pool(&args.runs, &args.out, args.against.as_ref())?;
@@ -51,14 +53,18 @@ pub fn run(args: &PoolArgs) -> Result<(), Box<dyn std::error::Error>> {
         match &pooled.compared {
             Some(Ok(comparisons)) => {
                 let reference = args.against.as_ref().map(ToString::to_string).unwrap_or_default();
+                println!("  against {reference} (each curve against the curve of its other levels):");
                 for c in comparisons {
-                    let (n, accuracy, reached) = c.last;
-                    let reached = match reached {
-                        Some(m) => format!("after {m} readings"),
-                        None => "never".to_string(),
+                    let target = format!(
+                        "{:.3} (the reference at {} readings)",
+                        c.reference_accuracy, c.reference_readings
+                    );
+                    let reached = match c.readings_to_reach {
+                        Some(m) => format!("reaches {target} after {m} readings"),
+                        None => format!("does not reach {target} within its readings"),
                     };
                     println!(
-                        "  against {reference}: {} {}: level or ahead at {} of {} counts; reaches the reference's {accuracy:.3} at {n} readings {reached}",
+                        "    {} {}: level or ahead at {} of {} reading counts; {reached}",
                         c.descriptor, c.factors, c.counts_level_or_ahead, c.counts
                     );
                 }

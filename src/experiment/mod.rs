@@ -45,8 +45,8 @@ pub use name::{ExperimentName, KeyBuilder, NameError, SafeName, UnitKey};
 pub use pool::{
     BySeedRow, INTERVAL_BAND_LABEL, PoolRecord, PoolReport, PooledExperiment, PooledRow, PooledRun, pool,
 };
-pub use reference::{Comparison, DifferenceRow, ReferenceCurve};
-pub use resample::{INTERVAL_LEVEL, RESAMPLES};
+pub use reference::{Comparison, DifferenceRow, ReferenceLevels};
+pub use resample::{INTERVAL_LEVEL, RESAMPLES, TIE_TOLERANCE};
 pub use runner::{Experiment, RunOptions, RunReport, check_resumable, run};
 pub use shard::{Shard, ShardError};
 pub use spec::{ExperimentSpec, Manifest};

@@ -21,7 +21,7 @@
 //! | `<experiment>_by_seed.csv` | one row per curve, seed and number of readings ([`BySeedRow`]) |
 //! | `<experiment>_reliability.csv` | the reliability table of each curve, every seed's predictions summed ([`ReliabilityRow`]), when the runs have one |
 //! | `<stem>.svg`, `.png` | the experiment's plots over every seed: accuracy with the interval as band, reliability diagrams, and line plots of the main table's own columns (their mean over every seed's rows) |
-//! | `pool.json` | the runs and seeds pooled, the resampling, and the configuration they share |
+//! | `pool.json` | the runs and seeds pooled, the resampling, the reference compared with (`--against`, when this experiment's curves were), and the configuration they share |
 //!
 //! With `--against`, each curve is also compared with a reference curve, seed by seed
 //! ([`super::reference`]: `<experiment>_differences.csv`).
@@ -46,14 +46,14 @@ use super::plot::{
     Ordered, PlotKind, PlotSpec, SummarisedCurve, calibration_labels, csv_error, render_plot,
     summarised_accuracy_figure,
 };
-use super::reference::{Compared, Comparison, ReferenceCurve, against};
+use super::reference::{Compared, Comparison, ReferenceLevels, against};
 use super::resample::{
     CurveKey, INTERVAL_LEVEL, PointSums, RESAMPLE_SEED, RESAMPLES, SeedSums, interval, pooled_accuracy,
     resamples,
 };
 use super::spec::{Manifest, to_json};
 use super::unit::DetailRow;
-use crate::atomic::{remove_stale_temporaries, write_if_changed};
+use crate::atomic::{remove_if_present, remove_stale_temporaries, write_if_changed};
 use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
 
 /// What the bands of a pooled accuracy plot are.
@@ -209,7 +209,7 @@ pub struct PooledRun {
 pub fn pool(
     inputs: &[PathBuf],
     out: &Path,
-    reference: Option<&ReferenceCurve>,
+    reference: Option<&ReferenceLevels>,
 ) -> Result<PoolReport, ExperimentError> {
     if inputs.len() < 2 {
         return Err(ExperimentError::PoolNeedsSeeds { given: inputs.len() });
@@ -245,6 +245,7 @@ pub fn pool(
         }
     }
     if let Some(reference) = reference
+        && !prepared.is_empty()
         && !prepared.iter().any(|p| matches!(p.compared, Some(Ok(_))))
     {
         let why = prepared
@@ -327,7 +328,7 @@ struct Prepared {
 fn prepare(
     runs: &[&ExperimentDir],
     out: &Path,
-    reference: Option<&ReferenceCurve>,
+    reference: Option<&ReferenceLevels>,
 ) -> Result<Result<Prepared, String>, ExperimentError> {
     let first = runs[0];
     let name = first.name();
@@ -369,7 +370,8 @@ fn prepare(
     let sources: Vec<PathBuf> = runs.iter().map(|r| r.dir.csv()).collect();
     let union = concatenate(&sources)?;
     let curves = Curves::of(&runs, &extras)?;
-    let compared = reference.map(|r| against(&curves.curves.items, r, name.as_str(), &resamples(runs.len())));
+    let draws = resamples(runs.len());
+    let compared = reference.map(|r| against(&curves.curves.items, r, name.as_str(), &draws));
     let reliability = pool_reliability(&runs, &manifest)?;
     let record = PoolRecord {
         experiment: name.clone(),
@@ -383,12 +385,14 @@ fn prepare(
         resamples: RESAMPLES,
         interval_level: INTERVAL_LEVEL,
         resample_seed: RESAMPLE_SEED,
-        against: reference.map(ReferenceCurve::to_string),
+        against: reference
+            .filter(|_| matches!(compared, Some(Ok(_))))
+            .map(ReferenceLevels::to_string),
         config,
     };
     Ok(Ok(Prepared {
         name: name.clone(),
-        pooled: curves.pooled(name, &extras),
+        pooled: curves.pooled(name, &extras, &draws),
         by_seed: curves.by_seed(name, &seeds),
         target,
         manifest,
@@ -425,15 +429,18 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
     let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
     write_if_changed(&by_seed_csv, &csv_bytes(&by_seed, &by_seed_csv)?)?;
     let mut files = vec![union_csv.clone(), pooled_csv.clone(), by_seed_csv];
+    let differences_csv = target.root().join(format!("{name}_differences.csv"));
     let compared = match compared {
         Some(Ok((differences, comparisons))) => {
-            let differences_csv = target.root().join(format!("{name}_differences.csv"));
             write_if_changed(&differences_csv, &csv_bytes(&differences, &differences_csv)?)?;
             files.push(differences_csv);
             Some(Ok(comparisons))
         }
-        Some(Err(why)) => Some(Err(why)),
-        None => None,
+        // An earlier pool's differences would stand beside this pool's tables as if they were its.
+        not_compared => {
+            remove_if_present(&differences_csv)?;
+            not_compared.map(|c| c.map(|(_, comparisons)| comparisons))
+        }
     };
     let reliability_csv = match &reliability {
         Some((table, rows)) => {
@@ -699,7 +706,6 @@ fn read_run<'a>(
 /// readings, each seed's sums in the order the runs were given.
 struct Curves {
     curves: Ordered<CurveKey, PointSums>,
-    seeds: usize,
 }
 
 impl Curves {
@@ -738,21 +744,17 @@ impl Curves {
                 }
             }
         }
-        Ok(Self {
-            curves,
-            seeds: runs.len(),
-        })
+        Ok(Self { curves })
     }
 
     /// The pooled rows, curve by curve, each point's interval from one shared set of resamples.
-    fn pooled(&self, experiment: &ExperimentName, extras: &[String]) -> Vec<PooledRow> {
-        let draws = resamples(self.seeds);
+    fn pooled(&self, experiment: &ExperimentName, extras: &[String], draws: &[Vec<usize>]) -> Vec<PooledRow> {
         let mut rows = Vec::new();
         for ((descriptor, factors), points) in &self.curves.items {
             for (&n, sums) in points {
                 let trials: usize = sums.iter().map(|s| s.trials).sum();
                 let mean = |part: fn(&SeedSums) -> f64| sums.iter().map(part).sum::<f64>() / trials as f64;
-                let (accuracy_low, accuracy_high) = interval(sums, &draws);
+                let (accuracy_low, accuracy_high) = interval(sums, draws);
                 rows.push(PooledRow {
                     experiment: experiment.to_string(),
                     descriptor: descriptor.clone(),

@@ -14,7 +14,7 @@
 //!
 //! | file | what |
 //! |---|---|
-//! | `<experiment>_differences.csv` | one row per compared curve and number of readings both curves have ([`DifferenceRow`]), with the readings the curve needs to reach the reference's accuracy there |
+//! | `<experiment>_differences.csv` | one row per compared curve and number of readings both curves have ([`DifferenceRow`]), with the first number of readings at which the curve reaches the reference's accuracy there |
 //!
 //! and a summary per compared curve ([`Comparison`]), which `taction pool` prints.
 
@@ -25,17 +25,17 @@ use serde::Serialize;
 use serde::ser::{SerializeStruct, Serializer};
 
 use super::factor::{Factor, Factors};
-use super::resample::{CurveKey, PointSums, percentile_interval, pooled_accuracy};
+use super::resample::{CurveKey, PointSums, TIE_TOLERANCE, level_or_ahead, paired_interval, pooled_accuracy};
 
 /// The curve every other curve is compared with: the levels it takes of some of the experiment's
 /// factors, and optionally its descriptor (`descriptor=mnti`), as `--against` names them.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ReferenceCurve {
+pub struct ReferenceLevels {
     descriptor: Option<String>,
     levels: Vec<(Factor, String)>,
 }
 
-impl ReferenceCurve {
+impl ReferenceLevels {
     /// The reference of the curve `(descriptor, factors)`: its own descriptor and levels, those the
     /// reference names replaced; `None` when the curve lacks a factor the reference names.
     fn of(&self, (descriptor, factors): &CurveKey) -> Option<CurveKey> {
@@ -52,6 +52,27 @@ impl ReferenceCurve {
         Some((descriptor, Factors::new(levels)))
     }
 
+    /// The levels the curves take of each column the reference names, for a message.
+    fn levels_taken(&self, curves: &[(CurveKey, PointSums)]) -> String {
+        let mut named: Vec<String> = Vec::new();
+        let mut list = |column: &str, level: &dyn Fn(&CurveKey) -> Option<String>| {
+            let mut levels: Vec<String> = Vec::new();
+            for (key, _) in curves {
+                if let Some(l) = level(key).filter(|l| !levels.contains(l)) {
+                    levels.push(l);
+                }
+            }
+            named.push(format!("{column} {}", levels.join(", ")));
+        };
+        if self.descriptor.is_some() {
+            list("descriptor", &|(d, _)| Some(d.clone()));
+        }
+        for (factor, _) in &self.levels {
+            list(factor.column(), &|(_, f)| f.level(*factor).map(str::to_string));
+        }
+        named.join("; ")
+    }
+
     /// The factors named that no curve of an experiment has, for its note of why nothing was
     /// compared.
     fn missing_factors(&self, curves: &[(CurveKey, PointSums)]) -> Vec<Factor> {
@@ -64,7 +85,7 @@ impl ReferenceCurve {
 }
 
 /// `descriptor=mnti,strategy=blind`: as `--against` takes it.
-impl fmt::Display for ReferenceCurve {
+impl fmt::Display for ReferenceLevels {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let descriptor = self.descriptor.iter().map(|d| format!("descriptor={d}"));
         let levels = self
@@ -75,7 +96,7 @@ impl fmt::Display for ReferenceCurve {
     }
 }
 
-impl FromStr for ReferenceCurve {
+impl FromStr for ReferenceLevels {
     type Err = String;
 
     /// `column=level` pairs joined by commas: each column a factor (or `descriptor`), at most once,
@@ -124,10 +145,10 @@ impl FromStr for ReferenceCurve {
 /// | `reference` | the reference as `--against` named it |
 /// | `seeds` | runs pooled |
 /// | `accuracy`, `reference_accuracy` | each curve's pooled accuracy (the mean over every trial of every seed) |
-/// | `difference` | `accuracy - reference_accuracy` |
+/// | `difference` | `accuracy - reference_accuracy`, 0 within [`TIE_TOLERANCE`] (a tie whose sums were added in another order) |
 /// | `difference_low`, `difference_high` | the 90% percentile interval of the difference over resamples of whole seeds, the same seeds for both curves |
-/// | `seeds_level_or_ahead` | the seeds whose own accuracy is at least their reference's |
-/// | `readings_to_reach` | the fewest readings after which the pooled curve is at least `reference_accuracy`; empty when it never is |
+/// | `seeds_level_or_ahead` | the seeds whose own accuracy is level with (within [`TIE_TOLERANCE`]) or ahead of their reference's |
+/// | `readings_to_reach` | the first number of readings at which the pooled curve reaches `reference_accuracy` (level within [`TIE_TOLERANCE`]); empty when it does not within the readings run |
 #[derive(Debug, Clone, PartialEq)]
 pub struct DifferenceRow {
     pub experiment: String,
@@ -172,11 +193,13 @@ pub struct Comparison {
     pub factors: Factors,
     /// The numbers of readings both curves have.
     pub counts: usize,
-    /// Those where the pooled curve is at least the pooled reference.
+    /// Those where the pooled curve is level with or ahead of the pooled reference.
     pub counts_level_or_ahead: usize,
-    /// The reference's last number of readings both curves have, its pooled accuracy there, and
-    /// the fewest readings after which the pooled curve is at least that.
-    pub last: (u32, f64, Option<u32>),
+    /// The last number of readings both curves have, and the reference's pooled accuracy there.
+    pub reference_readings: u32,
+    pub reference_accuracy: f64,
+    /// The first number of readings at which the pooled curve reaches that accuracy.
+    pub readings_to_reach: Option<u32>,
 }
 
 /// An experiment's curves against a reference: the differences' rows and a summary per compared
@@ -184,10 +207,11 @@ pub struct Comparison {
 pub(super) type Compared = Result<(Vec<DifferenceRow>, Vec<Comparison>), String>;
 
 /// The `curves` (each with its points' per-seed sums) against `reference` (see [`Compared`]);
-/// none when the reference names a factor no curve has, or no curve has a reference curve.
+/// none when the reference names a factor no curve has, or no curve but the reference curves has a
+/// reference curve (the message then lists the levels the curves take).
 pub(super) fn against(
     curves: &[(CurveKey, PointSums)],
-    reference: &ReferenceCurve,
+    reference: &ReferenceLevels,
     experiment: &str,
     draws: &[Vec<usize>],
 ) -> Compared {
@@ -209,20 +233,13 @@ pub(super) fn against(
             .map(|(&n, sums)| (n, pooled_accuracy(sums, None)))
             .collect();
         let first = differences.len();
-        for (&n, sums) in points {
+        for (&(n, accuracy), sums) in pooled.iter().zip(points.values()) {
             let Some(reference_sums) = reference_points.get(&n) else {
                 continue;
             };
-            let accuracy = pooled_accuracy(sums, None);
             let reference_accuracy = pooled_accuracy(reference_sums, None);
-            let (difference_low, difference_high) = percentile_interval(
-                draws
-                    .iter()
-                    .map(|draw| {
-                        pooled_accuracy(sums, Some(draw)) - pooled_accuracy(reference_sums, Some(draw))
-                    })
-                    .collect(),
-            );
+            let (difference_low, difference_high) = paired_interval(sums, reference_sums, draws);
+            let difference = accuracy - reference_accuracy;
             differences.push(DifferenceRow {
                 experiment: experiment.to_string(),
                 descriptor: key.0.clone(),
@@ -232,18 +249,22 @@ pub(super) fn against(
                 seeds: sums.len(),
                 accuracy,
                 reference_accuracy,
-                difference: accuracy - reference_accuracy,
+                difference: if difference.abs() <= TIE_TOLERANCE {
+                    0.0
+                } else {
+                    difference
+                },
                 difference_low,
                 difference_high,
                 seeds_level_or_ahead: sums
                     .iter()
                     .zip(reference_sums)
-                    .filter(|(s, r)| s.mean_accuracy() >= r.mean_accuracy())
+                    .filter(|(s, r)| level_or_ahead(s.mean_accuracy(), r.mean_accuracy()))
                     .count(),
                 readings_to_reach: pooled
                     .iter()
-                    .find(|(_, a)| *a >= reference_accuracy)
-                    .map(|(m, _)| *m),
+                    .find(|&&(_, a)| level_or_ahead(a, reference_accuracy))
+                    .map(|&(m, _)| m),
             });
         }
         let rows = &differences[first..];
@@ -252,13 +273,21 @@ pub(super) fn against(
                 descriptor: key.0.clone(),
                 factors: key.1.clone(),
                 counts: rows.len(),
-                counts_level_or_ahead: rows.iter().filter(|r| r.difference >= 0.0).count(),
-                last: (last.n_readings, last.reference_accuracy, last.readings_to_reach),
+                counts_level_or_ahead: rows
+                    .iter()
+                    .filter(|r| level_or_ahead(r.accuracy, r.reference_accuracy))
+                    .count(),
+                reference_readings: last.n_readings,
+                reference_accuracy: last.reference_accuracy,
+                readings_to_reach: last.readings_to_reach,
             });
         }
     }
     if comparisons.is_empty() {
-        return Err(format!("no curve has a reference curve at {reference}"));
+        return Err(format!(
+            "no curve other than the reference has a reference curve at {reference} (the curves' levels: {})",
+            reference.levels_taken(curves)
+        ));
     }
     Ok((differences, comparisons))
 }
@@ -275,21 +304,30 @@ mod tests {
     /// (`0.2`) is the reference plus a quarter in every seed.
     const REFERENCE: [[f64; 3]; 3] = [[0.25, 0.5, 0.5], [0.5, 0.5, 0.75], [0.0, 0.25, 0.5]];
 
-    /// Three finished runs (seeds 1-3) of a toy experiment with two curves.
-    fn runs(root: &Path) -> Vec<PathBuf> {
+    /// Finished runs of a toy experiment with two curves, the reference (`noise_fraction = 0.1`)
+    /// and another (`0.2`), one run per seed of `seeds`, `trials` trials each with the accuracy
+    /// `accuracy(seed, other, trial, n)` at `n` readings (from 1 to `readings`).
+    fn runs_of(
+        root: &Path,
+        seeds: u64,
+        (trials, readings): (usize, usize),
+        accuracy: impl Fn(u64, bool, usize, usize) -> f64,
+    ) -> Vec<PathBuf> {
         let manifest = r#"{"name":"toy","description":"a toy","plots":[{"stem":"toy","title":"Toy","kind":"accuracy","objects":4}],"details":[],"units":["all"]}"#;
-        (1..=3u64)
+        (1..=seeds)
             .map(|seed| {
                 let dir = root.join(format!("s{seed}/toy"));
                 std::fs::create_dir_all(&dir).unwrap();
                 std::fs::write(dir.join("manifest.json"), manifest).unwrap();
                 std::fs::write(dir.join("config.json"), format!(r#"{{"seed": {seed}}}"#)).unwrap();
-                let mut csv =
-                    String::from("experiment,descriptor,noise_fraction,trial,n_readings,accuracy,reliability,seed,stream_seed\n");
-                for (level, plus) in [("0.1", 0.0), ("0.2", 0.25)] {
-                    for trial in 0..2 {
-                        for (n, a) in REFERENCE[seed as usize - 1].iter().enumerate() {
-                            csv += &format!("toy,mnti,{level},{trial},{},{},0.5,{seed},7\n", n + 1, a + plus);
+                let mut csv = String::from(
+                    "experiment,descriptor,noise_fraction,trial,n_readings,accuracy,reliability,seed,stream_seed\n",
+                );
+                for (level, other) in [("0.1", false), ("0.2", true)] {
+                    for trial in 0..trials {
+                        for n in 1..=readings {
+                            let a = accuracy(seed, other, trial, n);
+                            csv += &format!("toy,mnti,{level},{trial},{n},{a},0.5,{seed},7\n");
                         }
                     }
                 }
@@ -297,6 +335,13 @@ mod tests {
                 dir
             })
             .collect()
+    }
+
+    /// Three runs whose other curve is the reference plus a quarter in every seed.
+    fn runs(root: &Path) -> Vec<PathBuf> {
+        runs_of(root, 3, (2, 3), |seed, other, _, n| {
+            REFERENCE[seed as usize - 1][n - 1] + if other { 0.25 } else { 0.0 }
+        })
     }
 
     fn rows(path: &Path) -> Vec<csv::StringRecord> {
@@ -309,9 +354,9 @@ mod tests {
 
     #[test]
     fn a_reference_reads_as_it_is_written_and_bad_ones_are_refused_naming_the_column() {
-        let reference: ReferenceCurve = "strategy=blind, local_probability=1".parse().unwrap();
+        let reference: ReferenceLevels = "strategy=blind, local_probability=1".parse().unwrap();
         assert_eq!(reference.to_string(), "strategy=blind,local_probability=1");
-        let with_descriptor: ReferenceCurve = "descriptor=mnti".parse().unwrap();
+        let with_descriptor: ReferenceLevels = "descriptor=mnti".parse().unwrap();
         assert_eq!(with_descriptor.to_string(), "descriptor=mnti");
         for (text, says) in [
             ("strategy", "not column=level"),
@@ -322,7 +367,7 @@ mod tests {
             ("strategy=a b", "holds a space"),
             ("strategy=a=b", "holds a space or '='"),
         ] {
-            let e = text.parse::<ReferenceCurve>().unwrap_err();
+            let e = text.parse::<ReferenceLevels>().unwrap_err();
             assert!(e.contains(says), "{text}: {e}");
         }
     }
@@ -331,7 +376,7 @@ mod tests {
     fn a_curve_a_quarter_above_its_reference_in_every_seed_differs_by_a_quarter_in_every_resample() {
         let root = tempfile::tempdir().unwrap();
         let out = root.path().join("pooled");
-        let reference: ReferenceCurve = "noise_fraction=0.1".parse().unwrap();
+        let reference: ReferenceLevels = "noise_fraction=0.1".parse().unwrap();
         let report = pool(&runs(root.path()), &out, Some(&reference)).unwrap();
 
         let differences = rows(&out.join("toy/toy_differences.csv"));
@@ -366,13 +411,13 @@ mod tests {
         assert_eq!(comparisons.len(), 1);
         let c = &comparisons[0];
         assert_eq!((c.counts, c.counts_level_or_ahead), (3, 3));
-        assert_eq!((c.last.0, c.last.2), (3, Some(2)));
+        assert_eq!((c.reference_readings, c.readings_to_reach), (3, Some(2)));
         let record = std::fs::read_to_string(out.join("toy/pool.json")).unwrap();
         assert!(record.contains(r#""against": "noise_fraction=0.1""#), "{record}");
     }
 
     #[test]
-    fn a_reference_no_experiment_has_is_refused_before_anything_is_written() {
+    fn a_reference_no_experiment_has_is_refused_naming_the_levels_there_are_before_anything_is_written() {
         let root = tempfile::tempdir().unwrap();
         let runs = runs(root.path());
         let out = root.path().join("pooled");
@@ -380,14 +425,55 @@ mod tests {
             ("strategy=blind", "toy: its curves have no factor strategy"),
             (
                 "noise_fraction=0.3",
-                "toy: no curve has a reference curve at noise_fraction=0.3",
+                "toy: no curve other than the reference has a reference curve at noise_fraction=0.3 \
+                 (the curves' levels: noise_fraction 0.1, 0.2)",
             ),
         ] {
-            let reference: ReferenceCurve = text.parse().unwrap();
+            let reference: ReferenceLevels = text.parse().unwrap();
             let e = pool(&runs, &out, Some(&reference)).unwrap_err();
             assert!(matches!(e, ExperimentError::NothingAgainst { .. }), "{e}");
             assert!(e.to_string().contains(says), "{e}");
             assert!(!out.exists(), "{} was written", out.display());
         }
+    }
+
+    #[test]
+    fn equal_accuracies_summed_in_another_order_are_level() {
+        let root = tempfile::tempdir().unwrap();
+        // The reference's trials 0.1, 0.2, 0.3 and the other curve's 0.3, 0.2, 0.1 in every seed:
+        // the same accuracy, whose sums differ in the last bit.
+        let value = |other: bool, trial: usize| [0.1, 0.2, 0.3][if other { 2 - trial } else { trial }];
+        let sum = |other: bool| (0..6).map(|t| value(other, t % 3)).fold(0.0, |a, v| a + v);
+        assert_ne!(
+            sum(false),
+            sum(true),
+            "the test wants sums that differ in rounding"
+        );
+        let runs = runs_of(root.path(), 2, (3, 1), |_, other, trial, _| value(other, trial));
+        let out = root.path().join("pooled");
+        let reference: ReferenceLevels = "noise_fraction=0.1".parse().unwrap();
+        let report = pool(&runs, &out, Some(&reference)).unwrap();
+        let differences = rows(&out.join("toy/toy_differences.csv"));
+        assert_eq!(&differences[0][8], "0.0", "{:?}", differences[0]);
+        assert_eq!((&differences[0][11], &differences[0][12]), ("2", "1"));
+        let Some(Ok(comparisons)) = &report.pooled[0].compared else {
+            panic!("{:?}", report.pooled[0].compared);
+        };
+        assert_eq!(comparisons[0].counts_level_or_ahead, 1);
+    }
+
+    #[test]
+    fn a_pool_without_the_reference_leaves_no_earlier_differences_behind() {
+        let root = tempfile::tempdir().unwrap();
+        let runs = runs(root.path());
+        let out = root.path().join("pooled");
+        let reference: ReferenceLevels = "noise_fraction=0.1".parse().unwrap();
+        pool(&runs, &out, Some(&reference)).unwrap();
+        let differences = out.join("toy/toy_differences.csv");
+        assert!(differences.is_file());
+        pool(&runs, &out, None).unwrap();
+        assert!(!differences.exists(), "{} was left", differences.display());
+        let record = std::fs::read_to_string(out.join("toy/pool.json")).unwrap();
+        assert!(!record.contains("against"), "{record}");
     }
 }

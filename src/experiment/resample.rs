@@ -52,7 +52,7 @@ pub(super) fn resamples(seeds: usize) -> Vec<Vec<usize>> {
         .collect()
 }
 
-/// The [`INTERVAL_LEVEL`] percentile interval of the pooled accuracy over `draws`.
+/// The [`INTERVAL_LEVEL`] percentile interval of the pooled accuracy of `sums` over `draws`.
 pub(super) fn interval(sums: &[SeedSums], draws: &[Vec<usize>]) -> (f64, f64) {
     percentile_interval(
         draws
@@ -60,6 +60,29 @@ pub(super) fn interval(sums: &[SeedSums], draws: &[Vec<usize>]) -> (f64, f64) {
             .map(|draw| pooled_accuracy(sums, Some(draw)))
             .collect(),
     )
+}
+
+/// The [`INTERVAL_LEVEL`] percentile interval of `sums`' pooled accuracy minus `reference`'s over
+/// `draws`, both curves on the same drawn seeds.
+pub(super) fn paired_interval(sums: &[SeedSums], reference: &[SeedSums], draws: &[Vec<usize>]) -> (f64, f64) {
+    percentile_interval(
+        draws
+            .iter()
+            .map(|draw| pooled_accuracy(sums, Some(draw)) - pooled_accuracy(reference, Some(draw)))
+            .collect(),
+    )
+}
+
+/// How far apart two pooled accuracies may be and still be equal. An accuracy is a count of right
+/// guesses over a count of runs, but it is pooled as a sum of per-trial fractions, whose rounding
+/// depends on the order of the trials: two curves with the same counts can differ in the last bit
+/// (491/540 as 0.9092592592592591 and as 0.9092592592592592), while two different fractions of at
+/// most 10,000 runs each differ by at least 1e-8 (a curve of fifteen seeds pools 540 runs a point).
+pub const TIE_TOLERANCE: f64 = 1e-9;
+
+/// Whether accuracy `a` is at least `b`, a tie within [`TIE_TOLERANCE`] counting as level.
+pub(super) fn level_or_ahead(a: f64, b: f64) -> bool {
+    a >= b - TIE_TOLERANCE
 }
 
 /// The mean accuracy over every trial of the seeds `draw` names (with repeats), or of every seed.

@@ -670,7 +670,8 @@ mod tests {
     /// MuJoCo, as [`keep_mujoco_log_off_disk`] requires.
     #[ctor::ctor(unsafe)]
     fn log_off_disk() {
-        // SAFETY: constructors run before `main`, on the one thread there is.
+        // SAFETY: constructors run before `main`, on the one thread there is, and after those of
+        // libmujoco.so, a shared library the executable links (its globals are set up).
         unsafe { keep_mujoco_log_off_disk() };
     }
 
