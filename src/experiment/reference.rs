@@ -27,8 +27,9 @@ use serde::ser::{SerializeStruct, Serializer};
 use super::factor::{Factor, Factors};
 use super::resample::{CurveKey, PointSums, TIE_TOLERANCE, level_or_ahead, paired_interval, pooled_accuracy};
 
-/// The curve every other curve is compared with: the levels it takes of some of the experiment's
-/// factors, and optionally its descriptor (`descriptor=mnti`), as `--against` names them.
+/// The levels of the reference curves, as `--against` names them: some of the experiment's factors
+/// and optionally the descriptor (`descriptor=mnti`). Each curve's reference is the curve of its
+/// own levels with these replaced, so `strategy=blind` names one reference per object motion.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReferenceLevels {
     descriptor: Option<String>,
