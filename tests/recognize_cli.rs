@@ -220,6 +220,19 @@ fn the_neighbour_codebook_trains_with_its_own_defaults_and_recognises() {
 }
 
 /// Trains a polar-fourier model of the toy objects on 40 readings each into `dir/model.json`.
+/// The toy model trained in `dir` recognising a test set of 20 readings of each object (two
+/// trials of ten), readings `readings`, into `dir/out`; its stdout and stderr.
+fn recognise_toy(dir: &std::path::Path, readings: &str) -> (String, String) {
+    toy_model(dir);
+    recognize_toy::dataset(20, 3)
+        .write(&dir.join("test.csv"))
+        .unwrap();
+    let p = |name: &str| dir.join(name).display().to_string();
+    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), readings, &p("out"));
+    assert!(ok, "{stderr}");
+    (stdout, stderr)
+}
+
 fn toy_model(dir: &std::path::Path) {
     let train = dir.join("train.csv");
     recognize_toy::dataset(40, 1).write(&train).unwrap();
@@ -244,13 +257,8 @@ fn toy_model(dir: &std::path::Path) {
 #[test]
 fn readings_beyond_the_data_are_labelled_as_used_and_warned_about() {
     let dir = tempfile::tempdir().unwrap();
+    let (stdout, stderr) = recognise_toy(dir.path(), "50");
     let p = |name: &str| dir.path().join(name).display().to_string();
-    toy_model(dir.path());
-    recognize_toy::dataset(20, 3)
-        .write(dir.path().join("test.csv").as_path())
-        .unwrap();
-    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), "50", &p("out"));
-    assert!(ok, "{stderr}");
     assert!(
         stderr.contains("warning: --readings 1..50")
             && stderr.contains("more than 20 converged readings")
@@ -351,13 +359,7 @@ fn recognize_plots_accuracy_with_its_band_and_chance_beside_the_csvs() {
 #[test]
 fn recognize_writes_the_reliability_table_and_prints_its_ece() {
     let dir = tempfile::tempdir().unwrap();
-    let p = |name: &str| dir.path().join(name).display().to_string();
-    toy_model(dir.path());
-    recognize_toy::dataset(20, 3)
-        .write(dir.path().join("test.csv").as_path())
-        .unwrap();
-    let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), "1..10", &p("out"));
-    assert!(ok, "{stderr}");
+    let (stdout, _) = recognise_toy(dir.path(), "1..10");
     let posterior = std::fs::read_to_string(dir.path().join("out/posterior.csv")).unwrap();
     let predictions = posterior.lines().count() - 1;
     assert_eq!(predictions, 3 * 2 * 10);
@@ -509,4 +511,74 @@ fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
         !ok && stderr.contains("bayes") && stderr.contains("eq15"),
         "{stderr}"
     );
+}
+
+/// Issue 38: `recognize` replays the confidence stop on every trial (`stop.csv`, one row per
+/// threshold, and a line each on stdout): the counts are those of posterior_long.csv replayed by
+/// hand (the top guess held at or above the threshold over two touches). A range that does not
+/// start at one reading has no stop to replay.
+#[test]
+fn recognize_replays_the_confidence_stop_as_posterior_long_shows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (stdout, _) = recognise_toy(dir.path(), "1..10");
+    let p = |name: &str| dir.path().join(name).display().to_string();
+
+    // Per trial, in order of readings: the top guess and its probability.
+    let mut traces: std::collections::BTreeMap<usize, Vec<(usize, String, f64, String)>> = Default::default();
+    let long = std::fs::read_to_string(dir.path().join("out/posterior_long.csv")).unwrap();
+    for line in long.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (trial, truth, n, object, p) = (
+            f[0].parse().unwrap(),
+            f[1],
+            f[2].parse().unwrap(),
+            f[3],
+            f[4].parse::<f64>().unwrap(),
+        );
+        let trace = traces.entry(trial).or_default();
+        match trace.iter_mut().find(|t| t.0 == n) {
+            Some(top) if p > top.2 => (top.1, top.2) = (object.to_string(), p),
+            Some(_) => {}
+            None => trace.push((n, object.to_string(), p, truth.to_string())),
+        }
+    }
+    let table = std::fs::read_to_string(dir.path().join("out/stop.csv")).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next(),
+        Some("threshold,held_readings,budget,trials,stopped,right,share_right,mean_touches")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3);
+    assert_ne!(rows[0][4], "0", "the toy's trials should reach 0.9: {table}");
+    for (row, threshold) in rows.iter().zip([0.9, 0.95, 0.99]) {
+        let (mut stopped, mut right) = (0, 0);
+        for trace in traces.values() {
+            let fires = (1..trace.len()).find(|&k| {
+                trace[k].1 == trace[k - 1].1 && trace[k].2 >= threshold && trace[k - 1].2 >= threshold
+            });
+            if let Some(k) = fires {
+                stopped += 1;
+                right += usize::from(trace[k].1 == trace[k].3);
+            }
+        }
+        assert_eq!(
+            row[..6],
+            [
+                threshold.to_string().as_str(),
+                "2",
+                "10",
+                "6",
+                &stopped.to_string(),
+                &right.to_string()
+            ]
+        );
+        let line =
+            format!("stop at {threshold} (the guess held over 2 touches): {stopped} of 6 trials stopped");
+        assert!(stdout.contains(&line), "expected '{line}' in {stdout}");
+    }
+
+    let (ok, _, stderr) = recognise(&p("model.json"), &p("test.csv"), "3..10", &p("later"));
+    assert!(ok, "{stderr}");
+    assert!(!dir.path().join("later/stop.csv").exists());
 }

@@ -43,8 +43,10 @@
 //! planner and the belief of one object's exploration, and touches toward the candidate it is told.
 
 mod episode;
+mod stop;
 
 pub use episode::{EpisodeConfig, TouchEpisode};
+pub use stop::{REPORTED_STOPS, StopRecord, stops};
 
 use std::collections::BTreeMap;
 

@@ -1,15 +1,18 @@
 //! `taction recognize`: run a saved model over a test dataset touch by touch and write the
 //! per-touch posterior, accuracy against the number of readings (CSV and plot), the confusion
-//! matrix, and calibration: the reliability table of every belief (CSV and diagram) and its ECE.
+//! matrix, and calibration: the reliability table of every belief (CSV and diagram) and its ECE,
+//! and where a confidence stop would have ended each trial (`stop.csv`).
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 use indicatif::ProgressBar;
+use taction::active_touch::{REPORTED_STOPS, StopRecord};
 use taction::atomic::write_atomic;
 use taction::dataset::Dataset;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
 use taction::experiment::{build_figure, reliability_figure};
+use taction::explore::{ConfidenceStop, Probability};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer, Tempering};
 
 use crate::cli::common::PosteriorArg;
@@ -32,7 +35,9 @@ pub struct RecognizeArgs {
     /// posterior.csv in 10 bins of top probability: count, mean confidence, accuracy) with its
     /// diagram reliability.svg and reliability.png, and the plot of accuracy against readings:
     /// accuracy.svg and accuracy.png, from accuracy_trials.csv (the k-th trial of every object as
-    /// trial k, the band from the lowest to the highest).
+    /// trial k, the band from the lowest to the highest), and stop.csv (where a stop at 0.9, 0.95
+    /// and 0.99, the guess held over two touches, would have ended each trial: trials stopped,
+    /// right, the share right, the mean touches; when `--readings` starts at 1).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     #[command(flatten)]
@@ -74,6 +79,9 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
         &plot_title(args),
     )?);
     print_summary(&model, &evaluation, trials, used);
+    if args.readings.first() == 1 {
+        paths.push(write_stops(&args.out, &evaluation, trials, args.readings.last())?);
+    }
     let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     println!("wrote {}", names.join(", "));
     Ok(())
@@ -122,6 +130,37 @@ fn print_summary(model: &Recognizer, evaluation: &Evaluation, trials: usize, use
         ),
         None => println!("ECE (10 bins): none, no predictions"),
     }
+}
+
+/// Replays the confidence stops of [`REPORTED_STOPS`] (the guess held over the default two
+/// touches) on every trial within `budget` readings, prints each and writes them to `stop.csv`.
+fn write_stops(
+    dir: &Path,
+    evaluation: &Evaluation,
+    trials: usize,
+    budget: usize,
+) -> Result<PathBuf, Box<dyn std::error::Error>> {
+    let mut writer = csv::Writer::from_writer(Vec::new());
+    for threshold in REPORTED_STOPS {
+        let stop = ConfidenceStop::new(Probability::new(threshold)?);
+        let record = StopRecord::of(evaluation, trials, stop, budget);
+        let outcome = match (record.share_right, record.mean_touches) {
+            (Some(share), Some(touches)) => format!(
+                "{} right ({:.1}%), after {touches:.1} touches on average",
+                record.right,
+                100.0 * share
+            ),
+            _ => "none".to_string(),
+        };
+        println!(
+            "stop at {threshold} (the guess held over {} touches): {} of {trials} trials stopped, {outcome}",
+            record.held_readings, record.stopped
+        );
+        writer.serialize(&record)?;
+    }
+    let path = dir.join("stop.csv");
+    write_atomic(&path, &writer.into_inner().map_err(|e| e.to_string())?)?;
+    Ok(path)
 }
 
 /// Draws the reliability diagram of every belief of `evaluation` as reliability.svg and

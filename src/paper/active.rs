@@ -34,7 +34,7 @@ use super::recognition::{
     Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData, TestData, training_config,
 };
 use super::scale::DataCounts;
-use crate::active_touch::{ActiveRecognition, TouchPlan, explore_recognizing};
+use crate::active_touch::{ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, stops};
 use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
@@ -50,20 +50,16 @@ use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES, Probability};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
-    CodebookKind, Evaluation, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel,
-    Trial, evaluate,
+    CodebookKind, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
 };
 use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "active";
 pub const DESCRIPTION: &str = "Beyond the paper: active touch by expected information gain vs L = 1 and L = 0.5 (3D set, fixed and perturbed; PF), with touches to 95% confidence";
 
-/// The confidence stop the `confident` and `correct_at_stop` columns apply.
-pub const STOP_AT_CONFIDENCE: f64 = 0.95;
-
-/// The stops of the rows' columns: 0.95 as `confident` and `correct_at_stop`, the others as
-/// `confident_<p>` and `correct_at_stop_<p>`.
-pub const STOPS: [f64; 3] = [0.9, STOP_AT_CONFIDENCE, 0.99];
+/// The stops of the rows' columns, those `taction recognize` reports: 0.95 as `confident` and
+/// `correct_at_stop`, the others as `confident_<p>` and `correct_at_stop_<p>`.
+pub const STOPS: [f64; 3] = REPORTED_STOPS;
 
 /// The descriptor: Polar-Fourier, one of the paper's top three (Sec. V-B2) and the demo's.
 const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
@@ -539,26 +535,6 @@ fn curve_rows(
     }
     let reliability = curve.map_or_else(Vec::new, |meta| meta.reliability_rows(&table));
     Ok((rows, (per_object, reliability)))
-}
-
-/// Per object trial: the touch at which the stop fires and whether the guess there is right;
-/// `None` when it never fires within `budget` touches.
-fn stops(
-    evaluation: &Evaluation,
-    trials: usize,
-    stop: ConfidenceStop,
-    budget: usize,
-) -> Vec<Option<(usize, bool)>> {
-    (0..trials)
-        .map(|t| {
-            let touches: Vec<_> = evaluation.touches.iter().filter(|r| r.trial == t).collect();
-            let trace: Vec<(usize, f64)> = touches.iter().map(|r| (r.object_guess, r.p_guess())).collect();
-            stop.touches_used(&trace, budget).map(|k| {
-                let at = touches[k - 1];
-                (k, at.object_guess == at.object_true)
-            })
-        })
-        .collect()
 }
 
 #[cfg(test)]
