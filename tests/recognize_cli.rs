@@ -450,6 +450,47 @@ fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
         on_arm.split("tau").nth(1),
         "{on_arm_short}\n{on_arm}"
     );
+    // Several calibration datasets are fitted on together: the arm's twice is the arm's (the same
+    // mean loss over the same paths), the arm's with other runs another tempering.
+    let (ok, twice, stderr) = train(&["--calibration", &arm, "--calibration", &arm], "twice.json");
+    assert!(ok, "{stderr}");
+    let on_twice = line(&twice, "arm.csv + ");
+    assert_eq!(
+        on_twice.split("tau").nth(1),
+        on_arm.split("tau").nth(1),
+        "{twice}\n{on_arm}"
+    );
+    let wrong = p("wrong.csv");
+    let relabelled: String = std::fs::read_to_string(&arm)
+        .unwrap()
+        .lines()
+        .map(|l| match l.split_once(',') {
+            Some(("ridges", rest)) => format!("bumps,{rest}\n"),
+            Some(("bumps", rest)) => format!("flat,{rest}\n"),
+            Some(("flat", rest)) => format!("ridges,{rest}\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&wrong, relabelled).unwrap();
+    let both_args = [
+        "--calibration",
+        &arm,
+        "--calibration",
+        &wrong,
+        "--calibration-trial-readings",
+        "2",
+    ];
+    let (ok, both, stderr) = train(&both_args, "both.json");
+    assert!(ok, "{stderr}");
+    let on_both = line(&both, "arm.csv + ");
+    assert!(on_both.contains("wrong.csv"), "{both}");
+    // Half the paths confidently wrong: the largest floor the fit tries, and far less evidence.
+    assert!(on_both.contains("floor = 0.120"), "{on_both}");
+    assert_ne!(
+        on_both.split("tau").nth(1),
+        on_arm_short.split("tau").nth(1),
+        "{both}\n{on_arm_short}"
+    );
     for (extra, needle) in [
         (
             vec!["--calibration", arm.as_str(), "--calibration-trial-readings", "0"],

@@ -59,9 +59,11 @@ pub struct TrainArgs {
     /// Calibration dataset: the posterior's tempering is fitted on it instead of on the
     /// validation readings. Give the arm's own explorations (`collect --mode planner`) when the
     /// model will recognise them: their successive touches are correlated, which sampler
-    /// validation readings cannot show.
+    /// validation readings cannot show. Repeat the flag to fit on several datasets together
+    /// (explorations of each kind the model will see: L = 1 touches one region again and again,
+    /// and a tempering fitted on L = 0.5 alone trusts them too much; docs/measurements.md).
     #[arg(long, value_name = "FILE")]
-    pub calibration: Option<PathBuf>,
+    pub calibration: Vec<PathBuf>,
     /// Readings per calibration trial: the length of the runs the model will recognise (the
     /// tempering is only fitted at the reading counts the trials reach) [default: each object's
     /// readings in the calibration dataset as one trial].
@@ -112,24 +114,28 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         let model = models.into_iter().next().ok_or("no descriptor to train")?;
         Recognizer::Single(Box::new(model))
     };
-    let model = match &args.calibration {
-        Some(path) => {
-            let data = read_dataset(path)?;
-            let (trial_readings, trials) = match args.calibration_trial_readings {
-                Some(n) => (n, format!("trials of {n} readings")),
-                None => (usize::MAX, "each object's readings one trial".to_string()),
-            };
-            let model = model
-                .calibrate_on(&data, trial_readings)
-                .map_err(|e| format!("--calibration {}: {e}", path.display()))?;
-            print_tempering(
-                &args.descriptor.name(),
-                &format!("{} ({trials})", path.display()),
-                model.tempering(),
-            );
-            model
-        }
-        None => model,
+    let model = if args.calibration.is_empty() {
+        model
+    } else {
+        let data = args
+            .calibration
+            .iter()
+            .map(|path| read_dataset(path))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (trial_readings, trials) = match args.calibration_trial_readings {
+            Some(n) => (n, format!("trials of {n} readings")),
+            None => (usize::MAX, "each object's readings one trial".to_string()),
+        };
+        let names: Vec<String> = args.calibration.iter().map(|p| p.display().to_string()).collect();
+        let model = model
+            .calibrate_on_all(&data.iter().collect::<Vec<_>>(), trial_readings)
+            .map_err(|e| format!("--calibration {}: {e}", names.join(", ")))?;
+        print_tempering(
+            &args.descriptor.name(),
+            &format!("{} ({trials})", names.join(" + ")),
+            model.tempering(),
+        );
+        model
     };
     model.save(&args.out)?;
     let kind = if args.descriptor.is_fused() {

@@ -192,8 +192,20 @@ impl FusedModel {
 
     /// The same models with the fused posterior's tempering fitted again on the converged
     /// readings of `data` in trials of `trial_readings` ([`TrainedModel::calibrate_on`]).
-    pub fn calibrate_on(mut self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
-        let trials = self.trials(data, trial_readings)?;
+    pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
+        self.calibrate_on_all(&[data], trial_readings)
+    }
+
+    /// [`calibrate_on`](Self::calibrate_on) the trials of every dataset of `data` together.
+    pub fn calibrate_on_all(
+        mut self,
+        data: &[&Dataset],
+        trial_readings: usize,
+    ) -> Result<Self, RecognizeError> {
+        let mut trials = Vec::new();
+        for dataset in data {
+            trials.extend(self.trials(dataset, trial_readings)?);
+        }
         self.tempering = Tempering::fit(&self.evidence_paths(&trials)?);
         Ok(self)
     }
@@ -455,9 +467,16 @@ impl Recognizer {
 
     /// The same model with its posterior calibrated on `data` ([`TrainedModel::calibrate_on`]).
     pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
+        self.calibrate_on_all(&[data], trial_readings)
+    }
+
+    /// The same model with its posterior calibrated on the trials of every dataset of `data`
+    /// together ([`TrainedModel::calibrate_on_all`]): explorations of several kinds, such as the
+    /// blind planner's at L = 0.5 and at L = 1, whose readings are correlated to different degrees.
+    pub fn calibrate_on_all(self, data: &[&Dataset], trial_readings: usize) -> Result<Self, RecognizeError> {
         Ok(match self {
-            Self::Single(m) => Self::Single(Box::new(m.calibrate_on(data, trial_readings)?)),
-            Self::Fused(f) => Self::Fused(f.calibrate_on(data, trial_readings)?),
+            Self::Single(m) => Self::Single(Box::new(m.calibrate_on_all(data, trial_readings)?)),
+            Self::Fused(f) => Self::Fused(f.calibrate_on_all(data, trial_readings)?),
         })
     }
 
