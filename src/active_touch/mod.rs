@@ -46,7 +46,7 @@ mod episode;
 mod stop;
 
 pub use episode::{EpisodeConfig, TouchEpisode};
-pub use stop::{REPORTED_STOPS, StopRecord, stops};
+pub use stop::{REPORTED_STOPS, StopRecord, reported_stops, stops};
 
 use std::collections::BTreeMap;
 

@@ -9,11 +9,19 @@
 
 use serde::Serialize;
 
-use crate::explore::active::ConfidenceStop;
+use crate::explore::active::{ConfidenceStop, Probability};
 use crate::recognize::Evaluation;
 
 /// The thresholds a recognition reports its stop at: the demo's 0.95 and one either side.
 pub const REPORTED_STOPS: [f64; 3] = [0.9, 0.95, 0.99];
+
+/// The stops at [`REPORTED_STOPS`], each held over the default touches
+/// ([`ConfidenceStop::DEFAULT_HELD_READINGS`]).
+pub fn reported_stops() -> [ConfidenceStop; 3] {
+    REPORTED_STOPS.map(|p| {
+        ConfidenceStop::new(Probability::new(p).expect("every reported stop is a probability in (0, 1]"))
+    })
+}
 
 /// Where `stop` ends each of the `trials` of `evaluation` within `budget` readings: the readings
 /// used and whether the guess there was right, or `None` when it never fires. The evaluation's

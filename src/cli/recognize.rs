@@ -7,12 +7,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use indicatif::ProgressBar;
-use taction::active_touch::{REPORTED_STOPS, StopRecord};
+use taction::active_touch::{StopRecord, reported_stops};
 use taction::atomic::write_atomic;
 use taction::dataset::Dataset;
 use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeName};
 use taction::experiment::{build_figure, reliability_figure};
-use taction::explore::{ConfidenceStop, Probability};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer, Tempering};
 
 use crate::cli::common::PosteriorArg;
@@ -132,7 +131,7 @@ fn print_summary(model: &Recognizer, evaluation: &Evaluation, trials: usize, use
     }
 }
 
-/// Replays the confidence stops of [`REPORTED_STOPS`] (the guess held over the default two
+/// Replays the reported confidence stops (0.9, 0.95, 0.99, the guess held over the default two
 /// touches) on every trial within `budget` readings, prints each and writes them to `stop.csv`.
 fn write_stops(
     dir: &Path,
@@ -141,8 +140,8 @@ fn write_stops(
     budget: usize,
 ) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let mut writer = csv::Writer::from_writer(Vec::new());
-    for threshold in REPORTED_STOPS {
-        let stop = ConfidenceStop::new(Probability::new(threshold)?);
+    for stop in reported_stops() {
+        let threshold = stop.threshold().get();
         let record = StopRecord::of(evaluation, trials, stop, budget);
         let outcome = match (record.share_right, record.mean_touches) {
             (Some(share), Some(touches)) => format!(

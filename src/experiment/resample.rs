@@ -97,7 +97,7 @@ pub(super) fn pooled_accuracy(sums: &[SeedSums], draw: Option<&[usize]>) -> f64 
 
 /// The [`INTERVAL_LEVEL`] percentile interval of resampled `values` (linear interpolation between
 /// order statistics, numpy's default).
-pub(super) fn percentile_interval(mut values: Vec<f64>) -> (f64, f64) {
+fn percentile_interval(mut values: Vec<f64>) -> (f64, f64) {
     values.sort_by(f64::total_cmp);
     let tail = (1.0 - INTERVAL_LEVEL) / 2.0;
     (percentile(&values, tail), percentile(&values, 1.0 - tail))

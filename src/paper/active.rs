@@ -16,7 +16,7 @@
 //! The confidence stop needs no second run: the planner's draws do not depend on it, so a run with
 //! the stop is the run without it cut at the touch where the stop fires ([`ConfidenceStop`], the
 //! product's default: one guess held at the threshold over the last two touches). Each row adds,
-//! for each threshold of [`STOPS`], the fraction of objects stopped by then (`confident`, the
+//! for each threshold of [`REPORTED_STOPS`], the fraction of objects stopped by then (`confident`, the
 //! cumulative distribution of touches-to-confidence) and the fraction stopped with the right guess
 //! (`correct_at_stop`).
 
@@ -34,7 +34,9 @@ use super::recognition::{
     Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData, TestData, training_config,
 };
 use super::scale::DataCounts;
-use crate::active_touch::{ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, stops};
+use crate::active_touch::{
+    ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, reported_stops, stops,
+};
 use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
@@ -46,7 +48,7 @@ use crate::experiment::progress::Progress;
 use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
-use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES, Probability};
+use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES};
 use crate::explore::collect::CollectMode;
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
@@ -56,10 +58,6 @@ use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "active";
 pub const DESCRIPTION: &str = "Beyond the paper: active touch by expected information gain vs L = 1 and L = 0.5 (3D set, fixed and perturbed; PF), with touches to 95% confidence";
-
-/// The stops of the rows' columns, those `taction recognize` reports: 0.95 as `confident` and
-/// `correct_at_stop`, the others as `confident_<p>` and `correct_at_stop_<p>`.
-pub const STOPS: [f64; 3] = REPORTED_STOPS;
 
 /// The descriptor: Polar-Fourier, one of the paper's top three (Sec. V-B2) and the demo's.
 const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
@@ -80,7 +78,7 @@ const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActiveRow {
     pub accuracy: AccuracyRow,
-    /// Per threshold of [`STOPS`], in order: the fraction of objects stopped by `n_readings`
+    /// Per threshold of [`REPORTED_STOPS`], in order: the fraction of objects stopped by `n_readings`
     /// readings, and of them stopped with the right guess.
     pub stops: [StopShare; 3],
 }
@@ -92,7 +90,7 @@ pub struct StopShare {
     pub correct_at_stop: f64,
 }
 
-/// The column names of stop `i` of [`STOPS`].
+/// The column names of stop `i` of [`REPORTED_STOPS`].
 fn stop_columns(i: usize) -> (&'static str, &'static str) {
     match i {
         0 => ("confident_0.9", "correct_at_stop_0.9"),
@@ -261,7 +259,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             active_local_probability: ACTIVE_LOCAL_PROBABILITY,
             active_candidates: DEFAULT_CANDIDATES,
             neighbourhood_m,
-            stops: STOPS,
+            stops: REPORTED_STOPS,
             stop_held_readings: ConfidenceStop::DEFAULT_HELD_READINGS.get(),
             posterior: context.posterior(),
             calibration_explorations: counts.trials,
@@ -483,10 +481,6 @@ fn curve_rows(
     counts: DataCounts,
     run_seed: u64,
 ) -> Result<Rows, BoxError> {
-    let thresholds = STOPS
-        .iter()
-        .map(|p| Probability::new(*p).map(ConfidenceStop::new))
-        .collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut per_object) = (Vec::new(), Vec::new());
     let (mut table, mut curve) = (ReliabilityTable::default(), None);
     for (trial, (seed, object_trials)) in trials.iter().enumerate() {
@@ -497,15 +491,8 @@ fn curve_rows(
             );
         }
         let evaluation = evaluate(&model.bag, object_trials, ReadingRange::new(1, longest)?)?;
-        let mut stops_at = Vec::with_capacity(STOPS.len());
-        for &threshold in &thresholds {
-            stops_at.push(stops(
-                &evaluation,
-                object_trials.len(),
-                threshold,
-                counts.test_per_object,
-            ));
-        }
+        let stops_at = reported_stops()
+            .map(|stop| stops(&evaluation, object_trials.len(), stop, counts.test_per_object));
         let meta = AccuracyCurve {
             experiment: sweep.name.to_string(),
             descriptor: DESCRIPTOR.name().to_string(),

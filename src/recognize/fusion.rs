@@ -465,11 +465,6 @@ impl Recognizer {
         }
     }
 
-    /// The same model with its posterior calibrated on `data` ([`TrainedModel::calibrate_on`]).
-    pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
-        self.calibrate_on_all(&[data], trial_readings)
-    }
-
     /// The same model with its posterior calibrated on the trials of every dataset of `data`
     /// together ([`TrainedModel::calibrate_on_all`]): explorations of several kinds, such as the
     /// blind planner's at L = 0.5 and at L = 1, whose readings are correlated to different degrees.
