@@ -30,6 +30,19 @@ fn factor_columns(experiment: &str) -> &'static [&'static str] {
     }
 }
 
+/// Runs `taction args`, which must fail, without a panic, with `says` on stderr.
+fn refused(args: &[&str], says: &str) {
+    let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .output()
+        .expect("the taction binary runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let run = args.join(" ");
+    assert!(!output.status.success(), "taction {run} succeeded");
+    assert!(stderr.contains(says), "taction {run}: {stderr}");
+    assert!(!stderr.contains("panicked"), "taction {run}: {stderr}");
+}
+
 fn taction(args: &[&str]) -> Output {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
         .args(args)
@@ -556,14 +569,7 @@ fn bad_flags_and_unknown_experiments_are_clear_errors() {
             "--real",
         ),
     ] {
-        let output = Command::new(env!("CARGO_BIN_EXE_taction"))
-            .args(&args)
-            .output()
-            .expect("taction runs");
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{args:?} succeeded");
-        assert!(stderr.contains(needle), "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        refused(&args, needle);
     }
 }
 
@@ -647,13 +653,9 @@ fn an_experiment_runs_with_the_neighbour_codebook_and_keeps_it_apart() {
         let text = std::fs::read_to_string(model.unwrap().path()).unwrap();
         assert!(text.contains("\"kind\":\"knn\""));
     }
-    let gmm = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(args("gmm"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&gmm.stderr);
-    assert!(!gmm.status.success(), "a GMM run reused the kNN folder");
-    assert!(stderr.contains("config.json"), "{stderr}");
+    // A GMM run may not reuse the kNN run's folder.
+    let gmm = args("gmm");
+    refused(&gmm.iter().map(String::as_str).collect::<Vec<_>>(), "config.json");
 }
 
 #[test]
@@ -712,29 +714,11 @@ fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refu
     assert!(pooled.join("descriptors/descriptors_reliability.csv").is_file());
 
     // One seed twice is not two seeds; the output may not be one of the runs.
-    let again = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args([
-            "pool",
-            &arg(&one),
-            &arg(&one),
-            "--out",
-            &arg(&dir.path().join("x")),
-        ])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&again.stderr);
-    assert!(
-        !again.status.success() && stderr.contains("seed 1 in both"),
-        "{stderr}"
-    );
-    let into_run = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(["pool", &arg(&one), &arg(&two), "--out", &arg(&two)])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&into_run.stderr);
-    assert!(
-        !into_run.status.success() && stderr.contains("holds an experiment's run"),
-        "{stderr}"
+    let x = arg(&dir.path().join("x"));
+    refused(&["pool", &arg(&one), &arg(&one), "--out", &x], "seed 1 in both");
+    refused(
+        &["pool", &arg(&one), &arg(&two), "--out", &arg(&two)],
+        "holds an experiment's run",
     );
 
     // Every descriptor against the first, seed by seed: its difference at each point is the
@@ -781,21 +765,18 @@ fn runs_of_two_seeds_pool_to_the_mean_of_every_trial_and_a_repeated_seed_is_refu
             "{descriptor} {n}: {difference} vs {want}"
         );
     }
-    let unknown = Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args([
+    let y = arg(&dir.path().join("y"));
+    refused(
+        &[
             "pool",
             &arg(&one),
             &arg(&two),
             "--out",
-            &arg(&dir.path().join("y")),
-        ])
-        .args(["--against", "strategy=blind"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&unknown.stderr);
-    assert!(
-        !unknown.status.success() && stderr.contains("descriptors: its curves have no factor strategy"),
-        "{stderr}"
+            &y,
+            "--against",
+            "strategy=blind",
+        ],
+        "descriptors: its curves have no factor strategy",
     );
     assert!(!dir.path().join("y/descriptors").exists());
 }
