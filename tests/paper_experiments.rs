@@ -614,6 +614,49 @@ fn the_active_experiment_is_the_same_on_one_and_two_threads() {
         last = Some((curve.0, curve.1, c));
     }
     assert!(active_rows > 0, "no active rows:\n{text}");
+    calibrated_on_both_blind_strategies(&dir.path().join("one"));
+}
+
+/// The active run's posterior is calibrated on explorations of both blind strategies it judges,
+/// each on streams of its own: `config.json` names L = 0.5 and 1, and the run's data holds, at
+/// each L, as many planner datasets on seeds no test curve uses as there are test trials.
+fn calibrated_on_both_blind_strategies(out: &Path) {
+    let config = std::fs::read_to_string(out.join("active/config.json")).expect("config.json");
+    let config: serde_json::Value = serde_json::from_str(&config).expect("JSON");
+    let levels = &config["calibration_local_probabilities"];
+    assert_eq!(levels, &serde_json::json!([0.5, 1.0]), "{config}");
+    let trials = config["counts"]["trials"].as_u64().expect("counts.trials");
+    assert_eq!(config["calibration_explorations"].as_u64(), Some(trials));
+    let mut seeds: std::collections::BTreeMap<u64, BTreeSet<String>> = Default::default();
+    for entry in std::fs::read_dir(out.join("data")).expect("the run's data") {
+        let path = entry.expect("a data file").path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix("chess-planner-L-") else {
+            continue;
+        };
+        let level = rest.split('-').next().unwrap().to_string();
+        let text = std::fs::read_to_string(&path).expect("a dataset");
+        let header = text
+            .lines()
+            .nth(1)
+            .and_then(|l| l.strip_prefix("# "))
+            .expect("a header line");
+        let header: serde_json::Value = serde_json::from_str(header).expect("a JSON header");
+        let seed = header["seed"].as_u64().expect("the dataset's seed");
+        seeds.entry(seed).or_default().insert(level);
+    }
+    // A test trial's stream is read at both L (common random numbers); a calibration
+    // exploration's stream at one L only.
+    for level in ["0.5", "1"] {
+        let own = seeds
+            .values()
+            .filter(|levels| levels.len() == 1 && levels.contains(level));
+        assert_eq!(
+            own.count() as u64,
+            trials,
+            "calibration explorations at L = {level}: {seeds:?}"
+        );
+    }
 }
 
 /// `--codebook knn` trains every model of a run with the neighbour codebook: `config.json` says

@@ -5,9 +5,9 @@
 //!
 //! The model is the end-to-end recipe's (`end-to-end`, "reachable"): three times the scale's
 //! sampler readings per object from starts the arm can reach, with the run's codebook, its
-//! posterior calibrated on the arm's own explorations (a planner dataset at L = 0.5 on a stream
-//! of its own, `recognize::calibration`), each object's exploration one trial as long as a test
-//! run (`test_per_object` touches). The L curves recognise the same planner datasets as
+//! posterior calibrated on the arm's own explorations (planner datasets at L = 0.5 and L = 1, each
+//! on a stream of its own, `recognize::calibration`), each object's exploration one trial as long
+//! as a test run (`test_per_object` touches). The L curves recognise the same planner datasets as
 //! Figs. 8 and 10 (shared through `<out>/data`). The active curves cannot come from a
 //! dataset collected beforehand: where the arm touches next depends on the model's belief, so each
 //! unit explores with the trained model in the loop, with the random streams and sensor of the
@@ -31,7 +31,8 @@ use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
 use super::recognition::{
-    Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData, TestData, training_config,
+    CALIBRATION_LOCAL_PROBABILITIES, Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData,
+    TestData, training_config,
 };
 use super::scale::DataCounts;
 use crate::active_touch::{
@@ -198,8 +199,10 @@ struct ActiveConfig<'a> {
     /// Touches a guess must hold a stop's threshold over for the stop to fire.
     stop_held_readings: usize,
     /// The posterior: `calibrated` on the arm's explorations (`calibration_explorations` of each
-    /// object, `calibration_trial_readings` per trial), or the paper's `eq15`.
+    /// object at each of `calibration_local_probabilities`, `calibration_trial_readings` per
+    /// trial), or the paper's `eq15`.
     posterior: PosteriorRule,
+    calibration_local_probabilities: [f64; 2],
     calibration_explorations: usize,
     calibration_trial_readings: usize,
     scale: f64,
@@ -262,6 +265,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             stops: REPORTED_STOPS,
             stop_held_readings: ConfidenceStop::DEFAULT_HELD_READINGS.get(),
             posterior: context.posterior(),
+            calibration_local_probabilities: CALIBRATION_LOCAL_PROBABILITIES,
             calibration_explorations: counts.trials,
             calibration_trial_readings: counts.test_per_object,
             scale: context.scale.fraction(),
