@@ -106,13 +106,11 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
     );
     // The whole posterior, one row per (trial, reading, object); each touch's row sums to one and
     // its true object's probability is the wide file's p_true.
-    let long = std::fs::read_to_string(dir.path().join("out/posterior_long.csv")).unwrap();
-    let mut lines = long.lines();
-    assert_eq!(
-        lines.next(),
-        Some("trial,object_true,n_readings,object,probability")
+    let rows = out_table(
+        dir.path(),
+        "posterior_long.csv",
+        "trial,object_true,n_readings,object,probability",
     );
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3 * 30 * 3);
     for touch in rows.chunks(3) {
         let total: f64 = touch.iter().map(|r| r[4].parse::<f64>().unwrap()).sum();
@@ -123,7 +121,11 @@ fn train_then_recognise_writes_the_csvs_and_prints_accuracy() {
         .skip(1)
         .map(|l| l.split(',').nth(4).unwrap())
         .collect();
-    let p_true_long: Vec<&str> = rows.iter().filter(|r| r[1] == r[3]).map(|r| r[4]).collect();
+    let p_true_long: Vec<&str> = rows
+        .iter()
+        .filter(|r| r[1] == r[3])
+        .map(|r| r[4].as_str())
+        .collect();
     assert_eq!(p_true_wide, p_true_long);
 }
 
@@ -231,6 +233,15 @@ fn recognise_toy(dir: &std::path::Path, readings: &str) -> (String, String) {
     let (ok, stdout, stderr) = recognise(&p("model.json"), &p("test.csv"), readings, &p("out"));
     assert!(ok, "{stderr}");
     (stdout, stderr)
+}
+
+/// The rows of the CSV `name` that `recognize` wrote into `dir/out`, split at commas, once its
+/// header is `header`.
+fn out_table(dir: &std::path::Path, name: &str, header: &str) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(dir.join("out").join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(header), "the header of {name}");
+    lines.map(|l| l.split(',').map(String::from).collect()).collect()
 }
 
 fn toy_model(dir: &std::path::Path) {
@@ -364,21 +375,23 @@ fn recognize_writes_the_reliability_table_and_prints_its_ece() {
     let predictions = posterior.lines().count() - 1;
     assert_eq!(predictions, 3 * 2 * 10);
 
-    let table = std::fs::read_to_string(dir.path().join("out/reliability.csv")).unwrap();
-    let mut lines = table.lines();
-    assert_eq!(
-        lines.next(),
-        Some("bin,confidence_low,confidence_high,count,mean_confidence,accuracy")
+    let rows = out_table(
+        dir.path(),
+        "reliability.csv",
+        "bin,confidence_low,confidence_high,count,mean_confidence,accuracy",
     );
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 10);
-    let count = |r: &Vec<&str>| r[3].parse::<usize>().unwrap();
+    let count = |r: &Vec<String>| r[3].parse::<usize>().unwrap();
     assert_eq!(rows.iter().map(count).sum::<usize>(), predictions);
     let mut ece = 0.0;
     for (b, row) in rows.iter().enumerate() {
         assert_eq!(row[0], b.to_string());
         if count(row) == 0 {
-            assert_eq!((row[4], row[5]), ("", ""), "an empty bin has no mean or accuracy");
+            assert_eq!(
+                (row[4].as_str(), row[5].as_str()),
+                ("", ""),
+                "an empty bin has no mean or accuracy"
+            );
             continue;
         }
         let (confidence, accuracy): (f64, f64) = (row[4].parse().unwrap(), row[5].parse().unwrap());
@@ -566,14 +579,17 @@ fn recognize_replays_the_confidence_stop_as_posterior_long_shows_it() {
 
     // Per trial, in order of readings: the top guess and its probability.
     let mut traces: std::collections::BTreeMap<usize, Vec<(usize, String, f64, String)>> = Default::default();
-    let long = std::fs::read_to_string(dir.path().join("out/posterior_long.csv")).unwrap();
-    for line in long.lines().skip(1) {
-        let f: Vec<&str> = line.split(',').collect();
+    let long = out_table(
+        dir.path(),
+        "posterior_long.csv",
+        "trial,object_true,n_readings,object,probability",
+    );
+    for f in &long {
         let (trial, truth, n, object, p) = (
             f[0].parse().unwrap(),
-            f[1],
+            &f[1],
             f[2].parse().unwrap(),
-            f[3],
+            &f[3],
             f[4].parse::<f64>().unwrap(),
         );
         let trace = traces.entry(trial).or_default();
@@ -583,15 +599,13 @@ fn recognize_replays_the_confidence_stop_as_posterior_long_shows_it() {
             None => trace.push((n, object.to_string(), p, truth.to_string())),
         }
     }
-    let table = std::fs::read_to_string(dir.path().join("out/stop.csv")).unwrap();
-    let mut lines = table.lines();
-    assert_eq!(
-        lines.next(),
-        Some("threshold,held_readings,budget,trials,stopped,right,share_right,mean_touches")
+    let rows = out_table(
+        dir.path(),
+        "stop.csv",
+        "threshold,held_readings,budget,trials,stopped,right,share_right,mean_touches",
     );
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3);
-    assert_ne!(rows[0][4], "0", "the toy's trials should reach 0.9: {table}");
+    assert_ne!(rows[0][4], "0", "the toy's trials should reach 0.9: {rows:?}");
     for (row, threshold) in rows.iter().zip([0.9, 0.95, 0.99]) {
         let (mut stopped, mut right) = (0, 0);
         for trace in traces.values() {
