@@ -245,7 +245,8 @@ fn moving_the_object_changes_the_reading_without_rebuilding() {
     let first = sensor.read().unwrap();
     let model = sensor.scene().model_arc();
     let stats = sensor.covering().stats(&model, sensor.scene().data()).unwrap();
-    assert_eq!(stats.bvh_builds, 1);
+    // One BVH: built by this instance, or by the one MuJoCo's compiler made to test the model.
+    assert_eq!(stats.bvh_builds + stats.bvh_shared, 1);
     // One taxel (2 mm) to the right: the image shifts by one column.
     sensor.scene_mut().set_object_pose(at(0.001)).unwrap();
     let second = sensor.read().unwrap();
@@ -259,8 +260,56 @@ fn moving_the_object_changes_the_reading_without_rebuilding() {
         }
     }
     let after = sensor.covering().stats(&model, sensor.scene().data()).unwrap();
-    assert_eq!(after.bvh_builds, 1, "no BVH is rebuilt when the object moves");
+    assert_eq!(
+        (after.bvh_builds, after.bvh_shared),
+        (stats.bvh_builds, stats.bvh_shared),
+        "no BVH is rebuilt when the object moves"
+    );
     assert!(after.readings > stats.readings);
+}
+
+#[test]
+fn a_second_scene_of_a_mesh_reads_through_the_first_ones_bvh() {
+    // While one scene of a mesh is alive, another scene of it takes its BVH instead of building
+    // one, and reads what a BVH of its own gives: the same image, bit for bit.
+    let config = Valid::new(sharp(6, 6)).unwrap();
+    let r = 0.004;
+    let spec = || ObjectSpec {
+        mount: ObjectMount::Free,
+        ..ObjectSpec::new("ball", icosphere(DVec3::ZERO, r, 4))
+    };
+    let read = |sensor: &mut FreePad| {
+        sensor.place(&pad_looking_down(DVec3::ZERO));
+        let pose = Pose::new(
+            DVec3::new(0.0007, -0.0011, -(r + 0.4 * config.thickness_m)),
+            DQuat::IDENTITY,
+        );
+        sensor.scene_mut().set_object_pose(pose).unwrap();
+        let image = sensor.read().unwrap();
+        let model = sensor.scene().model_arc();
+        (
+            image,
+            sensor.covering().stats(&model, sensor.scene().data()).unwrap(),
+        )
+    };
+    let mut first = FreePad::new(spec(), &config).unwrap();
+    let (image, _) = read(&mut first);
+    let mut second = FreePad::new(spec(), &config).unwrap();
+    let (again, stats) = read(&mut second);
+    assert_eq!((stats.bvh_builds, stats.bvh_shared), (0, 1));
+    assert!(
+        image.values().iter().any(|&v| v > 0.0),
+        "the ball is pressed: {image}"
+    );
+    assert_eq!(image, again);
+    // A ball 1 um larger is another mesh: its own BVH, its own image.
+    let larger = ObjectSpec {
+        mount: ObjectMount::Free,
+        ..ObjectSpec::new("ball", icosphere(DVec3::ZERO, r + 1e-6, 4))
+    };
+    let mut third = FreePad::new(larger, &config).unwrap();
+    let (other, _) = read(&mut third);
+    assert_ne!(image, other);
 }
 
 #[test]

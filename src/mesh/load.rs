@@ -166,6 +166,30 @@ impl MeshBuilder {
         Ok(())
     }
 
+    /// Appends the OBJ records parsed from the text after this builder's (on their own: `later`'s
+    /// negative corners, OBJ's indices relative to the vertices read so far, count only `later`'s
+    /// vertices, and shift by this builder's). The result is the builder of the two texts read in
+    /// one pass.
+    pub(crate) fn append_obj_records(&mut self, later: MeshBuilder) {
+        let vertices_before = self.vertices.len() as i64;
+        let corners_before = self.corners.len();
+        self.vertices.extend(later.vertices);
+        self.corners
+            .extend(later.corners.into_iter().map(|(index, written)| {
+                if written < 0 {
+                    (index + vertices_before, written)
+                } else {
+                    (index, written)
+                }
+            }));
+        self.polygons.extend(
+            later
+                .polygons
+                .into_iter()
+                .map(|(at, end)| (at, end + corners_before)),
+        );
+    }
+
     /// Checks indices, fan-triangulates polygons (v0, v_i, v_i+1) and returns the mesh.
     pub(crate) fn finish(self) -> Result<TriMesh, MeshError> {
         if self.vertices.is_empty() {
@@ -201,8 +225,13 @@ impl MeshBuilder {
 
 /// The non-empty lines of a text file with their 1-based numbers, comments (from `#`) removed.
 pub(crate) fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.lines().enumerate().filter_map(|(i, line)| {
+    content_lines_from(text, 1)
+}
+
+/// [`content_lines`] of a part of a file whose first line is line `first_line`.
+pub(crate) fn content_lines_from(text: &str, first_line: usize) -> impl Iterator<Item = (usize, &str)> {
+    text.lines().enumerate().filter_map(move |(i, line)| {
         let line = line.split('#').next().unwrap_or("").trim();
-        (!line.is_empty()).then_some((i + 1, line))
+        (!line.is_empty()).then_some((first_line + i, line))
     })
 }

@@ -22,6 +22,8 @@
 //! copy of a large scan comes with the exact surface as two `<numeric>` fields
 //! (`sim::sensed_surface_names`); its BVH is built from those.
 
+use std::sync::Arc;
+
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{mjtGeom, mjtObj};
 
@@ -32,10 +34,11 @@ use crate::tactile::back_contact::triangle_overlaps_box;
 use crate::tactile::config::ConfigError;
 use crate::tactile::formation::ImageFormation;
 use crate::tactile::grid::SampleGrid;
-use crate::tactile::mesh_bvh::{Leaf, MeshBvh, MeshBvhError, OrientedBox};
+use crate::tactile::mesh_bvh::{CheckedMesh, Leaf, MeshBvh, MeshBvhError, OrientedBox};
 use crate::tactile::model_view::{ModelView, PoseView};
 use crate::tactile::primitive::{GeomShape, Solid};
 use crate::tactile::raster::DepthBuffer;
+use crate::tactile::shared_bvh::SHARED_BVHS;
 use crate::valid::Valid;
 
 /// Why a plugin instance cannot be set up; each names the offending part of the model, briefly
@@ -89,8 +92,11 @@ struct PadSensor {
 /// Counters for diagnostics and tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct CoveringStats {
-    /// BVHs built (all at init; compute never builds one).
+    /// BVHs built by this instance (all at init; compute never builds one).
     pub bvh_builds: usize,
+    /// BVHs taken, at init, from another instance that read the same mesh
+    /// (`tactile::shared_bvh`).
+    pub bvh_shared: usize,
     /// Triangles over all BVHs.
     pub bvh_triangles: usize,
     /// Readings computed since init.
@@ -119,7 +125,7 @@ pub struct Covering {
     grid: SampleGrid,
     formation: ImageFormation,
     sensors: Vec<PadSensor>,
-    meshes: Vec<MeshBvh>,
+    meshes: Vec<Arc<MeshBvh>>,
     // Scratch space, reused by every reading.
     depth: DepthBuffer,
     leaves: Vec<Leaf>,
@@ -200,10 +206,10 @@ fn rigid_back_touched(
         })
 }
 
-/// One BVH per mesh the sensed geoms use, built once at init (a reading never builds one), shared
-/// by every geom and sensor that uses the mesh.
+/// One BVH per mesh the sensed geoms use, built at init (a reading never builds one) or taken from
+/// an instance that read the same mesh, shared by every geom and sensor that uses the mesh.
 struct MeshCache {
-    meshes: Vec<MeshBvh>,
+    meshes: Vec<Arc<MeshBvh>>,
     /// The index into `meshes` of each model mesh, once built.
     slot: Vec<Option<usize>>,
     stats: CoveringStats,
@@ -218,14 +224,14 @@ impl MeshCache {
         }
     }
 
-    /// The slot of model mesh `mesh`, building its BVH the first time.
+    /// The slot of model mesh `mesh`, finding or building its BVH the first time.
     fn slot(&mut self, model: &ModelView, mesh: usize) -> Result<usize, CoveringError> {
         if let Some(slot) = self.slot[mesh] {
             return Ok(slot);
         }
         let name = model.name(mjtObj::mjOBJ_MESH, mesh);
-        let bvh = match sensed_surface(model, mesh, &name)? {
-            Some((vertex_xyz, face)) => MeshBvh::new(&vertex_xyz, &face),
+        let checked = match sensed_surface(model, mesh, &name)? {
+            Some((vertex_xyz, face)) => CheckedMesh::new(&vertex_xyz, &face),
             None => {
                 let (va, vn) = (
                     model.mesh_vertadr[mesh] as usize,
@@ -235,14 +241,19 @@ impl MeshCache {
                     model.mesh_faceadr[mesh] as usize,
                     model.mesh_facenum[mesh] as usize,
                 );
-                MeshBvh::new(
+                CheckedMesh::new(
                     &model.mesh_vert[3 * va..3 * (va + vn)],
                     &model.mesh_face[3 * fa..3 * (fa + fnum)],
                 )
             }
         }
         .map_err(|source| CoveringError::Mesh { mesh: name, source })?;
-        self.stats.bvh_builds += 1;
+        let (bvh, built) = SHARED_BVHS.find_or_build(checked);
+        if built {
+            self.stats.bvh_builds += 1;
+        } else {
+            self.stats.bvh_shared += 1;
+        }
         self.stats.bvh_triangles += bvh.triangle_count();
         self.meshes.push(bvh);
         self.slot[mesh] = Some(self.meshes.len() - 1);
@@ -250,7 +261,7 @@ impl MeshCache {
     }
 }
 
-/// A surface as [`MeshBvh::new`] takes it: flat `xyz` vertex coordinates and vertex-index triples.
+/// A surface as [`CheckedMesh::new`] takes it: flat `xyz` vertex coordinates and vertex-index triples.
 type FlatMesh = (Vec<f32>, Vec<i32>);
 
 /// The exact surface of model mesh `mesh` (named `name`) when the model carries it beside a coarse
@@ -362,7 +373,7 @@ fn sensed_geom(model: &ModelView, geom: usize, cache: &mut MeshCache) -> Result<
 impl Covering {
     /// Sets up the instance whose sensors are `sensor_ids` (the model's sensors using it): checks
     /// each is on a site with the right dimension, chooses the sensed geoms, and builds one BVH per
-    /// mesh they use.
+    /// mesh they use (or takes it from an instance that read the same mesh).
     pub fn new(
         model: &ModelView,
         config: Valid<SensorConfig>,
@@ -519,9 +530,78 @@ mod tests {
     use super::*;
     use crate::tactile::mesh_bvh::{bumpy_ball, random_rotation};
 
+    /// A random placement of a ball of bound `rbound_m` at the pad: any rotation, its bounding
+    /// sphere from 4 mm through the pad plane to 1 mm in front of it, the ball's rim often across
+    /// the pad's border.
+    fn random_press(rng: &mut crate::rng::Rng, rbound_m: f64) -> (DMat3, DVec3) {
+        use rand::RngExt;
+        let rotation = random_rotation(rng);
+        let offset = DVec3::new(
+            rng.random_range(-0.012..0.012),
+            rng.random_range(-0.012..0.012),
+            rbound_m + rng.random_range(-0.004..0.001),
+        );
+        (rotation, offset)
+    }
+
+    #[test]
+    fn a_tree_built_in_halves_holds_every_face_once_and_draws_what_the_whole_tree_draws() {
+        use crate::tactile::mesh_bvh::bumpy_ball_mesh;
+        let (xyz, faces) = bumpy_ball_mesh(0.008);
+        let checked = CheckedMesh::new(&xyz, &faces).unwrap();
+        let whole = MeshBvh::build_split_above(checked.clone(), usize::MAX);
+        let halves = MeshBvh::build_split_above(checked, 0);
+        // The shape: one root over two subtrees; each node's box holds its children's; each face
+        // in exactly one leaf.
+        let nodes = halves.nodes();
+        assert_eq!((nodes[0].prim_count, nodes[0].first_index), (0, 1));
+        let mut seen = vec![0; halves.triangle_count()];
+        let (mut stack, mut every) = (vec![0usize], Vec::new());
+        while let Some(i) = stack.pop() {
+            let node = &nodes[i];
+            if node.prim_count > 0 {
+                continue;
+            }
+            for child in [node.first_index as usize, node.first_index as usize + 1] {
+                let (outer, inner) = (node.aabb, nodes[child].aabb);
+                assert!(outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all());
+                stack.push(child);
+            }
+        }
+        halves.leaves_near(&OrientedBox::cube(1.0), &mut stack, &mut every);
+        for leaf in &every {
+            for (face, _) in halves.leaf_faces(*leaf) {
+                seen[face as usize] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "every face once");
+        // The readings: the leaves over the rays of either tree give the same depths, bit for bit.
+        let g = SampleGrid::new(&SensorConfig::default());
+        let t = SensorConfig::default().thickness_m;
+        let rbound_m = whole.bounding_radius_m();
+        let depths = |mesh: &MeshBvh, placement: (&DMat3, DVec3), stack: &mut Vec<usize>| {
+            let mut leaves = Vec::new();
+            mesh.leaves_near(&query_region(&g, placement, rbound_m, t), stack, &mut leaves);
+            let mut depth = DepthBuffer::new(&g);
+            depth.draw_mesh(&g, mesh, &leaves, placement, t);
+            depth.nearest_m
+        };
+        let mut rng = crate::rng::rng(29);
+        let mut read = 0;
+        for _ in 0..200 {
+            let (rotation, offset) = random_press(&mut rng, rbound_m);
+            let a = depths(&whole, (&rotation, offset), &mut stack);
+            let b = depths(&halves, (&rotation, offset), &mut stack);
+            for (s, (a, b)) in a.iter().zip(&b).enumerate() {
+                assert_eq!(a.to_bits(), b.to_bits(), "sample {s}: {a} vs {b}");
+            }
+            read += usize::from(a.iter().any(|z| z.is_finite()));
+        }
+        assert!(read > 100, "{read} of 200 poses reach the covering");
+    }
+
     #[test]
     fn the_query_regions_keep_every_face_that_changes_a_reading() {
-        use rand::RngExt;
         // Whether the ball lies wholly in front of the pad, touches the covering, or is pushed
         // through the pad plane: the leaves over the sample rays give the same depths, bit for bit,
         // as every leaf of the mesh, and the rigid-back query finds a face in the back exactly when
@@ -542,14 +622,7 @@ mod tests {
         let mut rng = crate::rng::rng(23);
         let (mut fewer, mut read, mut inside, mut backs) = (0, 0, 0, 0);
         for _ in 0..300 {
-            let rotation = random_rotation(&mut rng);
-            // The bounding sphere from 4 mm through the pad plane to 1 mm in front of it, the
-            // ball's rim often across the pad's border.
-            let offset = DVec3::new(
-                rng.random_range(-0.012..0.012),
-                rng.random_range(-0.012..0.012),
-                rbound_m + rng.random_range(-0.004..0.001),
-            );
+            let (rotation, offset) = random_press(&mut rng, rbound_m);
             let placement = (&rotation, offset);
             let mut near = Vec::new();
             mesh.leaves_near(&query_region(&g, placement, rbound_m, t), &mut stack, &mut near);

@@ -19,6 +19,7 @@ use glam::{DMat3, DVec3, Mat3A, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
+use obvhs::bvh2::node::Bvh2Node;
 use obvhs::triangle::Triangle;
 
 /// An oriented box in a mesh's frame: `centre + sum_i u_i axes[i]`, `|u_i| <= half[i]`.
@@ -168,8 +169,20 @@ pub enum MeshBvhError {
     NonFinite { vertex: usize },
 }
 
-impl MeshBvh {
-    /// Builds the BVH of a mesh given as flat `xyz` vertex coordinates and vertex-index triples.
+/// A mesh checked for [`MeshBvh::build`] (finite vertices, every face's corners in range) with its
+/// bound, its BVH not built yet: the covering checks its meshes when MuJoCo initialises it and
+/// builds their BVHs at its first reading (`covering::Covering::compute`), because MuJoCo's compiler
+/// initialises the plugin once more on a data it only tests and then frees.
+#[derive(Debug, Clone)]
+pub struct CheckedMesh {
+    /// Vertices in the mesh (geom) frame, metres.
+    vertices: Vec<DVec3>,
+    faces: Vec<[u32; 3]>,
+    bounding_radius_m: f64,
+}
+
+impl CheckedMesh {
+    /// Checks a mesh given as flat `xyz` vertex coordinates and vertex-index triples.
     pub fn new(vertex_xyz: &[f32], face_indices: &[i32]) -> Result<Self, MeshBvhError> {
         let vertices: Vec<DVec3> = vertex_xyz
             .chunks_exact(3)
@@ -193,6 +206,39 @@ impl MeshBvh {
             }
             faces.push(tri);
         }
+        // Widened so that the rounding of a placed vertex never puts it beyond the bound.
+        let bounding_radius_m = vertices.iter().map(|v| v.length()).fold(0.0, f64::max) * (1.0 + 1e-9);
+        Ok(Self {
+            vertices,
+            faces,
+            bounding_radius_m,
+        })
+    }
+
+    /// [`MeshBvh::bounding_radius_m`] of the mesh's BVH.
+    pub fn bounding_radius_m(&self) -> f64 {
+        self.bounding_radius_m
+    }
+}
+
+impl MeshBvh {
+    /// Builds the BVH of a mesh given as flat `xyz` vertex coordinates and vertex-index triples.
+    pub fn new(vertex_xyz: &[f32], face_indices: &[i32]) -> Result<Self, MeshBvhError> {
+        Ok(Self::build(CheckedMesh::new(vertex_xyz, face_indices)?))
+    }
+
+    /// Builds the BVH of a checked mesh (in two halves at once above `SPLIT_BUILD_TRIANGLES`).
+    pub fn build(mesh: CheckedMesh) -> Self {
+        Self::build_split_above(mesh, SPLIT_BUILD_TRIANGLES)
+    }
+
+    /// [`Self::build`] with the triangle count above which the tree is built in two halves.
+    pub(crate) fn build_split_above(mesh: CheckedMesh, split_above: usize) -> Self {
+        let CheckedMesh {
+            vertices,
+            faces,
+            bounding_radius_m,
+        } = mesh;
         let triangles: Vec<Triangle> = faces
             .iter()
             .map(|f| {
@@ -204,13 +250,7 @@ impl MeshBvh {
                 }
             })
             .collect();
-        let bvh = if triangles.is_empty() {
-            Bvh2::default()
-        } else {
-            build_bvh2_from_tris(&triangles, BvhBuildParams::fast_build(), &mut Duration::default())
-        };
-        // Widened so that the rounding of a placed vertex never puts it beyond the bound.
-        let bounding_radius_m = vertices.iter().map(|v| v.length()).fold(0.0, f64::max) * (1.0 + 1e-9);
+        let bvh = build_tree(triangles, split_above);
         let mut mesh = Self {
             bounding_radius_m,
             vertices,
@@ -221,7 +261,13 @@ impl MeshBvh {
             slot_corners: Vec::new(),
         };
         mesh.index_leaf_vertices();
-        Ok(mesh)
+        mesh
+    }
+
+    /// The nodes of the tree (for tests of its shape).
+    #[cfg(test)]
+    pub(crate) fn nodes(&self) -> &[Bvh2Node] {
+        &self.bvh.nodes
     }
 
     /// Lists each leaf's distinct vertices and its faces' corners within them.
@@ -256,6 +302,20 @@ impl MeshBvh {
             self.leaf_vertex_range[leaf.first as usize] =
                 (start as u32, (self.leaf_vertices.len() - start) as u32);
         }
+    }
+
+    /// Whether this BVH was built from `mesh`: the same faces, and the same vertex coordinates to
+    /// the bit (so a BVH found by `tactile::shared_bvh` gives the readings of one built
+    /// now).
+    pub fn is_built_from(&self, mesh: &CheckedMesh) -> bool {
+        let bits = |v: &DVec3| v.to_array().map(f64::to_bits);
+        self.faces == mesh.faces
+            && self.vertices.len() == mesh.vertices.len()
+            && self
+                .vertices
+                .iter()
+                .zip(&mesh.vertices)
+                .all(|(a, b)| bits(a) == bits(b))
     }
 
     /// A radius about the frame's origin that holds every vertex, even once placed by a rigid
@@ -361,17 +421,125 @@ impl MeshBvh {
     }
 }
 
+/// Meshes of more triangles than this have their BVH built as two halves at once: a scan's BVH
+/// (half a second for 1.3M triangles on one core) is the largest step from its file to its first
+/// reading (issue 39). Every built-in object has fewer, so its BVH is built whole.
+pub const SPLIT_BUILD_TRIANGLES: usize = 100_000;
+
+/// The BVH of `triangles`, its primitives their indices: built whole, or for a large mesh as the
+/// two halves of its triangles on either side of the median centroid along the longest axis,
+/// built on two threads and joined under one root. A reading draws the faces of the leaves over
+/// its rays, whatever tree holds them ([`crate::tactile::raster`]).
+fn build_tree(triangles: Vec<Triangle>, split_above: usize) -> Bvh2 {
+    let whole = |triangles: &[Triangle]| {
+        if triangles.is_empty() {
+            Bvh2::default()
+        } else {
+            build_bvh2_from_tris(triangles, BvhBuildParams::fast_build(), &mut Duration::default())
+        }
+    };
+    if triangles.len() <= split_above.max(1) {
+        return whole(&triangles);
+    }
+    let (low, high) = median_split(&triangles);
+    let subset = |faces: &[u32]| faces.iter().map(|&f| triangles[f as usize]).collect::<Vec<_>>();
+    let (low_triangles, high_triangles) = (subset(&low), subset(&high));
+    // The halves hold every triangle: the whole list is not kept through the builds.
+    drop(triangles);
+    let (low_tree, high_tree) = std::thread::scope(|scope| {
+        let high_tree = scope.spawn(|| whole(&high_triangles));
+        let low_tree = whole(&low_triangles);
+        // A build cannot panic on finite triangles; were its thread lost, it is built here.
+        (
+            low_tree,
+            high_tree.join().unwrap_or_else(|_| whole(&high_triangles)),
+        )
+    });
+    join_trees((low_tree, &low), (high_tree, &high))
+}
+
+/// The faces on either side of the median centroid along the longest axis of the centroids'
+/// bounds (ties by face index, so the split is the same on every run).
+fn median_split(triangles: &[Triangle]) -> (Vec<u32>, Vec<u32>) {
+    let centroid = |t: &Triangle| (t.v0 + t.v1 + t.v2) / 3.0;
+    let (lo, hi) = triangles.iter().map(centroid).fold(
+        (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
+        |(lo, hi), c| (lo.min(c), hi.max(c)),
+    );
+    let extent = hi - lo;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let key = |f: u32| (centroid(&triangles[f as usize])[axis], f);
+    let mut faces: Vec<u32> = (0..triangles.len() as u32).collect();
+    let half = faces.len() / 2;
+    faces.select_nth_unstable_by(half, |&a, &b| {
+        let ((ka, a), (kb, b)) = (key(a), key(b));
+        ka.total_cmp(&kb).then(a.cmp(&b))
+    });
+    let high = faces.split_off(half);
+    (faces, high)
+}
+
+/// One tree of two: a root over `low`'s and `high`'s roots, their nodes after it, their leaves'
+/// primitives the faces (`low.1`, `high.1`: the face of each of the subtree's primitives).
+fn join_trees((low, low_faces): (Bvh2, &[u32]), (high, high_faces): (Bvh2, &[u32])) -> Bvh2 {
+    // Nodes: [root, low's root, high's root, low's others, high's others].
+    let low_nodes = low.nodes.len() as u32;
+    let low_at = |i: u32| if i == 0 { 1 } else { i + 2 };
+    let high_at = |i: u32| if i == 0 { 2 } else { low_nodes + 1 + i };
+    let high_primitives = low.primitive_indices.len() as u32;
+    let place = |node: &Bvh2Node, at: &dyn Fn(u32) -> u32, primitive_offset: u32| {
+        let first_index = if node.is_leaf() {
+            node.first_index + primitive_offset
+        } else {
+            at(node.first_index)
+        };
+        Bvh2Node::new(node.aabb, node.prim_count, first_index)
+    };
+    let mut nodes = Vec::with_capacity(low.nodes.len() + high.nodes.len() + 1);
+    nodes.push(Bvh2Node::new(low.nodes[0].aabb.union(&high.nodes[0].aabb), 0, 1));
+    nodes.push(place(&low.nodes[0], &low_at, 0));
+    nodes.push(place(&high.nodes[0], &high_at, high_primitives));
+    nodes.extend(low.nodes[1..].iter().map(|n| place(n, &low_at, 0)));
+    nodes.extend(
+        high.nodes[1..]
+            .iter()
+            .map(|n| place(n, &high_at, high_primitives)),
+    );
+    let primitive_indices = (low.primitive_indices.iter().map(|&p| low_faces[p as usize]))
+        .chain(high.primitive_indices.iter().map(|&p| high_faces[p as usize]))
+        .collect();
+    Bvh2 {
+        nodes,
+        primitive_indices,
+        ..Bvh2::default()
+    }
+}
+
 /// A closed, bumpy box: `TriMesh::cuboid` split three times into four (shared edge midpoints,
 /// so it stays watertight and outward), its vertices pushed out by a ripple.
 #[cfg(test)]
 pub(crate) fn bumpy_box(half_m: f64) -> MeshBvh {
-    bumpy(half_m, false)
+    let (xyz, faces) = bumpy(half_m, false);
+    MeshBvh::new(&xyz, &faces).unwrap()
 }
 
 /// [`bumpy_box`] split once more (faces about 1 mm at 8 mm radius), its vertices moved onto the
 /// sphere of radius `radius_m` before the ripple: a bumpy ball, whose bounding sphere is tight.
 #[cfg(test)]
 pub(crate) fn bumpy_ball(radius_m: f64) -> MeshBvh {
+    let (xyz, faces) = bumpy_ball_mesh(radius_m);
+    MeshBvh::new(&xyz, &faces).unwrap()
+}
+
+/// [`bumpy_ball`]'s mesh as [`MeshBvh::new`] takes it.
+#[cfg(test)]
+pub(crate) fn bumpy_ball_mesh(radius_m: f64) -> (Vec<f32>, Vec<i32>) {
     bumpy(radius_m, true)
 }
 
@@ -385,7 +553,7 @@ pub(crate) fn random_rotation(rng: &mut crate::rng::Rng) -> DMat3 {
 }
 
 #[cfg(test)]
-fn bumpy(size_m: f64, ball: bool) -> MeshBvh {
+fn bumpy(size_m: f64, ball: bool) -> (Vec<f32>, Vec<i32>) {
     let mut mesh = crate::mesh::TriMesh::cuboid(DVec3::splat(size_m));
     for _ in 0..if ball { 4 } else { 3 } {
         let mut midpoints = std::collections::HashMap::new();
@@ -415,7 +583,7 @@ fn bumpy(size_m: f64, ball: bool) -> MeshBvh {
         .flat_map(|v| v.as_vec3().to_array())
         .collect();
     let faces: Vec<i32> = mesh.triangles.iter().flatten().map(|&i| i as i32).collect();
-    MeshBvh::new(&xyz, &faces).unwrap()
+    (xyz, faces)
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! plugin      registration with MuJoCo and the C callbacks
 //! covering    one instance's state: sensed geoms, BVHs, the per-reading pass
 //! mesh_bvh    one obvhs BVH per mesh, queried with the pad's slab
+//! shared_bvh  the BVHs of meshes already read, found by their mesh for the next instance
 //! raster      parallel rays as an orthographic z-buffer, and the inside test
 //! primitive   planes, spheres, capsules, ellipsoids, cylinders, boxes cut analytically
 //! grid        where the (supersampled) rays pierce the pad
@@ -29,6 +30,7 @@ pub(crate) mod plugin;
 pub(crate) mod primitive;
 pub(crate) mod raster;
 pub(crate) mod sensor;
+pub(crate) mod shared_bvh;
 
 // The sensor: its configuration, its image, and the handle that reads it from `sensordata`.
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
