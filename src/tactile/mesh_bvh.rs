@@ -170,9 +170,8 @@ pub enum MeshBvhError {
 }
 
 /// A mesh checked for [`MeshBvh::build`] (finite vertices, every face's corners in range) with its
-/// bound, its BVH not built yet: the covering checks its meshes when MuJoCo initialises it and
-/// builds their BVHs at its first reading (`covering::Covering::compute`), because MuJoCo's compiler
-/// initialises the plugin once more on a data it only tests and then frees.
+/// bound, its BVH not built yet: what the covering compares with the BVHs already built
+/// (`tactile::shared_bvh`) before it builds one.
 #[derive(Debug, Clone)]
 pub struct CheckedMesh {
     /// Vertices in the mesh (geom) frame, metres.
@@ -461,10 +460,10 @@ fn build_tree(triangles: Vec<Triangle>, split_above: usize) -> Bvh2 {
 /// The faces on either side of the median centroid along the longest axis of the centroids'
 /// bounds (ties by face index, so the split is the same on every run).
 fn median_split(triangles: &[Triangle]) -> (Vec<u32>, Vec<u32>) {
-    let centroid = |t: &Triangle| (t.v0 + t.v1 + t.v2) / 3.0;
-    let (lo, hi) = triangles.iter().map(centroid).fold(
+    let centroids: Vec<Vec3A> = triangles.iter().map(|t| (t.v0 + t.v1 + t.v2) / 3.0).collect();
+    let (lo, hi) = centroids.iter().fold(
         (Vec3A::splat(f32::INFINITY), Vec3A::splat(f32::NEG_INFINITY)),
-        |(lo, hi), c| (lo.min(c), hi.max(c)),
+        |(lo, hi), &c| (lo.min(c), hi.max(c)),
     );
     let extent = hi - lo;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -474,7 +473,7 @@ fn median_split(triangles: &[Triangle]) -> (Vec<u32>, Vec<u32>) {
     } else {
         2
     };
-    let key = |f: u32| (centroid(&triangles[f as usize])[axis], f);
+    let key = |f: u32| (centroids[f as usize][axis], f);
     let mut faces: Vec<u32> = (0..triangles.len() as u32).collect();
     let half = faces.len() / 2;
     faces.select_nth_unstable_by(half, |&a, &b| {
