@@ -113,10 +113,12 @@ fn fused_models_save_load_and_are_checked() {
     let Recognizer::Fused(loaded) = Recognizer::load(&path).unwrap() else {
         panic!("a fused file loaded as a single model")
     };
-    assert_eq!(loaded, model);
+    assert_eq!(*loaded, model);
     let test = recognize_toy::dataset(5, 9);
     let range = ReadingRange::new(1, 5).unwrap();
-    let (a, _) = Recognizer::Fused(model.clone()).evaluate(&test, range).unwrap();
+    let (a, _) = Recognizer::Fused(Box::new(model.clone()))
+        .evaluate(&test, range)
+        .unwrap();
     let (b, trials) = Recognizer::Fused(loaded).evaluate(&test, range).unwrap();
     assert_eq!(trials, 3);
     let bits = |e: &taction::recognize::Evaluation| -> Vec<u64> {

@@ -464,15 +464,27 @@ fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
         "{on_arm_short}\n{on_arm}"
     );
     // Several calibration datasets are fitted on together: the arm's twice is the arm's (the same
-    // mean loss over the same paths), the arm's with other runs another tempering.
+    // mean loss over the same paths), the arm's with other runs another tempering. Twice, its 120
+    // beliefs are enough for a confidence map (60 are not).
     let (ok, twice, stderr) = train(&["--calibration", &arm, "--calibration", &arm], "twice.json");
     assert!(ok, "{stderr}");
     let on_twice = line(&twice, "arm.csv + ");
+    let tau_beta_floor = |line: &str| -> String {
+        let fitted = line.split("tau").nth(1).unwrap_or_default();
+        let fitted = fitted.split(" (").next().unwrap_or_default();
+        fitted
+            .split(", confidence map")
+            .next()
+            .unwrap_or_default()
+            .to_string()
+    };
     assert_eq!(
-        on_twice.split("tau").nth(1),
-        on_arm.split("tau").nth(1),
+        tau_beta_floor(&on_twice),
+        tau_beta_floor(&on_arm),
         "{twice}\n{on_arm}"
     );
+    assert!(on_twice.contains("confidence map of "), "{on_twice}");
+    assert!(!on_arm.contains("confidence map"), "{on_arm}");
     let wrong = p("wrong.csv");
     let relabelled: String = std::fs::read_to_string(&arm)
         .unwrap()

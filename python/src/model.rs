@@ -279,13 +279,13 @@ fn fit(
             kind.build().as_ref(),
             &mut |_| {},
         )?)),
-        _ => Recognizer::Fused(FusedModel::fit(
+        _ => Recognizer::Fused(Box::new(FusedModel::fit(
             config,
             training,
             validation,
             choice,
             &mut |_| {},
-        )?),
+        )?)),
     })
 }
 
@@ -310,6 +310,6 @@ pub fn train_for_arm(
     let arm = calibration.map(|c| c.inner.clone());
     let model = py.detach(|| recipe.fit(&data, arm.as_deref())).map_err(refused)?;
     Ok(Model {
-        inner: Arc::new(Recognizer::Fused(model)),
+        inner: Arc::new(Recognizer::Fused(Box::new(model))),
     })
 }

@@ -308,8 +308,13 @@ impl<'a> ActiveRecognition<'a> {
         let belief = self.posterior.observe_features(&features)?;
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
-        self.gain
-            .record(image.pose().map(|p| p.center_m), &reading, belief.probabilities());
+        // The gain predicts by Bayes' rule, which the tempered belief follows and its confidence
+        // map does not (`recognize::calibration`): it starts from the belief before the map.
+        self.gain.record(
+            image.pose().map(|p| p.center_m),
+            &reading,
+            belief.decision.evidence(),
+        );
         Ok(belief)
     }
 

@@ -151,7 +151,7 @@ fn load_or_train(
         && model.fused.iter().all(|m| m.check_sensor(&sensor).is_ok())
     {
         println!("using the model trained before: {}", model_path.display());
-        return Ok(model);
+        return Ok(*model);
     }
     let model = train_model(&recipe, set, objects, sensor)?;
     model.save(&model_path)?;
@@ -195,12 +195,7 @@ fn train_model(
     );
     let model = recipe.fit(&dataset, Some(&calibration))?;
     let t = model.tempering;
-    println!(
-        "posterior calibrated on the arm's explorations: tau = {:.3}, beta = {:.2}, floor = {:.3}",
-        t.tau(),
-        t.beta(),
-        t.floor()
-    );
+    println!("posterior calibrated on the arm's explorations: {t}");
     Ok(model)
 }
 

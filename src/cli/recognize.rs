@@ -92,12 +92,7 @@ fn posterior_words(t: Tempering) -> String {
     if t == Tempering::EQ15 {
         "Eq. 15".to_string()
     } else {
-        format!(
-            "calibrated: tau = {:.3}, beta = {:.2}, floor = {:.3}",
-            t.tau(),
-            t.beta(),
-            t.floor()
-        )
+        format!("calibrated: {t}")
     }
 }
 

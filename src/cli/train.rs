@@ -109,7 +109,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     let model = if args.descriptor.is_fused() {
         let fused = FusedModel::new(models)?.calibrated(&config, &training, validation.as_ref())?;
         print_tempering("fused", "validation", fused.tempering);
-        Recognizer::Fused(fused)
+        Recognizer::Fused(Box::new(fused))
     } else {
         let model = models.into_iter().next().ok_or("no descriptor to train")?;
         Recognizer::Single(Box::new(model))
@@ -237,10 +237,7 @@ fn print_selection(model: &TrainedModel) {
 /// it off).
 fn print_tempering(name: &str, on: &str, t: Tempering) {
     println!(
-        "{name} posterior calibrated on {on}: tau = {:.3}, beta = {:.2}, floor = {:.3} (10 readings count as {:.1} independent ones, 30 as {:.1})",
-        t.tau(),
-        t.beta(),
-        t.floor(),
+        "{name} posterior calibrated on {on}: {t} (10 readings count as {:.1} independent ones, 30 as {:.1})",
         t.effective_readings(10),
         t.effective_readings(30)
     );

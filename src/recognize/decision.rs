@@ -2,7 +2,7 @@
 //! (Appendix, Eq. 12-16).
 
 use crate::recognize::calibration::Tempering;
-use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
+use crate::recognize::object_model::{ClusterHistogram, ObjectModels, guess_of};
 
 /// The cross-entropy of Eq. 4, `H(U, O_j) = -sum_i p(c_i | U) ln p(c_i | O_j)`: the KL divergence
 /// of Eq. 1-2 less the entropy of `p(c_i | U)`, which does not depend on `j`.
@@ -26,6 +26,9 @@ pub struct Decision {
     /// `p(O_j | U)` under a uniform prior: the softmax of `ln p(U | O_j) = -n_U H(U, O_j)`
     /// (Eq. 16); uniform when `n_U = 0`.
     pub probabilities: Vec<f64>,
+    /// The tempered posterior before its confidence map, where the tempering has one
+    /// (`recognize::calibration`): the belief a further reading updates by Bayes' rule.
+    pub evidence_probabilities: Option<Vec<f64>>,
     /// `n_U`.
     pub features: usize,
 }
@@ -78,20 +81,25 @@ impl Decision {
             .iter()
             .map(|l| if n == 0 { 0.0 } else { -l / n as f64 })
             .collect();
-        let guess = (0..log_likelihood.len()).fold(0, |best, j| {
-            if log_likelihood[j] > log_likelihood[best] {
-                j
-            } else {
-                best
-            }
-        });
-        let probabilities = tempering.probabilities(&log_likelihood, readings);
+        let guess = guess_of(&log_likelihood);
+        let evidence = tempering.evidence_probabilities(&log_likelihood, readings);
+        let probabilities = tempering.mapped(evidence.clone());
+        let evidence_probabilities = tempering.confidence_map().map(|_| evidence);
         Decision {
             guess,
             cross_entropy,
             probabilities,
+            evidence_probabilities,
             features: n,
         }
+    }
+
+    /// [`evidence_probabilities`](Self::evidence_probabilities), or the probabilities themselves
+    /// where no map moved them.
+    pub fn evidence(&self) -> &[f64] {
+        self.evidence_probabilities
+            .as_deref()
+            .unwrap_or(&self.probabilities)
     }
 }
 
@@ -119,6 +127,27 @@ mod tests {
             PseudoCount::LAPLACE,
         )
         .unwrap()
+    }
+
+    /// A tempering with a confidence map: the guess and the order of the objects are the
+    /// evidence's, the top probability the map's, and the belief before the map is kept for
+    /// what predicts by Bayes' rule (active touch).
+    #[test]
+    fn a_mapped_decision_keeps_the_guess_and_the_evidence() {
+        use crate::recognize::calibration::ConfidenceMap;
+        let log_likelihood = vec![-3.0, -1.0, -2.5];
+        let plain = Tempering::new(1.0, 1.0).unwrap();
+        let map = ConfidenceMap::new(&[[0.4, 0.35], [0.7, 0.45]]).unwrap();
+        let mapped = Decision::calibrated(log_likelihood.clone(), 4, plain.with_confidence_map(map), 4);
+        let before = Decision::calibrated(log_likelihood, 4, plain, 4);
+        assert_eq!(before.evidence_probabilities, None);
+        assert_eq!(mapped.guess, 1);
+        assert_eq!(mapped.guess, before.guess);
+        assert_eq!(mapped.evidence(), before.probabilities.as_slice());
+        let top = before.probabilities[1];
+        assert!(top > 0.7, "{before:?}");
+        assert!((mapped.probabilities[1] - 0.45).abs() < 1e-9, "{mapped:?}");
+        assert!(mapped.probabilities[2] > mapped.probabilities[0]);
     }
 
     #[test]

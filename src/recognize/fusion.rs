@@ -206,7 +206,7 @@ impl FusedModel {
         for dataset in data {
             trials.extend(self.trials(dataset, trial_readings)?);
         }
-        self.tempering = Tempering::fit(&self.evidence_paths(&trials)?);
+        self.tempering = Tempering::fit_with_confidence_map(&self.evidence_paths(&trials)?);
         Ok(self)
     }
 
@@ -384,7 +384,7 @@ fn zip_trials(per_model: Vec<Vec<Trial>>) -> Vec<Trial<Vec<Vec<Feature>>>> {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Recognizer {
     Single(Box<TrainedModel>),
-    Fused(FusedModel),
+    Fused(Box<FusedModel>),
 }
 
 impl Recognizer {
@@ -402,7 +402,7 @@ impl Recognizer {
         match fused {
             Some(value) => {
                 check_version(&value, origin)?;
-                Ok(Self::Fused(FusedModel::from_json(&value, origin)?))
+                Ok(Self::Fused(Box::new(FusedModel::from_json(&value, origin)?)))
             }
             None => Ok(Self::Single(Box::new(TrainedModel::from_json(bytes, origin)?))),
         }
@@ -461,7 +461,7 @@ impl Recognizer {
     pub fn with_posterior(self, rule: PosteriorRule) -> Self {
         match self {
             Self::Single(m) => Self::Single(Box::new(m.with_posterior(rule))),
-            Self::Fused(f) => Self::Fused(f.with_posterior(rule)),
+            Self::Fused(f) => Self::Fused(Box::new(f.with_posterior(rule))),
         }
     }
 
@@ -471,7 +471,7 @@ impl Recognizer {
     pub fn calibrate_on_all(self, data: &[&Dataset], trial_readings: usize) -> Result<Self, RecognizeError> {
         Ok(match self {
             Self::Single(m) => Self::Single(Box::new(m.calibrate_on_all(data, trial_readings)?)),
-            Self::Fused(f) => Self::Fused(f.calibrate_on_all(data, trial_readings)?),
+            Self::Fused(f) => Self::Fused(Box::new(f.calibrate_on_all(data, trial_readings)?)),
         })
     }
 

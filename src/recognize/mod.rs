@@ -56,7 +56,7 @@ pub use selection::{
 };
 
 // The posterior over objects, touch by touch (Eq. 15-16), calibrated by a fitted tempering.
-pub use calibration::{EvidencePath, PosteriorRule, Tempering};
+pub use calibration::{ConfidenceMap, EvidencePath, PosteriorRule, Tempering};
 pub use decision::{Decision, cross_entropy, entropy_nats};
 pub use posterior::{Belief, FusedPosterior, ModelPosterior, OnlinePosterior};
 

@@ -232,7 +232,9 @@ impl TrainedModel {
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
-            bag: self.bag.with_tempering(Tempering::fit(&paths)),
+            bag: self
+                .bag
+                .with_tempering(Tempering::fit_with_confidence_map(&paths)),
             ..self
         })
     }

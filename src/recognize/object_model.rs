@@ -245,6 +245,18 @@ impl ObjectModels {
     }
 }
 
+/// Eq. 4's guess from `ln p(U | O_j)` of every object: the most likely object, ties to the lower
+/// index (so with no features, every log-likelihood 0, object 0).
+pub(crate) fn guess_of(log_likelihood: &[f64]) -> usize {
+    (0..log_likelihood.len()).fold(0, |best, j| {
+        if log_likelihood[j] > log_likelihood[best] {
+            j
+        } else {
+            best
+        }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
