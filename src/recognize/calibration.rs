@@ -351,8 +351,8 @@ const MAX_POWER: f64 = 1024.0;
 /// A monotone map from the tempered posterior's top probability to the share of right guesses at
 /// that confidence (module docs), fitted on calibration beliefs by the pool-adjacent-violators
 /// algorithm over ten equal-count bins (`MAP_BINS`): piecewise linear between the pooled bins' mean
-/// confidence and accuracy, constant beyond the first and the last, raising no belief above
-/// 0.9 (`RAISE_CEILING`).
+/// confidence and accuracy, constant above the last, running to chance below the first
+/// ([`target`](Self::target)), raising no belief above 0.9 (`RAISE_CEILING`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConfidenceMap {
     confidence: [f64; MAP_BINS],

@@ -83,8 +83,12 @@ impl Decision {
             .collect();
         let guess = guess_of(&log_likelihood);
         let evidence = tempering.evidence_probabilities(&log_likelihood, readings);
-        let probabilities = tempering.mapped(evidence.clone());
-        let evidence_probabilities = tempering.confidence_map().map(|_| evidence);
+        // Every belief of every evaluation comes through here: the evidence is copied only when a
+        // map moves it.
+        let (probabilities, evidence_probabilities) = match tempering.confidence_map() {
+            Some(_) => (tempering.mapped(evidence.clone()), Some(evidence)),
+            None => (evidence, None),
+        };
         Decision {
             guess,
             cross_entropy,
