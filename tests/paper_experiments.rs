@@ -2,7 +2,7 @@
 //! end at a tiny scale on two objects, kill-and-resume, and shards merged against one run. Real
 //! MuJoCo, real sensor, real meshes (the two generated chess pieces and two raised letters).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -409,6 +409,31 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
         e2e.iter()
             .any(|r| r.factors.level(Factor::Training) == Some("reachable"))
     );
+    // Our Polar-Fourier model of end-to-end is active's (the same training, calibrated on the same
+    // explorations of the arm) judging the same blind explorations: the same points, beliefs too.
+    let point = |r: &AccuracyRow| {
+        let level = |f| r.factors.level(f).unwrap_or_default().to_string();
+        (
+            level(Factor::LocalProbability),
+            level(Factor::ObjectMotion),
+            r.trial,
+            r.n_readings,
+        )
+    };
+    let ours: BTreeMap<_, _> = e2e
+        .iter()
+        .filter(|r| r.descriptor == "polar-fourier" && r.factors.level(Factor::Training) == Some("reachable"))
+        .map(|r| (point(r), (r.accuracy, r.reliability)))
+        .collect();
+    let blind: BTreeMap<_, _> = rows(&out.join("active/active.csv"))
+        .iter()
+        .filter(|r| r.factors.level(Factor::Strategy) == Some("blind"))
+        .map(|r| (point(r), (r.accuracy, r.reliability)))
+        .collect();
+    assert!(
+        !ours.is_empty() && ours == blind,
+        "end-to-end's ours against active's blind curves"
+    );
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");
@@ -614,19 +639,72 @@ fn the_active_experiment_is_the_same_on_one_and_two_threads() {
         last = Some((curve.0, curve.1, c));
     }
     assert!(active_rows > 0, "no active rows:\n{text}");
-    calibrated_on_both_blind_strategies(&dir.path().join("one"));
+    let trials = arm_calibration(&dir.path().join("one"), "active").expect("calibrated on the arm");
+    assert_eq!(
+        calibration_explorations(&dir.path().join("one")),
+        [trials, trials]
+    );
 }
 
-/// The active run's posterior is calibrated on explorations of both blind strategies it judges,
-/// each on streams of its own: `config.json` names L = 0.5 and 1, and the run's data holds, at
-/// each L, as many planner datasets on seeds no test curve uses as there are test trials.
-fn calibrated_on_both_blind_strategies(out: &Path) {
-    let config = std::fs::read_to_string(out.join("active/config.json")).expect("config.json");
+/// The end-to-end experiment judges the arm's touches with posteriors calibrated on the arm's
+/// explorations, every setting's, as `active` does; under the paper's Eq. 15 it collects no
+/// calibration exploration, and the guesses, so the accuracies, are the same.
+#[test]
+fn the_end_to_end_experiment_calibrates_on_the_arm_and_eq15_needs_no_calibration() {
+    let dir = tempfile::tempdir().unwrap();
+    let (calibrated, eq15) = (dir.path().join("calibrated"), dir.path().join("eq15"));
+    run_experiment("end-to-end", &calibrated, &[]);
+    let trials = arm_calibration(&calibrated, "end-to-end").expect("calibrated on the arm");
+    assert_eq!(calibration_explorations(&calibrated), [trials, trials]);
+    let config = std::fs::read_to_string(calibrated.join("end-to-end/config.json")).unwrap();
+    let config: serde_json::Value = serde_json::from_str(&config).unwrap();
+    let settings = config["sweep"]["settings"].as_array().expect("settings");
+    assert_eq!(settings.len(), 2);
+    for setting in settings {
+        assert_eq!(setting["calibrated_on"], "arm_explorations", "{setting}");
+    }
+    run_experiment("end-to-end", &eq15, &["--posterior", "eq15"]);
+    assert_eq!(arm_calibration(&eq15, "end-to-end"), None);
+    assert_eq!(calibration_explorations(&eq15), [0, 0]);
+    let (with_arm, paper) = (
+        rows(&calibrated.join("end-to-end/end-to-end.csv")),
+        rows(&eq15.join("end-to-end/end-to-end.csv")),
+    );
+    let accuracy = |rows: &[AccuracyRow]| -> Vec<(String, u32, f64)> {
+        rows.iter()
+            .map(|r| (r.factors.to_string(), r.n_readings, r.accuracy))
+            .collect()
+    };
+    assert_eq!(accuracy(&with_arm), accuracy(&paper));
+    let belief = |rows: &[AccuracyRow]| -> Vec<f64> { rows.iter().map(|r| r.reliability).collect() };
+    assert_ne!(
+        belief(&with_arm),
+        belief(&paper),
+        "the calibration moves the beliefs"
+    );
+}
+
+/// The trials of `experiment`'s calibration on the arm's explorations as its `config.json`
+/// records them: at L = 0.5 and 1, as many explorations of each object at each as there are test
+/// trials (`None`: no such calibration).
+fn arm_calibration(out: &Path, experiment: &str) -> Option<u64> {
+    let config = std::fs::read_to_string(out.join(experiment).join("config.json")).expect("config.json");
     let config: serde_json::Value = serde_json::from_str(&config).expect("JSON");
-    let levels = &config["calibration_local_probabilities"];
-    assert_eq!(levels, &serde_json::json!([0.5, 1.0]), "{config}");
+    let calibration = config.get("arm_calibration")?;
+    assert_eq!(
+        calibration["local_probabilities"],
+        serde_json::json!([0.5, 1.0]),
+        "{config}"
+    );
     let trials = config["counts"]["trials"].as_u64().expect("counts.trials");
-    assert_eq!(config["calibration_explorations"].as_u64(), Some(trials));
+    assert_eq!(calibration["explorations"].as_u64(), Some(trials), "{config}");
+    Some(trials)
+}
+
+/// The planner datasets of a run at L = 0.5 and at L = 1 on seeds of their own (no test curve
+/// uses them: a test trial's stream is read at both L, common random numbers): the calibration
+/// explorations.
+fn calibration_explorations(out: &Path) -> [u64; 2] {
     let mut seeds: std::collections::BTreeMap<u64, BTreeSet<String>> = Default::default();
     for entry in std::fs::read_dir(out.join("data")).expect("the run's data") {
         let path = entry.expect("a data file").path();
@@ -645,18 +723,12 @@ fn calibrated_on_both_blind_strategies(out: &Path) {
         let seed = header["seed"].as_u64().expect("the dataset's seed");
         seeds.entry(seed).or_default().insert(level);
     }
-    // A test trial's stream is read at both L (common random numbers); a calibration
-    // exploration's stream at one L only.
-    for level in ["0.5", "1"] {
-        let own = seeds
+    ["0.5", "1"].map(|level| {
+        seeds
             .values()
-            .filter(|levels| levels.len() == 1 && levels.contains(level));
-        assert_eq!(
-            own.count() as u64,
-            trials,
-            "calibration explorations at L = {level}: {seeds:?}"
-        );
-    }
+            .filter(|levels| levels.len() == 1 && levels.contains(level))
+            .count() as u64
+    })
 }
 
 /// `--codebook knn` trains every model of a run with the neighbour codebook: `config.json` says

@@ -91,12 +91,21 @@ impl Model {
         self.inner.chosen_ks()
     }
 
-    /// The posterior's calibration fitted on validation at training: `{"tau", "beta", "floor"}`
-    /// (1, 1, 0 is the paper's Eq. 15).
+    /// The posterior's calibration (`recognize::calibration`): `{"tau", "beta", "floor",
+    /// "confidence_map"}`, the map a list of `[confidence, accuracy]` points or `None` (fitted only
+    /// when the model was calibrated on the arm's explorations). 1, 1, 0 and no map is the paper's
+    /// Eq. 15.
     #[getter]
-    fn calibration(&self) -> std::collections::BTreeMap<&'static str, f64> {
+    fn calibration(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         let t = self.inner.tempering();
-        [("tau", t.tau()), ("beta", t.beta()), ("floor", t.floor())].into()
+        let map = t.confidence_map().map(|map| map.points().collect::<Vec<_>>());
+        let calibration = serde_json::json!({
+            "tau": t.tau(),
+            "beta": t.beta(),
+            "floor": t.floor(),
+            "confidence_map": map,
+        });
+        crate::dataset::json_to_python(py, &calibration)
     }
 
     /// The same model recognising with the posterior `rule`: "calibrated" (the default) or

@@ -39,10 +39,10 @@ def test_a_model_file_round_trips(small_model, small_dataset, tmp_path):
 
 def test_the_calibrated_posterior_keeps_the_guess_and_eq15_is_a_choice(small_model, small_dataset):
     calibration = small_model.calibration
-    assert set(calibration) == {"tau", "beta", "floor"}
+    assert set(calibration) == {"tau", "beta", "floor", "confidence_map"}
     assert calibration["tau"] > 0 and 0 <= calibration["floor"] < 1
     eq15 = small_model.with_posterior("eq15")
-    assert eq15.calibration == {"tau": 1.0, "beta": 1.0, "floor": 0.0}
+    assert eq15.calibration == {"tau": 1.0, "beta": 1.0, "floor": 0.0, "confidence_map": None}
     images = small_dataset.images[small_dataset.status == "converged"][:5]
     calibrated, paper = small_model.posterior(), eq15.posterior()
     for image in images:
@@ -50,6 +50,55 @@ def test_the_calibrated_posterior_keeps_the_guess_and_eq15_is_a_choice(small_mod
         assert np.argmax(p) == np.argmax(q)
     with pytest.raises(taction.TactionError, match="posterior"):
         small_model.with_posterior("bayes")
+
+
+def tempering_in(node):
+    """The posterior's tempering in a model file's JSON: the object holding tau and beta."""
+    if isinstance(node, dict):
+        if "tau" in node and "beta" in node:
+            return node
+        node = list(node.values())
+    if isinstance(node, list):
+        for value in node:
+            found = tempering_in(value)
+            if found is not None:
+                return found
+    return None
+
+
+def test_a_confidence_map_in_the_model_file_moves_the_belief_and_keeps_the_guess(
+    small_model, small_dataset, tmp_path
+):
+    import json
+
+    path = tmp_path / "model.json"
+    small_model.save(path)
+    document = json.loads(path.read_text())
+    tempering = tempering_in(document)
+    assert tempering is not None and small_model.calibration["confidence_map"] is None
+    # Beliefs above 0.95 were right 60% of the time: a sure posterior is moved to 0.6.
+    points = [[0.6, 0.55], [0.95, 0.6]]
+    tempering["confidence_map"] = points
+    path.write_text(json.dumps(document))
+    mapped = taction.Model.load(path)
+    assert mapped.calibration["confidence_map"] == points
+    converged = small_dataset.status == "converged"
+    images, names = small_dataset.images[converged], small_dataset.object[converged]
+    sure = 0
+    for target in ("pawn", "rook"):
+        plain, moved = small_model.posterior(), mapped.posterior()
+        for image in images[names == target][:10]:
+            p, q = plain.observe(image), moved.observe(image)
+            assert np.argmax(p) == np.argmax(q)
+            assert abs(q.sum() - 1.0) < 1e-9
+            if p.max() > 0.95:
+                sure += 1
+                assert abs(q.max() - 0.6) < 1e-6
+    assert sure > 0
+    tempering["confidence_map"] = [[0.9, 0.6], [0.7, 0.8]]
+    path.write_text(json.dumps(document))
+    with pytest.raises(taction.TactionError, match="confidence map"):
+        taction.Model.load(path)
 
 
 def test_training_is_seeded(small_dataset):

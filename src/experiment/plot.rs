@@ -484,7 +484,9 @@ fn calibration_series(name: &str, ece: Option<f64>, points: Vec<(f64, f64)>) -> 
 type CalibrationCurves = Ordered<(String, Factors), (Option<f64>, Vec<(u32, f64, f64)>)>;
 
 /// The reliability rows of `csv`, one series per curve (descriptor, factor levels) in order of
-/// first appearance, named as accuracy plots name their lines; a curve's bin seen twice (a curve
+/// first appearance, named as accuracy plots name their lines and, since the diagram is one panel
+/// where an accuracy plot has one per descriptor, led by the descriptor when there are several
+/// (else the ECE list of the index named two curves alike); a curve's bin seen twice (a curve
 /// split over units) is an error.
 fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Series>, ExperimentError> {
     let mut reader = csv::Reader::from_path(csv).map_err(|e| csv_error(csv, e))?;
@@ -518,6 +520,12 @@ fn read_reliability_series(csv: &Path, legend: Option<&str>) -> Result<Vec<Serie
             let name = match (factors.len(), legend) {
                 (0, None) => descriptor.clone(),
                 (_, None) if descriptors.len() > 1 => format!("{descriptor}: {factors}"),
+                (_, Some(template)) if descriptors.len() > 1 && !template.contains("{descriptor}") => {
+                    format!(
+                        "{descriptor}: {}",
+                        setting_label(csv, legend, descriptor, factors)?
+                    )
+                }
                 _ => setting_label(csv, legend, descriptor, factors)?,
             };
             let mut points = points.clone();
@@ -761,4 +769,49 @@ fn padded(lo: f64, hi: f64, from_zero: bool) -> (f64, f64) {
     let pad = 0.05 * (hi - lo);
     let lo = if from_zero && lo == 0.0 { 0.0 } else { lo - pad };
     (lo, hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two descriptors drawn under a legend that does not name them: one panel, so each curve's
+    /// name leads with its descriptor; a legend that names it is taken as it is.
+    #[test]
+    fn reliability_curves_of_several_descriptors_are_named_apart() {
+        let dir = tempfile::tempdir().unwrap();
+        let csv = dir.path().join("toy_reliability.csv");
+        let mut text = String::from(
+            "experiment,descriptor,object_motion,bin,confidence_low,confidence_high,count,mean_confidence,accuracy,ece\n",
+        );
+        for descriptor in ["mnti", "polar-fourier"] {
+            text.push_str(&format!("toy,{descriptor},fixed,9,0.9,1.0,2,0.95,1.0,0.05\n"));
+        }
+        std::fs::write(&csv, text).unwrap();
+        let names = |legend: Option<&str>| -> Vec<String> {
+            read_reliability_series(&csv, legend)
+                .unwrap()
+                .into_iter()
+                .map(|s| s.label)
+                .collect()
+        };
+        assert_eq!(
+            names(Some("object = {object_motion}")),
+            [
+                "mnti: object = fixed (ECE 0.050)",
+                "polar-fourier: object = fixed (ECE 0.050)"
+            ]
+        );
+        assert_eq!(
+            names(Some("{descriptor}, {object_motion}")),
+            ["mnti, fixed (ECE 0.050)", "polar-fourier, fixed (ECE 0.050)"]
+        );
+        assert_eq!(
+            names(None),
+            [
+                "mnti: object_motion = fixed (ECE 0.050)",
+                "polar-fourier: object_motion = fixed (ECE 0.050)"
+            ]
+        );
+    }
 }

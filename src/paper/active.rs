@@ -31,14 +31,13 @@ use super::context::PaperContext;
 use super::data::Objects;
 use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
 use super::recognition::{
-    CALIBRATION_LOCAL_PROBABILITIES, Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData,
-    TestData, training_config,
+    ArmCalibration, CalibratedOn, Curve, RecognitionDetail, RecognitionSweep, Setting, SettingData, TestData,
+    training_config,
 };
 use super::scale::DataCounts;
 use crate::active_touch::{
     ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, reported_stops, stops,
 };
-use crate::dataset::Dataset;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
 use crate::experiment::factor::{Factor, Factors};
@@ -184,6 +183,7 @@ pub fn sweep() -> RecognitionSweep {
                 ..SamplerConfig::default()
             },
             training_fraction: END_TO_END_TRAINING_FRACTION,
+            calibrated_on: CalibratedOn::ArmExplorations,
             curves,
         }],
     }
@@ -198,13 +198,11 @@ struct ActiveConfig<'a> {
     stops: [f64; 3],
     /// Touches a guess must hold a stop's threshold over for the stop to fire.
     stop_held_readings: usize,
-    /// The posterior: `calibrated` on the arm's explorations (`calibration_explorations` of each
-    /// object at each of `calibration_local_probabilities`, `calibration_trial_readings` per
-    /// trial), or the paper's `eq15`.
+    /// The posterior: `calibrated` on the arm's explorations (`arm_calibration`), or the paper's
+    /// `eq15`.
     posterior: PosteriorRule,
-    calibration_local_probabilities: [f64; 2],
-    calibration_explorations: usize,
-    calibration_trial_readings: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    arm_calibration: Option<ArmCalibration>,
     scale: f64,
     counts: DataCounts,
     seed: u64,
@@ -224,9 +222,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
     let dir = ExperimentDir::new(&context.options.out, &name);
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
         let data = SettingData::new(context, &objects, &sweep.settings[0], counts);
-        let mut requests = data.requests()?;
-        requests.extend(data.calibration_requests()?);
-        context.store.prepare(&requests, dir.root())?;
+        context.store.prepare(&data.requests()?, dir.root())?;
     }
     let neighbourhood_m = PlannerConfig::default().grid_cell_m;
     let unit = {
@@ -265,9 +261,9 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             stops: REPORTED_STOPS,
             stop_held_readings: ConfidenceStop::DEFAULT_HELD_READINGS.get(),
             posterior: context.posterior(),
-            calibration_local_probabilities: CALIBRATION_LOCAL_PROBABILITIES,
-            calibration_explorations: counts.trials,
-            calibration_trial_readings: counts.test_per_object,
+            arm_calibration: sweep.settings[0]
+                .calibrated_on_arm(context)
+                .then(|| ArmCalibration::of(counts)),
             scale: context.scale.fraction(),
             counts,
             seed: context.seed,
@@ -303,25 +299,12 @@ impl ActiveUnit<'_> {
     fn rows(&self) -> Result<Rows, BoxError> {
         let descriptor = DESCRIPTOR.build();
         let data = self.data();
-        let model = self.context.store.model(
+        let model = data.judging_model(self.context.store.model(
             &data.training_request()?,
             &data.validation_request()?,
             descriptor.as_ref(),
             &self.training,
-        )?;
-        let model = match self.context.posterior() {
-            PosteriorRule::Calibrated => {
-                let explorations = data
-                    .calibration_requests()?
-                    .iter()
-                    .map(|request| self.context.store.dataset(request))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let explorations: Vec<&Dataset> = explorations.iter().map(AsRef::as_ref).collect();
-                let calibrate = || model.calibrate_on_all(&explorations, self.counts.test_per_object);
-                self.context.store.clock.training(calibrate)?
-            }
-            PosteriorRule::Eq15 => model,
-        };
+        )?)?;
         let (mut rows, mut per_object, mut reliability) = (Vec::new(), Vec::new(), Vec::new());
         for curve in &self.sweep.settings[0].curves {
             let (curve_rows, (curve_objects, curve_reliability)) =
