@@ -261,9 +261,7 @@ pub fn run_active(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
             stops: REPORTED_STOPS,
             stop_held_readings: ConfidenceStop::DEFAULT_HELD_READINGS.get(),
             posterior: context.posterior(),
-            arm_calibration: sweep.settings[0]
-                .calibrated_on_arm(context)
-                .then(|| ArmCalibration::of(counts)),
+            arm_calibration: sweep.arm_calibration(context, counts),
             scale: context.scale.fraction(),
             counts,
             seed: context.seed,

@@ -86,12 +86,11 @@ pub struct Curve {
 
 /// What the calibrated posterior (`recognize::calibration`) of a setting's models is fitted on.
 /// Under the paper's Eq. 15 (`--posterior eq15`) nothing is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CalibratedOn {
     /// The sampler's validation readings the model was chosen on (training fits it): the paper's
     /// figures, whose question is the paper's recipe.
-    #[default]
     Validation,
     /// The arm's own explorations ([`SettingData::calibration_requests`]), the kind of data the
     /// curves judge: the product's recipe for recognising the arm's touches. Fitted on the
@@ -123,7 +122,7 @@ pub(super) struct ArmCalibration {
 impl ArmCalibration {
     /// The calibration of a run with data `counts` (the explorations of
     /// [`SettingData::calibration_requests`]).
-    pub(super) fn of(counts: DataCounts) -> Self {
+    fn of(counts: DataCounts) -> Self {
         Self {
             local_probabilities: CALIBRATION_LOCAL_PROBABILITIES,
             explorations: counts.trials,
@@ -237,6 +236,20 @@ fn prepare_pending(
 }
 
 impl RecognitionSweep {
+    /// What its `config.json` records of the arm's explorations its posteriors are calibrated on
+    /// in `context` with data `counts`: `None` when no setting's are
+    /// ([`Setting::calibrated_on_arm`]).
+    pub(super) fn arm_calibration(
+        &self,
+        context: &PaperContext,
+        counts: DataCounts,
+    ) -> Option<ArmCalibration> {
+        self.settings
+            .iter()
+            .any(|setting| setting.calibrated_on_arm(context))
+            .then(|| ArmCalibration::of(counts))
+    }
+
     /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
     /// by what they are (real sensor frames, or the synthetic example's).
     pub(crate) fn plot_title(&self, real: Option<&RealData>) -> String {
@@ -264,11 +277,7 @@ impl RecognitionSweep {
             control: ControlConfig::default(),
             planner: PlannerConfig::default(),
             training: training_config(context, codebook, counts, objects.specs.len()),
-            arm_calibration: self
-                .settings
-                .iter()
-                .any(|setting| setting.calibrated_on_arm(context))
-                .then(|| ArmCalibration::of(counts)),
+            arm_calibration: self.arm_calibration(context, counts),
         };
         check_resumable(&context.options, &name, &config)?;
         let dir = ExperimentDir::new(&context.options.out, &name);
@@ -485,7 +494,7 @@ impl Setting {
 
     /// Whether the setting's posteriors are fitted on the arm's explorations in `context`: the
     /// setting asks for it and the run's posterior is calibrated.
-    pub(super) fn calibrated_on_arm(&self, context: &PaperContext) -> bool {
+    fn calibrated_on_arm(&self, context: &PaperContext) -> bool {
         self.calibrated_on == CalibratedOn::ArmExplorations
             && matches!(context.posterior(), PosteriorRule::Calibrated)
     }
