@@ -434,6 +434,20 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
         !ours.is_empty() && ours == blind,
         "end-to-end's ours against active's blind curves"
     );
+    // Figs. 7, 8 and 10 calibrate on the arm's explorations of the default sensor, the ones
+    // `active` and `end-to-end` use: the whole run explores each calibration stream once.
+    for experiment in ["descriptors", "strategy", "perturbation", "end-to-end", "active"] {
+        let config = std::fs::read_to_string(out.join(experiment).join("config.json")).expect("config.json");
+        let config: serde_json::Value = serde_json::from_str(&config).expect("JSON");
+        for setting in config["sweep"]["settings"].as_array().expect("settings") {
+            assert_eq!(
+                setting["calibrated_on"], "arm_explorations",
+                "{experiment}: {setting}"
+            );
+        }
+    }
+    let trials = arm_calibration(&out, "descriptors").expect("calibrated on the arm");
+    assert_eq!(calibration_explorations(&out), [trials, trials]);
     let index = std::fs::read_to_string(out.join("README.md")).expect("index written");
     for experiment in PaperExperiment::ALL {
         assert!(index.contains(experiment.name()), "index lists {experiment}");
@@ -684,6 +698,46 @@ fn the_end_to_end_experiment_calibrates_on_the_arm_and_eq15_needs_no_calibration
     );
 }
 
+/// Figs. 8 and 10 judge the same models (the top three descriptors on the default sensor),
+/// calibrated on the same arm explorations: run after Fig. 8 in its folder, Fig. 10 fits nothing
+/// (the calibrated models are read from the folder, none written again) and gives the rows it
+/// gives alone.
+#[test]
+fn figures_on_the_default_sensor_share_their_arm_calibrated_models() {
+    let dir = tempfile::tempdir().unwrap();
+    let (shared, alone) = (dir.path().join("shared"), dir.path().join("alone"));
+    run_experiment("strategy", &shared, &[]);
+    let saved = |dir: &Path| -> Vec<(std::ffi::OsString, std::time::SystemTime)> {
+        let mut files: Vec<_> = std::fs::read_dir(dir.join("models"))
+            .expect("the run's models")
+            .map(|entry| {
+                let entry = entry.expect("a model file");
+                let modified = entry.metadata().and_then(|m| m.modified()).expect("a time");
+                (entry.file_name(), modified)
+            })
+            .collect();
+        files.sort();
+        files
+    };
+    let models = saved(&shared);
+    let output = taction(&[
+        "experiment",
+        "perturbation",
+        "--scale",
+        "0.001",
+        "--objects",
+        "chess",
+        "--out",
+        shared.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("of which training 0.0)"), "{stderr}");
+    assert_eq!(saved(&shared), models, "no model written again");
+    let after = std::fs::read(shared.join("perturbation/perturbation.csv")).expect("assembled CSV");
+    assert_eq!(after, run_experiment("perturbation", &alone, &[]));
+    assert!(arm_calibration(&alone, "perturbation").is_some());
+}
+
 /// The trials of `experiment`'s calibration on the arm's explorations as its `config.json`
 /// records them: at L = 0.5 and 1, as many explorations of each object at each as there are test
 /// trials (`None`: no such calibration).
@@ -703,9 +757,10 @@ fn arm_calibration(out: &Path, experiment: &str) -> Option<u64> {
 
 /// The planner datasets of a run at L = 0.5 and at L = 1 on seeds of their own (no test curve
 /// uses them: a test trial's stream is read at both L, common random numbers): the calibration
-/// explorations.
+/// explorations, counted as files (a second sensor exploring the same streams adds its own).
 fn calibration_explorations(out: &Path) -> [u64; 2] {
-    let mut seeds: std::collections::BTreeMap<u64, BTreeSet<String>> = Default::default();
+    // Per seed: the levels it was explored at, and its datasets (one per sensor that explored it).
+    let mut seeds: std::collections::BTreeMap<u64, (BTreeSet<String>, u64)> = Default::default();
     for entry in std::fs::read_dir(out.join("data")).expect("the run's data") {
         let path = entry.expect("a data file").path();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
@@ -721,13 +776,16 @@ fn calibration_explorations(out: &Path) -> [u64; 2] {
             .expect("a header line");
         let header: serde_json::Value = serde_json::from_str(header).expect("a JSON header");
         let seed = header["seed"].as_u64().expect("the dataset's seed");
-        seeds.entry(seed).or_default().insert(level);
+        let (levels, files) = seeds.entry(seed).or_default();
+        levels.insert(level);
+        *files += 1;
     }
     ["0.5", "1"].map(|level| {
         seeds
             .values()
-            .filter(|levels| levels.len() == 1 && levels.contains(level))
-            .count() as u64
+            .filter(|(levels, _)| levels.len() == 1 && levels.contains(level))
+            .map(|(_, files)| files)
+            .sum()
     })
 }
 

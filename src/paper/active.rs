@@ -297,12 +297,7 @@ impl ActiveUnit<'_> {
     fn rows(&self) -> Result<Rows, BoxError> {
         let descriptor = DESCRIPTOR.build();
         let data = self.data();
-        let model = data.judging_model(self.context.store.model(
-            &data.training_request()?,
-            &data.validation_request()?,
-            descriptor.as_ref(),
-            &self.training,
-        )?)?;
+        let model = data.judging_model(descriptor.as_ref(), &self.training)?;
         let (mut rows, mut per_object, mut reliability) = (Vec::new(), Vec::new(), Vec::new());
         for curve in &self.sweep.settings[0].curves {
             let (curve_rows, (curve_objects, curve_reliability)) =

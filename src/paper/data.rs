@@ -4,12 +4,14 @@
 //!
 //! ```text
 //! <out>/data/<set>-<generator>-<key>.csv     a dataset (format of `crate::dataset`)
-//! <out>/models/<descriptor>-<key>.json       a trained model (format of `crate::recognize::model`)
+//! <out>/models/<descriptor>-<key>.json       a trained model (format of `crate::recognize::model`),
+//!                                            or one calibrated again on the arm's explorations
 //! ```
 //!
 //! `<key>` is a hash of everything the file's content depends on (the object set's id and the
 //! collection plan; for a model also the training and validation keys, the descriptor and the
-//! training configuration), so a file is reused exactly when it would be recomputed identically.
+//! training configuration, and the keys of the explorations it was calibrated on), so a file is
+//! reused exactly when it would be recomputed identically.
 //! Files are written atomically; a corrupt one is an error naming it.
 //!
 //! Datasets are collected in a preparation step before an experiment's units run ([`DataStore::
@@ -334,33 +336,9 @@ impl DataStore {
         descriptor: &dyn Descriptor,
         config: &TrainConfig,
     ) -> Result<TrainedModel, BoxError> {
-        #[derive(Serialize)]
-        struct ModelKey<'a> {
-            training: String,
-            validation: String,
-            descriptor: crate::describe::DescriptorParams,
-            config: &'a TrainConfig,
-            /// Models cached before their posterior was calibrated are not reused.
-            calibrated: bool,
-        }
-        let key = hash_of(&ModelKey {
-            training: training.key(),
-            validation: validation.key(),
-            descriptor: descriptor.params(),
-            config,
-            calibrated: true,
-        });
-        let path = self
-            .root
-            .join("models")
-            .join(format!("{}-{key}.json", descriptor.kind().name()));
-        if path.exists() {
-            return TrainedModel::load(&path)
-                .map(|m| m.with_posterior(self.posterior))
-                .map_err(|e| {
-                    format!("{e} (a model cached by an earlier run; delete the file to train it again)")
-                        .into()
-                });
+        let path = self.model_path(training, validation, descriptor, config, None);
+        if let Some(model) = self.cached_model(&path)? {
+            return Ok(model);
         }
         let training_data = self.dataset(training)?;
         let validation_data = self.dataset(validation)?;
@@ -374,8 +352,101 @@ impl DataStore {
                 &mut |_| {},
             )
         })?;
-        crate::experiment::files::create_dir_all(&self.root.join("models"))?;
-        model.save(&path)?;
+        self.save_model(&model, &path)?;
         Ok(model.with_posterior(self.posterior))
     }
+
+    /// [`model`](Self::model) with its posterior's tempering and confidence map fitted again on
+    /// the arm's `explorations` in trials of `trial_readings` (`TrainedModel::calibrate_on_all`,
+    /// timed as training), cached as a model of its own: the experiments on the default sensor
+    /// share their models and their calibration explorations (`paper::figures`), so each
+    /// calibration is fitted once per output root.
+    pub fn arm_calibrated_model(
+        &self,
+        training: &DataRequest,
+        validation: &DataRequest,
+        descriptor: &dyn Descriptor,
+        config: &TrainConfig,
+        explorations: &[DataRequest],
+        trial_readings: usize,
+    ) -> Result<TrainedModel, BoxError> {
+        let calibration = ArmCalibrationKey {
+            explorations: explorations.iter().map(DataRequest::key).collect(),
+            trial_readings,
+        };
+        let path = self.model_path(training, validation, descriptor, config, Some(calibration));
+        if let Some(model) = self.cached_model(&path)? {
+            return Ok(model);
+        }
+        let model = self.model(training, validation, descriptor, config)?;
+        let data = explorations
+            .iter()
+            .map(|request| self.dataset(request))
+            .collect::<Result<Vec<_>, _>>()?;
+        let data: Vec<&Dataset> = data.iter().map(AsRef::as_ref).collect();
+        let calibrated = self
+            .clock
+            .training(|| model.calibrate_on_all(&data, trial_readings))?;
+        self.save_model(&calibrated, &path)?;
+        Ok(calibrated.with_posterior(self.posterior))
+    }
+
+    /// Where the model of these inputs is cached: `<out>/models/<descriptor>-<key>.json`.
+    fn model_path(
+        &self,
+        training: &DataRequest,
+        validation: &DataRequest,
+        descriptor: &dyn Descriptor,
+        config: &TrainConfig,
+        arm_calibration: Option<ArmCalibrationKey>,
+    ) -> PathBuf {
+        #[derive(Serialize)]
+        struct ModelKey<'a> {
+            training: String,
+            validation: String,
+            descriptor: crate::describe::DescriptorParams,
+            config: &'a TrainConfig,
+            /// Models cached before their posterior was calibrated are not reused.
+            calibrated: bool,
+            /// Absent for a model as trained, so their keys are those of earlier runs.
+            #[serde(skip_serializing_if = "Option::is_none")]
+            arm_calibration: Option<ArmCalibrationKey>,
+        }
+        let key = hash_of(&ModelKey {
+            training: training.key(),
+            validation: validation.key(),
+            descriptor: descriptor.params(),
+            config,
+            calibrated: true,
+            arm_calibration,
+        });
+        self.root
+            .join("models")
+            .join(format!("{}-{key}.json", descriptor.kind().name()))
+    }
+
+    /// The model an earlier run saved at `path`, with the run's posterior rule.
+    fn cached_model(&self, path: &Path) -> Result<Option<TrainedModel>, BoxError> {
+        if !path.exists() {
+            return Ok(None);
+        }
+        TrainedModel::load(path)
+            .map(|m| Some(m.with_posterior(self.posterior)))
+            .map_err(|e| {
+                format!("{e} (a model cached by an earlier run; delete the file to train it again)").into()
+            })
+    }
+
+    fn save_model(&self, model: &TrainedModel, path: &Path) -> Result<(), BoxError> {
+        crate::experiment::files::create_dir_all(&self.root.join("models"))?;
+        Ok(model.save(path)?)
+    }
+}
+
+/// What a model's posterior was calibrated on besides its validation data: the arm's explorations
+/// (their dataset keys) in trials of `trial_readings`.
+#[derive(Serialize)]
+struct ArmCalibrationKey {
+    explorations: Vec<String>,
+    trial_readings: usize,
 }

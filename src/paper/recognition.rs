@@ -17,7 +17,6 @@ use super::context::{Family, PaperContext};
 use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
 use crate::control::ControlConfig;
-use crate::dataset::Dataset;
 use crate::dataset::recorded::RealData;
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow};
@@ -89,8 +88,9 @@ pub struct Curve {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CalibratedOn {
-    /// The sampler's validation readings the model was chosen on (training fits it): the paper's
-    /// figures, whose question is the paper's recipe.
+    /// The sampler's validation readings the model was chosen on (training fits it): Fig. 9,
+    /// which judges those readings, and the figures on other sensors than the default (Figs.
+    /// 11-13), which would each need explorations of their own (`paper::figures`).
     Validation,
     /// The arm's own explorations ([`SettingData::calibration_requests`]), the kind of data the
     /// curves judge: the product's recipe for recognising the arm's touches. Fitted on the
@@ -405,12 +405,7 @@ impl RecognitionSweep {
         real: Option<&RealData>,
     ) -> Result<RecognitionRows, BoxError> {
         let descriptor = kind.build();
-        let model = data.judging_model(data.context.store.model(
-            &data.training_request()?,
-            &data.validation_request()?,
-            descriptor.as_ref(),
-            training,
-        )?)?;
+        let model = data.judging_model(descriptor.as_ref(), training)?;
         let (mut rows, mut per_object, mut reliability) = (Vec::new(), Vec::new(), Vec::new());
         for curve in &data.setting.curves {
             let trials = match curve.test {
@@ -664,23 +659,29 @@ impl<'a> SettingData<'a> {
         Ok(requests)
     }
 
-    /// `model` with the posterior the setting's curves are judged by: with
-    /// [`CalibratedOn::ArmExplorations`] under the calibrated rule, its tempering and confidence
-    /// map fitted again on the arm's explorations ([`Self::calibration_requests`]) in trials as
-    /// long as a test run (`TrainedModel::calibrate_on_all`, timed as training); otherwise `model`
-    /// as trained.
-    pub(super) fn judging_model(&self, model: TrainedModel) -> Result<TrainedModel, BoxError> {
+    /// The model of `descriptor` trained by `training` on the setting's data, with the posterior
+    /// the setting's curves are judged by: with [`CalibratedOn::ArmExplorations`] under the
+    /// calibrated rule, its tempering and confidence map fitted again on the arm's explorations
+    /// ([`Self::calibration_requests`]) in trials as long as a test run
+    /// (`DataStore::arm_calibrated_model`, timed as training); otherwise as trained.
+    pub(super) fn judging_model(
+        &self,
+        descriptor: &dyn Descriptor,
+        training: &TrainConfig,
+    ) -> Result<TrainedModel, BoxError> {
+        let (data, validation) = (self.training_request()?, self.validation_request()?);
+        let store = &self.context.store;
         if !self.setting.calibrated_on_arm(self.context) {
-            return Ok(model);
+            return store.model(&data, &validation, descriptor, training);
         }
-        let explorations = self
-            .calibration_requests()?
-            .iter()
-            .map(|request| self.context.store.dataset(request))
-            .collect::<Result<Vec<_>, _>>()?;
-        let explorations: Vec<&Dataset> = explorations.iter().map(AsRef::as_ref).collect();
-        let calibrate = || model.calibrate_on_all(&explorations, self.counts.test_per_object);
-        Ok(self.context.store.clock.training(calibrate)?)
+        store.arm_calibrated_model(
+            &data,
+            &validation,
+            descriptor,
+            training,
+            &self.calibration_requests()?,
+            self.counts.test_per_object,
+        )
     }
 
     /// The trials of a curve read from datasets (every kind but real frames): per trial its seed
