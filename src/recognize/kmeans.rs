@@ -144,9 +144,9 @@ impl KMeans {
             }
         }
         let model = Self { centers };
-        let inertia = data
-            .iter_rows()
-            .map(|x| squared_distance(x, &model.centers[model.nearest(x)]))
+        let inertia = nearest_centres(data, &CentreBlocks::new(&model.centers))
+            .into_iter()
+            .map(|(_, distance)| distance)
             .sum();
         Ok((model, KMeansFit { iterations, inertia }))
     }
@@ -173,7 +173,8 @@ impl KMeans {
         self.centers[0].len()
     }
 
-    /// The index of the centre nearest to `x` (ties to the lower index).
+    /// The index of the centre nearest to `x` (ties to the lower index). One feature at a time;
+    /// [`labels`](Self::labels) gives the same answers for many at once, faster.
     pub fn nearest(&self, x: &[f64]) -> usize {
         let mut best = (0, f64::INFINITY);
         for (i, c) in self.centers.iter().enumerate() {
@@ -187,7 +188,10 @@ impl KMeans {
 
     /// The cluster of every feature.
     pub fn labels(&self, data: &FeatureMatrix) -> Vec<usize> {
-        data.iter_rows().map(|x| self.nearest(x)).collect()
+        nearest_centres(data, &CentreBlocks::new(&self.centers))
+            .into_iter()
+            .map(|(label, _)| label)
+            .collect()
     }
 
     pub(crate) fn check(&self) -> Result<(), String> {
@@ -222,35 +226,119 @@ fn mean_variance(data: &FeatureMatrix) -> f64 {
 /// Labels every feature with its nearest centre, in parallel (each feature independently, so the
 /// result does not depend on the thread count); returns how many labels changed.
 fn assign(data: &FeatureMatrix, centers: &[Vec<f64>], labels: &mut [usize], distances: &mut [f64]) -> usize {
+    let blocks = CentreBlocks::new(centers);
+    let nearest = nearest_centres(data, &blocks);
+    let mut changed = 0;
+    for ((label, distance), (best, best_distance)) in labels.iter_mut().zip(distances).zip(nearest) {
+        changed += usize::from(*label != best);
+        *label = best;
+        *distance = best_distance;
+    }
+    changed
+}
+
+/// Centres per block of [`CentreBlocks`]: two lanes of four.
+const BLOCK: usize = 8;
+
+/// The centres transposed in blocks of [`BLOCK`]: coordinate `a` of the block's centres side by
+/// side, so one pass over a feature's coordinates measures its distance to a whole block, each
+/// centre in its own lane. The last block is padded with NaN centres, whose distance is never
+/// below another.
+struct CentreBlocks {
+    dim: usize,
+    /// Block `b`, coordinate `a` at `b * dim + a`.
+    values: Vec<[f64; BLOCK]>,
+}
+
+impl CentreBlocks {
+    fn new(centers: &[Vec<f64>]) -> Self {
+        let dim = centers.first().map_or(0, Vec::len);
+        let mut values = vec![[f64::NAN; BLOCK]; centers.len().div_ceil(BLOCK) * dim];
+        for (i, centre) in centers.iter().enumerate() {
+            for (a, &v) in centre.iter().enumerate() {
+                values[i / BLOCK * dim + a][i % BLOCK] = v;
+            }
+        }
+        Self { dim, values }
+    }
+}
+
+/// The nearest centre of every feature and its squared distance, in parallel, in feature order:
+/// [`KMeans::nearest`]'s answer (ties to the lower index) and [`squared_distance`]'s bits.
+fn nearest_centres(data: &FeatureMatrix, blocks: &CentreBlocks) -> Vec<(usize, f64)> {
     const CHUNK: usize = 512;
     let d = data.dim();
+    let mut nearest = vec![(0, f64::INFINITY); data.rows()];
+    if d == 0 || blocks.dim != d {
+        return nearest;
+    }
+    #[cfg(target_arch = "x86_64")]
+    let wide = crate::simd::has_avx2();
     data.as_slice()
         .par_chunks(CHUNK * d)
-        .zip(labels.par_chunks_mut(CHUNK))
-        .zip(distances.par_chunks_mut(CHUNK))
-        .map(|((rows, labels), distances)| {
-            let mut changed = 0;
-            for ((x, label), dist) in rows
-                .chunks_exact(d)
-                .zip(labels.iter_mut())
-                .zip(distances.iter_mut())
-            {
-                let mut best = (0, f64::INFINITY);
-                for (i, c) in centers.iter().enumerate() {
-                    let dd = squared_distance(x, c);
-                    if dd < best.1 {
-                        best = (i, dd);
-                    }
-                }
-                if *label != best.0 {
-                    changed += 1;
-                    *label = best.0;
-                }
-                *dist = best.1;
+        .zip(nearest.par_chunks_mut(CHUNK))
+        .for_each(|(rows, out)| {
+            #[cfg(target_arch = "x86_64")]
+            if wide {
+                // SAFETY: `wide` is set only where the processor has AVX2.
+                return unsafe { nearest_of_rows_avx2(rows, blocks, out) };
             }
-            changed
-        })
-        .sum()
+            nearest_of_rows(rows, blocks, out);
+        });
+    nearest
+}
+
+/// [`nearest_of_rows`] compiled with AVX2: the same operations, four lanes at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn nearest_of_rows_avx2(rows: &[f64], blocks: &CentreBlocks, out: &mut [(usize, f64)]) {
+    nearest_of_rows(rows, blocks, out);
+}
+
+/// The nearest centre of each feature of `rows` (row-major) into `out`. Each lane repeats
+/// [`squared_distance`] for its centre (the first square, then the others added in coordinate
+/// order, each rounded as there) and keeps its first strictly smaller distance, as the scan over
+/// the centres in order keeps it; of the lanes' bests the smallest distance wins, ties to the lower
+/// centre index, which is the scan's answer.
+#[inline(always)]
+fn nearest_of_rows(rows: &[f64], blocks: &CentreBlocks, out: &mut [(usize, f64)]) {
+    let d = blocks.dim;
+    for (x, out) in rows.chunks_exact(d).zip(out) {
+        let mut best = [f64::INFINITY; BLOCK];
+        let mut index = [0usize; BLOCK];
+        for (b, block) in blocks.values.chunks_exact(d).enumerate() {
+            let mut distance = [0.0; BLOCK];
+            for (lane, &c) in distance.iter_mut().zip(&block[0]) {
+                let t = x[0] - c;
+                *lane = t * t;
+            }
+            for (&v, centres) in x.iter().zip(block).skip(1) {
+                for (lane, &c) in distance.iter_mut().zip(centres) {
+                    let t = v - c;
+                    *lane += t * t;
+                }
+            }
+            for (lane, (&candidate, (best, index))) in distance
+                .iter()
+                .zip(best.iter_mut().zip(index.iter_mut()))
+                .enumerate()
+            {
+                let nearer = candidate < *best;
+                *best = if nearer { candidate } else { *best };
+                *index = if nearer { b * BLOCK + lane } else { *index };
+            }
+        }
+        *out = best
+            .iter()
+            .zip(&index)
+            .fold((0, f64::INFINITY), |(i, nearest), (&distance, &lane_index)| {
+                if distance < nearest || (distance == nearest && lane_index < i) {
+                    (lane_index, distance)
+                } else {
+                    (i, nearest)
+                }
+            });
+    }
 }
 
 /// Moves, into every empty cluster, the feature farthest from its current centre (ties to the
@@ -300,6 +388,64 @@ mod tests {
             })
             .collect();
         FeatureMatrix::from_features(&features, "blobs").unwrap()
+    }
+
+    /// The blocked search against the scan of [`KMeans::nearest`] and [`squared_distance`], bit for
+    /// bit, in both builds: blocks whole and padded, one coordinate and many, and ties (repeated
+    /// centres, features on a centre, features halfway between two).
+    #[test]
+    fn the_blocked_search_finds_the_scans_nearest_centre_and_distance() {
+        let mut rng = stream(8, 0);
+        for (dim, k) in [(1, 1), (1, 9), (2, 8), (3, 17), (7, 5), (10, 400), (13, 24)] {
+            let mut centers: Vec<Vec<f64>> = (0..k)
+                .map(|_| (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect())
+                .collect();
+            if k > 3 {
+                centers[k - 1] = centers[1].clone();
+                centers[2] = centers[k - 2].clone();
+            }
+            let mut features: Vec<Vec<f64>> = (0..300)
+                .map(|_| (0..dim).map(|_| rng.random_range(-1.5..1.5)).collect())
+                .collect();
+            features.extend(centers.iter().cloned());
+            if k > 1 {
+                features.push(
+                    centers[0]
+                        .iter()
+                        .zip(&centers[1])
+                        .map(|(a, b)| 0.5 * (a + b))
+                        .collect(),
+                );
+            }
+            let data = FeatureMatrix::from_features(&features, "search").unwrap();
+            let model = KMeans::from_centers(centers).unwrap();
+            let want: Vec<(usize, u64)> = features
+                .iter()
+                .map(|x| {
+                    let i = model.nearest(x);
+                    (i, squared_distance(x, &model.centers()[i]).to_bits())
+                })
+                .collect();
+            let blocks = CentreBlocks::new(model.centers());
+            let bits = |found: Vec<(usize, f64)>| -> Vec<(usize, u64)> {
+                found.into_iter().map(|(i, d)| (i, d.to_bits())).collect()
+            };
+            let mut baseline = vec![(0, 0.0); features.len()];
+            nearest_of_rows(data.as_slice(), &blocks, &mut baseline);
+            assert_eq!(bits(baseline), want, "baseline, dim {dim}, k {k}");
+            assert_eq!(bits(nearest_centres(&data, &blocks)), want, "dim {dim}, k {k}");
+            #[cfg(target_arch = "x86_64")]
+            if crate::simd::has_avx2() {
+                let mut wide = vec![(0, 0.0); features.len()];
+                // SAFETY: the processor has AVX2.
+                unsafe { nearest_of_rows_avx2(data.as_slice(), &blocks, &mut wide) };
+                assert_eq!(bits(wide), want, "AVX2, dim {dim}, k {k}");
+            }
+            assert_eq!(
+                model.labels(&data),
+                want.iter().map(|&(i, _)| i).collect::<Vec<_>>()
+            );
+        }
     }
 
     #[test]
