@@ -20,7 +20,9 @@ use crate::recognize::exp::{
     Shift, add_exp_of_differences, exp_of_differences_in_place, sum_exp_of_differences,
 };
 use crate::recognize::features::FeatureMatrix;
-use crate::recognize::gmm_products::{weighted_column_sums, weighted_scatter, whitened_distances};
+use crate::recognize::gmm_products::{
+    WhitenedDistances, weighted_column_sums, weighted_scatter, whitened_distances,
+};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
 use crate::rng::Rng;
 
@@ -133,10 +135,11 @@ impl GaussianMixture {
         let mut lower_bound = f64::NEG_INFINITY;
         let mut converged = false;
         let mut iterations = 0;
+        let mut responsibilities = responsibilities;
         for iteration in 1..=config.max_iterations {
             iterations = iteration;
             let previous = lower_bound;
-            let (mean_ll, responsibilities) = model.e_step(&x);
+            let mean_ll = model.e_step(&x, &mut responsibilities);
             model = m_step(&x, data.as_slice(), &responsibilities, config.reg_covar)?;
             lower_bound = mean_ll;
             if (lower_bound - previous).abs() < config.tolerance {
@@ -295,12 +298,46 @@ impl GaussianMixture {
             .collect()
     }
 
-    /// The E-step: mean log-likelihood and responsibilities (`k` columns of length `n`).
-    fn e_step(&self, x: &DMatrix<f64>) -> (f64, Vec<Vec<f64>>) {
+    /// The E-step: the mean log-likelihood, and the responsibilities into `columns` (`k` columns
+    /// of length `n`, their earlier values overwritten). Where the distances are repeated on the
+    /// triangle ([`WhitenedDistances`]) every block of rows takes its log-densities, their
+    /// log-sum-exps and its responsibilities in one visit, while its values are in the cache:
+    /// each row's values are the same bits as from whole columns.
+    fn e_step(&self, x: &DMatrix<f64>, columns: &mut Vec<Vec<f64>>) -> f64 {
         let n = x.nrows();
-        let mut columns = self.weighted_log_prob_columns(x);
-        let norms = normalise_rows(&mut columns);
-        (norms.iter().sum::<f64>() / n as f64, columns)
+        let norms = match self.component_distances(x) {
+            Some(components) => {
+                columns.resize_with(components.len(), Vec::new);
+                columns.iter_mut().for_each(|column| column.resize(n, 0.0));
+                let x = x.as_slice();
+                normalise_rows(columns, |first, block| {
+                    for ((distances, offset), rows) in components.iter().zip(block) {
+                        distances.of_rows(x, n, first, rows);
+                        rows.iter_mut().for_each(|q| *q = offset - 0.5 * *q);
+                    }
+                })
+            }
+            None => {
+                *columns = self.weighted_log_prob_columns(x);
+                normalise_rows(columns, |_, _| {})
+            }
+        };
+        norms.iter().sum::<f64>() / n as f64
+    }
+
+    /// Every component's [`WhitenedDistances`] to the rows of `x` and its offset `-d/2 ln 2 pi +
+    /// ln det P_i + ln pi_i`; `None` where a distance needs the general product.
+    fn component_distances(&self, x: &DMatrix<f64>) -> Option<Vec<(WhitenedDistances, f64)>> {
+        let (n, d) = x.shape();
+        let constant = -0.5 * d as f64 * LN_2PI;
+        (0..self.k())
+            .map(|i| {
+                let p = &self.precision_chol[i];
+                let mu_p = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
+                let offset = constant + self.log_det_precision[i] + self.log_weights[i];
+                Some((WhitenedDistances::new(n, p, mu_p.as_slice())?, offset))
+            })
+            .collect()
     }
 }
 
@@ -462,8 +499,9 @@ pub(crate) fn log_sum_exp_of_parts(max: f64, sum: f64) -> f64 {
 }
 
 /// Rows per block of [`log_sum_exp_rows`] and [`normalise_rows`]: a block's values in every
-/// column, its maxima and sums stay in the cache between the passes over them.
-const ROW_BLOCK: usize = 512;
+/// column, its maxima and sums stay in the cache between the passes over them (at the letters' 400
+/// components a block of 128 rows is 400 KB).
+const ROW_BLOCK: usize = 128;
 
 /// `ln sum_i exp(columns[i][r])` for every row `r`: the same arithmetic as [`log_sum_exp`] on each
 /// row (the exponentials summed in component order), computed a block of rows at a time so every
@@ -498,9 +536,11 @@ fn log_sum_exp_of_block(block: &[&[f64]], out: &mut [f64]) {
 
 /// The responsibilities from the weighted log-densities: every row `r` of `columns` replaced by
 /// `exp(columns[i][r] - ln sum_m exp(columns[m][r]))`, the row's log-sum-exp returned. One block of
-/// rows at a time, as [`log_sum_exp_rows`] forms it, its exponentials taken while the block is in
-/// the cache: the same bits as the log-sum-exp of every row and then the exponentials.
-fn normalise_rows(columns: &mut [Vec<f64>]) -> Vec<f64> {
+/// rows at a time, the blocks in parallel: `fill(first, block)` first writes the block's
+/// log-densities (rows `first..`, `block[i]` component `i`'s), then the block's log-sum-exps are
+/// formed as [`log_sum_exp_rows`] forms them and its exponentials taken while the block is in the
+/// cache: the same bits as the log-sum-exp of every row and then the exponentials.
+fn normalise_rows(columns: &mut [Vec<f64>], fill: impl Fn(usize, &mut [&mut [f64]]) + Sync) -> Vec<f64> {
     let n = columns.first().map_or(0, Vec::len);
     // Per block, its rows of every column.
     let mut blocks: Vec<Vec<&mut [f64]>> = (0..n.div_ceil(ROW_BLOCK)).map(|_| Vec::new()).collect();
@@ -513,7 +553,9 @@ fn normalise_rows(columns: &mut [Vec<f64>]) -> Vec<f64> {
     norms
         .par_chunks_mut(ROW_BLOCK)
         .zip(blocks.par_iter_mut())
-        .for_each(|(norms, block)| {
+        .enumerate()
+        .for_each(|(b, (norms, block))| {
+            fill(b * ROW_BLOCK, block);
             let values: Vec<&[f64]> = block.iter().map(|rows| &**rows).collect();
             log_sum_exp_of_block(&values, norms);
             for rows in block.iter_mut() {
@@ -585,6 +627,48 @@ mod tests {
                 (false, _) => rng.random_range(0.0..1.0),
             })
             .collect()
+    }
+
+    /// The E-step by blocks of rows (each block's distances, log-sum-exps and responsibilities in
+    /// one visit) against the E-step by whole columns (every component's log-densities, then the
+    /// rows normalised), bit for bit: nalgebra's own chains (`d` = 3) and the triangle's (`d` =
+    /// 7, 10), rows in whole blocks and not, a buffer of another shape overwritten.
+    #[test]
+    fn the_e_step_by_blocks_of_rows_gives_the_e_step_by_columns_bits() {
+        let mut rng = crate::rng::stream(12, 0);
+        for (n, d, k) in [(300, 3, 5), (2 * ROW_BLOCK, 7, 9), (3 * ROW_BLOCK + 13, 10, 17)] {
+            let x = random_matrix(&mut rng, n, d);
+            let data = FeatureMatrix::from_features(
+                &x.row_iter()
+                    .map(|r| r.iter().copied().collect())
+                    .collect::<Vec<_>>(),
+                "e-step",
+            )
+            .unwrap();
+            let config = GmmConfig {
+                max_iterations: 3,
+                ..GmmConfig::default()
+            };
+            let (model, _) = GaussianMixture::fit(&data, k, &config, &mut rng).unwrap();
+            if d > 5 && !has_avx2_fma() {
+                assert!(model.component_distances(&x).is_none());
+                continue;
+            }
+            assert!(model.component_distances(&x).is_some(), "n {n}, d {d}");
+            let mut columns = model.weighted_log_prob_columns(&x);
+            let norms = normalise_rows(&mut columns, |_, _| {});
+            let want = norms.iter().sum::<f64>() / n as f64;
+            let mut blocks = vec![vec![0.5; 7]; 2];
+            let mean = model.e_step(&x, &mut blocks);
+            assert_eq!(mean.to_bits(), want.to_bits(), "n {n}, d {d}");
+            assert_eq!(blocks.len(), k);
+            for (i, (by_block, by_column)) in blocks.iter().zip(&columns).enumerate() {
+                assert_eq!(by_block.len(), n);
+                for (r, (a, b)) in by_block.iter().zip(by_column).enumerate() {
+                    assert_eq!(a.to_bits(), b.to_bits(), "n {n}, d {d}, component {i}, row {r}");
+                }
+            }
+        }
     }
 
     /// [`whitened_distances`] against the general product on `n` random features of `d` values,

@@ -78,20 +78,62 @@ fn is_small_product(n: usize, d: usize) -> bool {
 /// triangular precision factor. `None` where the general product would sum another way.
 pub(super) fn whitened_distances(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Option<Vec<f64>> {
     let (n, d) = x.shape();
-    if d == 0 || p.shape() != (d, d) || shift.len() != d {
+    if p.nrows() != d {
         return None;
     }
-    if is_small_product(n, d) {
-        return Some(small_distances(x, p, shift));
-    }
-    if !repeats_the_general_product(n, d) {
-        return None;
-    }
-    let rows = PaddedRows::upper(p);
+    let distances = WhitenedDistances::new(n, p, shift)?;
     let mut q = vec![0.0; n];
-    // SAFETY: `repeats_the_general_product` checked that the processor has AVX2 and FMA.
-    unsafe { distances_fma(x.as_slice(), n, &rows, shift, &mut q) };
+    distances.of_rows(x.as_slice(), n, 0, &mut q);
     Some(q)
+}
+
+/// One component's [`whitened_distances`], ready for any rows of the data: the E-step takes a
+/// block of rows' distances to every component while the block is in the cache. Each row's
+/// distance is the same bits whichever rows it is computed with.
+pub(super) struct WhitenedDistances {
+    factor: Factor,
+    shift: Vec<f64>,
+}
+
+/// How [`WhitenedDistances`] repeats the general product's sums.
+enum Factor {
+    /// nalgebra's own chains ([`is_small_product`]): the factor as it is.
+    Small(DMatrix<f64>),
+    /// `matrixmultiply`'s FMA chains on the triangle.
+    Triangle(PaddedRows),
+}
+
+impl WhitenedDistances {
+    /// The distances of `n` features to the component of upper triangular precision factor `p`,
+    /// `shift = P^T mu`; `None` where the general product would sum another way (or the shapes
+    /// disagree).
+    pub(super) fn new(n: usize, p: &DMatrix<f64>, shift: &[f64]) -> Option<Self> {
+        let d = p.nrows();
+        if d == 0 || p.ncols() != d || shift.len() != d {
+            return None;
+        }
+        let factor = if is_small_product(n, d) {
+            Factor::Small(p.clone())
+        } else if repeats_the_general_product(n, d) {
+            Factor::Triangle(PaddedRows::upper(p))
+        } else {
+            return None;
+        };
+        Some(Self {
+            factor,
+            shift: shift.to_vec(),
+        })
+    }
+
+    /// `q` of rows `first..first + q.len()` of `x` (`n x d`, column-major), into `q`.
+    pub(super) fn of_rows(&self, x: &[f64], n: usize, first: usize, q: &mut [f64]) {
+        match &self.factor {
+            Factor::Small(p) => small_distances(x, n, p, &self.shift, first, q),
+            // SAFETY: a triangle is made only where `repeats_the_general_product` found AVX2 and
+            // FMA.
+            Factor::Triangle(rows) => unsafe { distances_fma(x, n, rows, &self.shift, first, q) },
+        }
+    }
 }
 
 /// The rows of an upper-triangular `d x d` matrix, row-major, each padded with zeros to a whole
@@ -119,13 +161,13 @@ impl PaddedRows {
 /// The E-step's distances, compiled with AVX2 and FMA where they exist (callers check the
 /// processor first; elsewhere nothing calls it).
 #[cfg_attr(target_arch = "x86_64", target_feature(enable = "avx2,fma"))]
-unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], q: &mut [f64]) {
-    let whole = n - n % ROWS;
+unsafe fn distances_fma(x: &[f64], n: usize, p: &PaddedRows, shift: &[f64], first: usize, q: &mut [f64]) {
+    let whole = q.len() - q.len() % ROWS;
     for (group, out) in q[..whole].chunks_exact_mut(ROWS).enumerate() {
-        out.copy_from_slice(&distances_of_rows::<ROWS>(x, n, group * ROWS, p, shift));
+        out.copy_from_slice(&distances_of_rows::<ROWS>(x, n, first + group * ROWS, p, shift));
     }
     for (r, out) in q.iter_mut().enumerate().skip(whole) {
-        *out = distances_of_rows::<1>(x, n, r, p, shift)[0];
+        *out = distances_of_rows::<1>(x, n, first + r, p, shift)[0];
     }
 }
 
@@ -187,23 +229,20 @@ pub(super) fn weighted_scatter(x_rows: &[f64], mean: &[f64], resp: &[f64]) -> Op
 
 /// [`whitened_distances`] for a small product: `(X P)_rj` as nalgebra's chain over `i` (every
 /// term, the structural zeros too), then the squares added in column order.
-fn small_distances(x: &DMatrix<f64>, p: &DMatrix<f64>, shift: &[f64]) -> Vec<f64> {
-    let (n, d) = x.shape();
-    let x = x.as_slice();
-    (0..n)
-        .map(|r| {
-            let mut q = 0.0;
-            for (column, &s) in p.as_slice().chunks_exact(d).zip(shift) {
-                let mut y = x[r] * column[0];
-                for (i, &pij) in column.iter().enumerate().skip(1) {
-                    y += x[i * n + r] * pij;
-                }
-                let t = y - s;
-                q += t * t;
+fn small_distances(x: &[f64], n: usize, p: &DMatrix<f64>, shift: &[f64], first: usize, q: &mut [f64]) {
+    let d = p.nrows();
+    for (r, q) in (first..).zip(q.iter_mut()) {
+        let mut sum = 0.0;
+        for (column, &s) in p.as_slice().chunks_exact(d).zip(shift) {
+            let mut y = x[r] * column[0];
+            for (i, &pij) in column.iter().enumerate().skip(1) {
+                y += x[i * n + r] * pij;
             }
-            q
-        })
-        .collect()
+            let t = y - s;
+            sum += t * t;
+        }
+        *q = sum;
+    }
 }
 
 /// [`weighted_scatter`] for a small product: `S_ab` as nalgebra's chain over the features of
