@@ -118,10 +118,11 @@ impl KMeans {
         let threshold = config.tolerance * mean_variance(data);
         let mut labels = vec![usize::MAX; n];
         let mut distances = vec![0.0; n];
+        let mut bounds = LowerBounds::new(data);
         let mut iterations = 0;
         while iterations < config.max_iterations {
             iterations += 1;
-            let changed = assign(data, &centers, &mut labels, &mut distances);
+            let changed = assign(data, &centers, &mut labels, &mut distances, &mut bounds).changed;
             let mut sums = vec![vec![0.0; d]; k];
             let mut counts = vec![0usize; k];
             for (x, &l) in data.iter_rows().zip(&labels) {
@@ -130,15 +131,27 @@ impl KMeans {
                     *s += v;
                 }
             }
-            reseed_empty(data, &mut labels, &mut distances, &mut sums, &mut counts);
+            reseed_empty(
+                data,
+                &mut labels,
+                &mut distances,
+                &mut sums,
+                &mut counts,
+                &mut bounds,
+            );
             let mut shift = 0.0;
+            let mut largest_move: f64 = 0.0;
             for ((center, sum), &count) in centers.iter_mut().zip(&sums).zip(&counts) {
+                let mut moved = 0.0;
                 for (c, s) in center.iter_mut().zip(sum) {
                     let new = s / count as f64;
                     shift += (new - *c) * (new - *c);
+                    moved += (new - *c) * (new - *c);
                     *c = new;
                 }
+                largest_move = largest_move.max(f64::sqrt(moved));
             }
+            bounds.centres_moved(largest_move);
             if changed == 0 || shift <= threshold {
                 break;
             }
@@ -146,7 +159,7 @@ impl KMeans {
         let model = Self { centers };
         let inertia = nearest_centres(data, &CentreBlocks::new(&model.centers))
             .into_iter()
-            .map(|(_, distance)| distance)
+            .map(|nearest| nearest.distance)
             .sum();
         Ok((model, KMeansFit { iterations, inertia }))
     }
@@ -190,7 +203,7 @@ impl KMeans {
     pub fn labels(&self, data: &FeatureMatrix) -> Vec<usize> {
         nearest_centres(data, &CentreBlocks::new(&self.centers))
             .into_iter()
-            .map(|(label, _)| label)
+            .map(|nearest| nearest.index)
             .collect()
     }
 
@@ -223,18 +236,184 @@ fn mean_variance(data: &FeatureMatrix) -> f64 {
     total / (n * d as f64)
 }
 
-/// Labels every feature with its nearest centre, in parallel (each feature independently, so the
-/// result does not depend on the thread count); returns how many labels changed.
-fn assign(data: &FeatureMatrix, centers: &[Vec<f64>], labels: &mut [usize], distances: &mut [f64]) -> usize {
-    let blocks = CentreBlocks::new(centers);
-    let nearest = nearest_centres(data, &blocks);
-    let mut changed = 0;
-    for ((label, distance), (best, best_distance)) in labels.iter_mut().zip(distances).zip(nearest) {
-        changed += usize::from(*label != best);
-        *label = best;
-        *distance = best_distance;
+/// Hamerly's lower bounds (2010, "Making k-means even faster"): per feature, at most its distance
+/// to every centre but its own. A Lloyd iteration then skips the full search for a feature whose
+/// distance to its own centre is clearly below both this bound and half the gap from its centre
+/// to the next (the triangle inequality puts every other centre farther), and only measures that
+/// one distance, which `distances` needs anyway. Skipped or not, a feature gets the label and
+/// distance of the full search, to the bit: "clearly" leaves a margin of [`BOUND_MARGIN`] of the
+/// data's extent, far above the rounding of the bounds and of the distances.
+struct LowerBounds {
+    /// Per feature; `-inf` until a full search has set it.
+    lower: Vec<f64>,
+    /// The margin of a skip: [`BOUND_MARGIN`] times the diagonal of the data's bounding box.
+    margin: f64,
+}
+
+/// The margin of a skip, relative to the data's extent: the bounds' rounding over hundreds of
+/// iterations stays below 1e-12 of it.
+const BOUND_MARGIN: f64 = 1e-9;
+
+impl LowerBounds {
+    fn new(data: &FeatureMatrix) -> Self {
+        let d = data.dim();
+        let mut low = vec![f64::INFINITY; d];
+        let mut high = vec![f64::NEG_INFINITY; d];
+        for x in data.iter_rows() {
+            for ((low, high), &v) in low.iter_mut().zip(&mut high).zip(x) {
+                *low = low.min(v);
+                *high = high.max(v);
+            }
+        }
+        let diagonal = low
+            .iter()
+            .zip(&high)
+            .map(|(l, h)| (h - l) * (h - l))
+            .sum::<f64>()
+            .sqrt();
+        Self {
+            lower: vec![f64::NEG_INFINITY; data.rows()],
+            margin: BOUND_MARGIN * diagonal,
+        }
     }
-    changed
+
+    /// After the centres moved, every distance to another centre may have shrunk by the largest
+    /// move. A move that is not a number leaves no bound.
+    fn centres_moved(&mut self, largest_move: f64) {
+        let largest_move = if largest_move.is_nan() {
+            f64::INFINITY
+        } else {
+            largest_move
+        };
+        self.lower.iter_mut().for_each(|l| *l -= largest_move);
+    }
+
+    /// Feature `i` was given another centre outside a search: nothing bounds its other distances.
+    fn forget(&mut self, i: usize) {
+        self.lower[i] = f64::NEG_INFINITY;
+    }
+}
+
+/// Half the distance from every centre to its nearest other centre (infinite for a lone centre).
+/// A feature nearer than this to its centre is nearer to it than to any other.
+fn half_gaps(centers: &[Vec<f64>]) -> Vec<f64> {
+    let mut gaps = vec![f64::INFINITY; centers.len()];
+    for (i, a) in centers.iter().enumerate() {
+        for (j, b) in centers.iter().enumerate().skip(i + 1) {
+            let gap = squared_distance(a, b).sqrt();
+            gaps[i] = gaps[i].min(gap);
+            gaps[j] = gaps[j].min(gap);
+        }
+    }
+    gaps.iter_mut().for_each(|g| *g *= 0.5);
+    gaps
+}
+
+/// Labels every feature with its nearest centre and records its squared distance, in parallel
+/// (each feature independently, so the result does not depend on the thread count), searching
+/// only where the [`LowerBounds`] leave the answer open.
+fn assign(
+    data: &FeatureMatrix,
+    centers: &[Vec<f64>],
+    labels: &mut [usize],
+    distances: &mut [f64],
+    bounds: &mut LowerBounds,
+) -> Assignment {
+    const CHUNK: usize = 512;
+    let d = data.dim();
+    let search = Search {
+        centers,
+        blocks: CentreBlocks::new(centers),
+        half_gaps: half_gaps(centers),
+        margin: bounds.margin,
+    };
+    #[cfg(target_arch = "x86_64")]
+    let wide = crate::simd::has_avx2();
+    data.as_slice()
+        .par_chunks(CHUNK * d)
+        .zip(labels.par_chunks_mut(CHUNK))
+        .zip(distances.par_chunks_mut(CHUNK))
+        .zip(bounds.lower.par_chunks_mut(CHUNK))
+        .map(|(((rows, labels), distances), lower)| {
+            #[cfg(target_arch = "x86_64")]
+            if wide {
+                // SAFETY: `wide` is set only where the processor has AVX2.
+                return unsafe { search.assign_avx2(rows, labels, distances, lower) };
+            }
+            search.assign(rows, labels, distances, lower)
+        })
+        .reduce(Assignment::default, |a, b| Assignment {
+            changed: a.changed + b.changed,
+            searched: a.searched + b.searched,
+        })
+}
+
+/// What an assignment did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Assignment {
+    /// Features whose label changed.
+    changed: usize,
+    /// Features searched over every centre (the others were settled by their bounds).
+    searched: usize,
+}
+
+/// What one Lloyd iteration's assignment reads: the centres as they are and in blocks, their half
+/// gaps, the margin of a skip.
+struct Search<'a> {
+    centers: &'a [Vec<f64>],
+    blocks: CentreBlocks,
+    half_gaps: Vec<f64>,
+    margin: f64,
+}
+
+impl Search<'_> {
+    /// [`assign`](Self::assign) compiled with AVX2: the same operations, four lanes at a time.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn assign_avx2(
+        &self,
+        rows: &[f64],
+        labels: &mut [usize],
+        distances: &mut [f64],
+        lower: &mut [f64],
+    ) -> Assignment {
+        self.assign(rows, labels, distances, lower)
+    }
+
+    /// [`assign`] for the features of `rows` (row-major).
+    #[inline(always)]
+    fn assign(
+        &self,
+        rows: &[f64],
+        labels: &mut [usize],
+        distances: &mut [f64],
+        lower: &mut [f64],
+    ) -> Assignment {
+        let d = self.blocks.dim;
+        let mut done = Assignment::default();
+        for (((x, label), distance), lower) in rows
+            .chunks_exact(d)
+            .zip(labels.iter_mut())
+            .zip(distances.iter_mut())
+            .zip(lower.iter_mut())
+        {
+            if let Some(centre) = self.centers.get(*label) {
+                let own = squared_distance(x, centre);
+                let clear = self.half_gaps[*label].max(*lower) - self.margin;
+                if own.sqrt() < clear {
+                    *distance = own;
+                    continue;
+                }
+            }
+            let nearest = nearest_of(x, &self.blocks);
+            done.changed += usize::from(*label != nearest.index);
+            done.searched += 1;
+            *label = nearest.index;
+            *distance = nearest.distance;
+            *lower = nearest.second.sqrt();
+        }
+        done
+    }
 }
 
 /// Centres per block of [`CentreBlocks`]: two lanes of four.
@@ -263,12 +442,26 @@ impl CentreBlocks {
     }
 }
 
-/// The nearest centre of every feature and its squared distance, in parallel, in feature order:
-/// [`KMeans::nearest`]'s answer (ties to the lower index) and [`squared_distance`]'s bits.
-fn nearest_centres(data: &FeatureMatrix, blocks: &CentreBlocks) -> Vec<(usize, f64)> {
+/// A feature's nearest centre (ties to the lower index), its squared distance, and the squared
+/// distance of the next nearest (infinite for a lone centre).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Nearest {
+    index: usize,
+    distance: f64,
+    second: f64,
+}
+
+/// The nearest centre of every feature, in parallel, in feature order: [`KMeans::nearest`]'s
+/// answer (ties to the lower index) and [`squared_distance`]'s bits.
+fn nearest_centres(data: &FeatureMatrix, blocks: &CentreBlocks) -> Vec<Nearest> {
     const CHUNK: usize = 512;
     let d = data.dim();
-    let mut nearest = vec![(0, f64::INFINITY); data.rows()];
+    let none = Nearest {
+        index: 0,
+        distance: f64::INFINITY,
+        second: f64::INFINITY,
+    };
+    let mut nearest = vec![none; data.rows()];
     if d == 0 || blocks.dim != d {
         return nearest;
     }
@@ -291,53 +484,65 @@ fn nearest_centres(data: &FeatureMatrix, blocks: &CentreBlocks) -> Vec<(usize, f
 /// [`nearest_of_rows`] compiled with AVX2: the same operations, four lanes at a time.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn nearest_of_rows_avx2(rows: &[f64], blocks: &CentreBlocks, out: &mut [(usize, f64)]) {
+unsafe fn nearest_of_rows_avx2(rows: &[f64], blocks: &CentreBlocks, out: &mut [Nearest]) {
     nearest_of_rows(rows, blocks, out);
 }
 
-/// The nearest centre of each feature of `rows` (row-major) into `out`. Each lane repeats
-/// [`squared_distance`] for its centre (the first square, then the others added in coordinate
-/// order, each rounded as there) and keeps its first strictly smaller distance, as the scan over
-/// the centres in order keeps it; of the lanes' bests the smallest distance wins, ties to the lower
-/// centre index, which is the scan's answer.
+/// [`nearest_of`] each feature of `rows` (row-major), into `out`.
 #[inline(always)]
-fn nearest_of_rows(rows: &[f64], blocks: &CentreBlocks, out: &mut [(usize, f64)]) {
+fn nearest_of_rows(rows: &[f64], blocks: &CentreBlocks, out: &mut [Nearest]) {
+    for (x, out) in rows.chunks_exact(blocks.dim).zip(out) {
+        *out = nearest_of(x, blocks);
+    }
+}
+
+/// The nearest centre of `x`. Each lane repeats [`squared_distance`] for its centre (the first
+/// square, then the others added in coordinate order, each rounded as there) and keeps its first
+/// strictly smaller distance, as the scan over the centres in order keeps it, and its next
+/// smallest; of the lanes' bests the smallest distance wins, ties to the lower centre index, which
+/// is the scan's answer.
+#[inline(always)]
+fn nearest_of(x: &[f64], blocks: &CentreBlocks) -> Nearest {
     let d = blocks.dim;
-    for (x, out) in rows.chunks_exact(d).zip(out) {
-        let mut best = [f64::INFINITY; BLOCK];
-        let mut index = [0usize; BLOCK];
-        for (b, block) in blocks.values.chunks_exact(d).enumerate() {
-            let mut distance = [0.0; BLOCK];
-            for (lane, &c) in distance.iter_mut().zip(&block[0]) {
-                let t = x[0] - c;
-                *lane = t * t;
-            }
-            for (&v, centres) in x.iter().zip(block).skip(1) {
-                for (lane, &c) in distance.iter_mut().zip(centres) {
-                    let t = v - c;
-                    *lane += t * t;
-                }
-            }
-            for (lane, (&candidate, (best, index))) in distance
-                .iter()
-                .zip(best.iter_mut().zip(index.iter_mut()))
-                .enumerate()
-            {
-                let nearer = candidate < *best;
-                *best = if nearer { candidate } else { *best };
-                *index = if nearer { b * BLOCK + lane } else { *index };
+    let mut best = [f64::INFINITY; BLOCK];
+    let mut second = [f64::INFINITY; BLOCK];
+    let mut index = [0usize; BLOCK];
+    for (b, block) in blocks.values.chunks_exact(d).enumerate() {
+        let mut distance = [0.0; BLOCK];
+        for (lane, &c) in distance.iter_mut().zip(&block[0]) {
+            let t = x[0] - c;
+            *lane = t * t;
+        }
+        for (&v, centres) in x.iter().zip(block).skip(1) {
+            for (lane, &c) in distance.iter_mut().zip(centres) {
+                let t = v - c;
+                *lane += t * t;
             }
         }
-        *out = best
-            .iter()
-            .zip(&index)
-            .fold((0, f64::INFINITY), |(i, nearest), (&distance, &lane_index)| {
-                if distance < nearest || (distance == nearest && lane_index < i) {
-                    (lane_index, distance)
-                } else {
-                    (i, nearest)
-                }
-            });
+        for (lane, &candidate) in distance.iter().enumerate() {
+            let nearer = candidate < best[lane];
+            second[lane] = if nearer {
+                best[lane]
+            } else if candidate < second[lane] {
+                candidate
+            } else {
+                second[lane]
+            };
+            best[lane] = if nearer { candidate } else { best[lane] };
+            index[lane] = if nearer { b * BLOCK + lane } else { index[lane] };
+        }
+    }
+    let mut winner = 0;
+    for lane in 1..BLOCK {
+        if best[lane] < best[winner] || (best[lane] == best[winner] && index[lane] < index[winner]) {
+            winner = lane;
+        }
+    }
+    let others = (0..BLOCK).filter(|&lane| lane != winner).map(|lane| best[lane]);
+    Nearest {
+        index: index[winner],
+        distance: best[winner],
+        second: others.fold(second[winner], f64::min),
     }
 }
 
@@ -349,6 +554,7 @@ fn reseed_empty(
     distances: &mut [f64],
     sums: &mut [Vec<f64>],
     counts: &mut [usize],
+    bounds: &mut LowerBounds,
 ) {
     for empty in 0..counts.len() {
         if counts[empty] > 0 {
@@ -370,6 +576,7 @@ fn reseed_empty(
         counts[empty] = 1;
         labels[i] = empty;
         distances[i] = 0.0;
+        bounds.forget(i);
     }
 }
 
@@ -427,16 +634,24 @@ mod tests {
                 })
                 .collect();
             let blocks = CentreBlocks::new(model.centers());
-            let bits = |found: Vec<(usize, f64)>| -> Vec<(usize, u64)> {
-                found.into_iter().map(|(i, d)| (i, d.to_bits())).collect()
+            let bits = |found: Vec<Nearest>| -> Vec<(usize, u64)> {
+                found
+                    .into_iter()
+                    .map(|n| (n.index, n.distance.to_bits()))
+                    .collect()
             };
-            let mut baseline = vec![(0, 0.0); features.len()];
+            let none = Nearest {
+                index: 0,
+                distance: 0.0,
+                second: 0.0,
+            };
+            let mut baseline = vec![none; features.len()];
             nearest_of_rows(data.as_slice(), &blocks, &mut baseline);
             assert_eq!(bits(baseline), want, "baseline, dim {dim}, k {k}");
             assert_eq!(bits(nearest_centres(&data, &blocks)), want, "dim {dim}, k {k}");
             #[cfg(target_arch = "x86_64")]
             if crate::simd::has_avx2() {
-                let mut wide = vec![(0, 0.0); features.len()];
+                let mut wide = vec![none; features.len()];
                 // SAFETY: the processor has AVX2.
                 unsafe { nearest_of_rows_avx2(data.as_slice(), &blocks, &mut wide) };
                 assert_eq!(bits(wide), want, "AVX2, dim {dim}, k {k}");
@@ -445,6 +660,69 @@ mod tests {
                 model.labels(&data),
                 want.iter().map(|&(i, _)| i).collect::<Vec<_>>()
             );
+        }
+    }
+
+    /// The assignment with Hamerly's bounds against the full search, bit for bit, over centres
+    /// that move by steps from a thousandth to a third of the data's extent (so the bounds settle
+    /// most features on small steps and must give way on large ones), a lone centre, and centres
+    /// repeated (ties); the second nearest distance too.
+    #[test]
+    fn the_bounded_assignment_gives_the_full_searchs_labels_and_distances() {
+        let mut rng = stream(9, 0);
+        for (dim, k) in [(3, 20), (10, 64), (2, 1), (4, 9)] {
+            let features: Vec<Vec<f64>> = (0..1500)
+                .map(|i| {
+                    let blob = (i % 7) as f64;
+                    (0..dim)
+                        .map(|a| blob * (a as f64 + 1.0) + rng.random_range(-1.0..1.0))
+                        .collect()
+                })
+                .collect();
+            let data = FeatureMatrix::from_features(&features, "bounded").unwrap();
+            let mut centers: Vec<Vec<f64>> = (0..k).map(|i| features[i * 97 % 1500].clone()).collect();
+            if k > 3 {
+                centers[3] = centers[1].clone();
+            }
+            let mut labels = vec![usize::MAX; features.len()];
+            let mut distances = vec![0.0; features.len()];
+            let mut bounds = LowerBounds::new(&data);
+            let mut skipped = 0;
+            for step in 0..24 {
+                let done = assign(&data, &centers, &mut labels, &mut distances, &mut bounds);
+                skipped += features.len() - done.searched;
+                let model = KMeans::from_centers(centers.clone()).unwrap();
+                for (i, x) in features.iter().enumerate() {
+                    let want = model.nearest(x);
+                    assert_eq!(labels[i], want, "dim {dim}, k {k}, step {step}, feature {i}");
+                    let distance = squared_distance(x, &centers[want]);
+                    assert_eq!(
+                        distances[i].to_bits(),
+                        distance.to_bits(),
+                        "step {step}, feature {i}"
+                    );
+                    let second = centers
+                        .iter()
+                        .enumerate()
+                        .filter(|&(j, _)| j != want)
+                        .map(|(_, c)| squared_distance(x, c))
+                        .fold(f64::INFINITY, f64::min);
+                    assert_eq!(nearest_of(x, &CentreBlocks::new(&centers)).second, second);
+                }
+                let step_size = [1e-3, 0.02, 0.3][step % 3] * 8.0 * dim as f64;
+                let mut largest_move: f64 = 0.0;
+                for centre in &mut centers {
+                    let mut moved = 0.0;
+                    for c in centre.iter_mut() {
+                        let new = *c + rng.random_range(-step_size..step_size);
+                        moved += (new - *c) * (new - *c);
+                        *c = new;
+                    }
+                    largest_move = largest_move.max(f64::sqrt(moved));
+                }
+                bounds.centres_moved(largest_move);
+            }
+            assert!(skipped > 0, "dim {dim}, k {k}: the bounds settled no feature");
         }
     }
 
