@@ -335,12 +335,18 @@ fn assign(
         .zip(distances.par_chunks_mut(CHUNK))
         .zip(bounds.lower.par_chunks_mut(CHUNK))
         .map(|(((rows, labels), distances), lower)| {
+            let features = Features {
+                rows,
+                labels,
+                distances,
+                lower,
+            };
             #[cfg(target_arch = "x86_64")]
             if wide {
                 // SAFETY: `wide` is set only where the processor has AVX2.
-                return unsafe { search.assign_avx2(rows, labels, distances, lower) };
+                return unsafe { search.assign_avx2(features) };
             }
-            search.assign(rows, labels, distances, lower)
+            search.assign(features)
         })
         .reduce(Assignment::default, |a, b| Assignment {
             changed: a.changed + b.changed,
@@ -366,29 +372,31 @@ struct Search<'a> {
     margin: f64,
 }
 
+/// A run of features (`rows`, row-major) with their labels, distances and lower bounds.
+struct Features<'a> {
+    rows: &'a [f64],
+    labels: &'a mut [usize],
+    distances: &'a mut [f64],
+    lower: &'a mut [f64],
+}
+
 impl Search<'_> {
     /// [`assign`](Self::assign) compiled with AVX2: the same operations, four lanes at a time.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn assign_avx2(
-        &self,
-        rows: &[f64],
-        labels: &mut [usize],
-        distances: &mut [f64],
-        lower: &mut [f64],
-    ) -> Assignment {
-        self.assign(rows, labels, distances, lower)
+    unsafe fn assign_avx2(&self, features: Features) -> Assignment {
+        self.assign(features)
     }
 
-    /// [`assign`] for the features of `rows` (row-major).
+    /// [`assign`] for a run of features.
     #[inline(always)]
-    fn assign(
-        &self,
-        rows: &[f64],
-        labels: &mut [usize],
-        distances: &mut [f64],
-        lower: &mut [f64],
-    ) -> Assignment {
+    fn assign(&self, features: Features) -> Assignment {
+        let Features {
+            rows,
+            labels,
+            distances,
+            lower,
+        } = features;
         let d = self.blocks.dim;
         let mut done = Assignment::default();
         for (((x, label), distance), lower) in rows
