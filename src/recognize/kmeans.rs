@@ -149,7 +149,12 @@ impl KMeans {
                     moved += (new - *c) * (new - *c);
                     *c = new;
                 }
-                largest_move = largest_move.max(f64::sqrt(moved));
+                // `max` would pass over a move that is not a number; it bounds nothing.
+                largest_move = if moved.is_nan() {
+                    f64::INFINITY
+                } else {
+                    largest_move.max(f64::sqrt(moved))
+                };
             }
             bounds.centres_moved(largest_move);
             if changed == 0 || shift <= threshold {
@@ -278,13 +283,8 @@ impl LowerBounds {
     }
 
     /// After the centres moved, every distance to another centre may have shrunk by the largest
-    /// move. A move that is not a number leaves no bound.
+    /// move (infinite when a move is not a number: then nothing is bounded).
     fn centres_moved(&mut self, largest_move: f64) {
-        let largest_move = if largest_move.is_nan() {
-            f64::INFINITY
-        } else {
-            largest_move
-        };
         self.lower.iter_mut().for_each(|l| *l -= largest_move);
     }
 
