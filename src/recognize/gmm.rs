@@ -283,19 +283,27 @@ impl GaussianMixture {
     /// with `P_i^T (x - mu_i)` computed for all rows at once as `X P_i - mu_i^T P_i` (one
     /// triangular product per component, `gmm_products`).
     fn weighted_log_prob_columns(&self, x: &DMatrix<f64>) -> Vec<Vec<f64>> {
-        let d = x.ncols();
-        let constant = -0.5 * d as f64 * LN_2PI;
         (0..self.k())
             .into_par_iter()
             .map(|i| {
                 let p = &self.precision_chol[i];
-                let mu_p = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
-                let q = whitened_distances(x, p, mu_p.as_slice())
-                    .unwrap_or_else(|| whitened_distances_general(x, p, mu_p.as_slice()));
-                let offset = constant + self.log_det_precision[i] + self.log_weights[i];
-                q.iter().map(|q| offset - 0.5 * q).collect()
+                let (shift, offset) = self.whitening(i, x.ncols());
+                let mut q = whitened_distances(x, p, shift.as_slice())
+                    .unwrap_or_else(|| whitened_distances_general(x, p, shift.as_slice()));
+                log_densities_in_place(offset, &mut q);
+                q
             })
             .collect()
+    }
+
+    /// Component `i`'s shift `P_i^T mu_i` of its whitened distances `q` to features of `d` values,
+    /// and the offset `-d/2 ln 2 pi + ln det P_i + ln pi_i` of its weighted log-density
+    /// `offset - q / 2`.
+    fn whitening(&self, i: usize, d: usize) -> (DVector<f64>, f64) {
+        let p = &self.precision_chol[i];
+        let shift = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
+        let constant = -0.5 * d as f64 * LN_2PI;
+        (shift, constant + self.log_det_precision[i] + self.log_weights[i])
     }
 
     /// The E-step: the mean log-likelihood, and the responsibilities into `columns` (`k` columns
@@ -311,9 +319,9 @@ impl GaussianMixture {
                 columns.iter_mut().for_each(|column| column.resize(n, 0.0));
                 let x = x.as_slice();
                 normalise_rows(columns, |first, block| {
-                    for ((distances, offset), rows) in components.iter().zip(block) {
+                    for (&(ref distances, offset), rows) in components.iter().zip(block) {
                         distances.of_rows(x, n, first, rows);
-                        rows.iter_mut().for_each(|q| *q = offset - 0.5 * *q);
+                        log_densities_in_place(offset, rows);
                     }
                 })
             }
@@ -328,17 +336,20 @@ impl GaussianMixture {
     /// Every component's [`WhitenedDistances`] to the rows of `x` and its offset `-d/2 ln 2 pi +
     /// ln det P_i + ln pi_i`; `None` where a distance needs the general product.
     fn component_distances(&self, x: &DMatrix<f64>) -> Option<Vec<(WhitenedDistances, f64)>> {
-        let (n, d) = x.shape();
-        let constant = -0.5 * d as f64 * LN_2PI;
         (0..self.k())
             .map(|i| {
-                let p = &self.precision_chol[i];
-                let mu_p = p.tr_mul(&DVector::from_column_slice(&self.params.means[i]));
-                let offset = constant + self.log_det_precision[i] + self.log_weights[i];
-                Some((WhitenedDistances::new(n, p, mu_p.as_slice())?, offset))
+                let (shift, offset) = self.whitening(i, x.ncols());
+                let distances = WhitenedDistances::new(x.nrows(), &self.precision_chol[i], shift.as_slice())?;
+                Some((distances, offset))
             })
             .collect()
     }
+}
+
+/// A component's whitened distances `q` replaced by its weighted log-densities `offset - q / 2`
+/// ([`GaussianMixture::whitening`]).
+fn log_densities_in_place(offset: f64, q: &mut [f64]) {
+    q.iter_mut().for_each(|q| *q = offset - 0.5 * *q);
 }
 
 /// `|P^T x_r - shift|^2` of every row of `x` as one general product `X P`: the sums that
