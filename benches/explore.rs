@@ -14,6 +14,10 @@
 //!   each, one thread, the workspace fitted to the set as `taction collect` does; the summary
 //!   reports converged readings per second per core and the fraction of attempts that converge,
 //!   per object and over the set;
+//! - `planner/shapes_screened` and `planner/shapes_unscreened`: the planner over every object of
+//!   the set in scenes compiled once, kinematic motions clearing their samples with the contact
+//!   screen (the default, `sim/contact_screen.rs`) and with `mj_collision` at every sample (the
+//!   baseline); the summary reports the ratio, the same readings checked to be made;
 //! - `active/score_12_candidates`: the active strategy's extra work per planner iteration, the
 //!   expected-information-gain scores of 12 candidate targets (`active_touch`) for a model of
 //!   12 objects and 50 clusters after 30 readings; the summary reports it per iteration against a
@@ -102,17 +106,29 @@ fn sampler_run(free: &mut FreePad, seed: u64) -> ExplorationReport {
 }
 
 fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u64) -> ExplorationReport {
-    let home = scene.arm().expect("arm").q(scene.data());
-    let arm = scene.arm().expect("arm").clone();
-    arm.teleport(scene, &home);
-    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).expect("sensor"));
     let config = PlannerConfig {
         execution,
         ..PlannerConfig::default()
     };
+    explore_in(scene, config, "pawn", readings, seed)
+}
+
+/// `readings` converged readings of the planner configured by `config` on the object `name` of
+/// `scene`, from the arm's home configuration and back to it.
+fn explore_in(
+    scene: &mut Scene,
+    config: PlannerConfig,
+    name: &str,
+    readings: usize,
+    seed: u64,
+) -> ExplorationReport {
+    let home = scene.arm().expect("arm").q(scene.data());
+    let arm = scene.arm().expect("arm").clone();
+    arm.teleport(scene, &home);
+    let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE).expect("sensor"));
     let mut planner = Planner::new(
         scene,
-        Valid::new(config).expect("the default planner config is valid"),
+        Valid::new(config).expect("a valid planner config"),
         taction::explore::TouchSetup {
             sensor: sensor(),
             control: Valid::default(),
@@ -122,7 +138,7 @@ fn planner_run(scene: &mut Scene, execution: Execution, readings: usize, seed: u
         reader,
     )
     .expect("planner");
-    let report = planner.explore(scene, "pawn", readings).expect("planner run");
+    let report = planner.explore(scene, name, readings).expect("planner run");
     arm.teleport(scene, &home);
     report
 }
@@ -197,6 +213,31 @@ fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
     plan.collect(objects, 1).expect("planner runs")
 }
 
+/// The shapes' arm scenes, compiled once, with the contact screen or without it.
+fn shapes_scenes(objects: &[ObjectSpec], screened: bool) -> Vec<Scene> {
+    objects
+        .iter()
+        .map(|object| {
+            let scene = arm_scene(object);
+            if screened {
+                scene
+            } else {
+                scene.without_contact_screen()
+            }
+        })
+        .collect()
+}
+
+/// `SHAPES_READINGS` converged planner readings of every object in its scene of `scenes`.
+fn scenes_run(objects: &[ObjectSpec], scenes: &mut [Scene], seed: u64) -> Vec<ExplorationReport> {
+    let config = PlannerConfig::default().fitted_to(objects);
+    objects
+        .iter()
+        .zip(scenes.iter_mut())
+        .map(|(object, scene)| explore_in(scene, config, &object.name, SHAPES_READINGS, seed))
+        .collect()
+}
+
 fn benches(c: &mut Criterion) {
     let object = pawn();
     let pose = touching_pose();
@@ -241,6 +282,19 @@ fn benches(c: &mut Criterion) {
             shapes_run(&objects, seed)
         })
     });
+    for (name, screened) in [
+        ("planner/shapes_screened", true),
+        ("planner/shapes_unscreened", false),
+    ] {
+        let mut scenes = shapes_scenes(&objects, screened);
+        let mut seed = 500;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                seed += 1;
+                scenes_run(&objects, &mut scenes, seed)
+            })
+        });
+    }
     group.finish();
 }
 
@@ -336,6 +390,22 @@ fn summary() {
     for (object, (c, a)) in objects.iter().zip(&per_object) {
         println!("    {:12} {c:3}/{a:3} converged", object.name);
     }
+    // The contact screen against `mj_collision` at every sample, alternating, the same readings.
+    let (mut screened, mut unscreened) = (shapes_scenes(&objects, true), shapes_scenes(&objects, false));
+    let (mut with_s, mut without_s) = (0.0, 0.0);
+    for seed in 0..3 {
+        let start = Instant::now();
+        let reports = scenes_run(&objects, &mut unscreened, 4000 + seed);
+        without_s += start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let same = scenes_run(&objects, &mut screened, 4000 + seed) == reports;
+        with_s += start.elapsed().as_secs_f64();
+        assert!(same, "the contact screen changed a planner run");
+    }
+    println!(
+        "  planner, shapes set, contact screen {with_s:.2} s against mj_collision at every sample {without_s:.2} s: {:.2}x faster, the same readings",
+        without_s / with_s
+    );
 }
 
 criterion_group!(explore, benches);

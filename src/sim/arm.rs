@@ -13,7 +13,9 @@
 //! - [`Execution::Kinematic`]: the segment is sampled (at most `max_step_rad` per joint and
 //!   `max_pad_step_m` of pad travel between samples, the observer may ask for finer samples near a
 //!   surface) and each sample is checked with MuJoCo's own kinematics and collision detection, as
-//!   sampling-based motion planners check edges; the arm is then placed at rest at the end. This is
+//!   sampling-based motion planners check edges (a sample whose every arm geom is clear of
+//!   everything by more than 0.1 mm is cleared without the collision detection, with the same
+//!   outcome: `contact_screen.rs`); the arm is then placed at rest at the end. This is
 //!   what the servo execution converges to: the arm is gravity-compensated, position-controlled and
 //!   the soft covering exerts no force in MuJoCo (the sensor plugin measures it), so at rest the
 //!   servos hold exactly the commanded configuration and, short of a rigid contact, which stops both
@@ -28,6 +30,7 @@ use serde::{Deserialize, Serialize};
 use crate::bodies::{ARM_BASE, OBJECT_BODY, PAD_BODY};
 use crate::pose::{PadPose, Pose};
 use crate::sim::SimError;
+use crate::sim::contact_screen::Screened;
 use crate::sim::mjcf::COLLISION_GROUP;
 use crate::sim::scene::Scene;
 
@@ -370,9 +373,9 @@ impl Arm {
     /// with anything, or when `observer` returns `true`. Servo execution drives the position servos
     /// in small interpolated steps while MuJoCo steps, the observer running after every control
     /// interval; kinematic execution runs it after every checked sample (see
-    /// [`move_kinematic`](Self::move_kinematic)). Either way the observer sees current kinematics and
-    /// contacts but stale `sensordata`: to read a sensor it runs `mj_forward` (or
-    /// [`Scene::compute_sensors`]) first.
+    /// [`move_kinematic`](Self::move_kinematic)). Either way the observer sees current kinematics but
+    /// stale `sensordata` (and, in a kinematic motion, contacts that may be stale): to read a sensor
+    /// it runs `mj_forward` (or [`Scene::compute_sensors`]) first.
     pub fn move_to<F>(
         &self,
         scene: &mut Scene,
@@ -473,9 +476,9 @@ impl Arm {
     /// The kinematic execution of a straight joint-space motion from the current configuration to
     /// `target`: samples no farther apart than `max_step_rad` on any joint and `max_pad_step_m` (or
     /// the observer's last, smaller request) of pad travel, each checked by MuJoCo's kinematics and
-    /// collision detection. At a collision the arm is placed at rest at the last collision-free
+    /// collision detection (a sample far from any contact cleared first, `sim/contact_screen.rs`). At a collision the arm is placed at rest at the last collision-free
     /// sample and the collision returned, as when the observer says [`Watch::Blocked`]; when it says
-    /// [`Watch::Stop`] (it sees the sample's kinematics and contacts) the arm is placed at rest at
+    /// [`Watch::Stop`] (it sees the sample's kinematics) the arm is placed at rest at
     /// that sample; otherwise at `target`.
     pub fn move_kinematic<F>(
         &self,
@@ -506,13 +509,13 @@ impl Arm {
         };
         while sample.s < 1.0 {
             self.next_sample(scene, &path, &mut sample, limit_m);
-            scene.data_mut().collision();
+            let contact = self.sample_contact(scene);
             scene.check_state()?;
-            if let Some(c) = self.collision(scene) {
+            if let Some(c) = contact {
                 self.place(scene, &last_free);
                 return Ok(MoveOutcome::Collided(c));
             }
-            // The observer may have computed sensors; kinematics and contacts stay those of `q`.
+            // The observer may have computed sensors; the kinematics stay those of `q`.
             match observer(scene)? {
                 Watch::Stop => {
                     self.rest_at(scene, &sample.q);
@@ -531,6 +534,19 @@ impl Arm {
         // The last sample was `target` itself: its kinematics and contacts are current.
         self.rest_at(scene, &target);
         Ok(MoveOutcome::Reached)
+    }
+
+    /// The first contact of the arm at the current kinematics, as [`collision`](Self::collision)
+    /// finds it after `mj_collision`. A sample the scene's contact screen
+    /// ([`Scene::screen_contacts`]) clears has none, and MuJoCo's contacts are then left as they
+    /// were (stale: nothing of a kinematic motion reads them but this, and the next `mj_forward` or
+    /// `mj_step` recomputes them).
+    fn sample_contact(&self, scene: &mut Scene) -> Option<Collision> {
+        if scene.screen_contacts() == Screened::Clear {
+            return None;
+        }
+        scene.data_mut().collision();
+        self.collision(scene)
     }
 
     /// Advances `sample` along `path` by at most `max_step_rad` on any joint and at most

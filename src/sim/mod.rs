@@ -3,6 +3,7 @@
 
 pub(crate) mod arm;
 pub(crate) mod collision_shell;
+pub(crate) mod contact_screen;
 pub(crate) mod ik;
 pub(crate) mod mjcf;
 pub(crate) mod object;
@@ -20,6 +21,9 @@ pub use arm::{
 };
 pub use ik::{IkError, IkOptions, InverseKinematics, PadTarget};
 pub use twin::ArmTwin;
+
+// Kinematic motions' samples cleared of contacts without MuJoCo's collision detection.
+pub use contact_screen::{CLEARANCE_M, Screened};
 
 // The object perturbed between readings (Sec. V-B4).
 pub use perturb::{Perturbation, PerturbationBounds};

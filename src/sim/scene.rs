@@ -10,6 +10,7 @@ use crate::mesh::TriMesh;
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::arm::Arm;
+use crate::sim::contact_screen::{ContactScreen, Screened};
 use crate::sim::mjcf::{ARM_XML, Document, Section, TABLE_XML, as_read_f32, sensed_surface_names};
 use crate::sim::object::{MeshAsset, OBJECT_MESH, ObjectMount, ObjectSpec, ObjectSurfaces};
 use crate::sim::twin::ArmTwin;
@@ -341,6 +342,9 @@ pub struct Scene {
     /// The arm compiled alone, where it is bit for bit the scene's: the pad's pose at a
     /// configuration without placing the rest of the world.
     twin: Option<ArmTwin>,
+    /// Clears the samples of the arm's kinematic motions that are far from any contact without
+    /// `mj_collision`; `None` without an arm, for contacts it does not model, or when switched off.
+    contact_screen: Option<ContactScreen>,
 }
 
 impl Scene {
@@ -369,12 +373,16 @@ impl Scene {
         let twin = arm
             .as_ref()
             .and_then(|arm| ArmTwin::of(arm_alone()?, &model, arm));
+        let contact_screen = arm
+            .as_ref()
+            .and_then(|arm| ContactScreen::new(&model, |b| arm.owns_body(&model, b)));
         let mut scene = Self {
             model,
             data,
             object,
             arm,
             twin,
+            contact_screen,
         };
         scene.data.forward();
         Ok(scene)
@@ -557,6 +565,22 @@ impl Scene {
     pub fn kinematics_and_collision(&mut self) {
         self.data.kinematics();
         self.data.collision();
+    }
+
+    /// Whether the current kinematics leave the arm clear of any contact without MuJoCo's collision
+    /// detection (`sim/contact_screen.rs`); [`Screened::Undecided`] when the scene has no screen.
+    pub fn screen_contacts(&mut self) -> Screened {
+        match self.contact_screen.as_mut() {
+            Some(screen) => screen.screen(&self.model, &mut self.data),
+            None => Screened::Undecided,
+        }
+    }
+
+    /// Switches the contact screen off: every sample of a kinematic motion then goes through
+    /// `mj_collision` (the reference the screen is tested and measured against).
+    pub fn without_contact_screen(mut self) -> Self {
+        self.contact_screen = None;
+        self
     }
 
     /// Kinematics and the position-stage sensors for the current `qpos` (and mocap poses): all that
