@@ -11,7 +11,7 @@ use taction::mesh::ObjectSet;
 use taction::pose::Pose;
 use taction::sim::{
     IkOptions, InverseKinematics, ObjectSpec, PAD_SITE, PadTarget, PerturbationBounds, Scene, SceneBuilder,
-    Screened,
+    Screened, Section,
 };
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
@@ -156,4 +156,21 @@ fn an_exploration_is_the_same_with_the_screen_as_without_it() {
             );
         }
     }
+}
+
+/// A world whose contacts the screen does not model (here a predefined `<pair>`, which MuJoCo
+/// collides whatever the contact bits say) gets no screen: every sample goes to `mj_collision`,
+/// where the same world without the pair clears the arm at home, far from everything.
+#[test]
+fn a_world_with_contacts_the_screen_does_not_model_is_not_screened() {
+    let object = objects().remove(0);
+    let mut plain = scene_of(&object);
+    assert_eq!(plain.screen_contacts(), Screened::Clear);
+    let builder = SceneBuilder::with_arm_and_table()
+        .object(object.clone())
+        .add(Section::Contact, r#"<pair geom1="link4" geom2="table"/>"#);
+    let mut paired = add_sensor(builder, &Valid::new(sensor()).unwrap(), "covering", PAD_SITE)
+        .build()
+        .unwrap();
+    assert_eq!(paired.screen_contacts(), Screened::Undecided);
 }

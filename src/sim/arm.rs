@@ -375,7 +375,8 @@ impl Arm {
     /// interval; kinematic execution runs it after every checked sample (see
     /// [`move_kinematic`](Self::move_kinematic)). Either way the observer sees current kinematics but
     /// stale `sensordata` (and, in a kinematic motion, contacts that may be stale): to read a sensor
-    /// it runs `mj_forward` (or [`Scene::compute_sensors`]) first.
+    /// it runs `mj_forward` (or [`Scene::compute_sensors`]) first. When the motion ends, kinematics
+    /// and contacts are those of where the arm stopped.
     pub fn move_to<F>(
         &self,
         scene: &mut Scene,
@@ -507,9 +508,12 @@ impl Arm {
             q: start.clone(),
             pad: self.site_pose(scene.data()),
         };
+        // Whether the last sample was cleared by the contact screen, its MuJoCo contacts not computed.
+        let mut cleared = false;
         while sample.s < 1.0 {
             self.next_sample(scene, &path, &mut sample, limit_m);
-            let contact = self.sample_contact(scene);
+            let contact;
+            (contact, cleared) = self.sample_contact(scene);
             scene.check_state()?;
             if let Some(c) = contact {
                 self.place(scene, &last_free);
@@ -519,6 +523,9 @@ impl Arm {
             match observer(scene)? {
                 Watch::Stop => {
                     self.rest_at(scene, &sample.q);
+                    if cleared {
+                        scene.data_mut().collision();
+                    }
                     return Ok(MoveOutcome::Stopped);
                 }
                 Watch::Blocked(c) => {
@@ -531,22 +538,25 @@ impl Arm {
             }
             last_free.copy_from_slice(&sample.q);
         }
-        // The last sample was `target` itself: its kinematics and contacts are current.
+        // The last sample was `target` itself: its kinematics are current, and so are its contacts
+        // once computed where the screen cleared it.
         self.rest_at(scene, &target);
+        if cleared {
+            scene.data_mut().collision();
+        }
         Ok(MoveOutcome::Reached)
     }
 
     /// The first contact of the arm at the current kinematics, as [`collision`](Self::collision)
-    /// finds it after `mj_collision`. A sample the scene's contact screen
-    /// ([`Scene::screen_contacts`]) clears has none, and MuJoCo's contacts are then left as they
-    /// were (stale: nothing of a kinematic motion reads them but this, and the next `mj_forward` or
-    /// `mj_step` recomputes them).
-    fn sample_contact(&self, scene: &mut Scene) -> Option<Collision> {
+    /// finds it after `mj_collision`, and whether the scene's contact screen
+    /// ([`Scene::screen_contacts`]) cleared the sample: it then has none, and MuJoCo's contacts are
+    /// left as they were (stale, until the motion computes them at the sample it ends on).
+    fn sample_contact(&self, scene: &mut Scene) -> (Option<Collision>, bool) {
         if scene.screen_contacts() == Screened::Clear {
-            return None;
+            return (None, true);
         }
         scene.data_mut().collision();
-        self.collision(scene)
+        (self.collision(scene), false)
     }
 
     /// Advances `sample` along `path` by at most `max_step_rad` on any joint and at most

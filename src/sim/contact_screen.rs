@@ -34,7 +34,10 @@
 //! The pairs screened are those MuJoCo's filters let through (`engine_collision_driver.c`): geoms of
 //! different bodies whose contact bits match, bodies not welded together, not both without degrees of
 //! freedom, not parent and child (unless the model disables that filter), not excluded. A model
-//! with predefined `<pair>`s, a contact filter override or sleeping bodies is not screened.
+//! with predefined `<pair>`s, flexes, a margin override, sleeping bodies, libccd in place of
+//! MuJoCo's native convex collision, or a `ccd_tolerance` above the default is not screened; nor is
+//! a process that installs a global contact filter (`mjcb_contactfilter`, which replaces the
+//! contact bits; taction never does).
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::prelude::*;
@@ -43,6 +46,10 @@ use mujoco_rs::wrappers::mj_model::traits::ModelType;
 /// How far apart a geom of the arm must be from everything it may touch for a sample to be cleared
 /// without `mj_collision`, metres.
 pub const CLEARANCE_M: f64 = 1e-4;
+
+/// The largest `ccd_tolerance` the screen trusts `mj_geomDistance` at (MuJoCo's default): its
+/// convex distances are within about that of the true ones, far below [`CLEARANCE_M`].
+const MAX_CCD_TOLERANCE: f64 = 1e-6;
 
 /// Rounding allowance of the screen's own bounds (sums and products of numbers under a metre),
 /// metres.
@@ -259,14 +266,18 @@ impl Region {
 
 impl ContactScreen {
     /// The screen of the arm whose bodies `owns_body` names, or `None` when the model's contacts
-    /// are not MuJoCo's default filtering (predefined pairs, a margin override, sleeping bodies),
-    /// which the screen does not model.
+    /// are not what the screen models (see the module documentation).
     pub fn new(model: &MjModel, owns_body: impl Fn(usize) -> bool) -> Option<Self> {
         let opt = model.opt();
         let enabled = |bit: MjtEnableBit| opt.enableflags & bit as i32 != 0;
+        let disabled = |bit: MjtDisableBit| opt.disableflags & bit as i32 != 0;
         if model.ffi().npair > 0
+            || model.ffi().nflex > 0
             || enabled(MjtEnableBit::mjENBL_OVERRIDE)
             || enabled(MjtEnableBit::mjENBL_SLEEP)
+            || disabled(MjtDisableBit::mjDSBL_NATIVECCD)
+            || opt.ccd_tolerance.is_nan()
+            || opt.ccd_tolerance > MAX_CCD_TOLERANCE
         {
             return None;
         }
@@ -293,11 +304,12 @@ impl ContactScreen {
                 ArmGeom { geom: a, neighbours }
             })
             .collect();
-        let margin_m = model
-            .geom_margin()
-            .iter()
-            .zip(model.geom_gap())
-            .fold(0.0_f64, |m, (margin, gap)| m.max(margin + gap));
+        let margin_m = 2.0
+            * model
+                .geom_margin()
+                .iter()
+                .zip(model.geom_gap())
+                .fold(0.0_f64, |m, (margin, gap)| m.max(margin + gap));
         Some(Self {
             settled: vec![None; arm_geoms.len()],
             arm_geoms,
@@ -529,10 +541,11 @@ fn travel_m(center: DVec3, xmat: &[f64; 9], a: &Bound, now_xmat: &[f64; 9]) -> f
     }
 }
 
-/// MuJoCo's margin plus gap of a geom pair (the larger of each): contacts are made below it.
+/// MuJoCo's margin plus gap of a geom pair (each the sum of the two geoms', as MuJoCo has summed them
+/// since 3.5): contacts are made below it, the gap's among them.
 fn pair_margin(model: &MjModel, a: usize, g: usize) -> f64 {
     let (margin, gap) = (model.geom_margin(), model.geom_gap());
-    margin[a].max(margin[g]) + gap[a].max(gap[g])
+    margin[a] + margin[g] + gap[a] + gap[g]
 }
 
 /// A geom's bounding sphere and oriented box (MuJoCo's `geom_rbound` and `geom_aabb`) in the world.
