@@ -158,9 +158,10 @@ fn an_exploration_is_the_same_with_the_screen_as_without_it() {
     }
 }
 
-/// A world whose contacts the screen does not model (here a predefined `<pair>`, which MuJoCo
-/// collides whatever the contact bits say) gets no screen: every sample goes to `mj_collision`,
-/// where the same world without the pair clears the arm at home, far from everything.
+/// A world whose contacts the screen does not model (a predefined `<pair>`, which MuJoCo collides
+/// whatever the contact bits say; a plane the arm may touch, which has no bounds) gets no screen:
+/// every sample goes to `mj_collision`, where the same world without them clears the arm at home,
+/// far from everything.
 #[test]
 fn a_world_with_contacts_the_screen_does_not_model_is_not_screened() {
     let object = objects().remove(0);
@@ -173,4 +174,14 @@ fn a_world_with_contacts_the_screen_does_not_model_is_not_screened() {
         .build()
         .unwrap();
     assert_eq!(paired.screen_contacts(), Screened::Undecided);
+    // A floor plane under the table: a shape without a bounding sphere, which the arm's links may
+    // touch.
+    let builder = SceneBuilder::with_arm_and_table().object(object.clone()).add(
+        Section::Worldbody,
+        r#"<geom name="floor" type="plane" size="2 2 0.1" pos="0 0 -0.5"/>"#,
+    );
+    let mut floored = add_sensor(builder, &Valid::new(sensor()).unwrap(), "covering", PAD_SITE)
+        .build()
+        .unwrap();
+    assert_eq!(floored.screen_contacts(), Screened::Undecided);
 }

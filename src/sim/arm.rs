@@ -477,8 +477,9 @@ impl Arm {
     /// The kinematic execution of a straight joint-space motion from the current configuration to
     /// `target`: samples no farther apart than `max_step_rad` on any joint and `max_pad_step_m` (or
     /// the observer's last, smaller request) of pad travel, each checked by MuJoCo's kinematics and
-    /// collision detection (a sample far from any contact cleared first, `sim/contact_screen.rs`). At a collision the arm is placed at rest at the last collision-free
-    /// sample and the collision returned, as when the observer says [`Watch::Blocked`]; when it says
+    /// collision detection (a sample far from any contact cleared first, `sim/contact_screen.rs`).
+    /// At a collision the arm is placed at rest at the last collision-free sample and the collision
+    /// returned, as when the observer says [`Watch::Blocked`]; when it says
     /// [`Watch::Stop`] (it sees the sample's kinematics) the arm is placed at rest at
     /// that sample; otherwise at `target`.
     pub fn move_kinematic<F>(

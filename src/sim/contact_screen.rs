@@ -15,10 +15,9 @@
 //! only a pair whose boxes come within the clearance is measured exactly, with MuJoCo's own
 //! `mj_geomDistance` (the same convex hulls and primitives its narrow phase collides). A sample
 //! whose every pair is clear cannot have a contact of the arm: it is cleared. Any pair nearer than
-//! the clearance, or of a shape the screen does not bound, leaves the sample to `mj_collision`,
-//! which then decides as before. So the motion stops at the same sample with the same
-//! [`Collision`](crate::sim::Collision), contact for contact: the screen only skips work on samples
-//! where MuJoCo would find no contact of the arm. The clearance is a hundred times MuJoCo's
+//! the clearance leaves the sample to `mj_collision`, which then decides as before. So the motion
+//! stops at the same sample with the same [`Collision`](crate::sim::Collision), contact for
+//! contact: the screen only skips work on samples where MuJoCo would find no contact of the arm. The clearance is a hundred times MuJoCo's
 //! convex-collision tolerance (`ccd_tolerance`, 1e-6), so a pair cleared by its measured distance is
 //! apart by far more than either computation's error.
 //!
@@ -34,10 +33,11 @@
 //! The pairs screened are those MuJoCo's filters let through (`engine_collision_driver.c`): geoms of
 //! different bodies whose contact bits match, bodies not welded together, not both without degrees of
 //! freedom, not parent and child (unless the model disables that filter), not excluded. A model
-//! with predefined `<pair>`s, flexes, a margin override, sleeping bodies, libccd in place of
-//! MuJoCo's native convex collision, or a `ccd_tolerance` above the default is not screened; nor is
-//! a process that installs a global contact filter (`mjcb_contactfilter`, which replaces the
-//! contact bits; taction never does).
+//! with predefined `<pair>`s, flexes, a geom of the arm or one it may touch without bounds (a
+//! plane, a height field, a signed distance field), a margin override, sleeping bodies, libccd in
+//! place of MuJoCo's native convex collision, or a `ccd_tolerance` above the default is not
+//! screened; nor is a process that installs a global contact filter (`mjcb_contactfilter`, which
+//! replaces the contact bits; taction never does).
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::prelude::*;
@@ -117,8 +117,6 @@ struct Neighbour {
     geoms: Vec<(usize, usize)>,
     /// The geoms' bounding spheres in the body's frame, in a tree of boxes.
     tree: SphereTree,
-    /// Geoms without a bounding sphere (a plane, a height field): never cleared.
-    unbounded: Vec<(usize, usize)>,
 }
 
 /// Bounding spheres in a body's frame, grouped in a binary tree of boxes: the object's shell has
@@ -283,9 +281,21 @@ impl ContactScreen {
         }
         let filter_parent = opt.disableflags & MjtDisableBit::mjDSBL_FILTERPARENT as i32 == 0;
         let ngeom = model.ffi().ngeom as usize;
-        let mut pairs = 0;
-        let arm_geoms: Vec<ArmGeom> = (0..ngeom)
+        let arm: Vec<usize> = (0..ngeom)
             .filter(|&g| owns_body(model.geom_bodyid()[g] as usize))
+            .collect();
+        // A geom the screen cannot bound (a plane, a height field) would leave every sample
+        // undecided: such a world is not screened at all.
+        let boundable = arm.iter().all(|&a| {
+            Bound::boundable(model, a)
+                && (0..ngeom).all(|g| !may_touch(model, a, g, filter_parent) || Bound::boundable(model, g))
+        });
+        if !boundable {
+            return None;
+        }
+        let mut pairs = 0;
+        let arm_geoms: Vec<ArmGeom> = arm
+            .into_iter()
             .map(|a| {
                 let mut by_body: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
                 for g in (0..ngeom).filter(|&g| may_touch(model, a, g, filter_parent)) {
@@ -324,9 +334,7 @@ impl ContactScreen {
     pub fn screen<M: ModelType>(&mut self, model: &MjModel, data: &mut MjData<M>) -> Screened {
         let clear_m = self.margin_m + CLEARANCE_M + ROUNDING_M;
         for (index, arm_geom) in self.arm_geoms.iter().enumerate() {
-            let Some(a) = Bound::of(model, data, arm_geom.geom) else {
-                return Screened::Undecided;
-            };
+            let a = Bound::of(model, data, arm_geom.geom);
             let arm_xmat = data.geom_xmat()[arm_geom.geom];
             let outside_settled = self.settled[index].as_ref().is_some_and(|settled| {
                 arm_geom.outside_bodies_in_place(data, &settled.bodies)
@@ -380,12 +388,9 @@ impl ArmGeom {
     ) -> Option<f64> {
         let mut gap_m = reach_m;
         for n in self.neighbours.iter().filter(|n| n.on_arm == on_arm) {
-            if !n.unbounded.is_empty() {
-                return None;
-            }
             // The arm geom in the body's frame, where the tree is.
-            let body = (DVec3::from_array(data.xpos()[n.body]), mat3(&data.xmat()[n.body]));
-            let region = Region::of(a, reach_m + ROUNDING_M, body.0, body.1);
+            let origin = DVec3::from_array(data.xpos()[n.body]);
+            let region = Region::of(a, reach_m + ROUNDING_M, origin, mat3(&data.xmat()[n.body]));
             let all_clear = n.tree.all_near(&region, |i| {
                 let (g, slot) = n.geoms[i];
                 let apart_m = pair_margin(model, a.geom, g) + CLEARANCE_M;
@@ -455,9 +460,7 @@ fn may_touch(model: &MjModel, a: usize, g: usize, filter_parent: bool) -> bool {
 /// The geoms `slots` of `body` an arm geom may touch: their bounding spheres about their origins
 /// (`geom_pos` in the body's frame, `geom_rbound`) in a tree.
 fn neighbour(model: &MjModel, body: usize, on_arm: bool, slots: Vec<(usize, usize)>) -> Neighbour {
-    let bounded = |g: usize| model.geom_rbound()[g] > 0.0 && Bound::SHAPES.contains(&model.geom_type()[g]);
-    let (bounded_slots, unbounded): (Vec<_>, Vec<_>) = slots.into_iter().partition(|&(g, _)| bounded(g));
-    let spheres: Vec<(DVec3, f64)> = bounded_slots
+    let spheres: Vec<(DVec3, f64)> = slots
         .iter()
         .map(|&(g, _)| (DVec3::from_array(model.geom_pos()[g]), model.geom_rbound()[g]))
         .collect();
@@ -465,14 +468,13 @@ fn neighbour(model: &MjModel, body: usize, on_arm: bool, slots: Vec<(usize, usiz
     Neighbour {
         body,
         on_arm,
-        geoms: order.iter().map(|&i| bounded_slots[i]).collect(),
+        geoms: order.iter().map(|&i| slots[i]).collect(),
         tree,
-        unbounded,
     }
 }
 
 /// A lower bound of the distance between arm geom `a` and geom `g`, `None` where none can be
-/// had (a shape without bounds, a failed measurement). The cheapest bound that clears `apart_m`
+/// had (a failed measurement). The cheapest bound that clears `apart_m`
 /// first: the distance kept in `measured` from an earlier sample less how far `a` can have moved
 /// since (`g` not moved); their bounding spheres; their oriented boxes; MuJoCo's distance now. A
 /// fresh bound is kept in `measured`.
@@ -495,7 +497,7 @@ fn lower_bound_m<M: ModelType>(
             return Some(bound_m);
         }
     }
-    let b = Bound::of(model, data, g)?;
+    let b = Bound::of(model, data, g);
     let sphere_gap_m = (b.center - a.center).length() - a.radius_m - b.radius_m - ROUNDING_M;
     let distance_m = if sphere_gap_m >= apart_m {
         sphere_gap_m
@@ -574,17 +576,18 @@ impl Bound {
         MjtGeomBase::mjGEOM_MESH,
     ];
 
-    /// The bounds of geom `g` at the current kinematics, or `None` for a shape without them (a
-    /// plane, a height field, a signed distance field).
-    fn of<M: ModelType>(model: &MjModel, data: &MjData<M>, g: usize) -> Option<Self> {
+    /// Whether geom `g` has the bounds (not a plane, a height field or a signed distance field).
+    fn boundable(model: &MjModel, g: usize) -> bool {
+        model.geom_rbound()[g] > 0.0 && Self::SHAPES.contains(&model.geom_type()[g])
+    }
+
+    /// The bounds of geom `g` (one [`boundable`](Self::boundable)) at the current kinematics.
+    fn of<M: ModelType>(model: &MjModel, data: &MjData<M>, g: usize) -> Self {
         let radius_m = model.geom_rbound()[g];
-        if radius_m.is_nan() || radius_m <= 0.0 || !Self::SHAPES.contains(&model.geom_type()[g]) {
-            return None;
-        }
         let center = DVec3::from_array(data.geom_xpos()[g]);
         let axes = mat3(&data.geom_xmat()[g]);
         let [cx, cy, cz, hx, hy, hz] = model.geom_aabb()[g];
-        Some(Self {
+        Self {
             geom: g,
             center,
             radius_m,
@@ -596,7 +599,7 @@ impl Bound {
                 MjtGeomBase::mjGEOM_SPHERE => Some(0.0),
                 _ => None,
             },
-        })
+        }
     }
 }
 
