@@ -2,7 +2,7 @@
 //! goes, so that a user can decide whether a scale fits the afternoon.
 //!
 //! Each experiment's wall time was measured on the reference machine (2 cores, 2 threads) at
-//! scales 0.2 and 1.0 (the paper's, the default: 20 minutes for all fifteen); at any other
+//! scales 0.2 and 1.0 (the paper's, the default: 17 minutes for all fifteen); at any other
 //! scale it is the power law through the 1.0 timing, `t(s) = t_1 s^p`, with the exponent the two
 //! timings give, `p = ln(t_1 / t_0.2) / ln 5`, held in [1, 3]: data collection grows linearly with
 //! the scale and codebook fitting faster, so a smaller `p` only says that the 0.2 timing was
@@ -24,26 +24,24 @@ pub const REFERENCE_THREADS: usize = 2;
 /// Wall seconds of each experiment at scale 0.2 and 1.0 on the reference machine (seed 1, the
 /// built-in sets, each experiment's own codebook; `reproduce` one experiment after another into an
 /// empty folder, so datasets shared between experiments were collected by the first one that
-/// needed them; the phases of both runs are in docs/benchmarks.md). Measured 2026-11-27, the
-/// 0.2 column before that day's faster dataset collection (it only sets the exponent, which the
-/// smaller 1.0 timings now clamp to linear for the collection-bound experiments); `active` at 1.0
-/// measured 2026-11-28, with its calibration explorations at L = 1.
+/// needed them). Measured 2026-11-29: the 1.0 column is the shipped `results/timings.csv`, the 0.2
+/// column a run of the same day.
 const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
-    ("exploration", 0.6, 0.5),
-    ("descriptors", 12.4, 54.8),
-    ("strategy", 19.2, 49.2),
-    ("validation", 14.3, 42.5),
-    ("perturbation", 5.3, 24.8),
-    ("thickness", 29.7, 104.4),
-    ("resolution", 20.8, 72.7),
-    ("noise", 30.6, 101.5),
-    ("convergence", 0.9, 0.4),
-    ("letters", 74.6, 383.2),
-    ("real-frames", 0.1, 0.2),
-    ("sim-to-real", 1.0, 6.3),
-    ("training-size", 49.4, 216.2),
-    ("active", 25.2, 120.4),
-    ("end-to-end", 1.5, 17.8),
+    ("exploration", 0.5, 0.5),
+    ("descriptors", 17.7, 78.9),
+    ("strategy", 11.2, 32.5),
+    ("validation", 11.6, 38.7),
+    ("perturbation", 3.6, 17.3),
+    ("thickness", 20.9, 94.3),
+    ("resolution", 11.7, 61.2),
+    ("noise", 21.1, 90.8),
+    ("convergence", 0.2, 0.4),
+    ("letters", 51.6, 296.2),
+    ("real-frames", 0.2, 0.2),
+    ("sim-to-real", 0.8, 6.0),
+    ("training-size", 35.0, 178.7),
+    ("active", 15.3, 76.0),
+    ("end-to-end", 3.8, 35.4),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for
@@ -177,7 +175,7 @@ mod tests {
             .filter_map(|(name, _, _)| estimated_seconds(name, Scale::PAPER, 2))
             .sum();
         assert!(
-            (19.8 * 60.0..20.1 * 60.0).contains(&whole_run),
+            (16.7 * 60.0..16.9 * 60.0).contains(&whole_run),
             "{whole_run} s at scale 1.0"
         );
         assert_eq!(estimated_seconds("no-such-experiment", scale(1.0), 2), None);
