@@ -95,6 +95,7 @@ def main(argv=None):
                 len(results),
                 np.mean([r["right"] for r in results]),
                 len(declared) / len(results),
+                np.mean([r["right"] for r in declared]) if declared else float("nan"),
                 np.mean([r["touches"] for r in declared]) if declared else float("nan"),
                 steps / seconds,
             )
@@ -108,10 +109,13 @@ def main(argv=None):
         writer.writerows(rows)
     print(f"objects: {args.objects} ({len(model.objects)}), budget {args.budget} touches, "
           f"declare at {args.declare_at}, model {model.descriptor} k={model.k}")
-    print("| policy | episodes | accuracy at the budget | declared | mean touches to a declaration | steps/s (one core) |")
-    print("|---|---|---|---|---|---|")
-    for policy, n, accuracy, declared, touches, rate in table:
-        print(f"| {policy} | {n} | {accuracy:.2f} | {declared:.2f} | {touches:.1f} | {rate:.1f} |")
+    print(
+        "| policy | episodes | accuracy at the budget | declared | right when declared "
+        "| mean touches to a declaration | steps/s (one core) |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for policy, n, accuracy, declared, right, touches, rate in table:
+        print(f"| {policy} | {n} | {accuracy:.2f} | {declared:.2f} | {right:.2f} | {touches:.1f} | {rate:.1f} |")
     print(f"episodes written to {args.out}", file=sys.stderr)
 
 

@@ -6,9 +6,11 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
+use taction::active_touch::ArmTrainingRecipe;
 use taction::dataset::{ExportFormat, Reading};
 use taction::explore::{Collect, PlannerConfig};
 use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::tactile::SensorConfig;
 
 use crate::array;
 use crate::error::{bad_argument, refused};
@@ -233,15 +235,7 @@ pub fn collect(
     reachable_by_arm: bool,
     object_set: &str,
 ) -> PyResult<Dataset> {
-    if objects.is_empty() {
-        return Err(bad_argument("objects", "no object to touch"));
-    }
-    let sensor = match sensor {
-        Some(s) => s.config,
-        None => Sensor::paper_config()?,
-    }
-    .into_inner();
-    let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
+    let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
     let collect = match mode {
         "sampler" => {
@@ -271,6 +265,55 @@ pub fn collect(
     Ok(Dataset {
         inner: Arc::new(dataset),
     })
+}
+
+/// The arm's own blind explorations that `train_for_arm` calibrates its posterior on, collected as
+/// `taction demo` collects them (`ArmTrainingRecipe::calibration_plan`): the planner at L = 0.5,
+/// the object fixed, a thirtieth of `training_readings` (10 to 100) converged readings per object,
+/// on a random stream of `seed` the training data does not use. Successive touches of one
+/// exploration are correlated, which readings held out of the sampler's training data cannot show:
+/// calibrated on those, the posterior is overconfident on the arm's touches.
+#[pyfunction]
+#[pyo3(signature = (objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set="python"))]
+pub fn collect_arm_calibration(
+    py: Python<'_>,
+    objects: Vec<PyRef<'_, Object>>,
+    training_readings: usize,
+    seed: u64,
+    sensor: Option<PyRef<'_, Sensor>>,
+    threads: usize,
+    object_set: &str,
+) -> PyResult<Dataset> {
+    let (sensor, specs) = touch_inputs(&objects, sensor)?;
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: training_readings,
+        seed,
+    };
+    let collect =
+        Collect::from_plan(recipe.calibration_plan(sensor, &specs).map_err(refused)?).threads(threads);
+    let dataset = py
+        .detach(|| collect.dataset(object_set, &specs))
+        .map_err(refused)?;
+    warn_of_shortfalls(py, &dataset, recipe.calibration_readings())?;
+    Ok(Dataset {
+        inner: Arc::new(dataset),
+    })
+}
+
+/// The objects to touch as the library's specifications, and the sensor (the paper's by default).
+fn touch_inputs(
+    objects: &[PyRef<'_, Object>],
+    sensor: Option<PyRef<'_, Sensor>>,
+) -> PyResult<(SensorConfig, Vec<ObjectSpec>)> {
+    if objects.is_empty() {
+        return Err(bad_argument("objects", "no object to touch"));
+    }
+    let sensor = match sensor {
+        Some(s) => s.config,
+        None => Sensor::paper_config()?,
+    }
+    .into_inner();
+    Ok((sensor, objects.iter().map(|o| o.spec()).collect()))
 }
 
 /// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run

@@ -40,6 +40,7 @@ fn _taction(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<sensor::Sensor>()?;
     m.add_class::<dataset::Dataset>()?;
     m.add_function(wrap_pyfunction!(dataset::collect, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::collect_arm_calibration, m)?)?;
     m.add_class::<model::Model>()?;
     m.add_class::<model::Posterior>()?;
     m.add_function(wrap_pyfunction!(model::train, m)?)?;

@@ -301,8 +301,9 @@ fn fit(
 /// The recogniser `taction demo` trains for the arm's own touches (`ArmTrainingRecipe`): sampler
 /// readings from starts the arm can reach, MNTI and SIFT fused over the neighbour codebook.
 /// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`; `calibration`, the
-/// arm's own explorations (`collect(..., mode="planner")`), calibrates the posterior (without it,
-/// the readings held out of `training` do).
+/// arm's own explorations (`collect_arm_calibration`, as the demo collects them), calibrates the
+/// posterior (without it, the readings held out of `training` do, and the arm's correlated touches
+/// make it overconfident).
 #[pyfunction]
 #[pyo3(signature = (training, seed=1, calibration=None))]
 pub fn train_for_arm(

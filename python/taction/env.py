@@ -12,7 +12,8 @@ episode is truncated after ``budget`` touches.
 
 The recogniser is ``model`` (a ``taction.Model`` or a model file), or by default the one
 ``taction demo`` trains for the arm's touches (``taction.train_for_arm`` on ``training_readings``
-sampler readings per object from starts the arm can reach), trained once per process and set.
+sampler readings per object from starts the arm can reach, its posterior calibrated on the arm's
+own explorations, ``taction.collect_arm_calibration``), trained once per process and set.
 """
 
 from __future__ import annotations
@@ -43,18 +44,24 @@ def _objects_of(objects: Union[str, Sequence["taction.Object"]]) -> list:
 
 def default_model(objects, training_readings: int = 1000, seed: int = 1) -> "taction.Model":
     """The recogniser ``taction demo`` trains for the arm (``taction.train_for_arm``) on ``objects``
-    (a set name or a list of objects); trained once per process for a set name."""
+    (a set name or a list of objects), its posterior calibrated on the arm's own explorations
+    (``taction.collect_arm_calibration``) as the demo's is; trained once per process for a set
+    name."""
     key = (objects, training_readings, seed) if isinstance(objects, str) else None
     if key is not None and key in _DEFAULT_MODELS:
         return _DEFAULT_MODELS[key]
+    touched = _objects_of(objects)
     training = taction.collect(
-        _objects_of(objects),
+        touched,
         mode="sampler",
         readings=training_readings,
         seed=seed,
         reachable_by_arm=True,
     )
-    model = taction.train_for_arm(training.converged(), seed=seed)
+    calibration = taction.collect_arm_calibration(
+        touched, training_readings=training_readings, seed=seed
+    )
+    model = taction.train_for_arm(training.converged(), seed=seed, calibration=calibration)
     if key is not None:
         _DEFAULT_MODELS[key] = model
     return model

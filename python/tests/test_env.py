@@ -134,3 +134,14 @@ def test_bad_arguments_raise(make, small_model):
         taction.TouchEpisode(small_model, env.unwrapped._episode_objects[0], candidates=10**9)
     with pytest.raises(taction.TactionError, match="objects"):
         taction.collect([])
+
+
+def test_the_default_recogniser_is_the_demos_calibrated_on_the_arm(chess):
+    from taction.env import default_model
+
+    model = default_model(chess, training_readings=110, seed=3)
+    training = taction.collect(chess, mode="sampler", readings=110, seed=3, reachable_by_arm=True)
+    calibration = taction.collect_arm_calibration(chess, training_readings=110, seed=3)
+    demos = taction.train_for_arm(training.converged(), seed=3, calibration=calibration)
+    assert model.calibration == demos.calibration
+    assert model.calibration != taction.train_for_arm(training.converged(), seed=3).calibration

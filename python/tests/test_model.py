@@ -135,3 +135,32 @@ def test_models_objects_and_datasets_pickle(small_model, small_dataset, chess):
     assert np.array_equal(taction.Sensor().read(pawn, pose), taction.Sensor().read(chess[0], pose))
     with pytest.raises(taction.TactionError, match="pickled model"):
         taction.Model.from_json(b"{}")
+
+
+def test_the_arm_calibration_is_the_recipes_exploration_and_calibrates_the_arm_model(chess):
+    calibration = taction.collect_arm_calibration(chess, training_readings=600, seed=3)
+    # A thirtieth of the training readings per object, by the planner at L = 0.5, the object fixed.
+    converged = calibration.status == "converged"
+    for name in ("pawn", "rook"):
+        assert (calibration.object[converged] == name).sum() == 20
+    assert "planner L=0.5" in repr(calibration)
+    again = taction.collect_arm_calibration(chess, training_readings=600, seed=3)
+    assert np.array_equal(calibration.images, again.images)
+    # Its own random stream: not the planner collection of the same seed.
+    plain_planner = taction.collect(chess, mode="planner", readings=20, seed=3)
+    assert not np.array_equal(calibration.images[:5], plain_planner.images[:5])
+    # At least 10 readings per object, however little training.
+    few = taction.collect_arm_calibration(chess, training_readings=60, seed=3)
+    assert ((few.object == "pawn") & (few.status == "converged")).sum() == 10
+
+    training = taction.collect(chess, mode="sampler", readings=110, seed=3, reachable_by_arm=True)
+    on_validation = taction.train_for_arm(training.converged(), seed=3)
+    on_arm = taction.train_for_arm(training.converged(), seed=3, calibration=few)
+    assert on_arm.calibration != on_validation.calibration
+    image = calibration.images[converged][0]
+    assert on_arm.posterior().observe(image).argmax() == on_validation.posterior().observe(image).argmax()
+
+
+def test_the_arm_calibration_rejects_no_objects():
+    with pytest.raises(taction.TactionError, match="objects: no object to touch"):
+        taction.collect_arm_calibration([])
