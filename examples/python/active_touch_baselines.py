@@ -10,7 +10,7 @@ Every policy declares its best guess once the belief reaches ``--declare-at`` (e
 runs to the budget, and the final best guess is scored). One core: the environment steps in this
 process only. Writes one CSV row per episode and prints the table.
 
-    taskset -c 1 .venv/bin/python examples/python/active_touch_baselines.py --objects shapes --episodes 36
+    taskset -c 1 .venv/bin/python examples/python/active_touch_baselines.py --objects shapes --episodes 144
 """
 
 import argparse

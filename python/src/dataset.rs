@@ -261,7 +261,7 @@ pub fn collect(
     let dataset = py
         .detach(|| collect.dataset(object_set, &specs))
         .map_err(refused)?;
-    warn_of_shortfalls(py, &dataset, readings)?;
+    warn_of_shortfalls(py, "collect", &dataset, readings)?;
     Ok(Dataset {
         inner: Arc::new(dataset),
     })
@@ -289,12 +289,16 @@ pub fn collect_arm_calibration(
         readings_per_object: training_readings,
         seed,
     };
-    let collect =
-        Collect::from_plan(recipe.calibration_plan(sensor, &specs).map_err(refused)?).threads(threads);
+    let plan = recipe.calibration_plan(sensor, &specs).map_err(refused)?;
     let dataset = py
-        .detach(|| collect.dataset(object_set, &specs))
+        .detach(|| plan.collect_dataset(object_set, &specs, threads, &|| {}))
         .map_err(refused)?;
-    warn_of_shortfalls(py, &dataset, recipe.calibration_readings())?;
+    warn_of_shortfalls(
+        py,
+        "collect_arm_calibration",
+        &dataset,
+        recipe.calibration_readings(),
+    )?;
     Ok(Dataset {
         inner: Arc::new(dataset),
     })
@@ -318,11 +322,16 @@ fn touch_inputs(
 
 /// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run
 /// out of iterations on an object it cannot reach well).
-fn warn_of_shortfalls(py: Python<'_>, dataset: &taction::dataset::Dataset, readings: usize) -> PyResult<()> {
+fn warn_of_shortfalls(
+    py: Python<'_>,
+    function: &str,
+    dataset: &taction::dataset::Dataset,
+    readings: usize,
+) -> PyResult<()> {
     let shortfalls = dataset.shortfalls(readings);
     if !shortfalls.is_empty() {
         let message = format!(
-            "taction.collect: fewer readings than asked: {}",
+            "taction.{function}: fewer readings than asked: {}",
             taction::dataset::describe_shortfalls(&shortfalls)
         );
         py.import("warnings")?.call_method1("warn", (message,))?;

@@ -24,8 +24,9 @@ pub const REFERENCE_THREADS: usize = 2;
 /// Wall seconds of each experiment at scale 0.2 and 1.0 on the reference machine (seed 1, the
 /// built-in sets, each experiment's own codebook; `reproduce` one experiment after another into an
 /// empty folder, so datasets shared between experiments were collected by the first one that
-/// needed them). Measured 2026-11-29: the 1.0 column is the shipped `results/timings.csv`, the 0.2
-/// column a run of the same day.
+/// needed them; docs/benchmarks.md has both runs). Measured 2026-11-29: the 1.0 column is the
+/// shipped `results/timings.csv`, the 0.2 column a run of the same day. The 0.2 column only sets the
+/// exponent, which set-up and datasets collected by earlier experiments clamp to linear for most.
 const REFERENCE_SECONDS: [(&str, f64, f64); 15] = [
     ("exploration", 0.5, 0.5),
     ("descriptors", 17.7, 78.9),
