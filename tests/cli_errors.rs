@@ -176,7 +176,8 @@ fn every_command_refuses_millimetres_and_takes_object_size_m() {
     let mesh = write(&meshes, "box_mm.obj", &TETRA.replace("0.05", "50"));
     let folder = meshes.display().to_string();
     let out = dir.path().join("out").display().to_string();
-    let commands: [&[&str]; 5] = [
+    let sense_out = dir.path().join("sense.csv").display().to_string();
+    let commands: [&[&str]; 6] = [
         &[
             "experiment",
             "descriptors",
@@ -201,6 +202,7 @@ fn every_command_refuses_millimetres_and_takes_object_size_m() {
         &["demo", "--objects", &folder, "--out", &out],
         &["scene", "export", "--object", &mesh, "--out", &out],
         &["objects", "export", &folder, "--out", &out],
+        &sense_args(&mesh, &sense_out),
     ];
     for args in commands {
         let line = fails_with(&taction(args), 1);
@@ -246,6 +248,11 @@ fn every_command_refuses_millimetres_and_takes_object_size_m() {
         2,
     );
     assert!(line.contains("not a positive number of metres"), "{line}");
+    // The free pad's commands take the flag their refusal names.
+    let mut sensed = sense_args(&mesh, &sense_out);
+    sensed.extend(["--object-size-m", "0.1"]);
+    let done = taction(&sensed);
+    assert!(done.status.success(), "{}", stderr(&done));
 }
 
 /// A quick look into the folder of an earlier run of another scale stops at once, naming the
@@ -730,4 +737,156 @@ fn a_reference_curve_that_is_not_column_equals_level_is_refused_before_any_run_i
             "{against}: {line}"
         );
     }
+}
+
+/// An `--out` that names a folder where a file is written, or a file where a folder is, is refused
+/// before any collecting or training (the system's "Not a directory" came after all the work).
+#[test]
+fn an_output_path_of_the_wrong_kind_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().display().to_string();
+    let line = fails_with(
+        &taction(&[
+            "collect",
+            "--objects",
+            "chess",
+            "--readings",
+            "1",
+            "--out",
+            &folder,
+        ]),
+        2,
+    );
+    assert!(line.contains("is a folder; give the file to write"), "{line}");
+    let model = toy_model(dir.path());
+    let train = dir.path().join("train.csv").display().to_string();
+    let line = fails_with(&train_vectorize(&train, &[], &folder), 2);
+    assert!(line.contains("is a folder"), "{line}");
+    let line = fails_with(
+        &taction(&[
+            "recognize",
+            "--model",
+            &model,
+            "--dataset",
+            &train,
+            "--out",
+            &train,
+        ]),
+        2,
+    );
+    assert!(line.contains("is a file; give the folder"), "{line}");
+    let inside_a_file = format!("{train}/scene");
+    let line = fails_with(
+        &taction(&["scene", "export", "--object", "pawn", "--out", &inside_a_file]),
+        2,
+    );
+    assert!(line.contains("is a file, not a folder"), "{line}");
+}
+
+/// `taction train --dataset TRAIN --descriptor vectorize EXTRA --out OUT`.
+fn train_vectorize(train: &str, extra: &[&str], out: &str) -> Output {
+    let mut args = vec!["train", "--dataset", train, "--descriptor", "vectorize"];
+    args.extend(extra);
+    args.extend(["--out", out]);
+    taction(&args)
+}
+
+/// `train`'s own flags are checked before the dataset is read and named as the user wrote them.
+#[test]
+fn training_flags_out_of_range_exit_2_named_by_their_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    toy_model(dir.path());
+    let train = dir.path().join("train.csv").display().to_string();
+    let out = dir.path().join("m.json").display().to_string();
+    for (flag, value) in [
+        ("--k", "0"),
+        ("--variance-kept", "1.5"),
+        ("--pseudo-count", "0"),
+        ("--restarts", "0"),
+        ("--trial-readings", "0"),
+    ] {
+        let line = fails_with(&train_vectorize(&train, &[flag, value], &out), 2);
+        assert!(line.starts_with(&format!("taction: {flag}: ")), "{flag}: {line}");
+    }
+    let line = fails_with(&taction(&["experiment", "bogus"]), 2);
+    assert!(line.contains("no experiment 'bogus'"), "{line}");
+}
+
+/// A controller file is an object of named fields: an array would set them by position, and the
+/// expected noise is the sensor's.
+#[test]
+fn a_control_file_names_its_fields_and_leaves_the_noise_to_the_sensor() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "tetra.obj", TETRA);
+    for (name, text, what) in [
+        ("array.json", "[0.9]", "want a JSON object"),
+        ("noise.json", r#"{"expected_noise_fraction": 0.5}"#, "--noise"),
+    ] {
+        let control = write(dir.path(), name, text);
+        let line = fails_with(
+            &taction(&[
+                "touch",
+                "--mesh",
+                &mesh,
+                "--pad-center",
+                "0.01,0.01,0.1",
+                "--pad-normal",
+                "0,0,-1",
+                "--control",
+                &control,
+            ]),
+            1,
+        );
+        assert!(line.contains(name) && line.contains(what), "{line}");
+    }
+}
+
+/// A model calibrated on the sampler's held-out readings warns when it judges the arm's
+/// exploration; `dataset show` tells a file's own format version from the one it is read as.
+#[test]
+fn recognize_warns_of_a_sampler_calibration_on_the_arms_touches() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = toy_model(dir.path());
+    let toy = recognize_toy::dataset(6, 2);
+    let header = DatasetHeader::new(
+        recognize_toy::sensor(),
+        "toy",
+        recognize_toy::OBJECTS.iter().map(|s| s.to_string()).collect(),
+        "planner L=0.5",
+        2,
+    );
+    let explored = dir.path().join("explored.csv");
+    Dataset::new(header, toy.readings().to_vec())
+        .unwrap()
+        .write(&explored)
+        .unwrap();
+    let sampled = dir.path().join("sampled.csv");
+    toy.write(&sampled).unwrap();
+    let recognize = |data: &Path, posterior: &str| {
+        let out = dir.path().join("runs").display().to_string();
+        let done = taction(&[
+            "recognize",
+            "--model",
+            &model,
+            "--dataset",
+            &data.display().to_string(),
+            "--posterior",
+            posterior,
+            "--out",
+            &out,
+        ]);
+        assert!(done.status.success(), "{}", stderr(&done));
+        stderr(&done)
+    };
+    assert!(recognize(&explored, "calibrated").contains("--calibration"));
+    assert!(!recognize(&explored, "eq15").contains("--calibration"));
+    assert!(!recognize(&sampled, "calibrated").contains("--calibration"));
+
+    let v2 = "tests/dataset_v2/chess_planner_seed4.csv";
+    let shown = taction(&["dataset", "show", v2]);
+    let text = String::from_utf8_lossy(&shown.stdout);
+    assert!(
+        text.contains("written in format version 2; read as version 3"),
+        "{text}"
+    );
 }

@@ -236,6 +236,26 @@ fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
             stdout.contains(&format!("after {used} touches")),
             "the touches used are reported:\n{stdout}"
         );
+        // run.json says which run the files beside it are.
+        let record: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).expect("run.json"))
+                .expect("JSON");
+        assert_eq!(record["strategy"], "active");
+        assert_eq!(record["posterior"], "eq15");
+        assert_eq!(record["seed"], 4);
+        assert_eq!(
+            record["stop_held_readings"].as_u64(),
+            Some(held.parse().expect("a count"))
+        );
+        assert_eq!(record["stop_at_confidence"].as_f64(), Some(threshold));
+        assert_eq!(record["touches"].as_u64(), Some(used as u64));
+        assert_eq!(record["touches_asked"], 8);
+        let ending = if stop.is_some() {
+            "stopped: confident"
+        } else {
+            "the touch budget spent"
+        };
+        assert_eq!(record["ending"], ending);
     }
     let (_, _, stderr) = taction_demo(dir.path(), &["--stop-at-confidence", "1.5"]);
     assert!(stderr.contains("--stop-at-confidence"), "{stderr}");

@@ -15,11 +15,7 @@ import argparse
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")  # no display needed
-import matplotlib.pyplot as plt  # noqa: E402
-import mujoco  # noqa: E402
+import mujoco
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -50,6 +46,13 @@ def main():
     image = d.sensordata[sensor.adr[0] : sensor.adr[0] + rows * cols].reshape(rows, cols)
     for row in image:
         print(" ".join(f"{v:.4f}" for v in row))
+
+    try:
+        import matplotlib
+    except ImportError:
+        sys.exit(f"saving {args.out} needs matplotlib (pip install matplotlib); the image is printed above")
+    matplotlib.use("Agg")  # no display needed
+    import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(3, 3))
     # Row 0 is the pad's up edge; column 0 its left edge seen from behind the pad.

@@ -12,9 +12,9 @@ use taction::explore::{Collect, PlannerConfig};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 
+use crate::args::{Objects, Whole};
 use crate::array;
 use crate::error::{bad_argument, refused};
-use crate::object::Object;
 use crate::sensor::Sensor;
 
 /// Readings of a set of objects, with the header saying how they were made. Columns come out as
@@ -65,7 +65,7 @@ impl Dataset {
     #[staticmethod]
     fn from_bytes(bytes: &[u8]) -> PyResult<Self> {
         let text = std::str::from_utf8(bytes).map_err(|e| bad_argument("bytes", e))?;
-        let dataset = taction::dataset::Dataset::parse(text, "the pickled dataset").map_err(refused)?;
+        let dataset = taction::dataset::Dataset::parse(text, "the dataset's bytes").map_err(refused)?;
         Ok(Self {
             inner: Arc::new(dataset),
         })
@@ -218,16 +218,16 @@ impl Dataset {
 /// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3). Same seed, same
 /// dataset, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (objects, mode="sampler", readings=100, seed=1, sensor=None, threads=0, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"))]
+#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python')")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
 pub fn collect(
     py: Python<'_>,
-    objects: Vec<PyRef<'_, Object>>,
+    objects: Objects,
     mode: &str,
-    readings: usize,
-    seed: u64,
+    readings: Whole<usize>,
+    seed: Whole<u64>,
     sensor: Option<PyRef<'_, Sensor>>,
-    threads: usize,
+    threads: Whole<usize>,
     local_probability: f64,
     perturb_deg: f64,
     perturb_frac: f64,
@@ -235,6 +235,7 @@ pub fn collect(
     reachable_by_arm: bool,
     object_set: &str,
 ) -> PyResult<Dataset> {
+    let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
     let collect = match mode {
@@ -274,16 +275,17 @@ pub fn collect(
 /// exploration are correlated, which readings held out of the sampler's training data cannot show:
 /// calibrated on those, the posterior is overconfident on the arm's touches.
 #[pyfunction]
-#[pyo3(signature = (objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set="python"))]
+#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python"), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python')")]
 pub fn collect_arm_calibration(
     py: Python<'_>,
-    objects: Vec<PyRef<'_, Object>>,
-    training_readings: usize,
-    seed: u64,
+    objects: Objects,
+    training_readings: Whole<usize>,
+    seed: Whole<u64>,
     sensor: Option<PyRef<'_, Sensor>>,
-    threads: usize,
+    threads: Whole<usize>,
     object_set: &str,
 ) -> PyResult<Dataset> {
+    let (Whole(training_readings), Whole(seed), Whole(threads)) = (training_readings, seed, threads);
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let recipe = ArmTrainingRecipe {
         readings_per_object: training_readings,
@@ -306,9 +308,10 @@ pub fn collect_arm_calibration(
 
 /// The objects to touch as the library's specifications, and the sensor (the paper's by default).
 fn touch_inputs(
-    objects: &[PyRef<'_, Object>],
+    objects: &Objects,
     sensor: Option<PyRef<'_, Sensor>>,
 ) -> PyResult<(SensorConfig, Vec<ObjectSpec>)> {
+    let Objects(objects) = objects;
     if objects.is_empty() {
         return Err(bad_argument("objects", "no object to touch"));
     }
@@ -317,7 +320,13 @@ fn touch_inputs(
         None => Sensor::paper_config()?,
     }
     .into_inner();
-    Ok((sensor, objects.iter().map(|o| o.spec()).collect()))
+    Ok((
+        sensor,
+        objects
+            .iter()
+            .map(|o| ObjectSpec::from(o.as_ref().clone()))
+            .collect(),
+    ))
 }
 
 /// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run

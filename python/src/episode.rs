@@ -10,8 +10,9 @@ use taction::explore::PlannerConfig;
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::valid::Valid;
 
+use crate::args::Whole;
 use crate::array;
-use crate::error::refused;
+use crate::error::{bad_argument, refused};
 use crate::model::Model;
 use crate::object::Object;
 
@@ -48,22 +49,36 @@ fn planner_for(objects: &[ObjectSpec], local_probability: f64) -> PlannerConfig 
 #[pymethods]
 impl TouchEpisode {
     #[new]
-    #[pyo3(signature = (model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None))]
+    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None)")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each an episode parameter
     fn new(
         py: Python<'_>,
         model: &Model,
         object: &Object,
-        seed: u64,
-        candidates: usize,
+        seed: Whole<u64>,
+        candidates: Whole<usize>,
         local_probability: f64,
         perturb_deg: f64,
         perturb_frac: f64,
         workspace: Option<Vec<PyRef<'_, Object>>>,
     ) -> PyResult<Self> {
+        let (Whole(seed), Whole(candidates)) = (seed, candidates);
         let spec = object.spec();
         let fitted_to: Vec<ObjectSpec> = match workspace {
-            Some(objects) => objects.iter().map(|o| o.spec()).collect(),
+            Some(objects) => {
+                // The planner's box is fitted to these objects; the episode's must be among them.
+                if !objects.iter().any(|o| o.inner.name == object.inner.name) {
+                    let names: Vec<&str> = objects.iter().map(|o| o.inner.name.as_str()).collect();
+                    return Err(bad_argument(
+                        "workspace",
+                        format!(
+                            "{names:?} does not include the episode's object '{}'",
+                            object.inner.name
+                        ),
+                    ));
+                }
+                objects.iter().map(|o| o.spec()).collect()
+            }
             None => vec![spec.clone()],
         };
         let planner = planner_for(&fitted_to, local_probability);
@@ -118,7 +133,8 @@ impl TouchEpisode {
 
     /// One planner iteration toward candidate `index`; `True` when it ended in a converged reading
     /// (the belief now includes it). New candidates are drawn either way.
-    fn touch(&self, py: Python<'_>, index: usize) -> PyResult<bool> {
+    fn touch(&self, py: Python<'_>, index: Whole<usize>) -> PyResult<bool> {
+        let Whole(index) = index;
         let mut episode = self.episode()?;
         let episode = &mut *episode;
         Ok(py

@@ -8,6 +8,7 @@
 //! library's own checks (`valid::Check`), so an error says what the CLI says, as a
 //! `taction.TactionError`. Collection and training release the GIL.
 
+mod args;
 mod array;
 mod dataset;
 mod episode;

@@ -15,6 +15,7 @@ use taction::recognize::{
 use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
+use crate::args::Whole;
 use crate::array;
 use crate::dataset::Dataset;
 use crate::error::{bad_argument, refused};
@@ -28,6 +29,7 @@ pub struct Model {
 
 #[pymethods]
 impl Model {
+    /// Reads a model file (`taction train`'s JSON, or what `save` wrote).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let model = py.detach(|| Recognizer::load(&path)).map_err(refused)?;
@@ -36,6 +38,7 @@ impl Model {
         })
     }
 
+    /// Writes the model file `taction recognize --model` reads.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         py.detach(|| self.inner.save(&path)).map_err(refused)
     }
@@ -60,7 +63,7 @@ impl Model {
     /// A model from the contents of a model file.
     #[staticmethod]
     fn from_json(bytes: &[u8]) -> PyResult<Self> {
-        let model = Recognizer::from_json(bytes, "the pickled model").map_err(refused)?;
+        let model = Recognizer::from_json(bytes, "the model's bytes").map_err(refused)?;
         Ok(Self {
             inner: Arc::new(model),
         })
@@ -130,8 +133,9 @@ impl Model {
     /// Recognition accuracy on `dataset` in trials of `readings` consecutive converged readings per
     /// object, as `taction recognize` scores it: `{"accuracy": [after 1, ..., after readings],
     /// "trials": n}`.
-    #[pyo3(signature = (dataset, readings=30))]
-    fn evaluate(&self, py: Python<'_>, dataset: &Dataset, readings: usize) -> PyResult<Py<PyAny>> {
+    #[pyo3(signature = (dataset, readings=Whole(30)), text_signature = "($self, dataset, readings=30)")]
+    fn evaluate(&self, py: Python<'_>, dataset: &Dataset, readings: Whole<usize>) -> PyResult<Py<PyAny>> {
+        let Whole(readings) = readings;
         let range = taction::recognize::ReadingRange::new(1, readings).map_err(refused)?;
         let (evaluation, trials) = py
             .detach(|| self.inner.evaluate(&dataset.inner, range))
@@ -230,7 +234,7 @@ impl Posterior {
 /// or `knn`; the codebook size chosen among `ks` (default: a grid sized to the data) on
 /// `validation` (default: the last 1/11 of each object's readings).
 #[pyfunction]
-#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10))]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10)), text_signature = "(dataset, descriptor='mnti', codebook='gmm', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
 pub fn train(
     py: Python<'_>,
@@ -238,13 +242,15 @@ pub fn train(
     descriptor: &str,
     codebook: &str,
     validation: Option<PyRef<'_, Dataset>>,
-    ks: Option<Vec<usize>>,
-    restarts: usize,
-    seed: u64,
+    ks: Option<Vec<Whole<usize>>>,
+    restarts: Whole<usize>,
+    seed: Whole<u64>,
     variance_kept: Option<f64>,
     pseudo_count: f64,
-    trial_readings: usize,
+    trial_readings: Whole<usize>,
 ) -> PyResult<Model> {
+    let (Whole(restarts), Whole(seed), Whole(trial_readings)) = (restarts, seed, trial_readings);
+    let ks: Option<Vec<usize>> = ks.map(|ks| ks.into_iter().map(|Whole(k)| k).collect());
     let choice = DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?;
     let codebook = CodebookKind::parse(codebook).map_err(|e| bad_argument("codebook", e))?;
     let config = TrainConfig {
@@ -305,13 +311,14 @@ fn fit(
 /// posterior (without it, the readings held out of `training` do, and the arm's correlated touches
 /// make it overconfident).
 #[pyfunction]
-#[pyo3(signature = (training, seed=1, calibration=None))]
+#[pyo3(signature = (training, seed=Whole(1), calibration=None), text_signature = "(training, seed=1, calibration=None)")]
 pub fn train_for_arm(
     py: Python<'_>,
     training: &Dataset,
-    seed: u64,
+    seed: Whole<u64>,
     calibration: Option<&Dataset>,
 ) -> PyResult<Model> {
+    let Whole(seed) = seed;
     let recipe = ArmTrainingRecipe {
         readings_per_object: training.inner.len(),
         seed,

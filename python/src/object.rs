@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use taction::mesh::{BuildOptions, ObjectSet};
+use taction::mesh::{BUILTIN_SETS, BuildOptions, ObjectSet};
 use taction::sim::{ObjectSpec, PAD_SITE, SceneBuilder};
 use taction::tactile::add_sensor;
 
@@ -52,6 +52,9 @@ impl Object {
     #[staticmethod]
     #[pyo3(signature = (path, size_m=None))]
     fn from_file(py: Python<'_>, path: PathBuf, size_m: Option<f64>) -> PyResult<Self> {
+        if let Some(size) = size_m {
+            positive_size(size)?;
+        }
         let object = py
             .detach(|| match size_m {
                 Some(d) => taction::mesh::Object::from_file_with_size(&path, d),
@@ -98,7 +101,7 @@ impl Object {
         &self.inner.name
     }
 
-    /// Triangles of the mesh.
+    /// How many triangles the mesh has.
     #[getter]
     fn triangles(&self) -> usize {
         self.inner.mesh.triangles.len()
@@ -130,12 +133,39 @@ impl Object {
     }
 }
 
+/// `size_m` as a bounding diagonal: a positive number of metres.
+fn positive_size(size: f64) -> PyResult<()> {
+    if size.is_finite() && size > 0.0 {
+        Ok(())
+    } else {
+        Err(bad_argument(
+            "size_m",
+            format!("{size} is not a positive number of metres"),
+        ))
+    }
+}
+
 /// The objects of a set: a built-in set's name (`shapes`, `chess`, `letters`), a folder of meshes or
 /// a set manifest (`.json`), as `taction objects list` takes it. The `shapes` meshes are fetched into
-/// the user's cache on first use.
+/// the user's cache on first use. `size_m` rescales a folder's meshes to that bounding diagonal
+/// (centred, resting on z = 0); built-in sets and manifests have their own sizes and refuse it.
 #[pyfunction]
 #[pyo3(signature = (set, size_m=None))]
 pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Vec<Object>> {
+    if let Some(size) = size_m {
+        positive_size(size)?;
+        let sized_by_set = BUILTIN_SETS.contains(&set.to_string_lossy().as_ref())
+            || set.extension().is_some_and(|e| e == "json");
+        if sized_by_set {
+            return Err(bad_argument(
+                "size_m",
+                format!(
+                    "'{}' sizes its own objects; size_m rescales a folder of meshes",
+                    set.display()
+                ),
+            ));
+        }
+    }
     let built = py
         .detach(|| {
             let set = ObjectSet::resolve(&[set], None, size_m)?;

@@ -10,6 +10,7 @@ use taction::pose::PadPose;
 use taction::tactile::{SensorConfig, TactileImage, psf_sigma_for_thickness};
 use taction::valid::Valid;
 
+use crate::args::Whole;
 use crate::array;
 use crate::error::{bad_argument, refused};
 use crate::object::Object;
@@ -66,21 +67,42 @@ pub fn pad_pose(value: &Bound<'_, PyAny>) -> PyResult<PadPose> {
         .ok_or_else(|| bad_argument("pad_pose", "the normal and up must be non-zero and not parallel"))
 }
 
+/// A reading's values lie in [0, 1]: an integer dtype would truncate them to zeros.
+fn image_dtype(dtype: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    let name = dtype
+        .py()
+        .import("numpy")?
+        .call_method1("dtype", (dtype,))
+        .and_then(|d| d.str())
+        .map(|s| s.to_string())
+        .map_err(|_| bad_argument("dtype", format!("{dtype} is not a numpy dtype")))?;
+    match name.as_str() {
+        "float32" => Ok("float32"),
+        "float64" => Ok("float64"),
+        other => Err(bad_argument(
+            "dtype",
+            format!("{other}: want float32 or float64 (values lie in [0, 1])"),
+        )),
+    }
+}
+
 #[pymethods]
 impl Sensor {
     #[new]
-    #[pyo3(signature = (rows=6, cols=6, pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=4, noise=0.0, seed=1))]
+    #[pyo3(signature = (rows=Whole(6), cols=Whole(6), pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=Whole(4), noise=0.0, seed=Whole(1)), text_signature = "(rows=6, cols=6, pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=4, noise=0.0, seed=1)")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a sensor parameter
     fn new(
-        rows: usize,
-        cols: usize,
+        rows: Whole<usize>,
+        cols: Whole<usize>,
         pad_m: f64,
         thickness_m: Option<f64>,
         psf_sigma_m: Option<f64>,
-        rays_per_taxel: usize,
+        rays_per_taxel: Whole<usize>,
         noise: f64,
-        seed: u64,
+        seed: Whole<u64>,
     ) -> PyResult<Self> {
+        let (Whole(rows), Whole(cols), Whole(rays_per_taxel), Whole(seed)) =
+            (rows, cols, rays_per_taxel, seed);
         let thickness_m = thickness_m.unwrap_or(0.1 * pad_m);
         let config = SensorConfig {
             rows,
@@ -100,15 +122,17 @@ impl Sensor {
     }
 
     /// One reading of `object` with the pad at `pad_pose` (9 numbers: centre xyz in metres,
-    /// normal xyz, up xyz): an array `(rows, cols)` of values in [0, 1], row 0 the pad's up edge.
-    #[pyo3(signature = (object, pad_pose, dtype="float32"))]
+    /// normal xyz, up xyz): an array `(rows, cols)` of values in [0, 1], row 0 the pad's up edge,
+    /// of `dtype` `float32` (the default) or `float64` (a name or a numpy dtype).
+    #[pyo3(signature = (object, pad_pose, dtype=None))]
     fn read<'py>(
         &self,
         py: Python<'py>,
         object: PyRef<'py, Object>,
         pad_pose: &Bound<'py, PyAny>,
-        dtype: &str,
+        dtype: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let dtype = dtype.map_or(Ok("float32"), image_dtype)?;
         let pose = self::pad_pose(pad_pose)?;
         let image = self.read_at(&object, &pose)?;
         array::from_f64(py, image.values(), &[image.rows(), image.cols()], dtype)

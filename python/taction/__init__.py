@@ -4,12 +4,14 @@ A Python face of the Rust library (Pezzementi et al., *Tactile Object Recognitio
 Information*, IEEE T-RO 2011): objects, the covering sensor, datasets, recognisers and their
 posterior, all speaking numpy; and the Gymnasium environment ``taction/ActiveTouch-v0``, registered on
 import. Importing the package also registers the ``taction.covering`` sensor plugin with stock
-``mujoco``, so ``mujoco.MjModel.from_xml_string(taction.scene(obj))`` compiles.
+``mujoco``, so ``mujoco.MjModel.from_xml_string(taction.scene(obj))`` compiles (unless the plugin
+library ``target/release/libtaction_covering.so`` registered it first; either serves).
 
     import taction
     pawn = taction.objects("chess")[0]
     sensor = taction.Sensor(rows=6, cols=6)
-    image = sensor.read(pawn, [0, 0, 0.06, 0, 0, -1, 0, 1, 0])   # numpy (6, 6) float32
+    top_m = pawn.bounds_m[1, 2]   # the pad 0.6 mm into the pawn's top: centre, normal, up
+    image = sensor.read(pawn, [0, 0, top_m + 0.0006, 0, 0, -1, 0, 1, 0])   # numpy (6, 6) float32
 """
 
 # The MuJoCo library the extension links is the one the `mujoco` package ships (the extension's

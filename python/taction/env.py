@@ -105,16 +105,33 @@ class ActiveTouchEnv(gymnasium.Env):
         if candidates < 1:
             raise taction.TactionError(f"candidates: {candidates} is not 1 or more")
         self._objects = _objects_of(objects)
+        names = [o.name for o in self._objects]
+        if not names:
+            raise taction.TactionError("objects: the set is empty")
+        repeated = sorted({name for name in names if names.count(name) > 1})
+        if repeated:
+            raise taction.TactionError(f"objects: {repeated} more than once")
         if isinstance(model, (str, os.PathLike)):
             model = taction.Model.load(model)
         elif model is None:
             model = default_model(objects if isinstance(objects, str) else self._objects,
                                   training_readings, training_seed)
+        elif not isinstance(model, taction.Model):
+            raise taction.TactionError(
+                f"model: {model!r} is neither a taction.Model, a model file nor None (the default recogniser)"
+            )
         self.model = model
         by_name = {o.name: o for o in self._objects}
-        missing = [name for name in model.objects if name not in by_name]
-        if missing:
-            raise taction.TactionError(f"model: knows objects not in the set: {missing}")
+        unknown = [name for name in model.objects if name not in by_name]
+        if unknown:
+            raise taction.TactionError(f"model: knows objects not in the set: {unknown}")
+        # An episode draws its object from the set, and the agent declares among the model's
+        # objects: a model that does not know some of the set would quietly shrink the task.
+        untrained = [name for name in names if name not in model.objects]
+        if untrained:
+            raise taction.TactionError(
+                f"model: was not trained on {untrained} of the set (it knows {list(model.objects)})"
+            )
         self.objects = list(model.objects)
         self._episode_objects = [by_name[name] for name in self.objects]
         self.budget = budget
@@ -148,6 +165,7 @@ class ActiveTouchEnv(gymnasium.Env):
         self.action_space = spaces.Discrete(candidates + len(self.objects))
         self._episode: Optional[taction.TouchEpisode] = None
         self._touches = 0
+        self._over = False
 
     # The episode's candidates, repeated in order when the planner offered fewer than K.
     def _candidates(self) -> np.ndarray:
@@ -168,18 +186,27 @@ class ActiveTouchEnv(gymnasium.Env):
         """The expected information gain (nats) of a touch toward each of the K candidates: what a
         touch there would teach times the chance it touches at all, judged from the episode's
         earlier touches; what the information-gain policy maximises (``taction.active_touch``)."""
+        if self._episode is None:
+            raise taction.TactionError("gains: call reset() first")
         offered = self._episode.gains()
         return offered[np.arange(self.k) % len(offered)]
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
         super().reset(seed=seed)
         options = options or {}
+        unknown = sorted(set(options) - {"object"})
+        if unknown:
+            raise taction.TactionError(f"options: {unknown} unknown (the one option is 'object')")
         index = options.get("object")
         if index is None:
             index = int(self.np_random.integers(len(self.objects)))
         elif isinstance(index, str) and index in self.objects:
             index = self.objects.index(index)
-        elif isinstance(index, (int, np.integer)) and 0 <= index < len(self.objects):
+        elif (
+            isinstance(index, (int, np.integer))
+            and not isinstance(index, (bool, np.bool_))
+            and 0 <= index < len(self.objects)
+        ):
             index = int(index)
         else:
             raise taction.TactionError(
@@ -195,11 +222,17 @@ class ActiveTouchEnv(gymnasium.Env):
             **self._settings,
         )
         self._touches = 0
+        self._over = False
         return self._observation(), {"attempts": 0, "readings": 0}
 
     def step(self, action):
         if self._episode is None:
             raise taction.TactionError("step: call reset() first")
+        if self._over:
+            raise taction.TactionError("step: the episode has ended (declared or truncated); call reset()")
+        if not isinstance(action, (int, np.integer)) or isinstance(action, (bool, np.bool_)):
+            if not (isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu"):
+                raise taction.TactionError(f"action: {action!r} is not an integer of the action space")
         action = int(action)
         if not 0 <= action < self.action_space.n:
             raise taction.TactionError(f"action: {action} is outside 0..{self.action_space.n - 1}")
@@ -222,4 +255,5 @@ class ActiveTouchEnv(gymnasium.Env):
         info["readings"] = e.readings
         if terminated or truncated:
             info["object"] = e.object
+            self._over = True
         return self._observation(), float(reward), terminated, truncated, info

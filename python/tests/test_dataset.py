@@ -81,3 +81,15 @@ def test_a_corrupt_dataset_file_names_the_file(tmp_path):
     path.write_text("# taction dataset\n# {not json\n")
     with pytest.raises(taction.TactionError, match="cut.csv"):
         taction.Dataset.load(path)
+
+
+def test_a_set_name_collects_its_objects_and_counts_are_whole_numbers(chess):
+    by_name = taction.collect("chess", readings=3, seed=2)
+    by_list = taction.collect(taction.objects("chess"), readings=3, seed=2)
+    assert list(by_name.objects) == list(by_list.objects)
+    assert np.array_equal(by_name.images, by_list.images)
+    for bad in [dict(readings=-5), dict(seed=-1), dict(threads=-1), dict(readings=2.5)]:
+        with pytest.raises(taction.TactionError, match="whole number"):
+            taction.collect(chess, **bad)
+    with pytest.raises(taction.TactionError, match="neither a list"):
+        taction.collect(42)

@@ -134,6 +134,67 @@ def test_bad_arguments_raise(make, small_model):
         taction.TouchEpisode(small_model, env.unwrapped._episode_objects[0], candidates=10**9)
     with pytest.raises(taction.TactionError, match="objects"):
         taction.collect([])
+    with pytest.raises(taction.TactionError, match="workspace"):
+        taction.TouchEpisode(small_model, env.unwrapped._episode_objects[0], workspace=[])
+    pawn, rook = env.unwrapped._episode_objects
+    with pytest.raises(taction.TactionError, match="workspace"):
+        taction.TouchEpisode(small_model, pawn, workspace=[rook])
+    episode = taction.TouchEpisode(small_model, pawn, seed=3)
+    with pytest.raises(taction.TactionError, match="indices below"):
+        episode.touch(len(episode.candidates))
+    for bad in [dict(seed=-1), dict(candidates=-2)]:
+        with pytest.raises(taction.TactionError, match="whole number"):
+            taction.TouchEpisode(small_model, pawn, **bad)
+
+
+def test_a_finished_episode_takes_no_more_steps(make):
+    env = make(budget=2)
+    env.reset(seed=0)
+    k = env.unwrapped.k
+    env.step(k)  # a declaration ends it
+    with pytest.raises(taction.TactionError, match="reset"):
+        env.step(k + 1)
+    env.reset(seed=0)
+    for _ in range(2):
+        _, _, _, truncated, _ = env.step(0)
+    assert truncated
+    with pytest.raises(taction.TactionError, match="reset"):
+        env.step(0)
+    obs, _ = env.reset(seed=0)  # a reset starts the next episode
+    assert env.observation_space.contains(obs)
+    env.step(0)
+
+
+def test_actions_and_options_are_what_the_spaces_say(make):
+    env = make()
+    with pytest.raises(taction.TactionError, match="reset"):
+        env.unwrapped.gains()
+    env.reset(seed=0)
+    for action in [3.7, "13", True, None]:
+        with pytest.raises(taction.TactionError, match="action"):
+            env.unwrapped.step(action)
+    env.unwrapped.step(np.int64(0))
+    env.unwrapped.step(np.array(1))
+    with pytest.raises(taction.TactionError, match="objekt"):
+        env.reset(seed=0, options={"objekt": "rook"})
+    with pytest.raises(taction.TactionError, match="object"):
+        env.reset(seed=0, options={"object": True})
+
+
+def test_the_model_must_know_every_object_of_the_set(chess):
+    pawn = chess[0]
+    training = taction.collect([pawn], readings=12, seed=1)
+    pawn_only = taction.train(training, descriptor="mnti", codebook="knn")
+    with pytest.raises(taction.TactionError, match="not trained on"):
+        gymnasium.make(ENV, objects="chess", model=pawn_only)
+    with pytest.raises(taction.TactionError, match="empty"):
+        gymnasium.make(ENV, objects=[], model=pawn_only)
+    with pytest.raises(taction.TactionError, match="more than once"):
+        gymnasium.make(ENV, objects=[pawn, pawn], model=pawn_only)
+    with pytest.raises(taction.TactionError, match="model"):
+        gymnasium.make(ENV, objects=[pawn], model=42)
+    env = gymnasium.make(ENV, objects=[pawn], model=pawn_only)
+    assert env.unwrapped.objects == ["pawn"]
 
 
 def test_the_default_recogniser_is_the_demos_calibrated_on_the_arm(chess):

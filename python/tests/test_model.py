@@ -133,7 +133,7 @@ def test_models_objects_and_datasets_pickle(small_model, small_dataset, chess):
     assert pawn.name == "pawn" and np.array_equal(pawn.bounds_m, chess[0].bounds_m)
     pose = [0, 0, chess[0].bounds_m[1, 2] + 0.0006, 0, 0, -1, 0, 1, 0]
     assert np.array_equal(taction.Sensor().read(pawn, pose), taction.Sensor().read(chess[0], pose))
-    with pytest.raises(taction.TactionError, match="pickled model"):
+    with pytest.raises(taction.TactionError, match="the model's bytes"):
         taction.Model.from_json(b"{}")
 
 

@@ -2,6 +2,8 @@
 
 import pathlib
 import re
+import subprocess
+import sys
 
 import mujoco
 import numpy as np
@@ -52,3 +54,35 @@ def test_the_python_blocks_run_as_written(document, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for block in blocks:
         exec(compile(block, document, "exec"), {})
+
+
+# The README's "In MuJoCo" block, then `import taction`, or the other way round: one process, two
+# copies of the plugin's code (the plugin library and the package's module).
+BOTH_ORDERS = """
+import sys
+import mujoco
+first = sys.argv[1]
+if first == "package":
+    import taction
+mujoco.mj_loadPluginLibrary("target/release/libtaction_covering.so")
+if first == "library":
+    import taction
+m = mujoco.MjModel.from_xml_path("mjcf/scene.xml")
+d = mujoco.MjData(m)
+mujoco.mj_resetDataKeyframe(m, d, m.key("touch").id)
+mujoco.mj_forward(m, d)
+adr = m.sensor("tactile").adr[0]
+print(max(d.sensordata[adr:adr + 36]))
+"""
+
+
+@pytest.mark.parametrize("first", ["library", "package"])
+def test_the_plugin_library_and_the_package_share_one_process(first):
+    """MuJoCo ends the process when a second plugin of one name registers: the copy that comes
+    second must leave the first's registration alone, and the sensor must still read."""
+    assert (ROOT / "target/release/libtaction_covering.so").exists(), "cargo xtask setup builds it"
+    done = subprocess.run(
+        [sys.executable, "-c", BOTH_ORDERS, first], cwd=ROOT, capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr + done.stdout
+    assert float(done.stdout.strip()) > 0.2

@@ -65,6 +65,9 @@ def test_a_broken_mesh_raises_an_error_naming_the_file(tmp_path):
 def test_out_of_range_parameters_name_the_field(sphere_path):
     with pytest.raises(taction.TactionError, match="rows"):
         taction.Sensor(rows=0)
+    for bad in [dict(rows=-1), dict(seed=-1), dict(rays_per_taxel=2.5)]:
+        with pytest.raises(taction.TactionError, match="whole number"):
+            taction.Sensor(**bad)
     with pytest.raises(taction.TactionError, match="noise"):
         taction.Sensor(noise=-0.1)
     sphere = taction.Object.from_file(sphere_path)
@@ -72,3 +75,28 @@ def test_out_of_range_parameters_name_the_field(sphere_path):
         taction.Sensor().read(sphere, [0, 0, 0.06, 0, 0, -1])
     with pytest.raises(taction.TactionError, match="pad_pose"):
         taction.Sensor().read(sphere, [0, 0, 0.06, 0, 0, -1, 0, 0, -1])
+
+
+def test_a_reading_comes_as_floats_only(sphere_path):
+    sphere = taction.Object.from_file(sphere_path)
+    pose = TOUCH
+    single = taction.Sensor().read(sphere, pose)
+    double = taction.Sensor().read(sphere, pose, dtype=np.float64)
+    assert single.dtype == np.float32 and double.dtype == np.float64
+    assert single.max() > 0.2 and np.array_equal(single, double.astype(np.float32))
+    for bad in ["uint8", np.int32, "nonsense"]:
+        with pytest.raises(taction.TactionError, match="dtype"):
+            taction.Sensor().read(sphere, pose, dtype=bad)
+
+
+def test_size_m_rescales_a_folder_and_built_in_sets_refuse_it(sphere_path):
+    folder = sphere_path.parent
+    (resized,) = [o for o in taction.objects(folder, size_m=0.08) if o.name == sphere_path.stem]
+    assert abs(resized.size_m - 0.08) < 1e-9
+    for bad in [-1.0, float("nan"), 0.0]:
+        with pytest.raises(taction.TactionError, match="size_m"):
+            taction.objects(folder, size_m=bad)
+        with pytest.raises(taction.TactionError, match="size_m"):
+            taction.Object.from_file(sphere_path, size_m=bad)
+    with pytest.raises(taction.TactionError, match="size_m"):
+        taction.objects("chess", size_m=0.05)

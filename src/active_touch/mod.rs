@@ -485,7 +485,7 @@ pub enum TouchError {
     Config(#[from] RangeError),
     /// A touch toward a candidate the episode did not offer.
     #[error(
-        "touch toward candidate {index}: the episode offers {candidates} candidates (0 to {candidates} - 1)"
+        "touch toward candidate {index}: the episode offers {candidates} candidates (indices below {candidates})"
     )]
     NoSuchCandidate { index: usize, candidates: usize },
     /// The object to explore is not one the model recognises.

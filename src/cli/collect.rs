@@ -14,7 +14,9 @@ use taction::tactile::SensorConfig;
 use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
-use crate::cli::common::{ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, flag_error};
+use crate::cli::common::{
+    ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, check_output_file, flag_error,
+};
 use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
 
@@ -85,6 +87,7 @@ pub struct CollectArgs {
 
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_flags(args)?;
+    check_output_file(&args.out, "out")?;
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed.seed)?.into_inner();
     let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;

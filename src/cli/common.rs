@@ -102,6 +102,15 @@ fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, NonZeroUsize::get)
 }
 
+/// A count flag that must be 1 or more.
+pub fn parse_at_least_one(text: &str) -> Result<NonZeroUsize, String> {
+    text.trim()
+        .parse::<usize>()
+        .ok()
+        .and_then(NonZeroUsize::new)
+        .ok_or_else(|| format!("'{text}' is not a whole number 1 or more"))
+}
+
 fn parse_threads(text: &str) -> Result<usize, String> {
     let n: usize = text
         .trim()
@@ -129,9 +138,11 @@ impl ThreadsArg {
 /// `--posterior`, how recognition turns likelihoods into probabilities.
 #[derive(Debug, Clone, Copy, Args)]
 pub struct PosteriorArg {
-    /// calibrated (the tempering fitted on validation when the model was trained: a stop at
-    /// p = 0.95 is right about 95% of the time) | eq15 (the paper's Eq. 15-16: readings counted as
-    /// independent evidence). Models trained before calibration existed recognise with eq15.
+    /// calibrated (the tempering fitted when the model was trained: on the arm's explorations with
+    /// `train --calibration`, where a stop at p = 0.95 was right 95-98% of the time on the arm's
+    /// touches; else on held-out sampler readings, which leaves it overconfident on the arm's) | eq15
+    /// (the paper's Eq. 15-16: readings counted as independent evidence). Models trained before
+    /// calibration existed recognise with eq15.
     #[arg(long = "posterior", value_name = "RULE", default_value = "calibrated", value_parser = parse_posterior)]
     pub rule: PosteriorRule,
 }
@@ -173,7 +184,18 @@ impl ControlArg {
             None => ControlConfig::default(),
             Some(path) => {
                 let text = std::fs::read_to_string(path).map_err(|e| self.error(e))?;
-                serde_json::from_str(&text).map_err(|e| self.error(e))?
+                let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| self.error(e))?;
+                // serde would also take a JSON array, field by field in order: a file of numbers
+                // whose meaning depends on the struct's field order.
+                let Some(fields) = value.as_object() else {
+                    return Err(self.error("want a JSON object of the controllers' fields by name"));
+                };
+                if fields.contains_key("expected_noise_fraction") {
+                    return Err(self.error(
+                        "expected_noise_fraction is the sensor's noise (--noise), not the file's; leave it out",
+                    ));
+                }
+                serde_json::from_value(value).map_err(|e| self.error(e))?
             }
         };
         config.expected_noise_fraction = noise_fraction;
@@ -208,6 +230,42 @@ pub fn flag_error(flag: &str, value: impl std::fmt::Display, what: impl std::fmt
     UsageError(format!("--{flag} {value}: {what}"))
 }
 
+/// Checks, before any work, that `--{flag} PATH` can become the file a command writes: not a
+/// folder, and not inside a path that is a file (else the run would collect or train first and
+/// then fail on the write with the system's "Not a directory").
+pub fn check_output_file(path: &Path, flag: &str) -> Result<(), UsageError> {
+    let shown = path.display();
+    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
+        return Err(UsageError(format!(
+            "--{flag} {shown}: is a folder; give the file to write"
+        )));
+    }
+    let file_above = path.ancestors().skip(1).find(|a| a.is_file());
+    match file_above {
+        Some(file) => Err(UsageError(format!(
+            "--{flag} {shown}: {} is a file, not a folder",
+            file.display()
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Checks, before any work, that `--{flag} PATH` can become the folder a command writes into.
+pub fn check_output_folder(path: &Path, flag: &str) -> Result<(), UsageError> {
+    match path.ancestors().find(|a| a.is_file()) {
+        Some(file) if file == path => Err(UsageError(format!(
+            "--{flag} {}: is a file; give the folder to write into",
+            path.display()
+        ))),
+        Some(file) => Err(UsageError(format!(
+            "--{flag} {}: {} is a file, not a folder",
+            path.display(),
+            file.display()
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Name of the lock file a run keeps in its output folder.
 pub const LOCK_FILE: &str = ".taction.lock";
 
@@ -223,6 +281,7 @@ impl OutputLock {
     /// Creates `dir` if needed and locks it; `flag` names the flag that chose it, for the message.
     pub fn acquire(dir: &Path, flag: &str) -> Result<Self, Box<dyn std::error::Error>> {
         let io = |path: &Path, e: std::io::Error| format!("--{flag} {}: {e}", path.display());
+        check_output_folder(dir, flag)?;
         std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
         let path: PathBuf = dir.join(LOCK_FILE);
         let mut file = OpenOptions::new()

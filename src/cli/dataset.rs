@@ -11,7 +11,7 @@ use taction::dataset::{Dataset, DatasetError, ExportFormat};
 use taction::paper::RealFramesOptions;
 use taction::paper::recorded_dataset;
 
-use crate::cli::common::{PreprocessArgs, UsageError};
+use crate::cli::common::{PreprocessArgs, UsageError, check_output_file};
 
 #[derive(Debug, Args)]
 pub struct DatasetArgs {
@@ -77,7 +77,16 @@ pub fn run(args: &DatasetArgs) -> Result<(), Box<dyn std::error::Error>> {
     match &args.command {
         DatasetCommand::Show { dataset } => {
             let data = read_dataset(dataset)?;
-            println!("{}", dataset.display());
+            let version = Dataset::file_format_version(dataset)?;
+            if version == data.header().format_version {
+                println!("{}", dataset.display());
+            } else {
+                println!(
+                    "{} (written in format version {version}; read as version {}, as every command reads it)",
+                    dataset.display(),
+                    data.header().format_version
+                );
+            }
             println!("{}", data.summary());
         }
         DatasetCommand::Import(import) => run_import(import)?,
@@ -106,6 +115,7 @@ pub fn read_dataset(path: &Path) -> Result<Dataset, Box<dyn std::error::Error>> 
 
 fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
     refuse_overwriting(&args.out, &args.frames, "frames file", "dataset")?;
+    check_output_file(&args.out, "out")?;
     let options = args.preprocess.options(RealFramesOptions::default().trials)?;
     let calibration = args
         .calibration
@@ -147,6 +157,7 @@ fn refuse_overwriting(out: &Path, input: &Path, what: &str, written: &str) -> Re
 
 fn run_export(args: &ExportArgs) -> Result<(), Box<dyn std::error::Error>> {
     refuse_overwriting(&args.out, &args.dataset, "dataset", "export")?;
+    check_output_file(&args.out, "out")?;
     let data = read_dataset(&args.dataset)?;
     data.export(&args.out, args.format)?;
     let sensor = &data.header().sensor;

@@ -29,7 +29,7 @@ use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
 use taction::recognize::Belief;
-use taction::recognize::{FusedModel, Recognizer};
+use taction::recognize::{FusedModel, PosteriorRule, Recognizer};
 use taction::rng;
 use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, Perturbation, PerturbationBounds, Scene, SceneBuilder};
@@ -37,7 +37,7 @@ use taction::tactile::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error};
+use crate::cli::common::{ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error, parse_at_least_one};
 use crate::cli::plausible::{Carrier, build_objects};
 
 /// The random stream that draws the unknown object and its pose, and the planner's own stream
@@ -82,7 +82,7 @@ pub struct DemoArgs {
     /// Touches the guess must hold --stop-at-confidence over before the stop fires: 1 stops at the
     /// first touch that reaches it, which is right less often than P promises (the first crossing
     /// is selected for being high).
-    #[arg(long, value_name = "N", default_value_t = ConfidenceStop::DEFAULT_HELD_READINGS, requires = "stop_at_confidence")]
+    #[arg(long, value_name = "N", default_value_t = ConfidenceStop::DEFAULT_HELD_READINGS, requires = "stop_at_confidence", value_parser = parse_at_least_one)]
     pub stop_held_readings: NonZeroUsize,
     #[command(flatten)]
     pub posterior: PosteriorArg,
@@ -441,19 +441,69 @@ fn write_outputs(
     )?;
     let belief = &explored.belief;
     let ending = if run.stopped_confident {
-        "stopped: confident"
+        "stopped: confident".to_string()
+    } else if images.len() >= args.touches {
+        "the touch budget spent".to_string()
     } else {
-        "touch budget spent or planner out of iterations"
+        format!(
+            "the planner ran out of iterations, {} of {} touches made",
+            images.len(),
+            args.touches
+        )
     };
+    let guess = belief.guess();
+    write_run_record(args, unknown, &ending, images.len(), run.attempts, names, belief)?;
     println!(
-        "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png, exploration.png}}",
+        "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png, exploration.png, run.json}}",
         images.len(),
         run.attempts,
-        names[belief.guess()],
-        belief.probabilities()[belief.guess()],
+        names[guess],
+        belief.probabilities()[guess],
         unknown.spec.name,
         args.out.display()
     );
+    Ok(())
+}
+
+/// `run.json`: what the run used and how it ended, so that the files beside it say which run made
+/// them (each run into the folder overwrites the last one's).
+fn write_run_record(
+    args: &DemoArgs,
+    unknown: &Unknown,
+    ending: &str,
+    touches: usize,
+    attempts: usize,
+    names: &[String],
+    belief: &Belief,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let pose = unknown.scene.object_pose().unwrap_or(unknown.spec.pose);
+    let guess = belief.guess();
+    let record = serde_json::json!({
+        "objects": args.objects.display().to_string(),
+        "seed": args.seed.seed,
+        "strategy": match args.strategy {
+            DemoStrategy::Blind => "blind",
+            DemoStrategy::Active => "active",
+        },
+        "stop_at_confidence": args.stop_at_confidence.map(f64::from),
+        "stop_held_readings": args.stop_at_confidence.map(|_| args.stop_held_readings.get()),
+        "posterior": match args.posterior.rule {
+            PosteriorRule::Calibrated => "calibrated",
+            PosteriorRule::Eq15 => "eq15",
+        },
+        "training_readings": args.training_readings,
+        "object": unknown.spec.name,
+        "object_position_m": pose.position_m.to_array(),
+        "object_quaternion_wxyz": [pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z],
+        "touches_asked": args.touches,
+        "touches": touches,
+        "attempts": attempts,
+        "ending": ending,
+        "guess": names[guess],
+        "p_guess": belief.probabilities()[guess],
+    });
+    let text = serde_json::to_string_pretty(&record)? + "\n";
+    taction::atomic::write_atomic(&args.out.join("run.json"), text.as_bytes())?;
     Ok(())
 }
 

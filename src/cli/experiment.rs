@@ -16,7 +16,7 @@ use taction::paper::{SHORTFALLS_FILE, read_shortfalls};
 use taction::paper::{TIMINGS_FILE, timings_table, write_timings};
 
 use crate::cli::common::{
-    ObjectSizeArg, OutputLock, PosteriorArg, PreprocessArgs, SeedArg, ThreadsArg, parse_codebook,
+    ObjectSizeArg, OutputLock, PosteriorArg, PreprocessArgs, SeedArg, ThreadsArg, UsageError, parse_codebook,
 };
 use crate::cli::plausible::{Carrier, build_objects};
 use taction::recognize::CodebookKind;
@@ -151,7 +151,7 @@ pub fn run_experiment(args: &ExperimentArgs) -> Result<(), Box<dyn std::error::E
         }
         return Ok(());
     }
-    let experiment = parse_experiment(&args.name)?;
+    let experiment = parse_experiment(&args.name).map_err(UsageError)?;
     let context = args.paper.context()?;
     let _lock = OutputLock::acquire(&context.options.out, "out")?;
     check_earlier_runs(&[experiment], &context)?;
@@ -290,7 +290,7 @@ pub fn run_reproduce(args: &ReproduceArgs) -> Result<(), Box<dyn std::error::Err
     } else {
         args.only
             .iter()
-            .map(|n| parse_experiment(n.trim()))
+            .map(|n| parse_experiment(n.trim()).map_err(|e| UsageError(format!("--only: {e}"))))
             .collect::<Result<_, _>>()?
     };
     let context = args.paper.context()?;

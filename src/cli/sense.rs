@@ -15,7 +15,7 @@ use taction::pose::PadPose;
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
-use crate::cli::common::SeedArg;
+use crate::cli::common::{SeedArg, check_output_file};
 use crate::cli::plausible::Carrier;
 use crate::cli::sensor_args::{PadArgs, PadFrameError, SensorArgs, SensorFlagError};
 
@@ -80,6 +80,7 @@ pub fn run(args: &SenseArgs) -> Result<(), Box<dyn std::error::Error>> {
     let config = args.config()?;
     let pose = args.pad_pose()?;
     let png = wants_png(&args.out)?;
+    check_output_file(&args.out, "out")?;
     let object = args.pad.load_object("sense", Carrier::FreePad)?;
     let mut pad = FreePad::new(object, &config).map_err(SenseError::from)?;
     let image = pad.read_at(&pose).map_err(SenseError::from)?;

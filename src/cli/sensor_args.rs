@@ -10,6 +10,7 @@ use taction::pose::PadPose;
 use taction::sim::ObjectSpec;
 use taction::tactile::{ConfigKey, SensorConfig, psf_sigma_for_thickness};
 
+use crate::cli::common::ObjectSizeArg;
 use crate::cli::plausible::{Carrier, check_mesh};
 use taction::valid::Valid;
 
@@ -106,9 +107,12 @@ impl SensorArgs {
 /// the covering, toward the object.
 #[derive(Debug, Clone, Args)]
 pub struct PadArgs {
-    /// The object: an OBJ, OFF or STL mesh, coordinates in metres, placed as given.
+    /// The object: an OBJ, OFF or STL mesh, coordinates in metres, placed as given (with
+    /// `--object-size-m`: rescaled to that bounding diagonal, centred and resting on z = 0).
     #[arg(long, value_name = "FILE")]
     pub mesh: PathBuf,
+    #[command(flatten)]
+    pub object_size: ObjectSizeArg,
     /// Centre of the pad (the back of the covering), world metres.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub pad_center: DVec3,
@@ -163,7 +167,10 @@ impl PadArgs {
         command: &str,
         carrier: Carrier,
     ) -> Result<ObjectSpec, Box<dyn std::error::Error>> {
-        let object = Object::from_file(&self.mesh)?;
+        let object = match self.object_size.m {
+            Some(size_m) => Object::from_file_with_size(&self.mesh, size_m)?,
+            None => Object::from_file(&self.mesh)?,
+        };
         check_mesh(&self.mesh.display().to_string(), &object.mesh, carrier)?;
         if !object.warnings.is_clean() {
             eprintln!(

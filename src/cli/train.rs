@@ -13,7 +13,7 @@ use taction::recognize::{
 };
 use taction::valid::Valid;
 
-use crate::cli::common::{SeedArg, flag_error, parse_codebook};
+use crate::cli::common::{SeedArg, UsageError, check_output_file, flag_error, parse_codebook};
 use crate::cli::dataset::read_dataset;
 
 #[derive(Debug, Args)]
@@ -74,23 +74,50 @@ pub struct TrainArgs {
     pub out: PathBuf,
 }
 
+/// A training parameter out of range, named by the flag that set it; others (the hold-out share,
+/// which no flag sets) keep the library's message.
+fn named_by_flag(e: RecognizeError) -> Box<dyn std::error::Error> {
+    match e {
+        RecognizeError::InvalidParameter { name, what } => {
+            let flag = match name {
+                "k" => "k",
+                "restarts" => "restarts",
+                "trial_readings" => "trial-readings",
+                "variance_kept" => "variance-kept",
+                "pseudo_count" => "pseudo-count",
+                _ => return RecognizeError::InvalidParameter { name, what }.into(),
+            };
+            UsageError(format!("--{flag}: {what}")).into()
+        }
+        other => other.into(),
+    }
+}
+
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     if args.calibration_trial_readings == Some(0) {
         return Err(flag_error("calibration-trial-readings", 0, "want 1 or more").into());
     }
-    let training = read_dataset(&args.dataset)?;
-    let config = TrainConfig {
+    check_output_file(&args.out, "out")?;
+    let variance_kept = match args.variance_kept {
+        Some(fraction) => VarianceFraction::new(fraction).map_err(named_by_flag)?,
+        None => args.codebook.default_variance_kept(),
+    };
+    let pseudo_count = PseudoCount::new(args.pseudo_count).map_err(named_by_flag)?;
+    let flags = TrainConfig {
         codebook: args.codebook,
         restarts: args.restarts,
         seed: args.seed.seed,
-        variance_kept: match args.variance_kept {
-            Some(fraction) => VarianceFraction::new(fraction)?,
-            None => args.codebook.default_variance_kept(),
-        },
-        pseudo_count: PseudoCount::new(args.pseudo_count)?,
+        variance_kept,
+        pseudo_count,
         trial_readings: args.trial_readings,
+        ks: args.ks.clone().unwrap_or_else(|| TrainConfig::default().ks),
         ..TrainConfig::default()
     };
+    // The flags' own values are checked before any dataset is read (a bad one exits 2, named by
+    // its flag); the grid a dataset chooses is checked again below.
+    Valid::new(flags.clone()).map_err(named_by_flag)?;
+    let training = read_dataset(&args.dataset)?;
+    let config = flags;
     let config = match &args.ks {
         Some(ks) => TrainConfig {
             ks: ks.clone(),

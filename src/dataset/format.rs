@@ -300,6 +300,25 @@ impl Dataset {
         Self::parse(text, &name)
     }
 
+    /// The format version the file at `path` was written in. Reading brings an older file's header
+    /// up to this build's version, so `header().format_version` of what [`read`](Self::read)
+    /// returns is always [`FORMAT_VERSION`]; `taction dataset show` tells both.
+    pub fn file_format_version(path: &Path) -> Result<u32, DatasetError> {
+        use std::io::BufRead;
+        let name = path.display().to_string();
+        let io = |source| DatasetError::Io {
+            path: name.clone(),
+            source,
+        };
+        let mut head = String::new();
+        let mut reader = std::io::BufReader::new(std::fs::File::open(path).map_err(io)?);
+        for _ in 0..2 {
+            reader.read_line(&mut head).map_err(io)?;
+        }
+        let (header_line, _) = split_magic_and_header(head.trim_end_matches('\n'), &name)?;
+        parse_header(header_line, &name).map(|(_, version)| version)
+    }
+
     /// Parses the text of a dataset file; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Dataset, DatasetError> {
         let path = || origin.to_string();

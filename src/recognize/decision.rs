@@ -12,7 +12,8 @@ pub fn cross_entropy(p_u: &[f64], log_p_o: &[f64]) -> f64 {
 
 /// Shannon entropy `-sum p ln p` in nats (`0 ln 0 = 0`).
 pub fn entropy_nats(p: &[f64]) -> f64 {
-    -p.iter().filter(|&&p| p > 0.0).map(|p| p * p.ln()).sum::<f64>()
+    // `0 - sum`, not `-sum`: a certain belief's entropy is 0, not the -0 a CSV would show.
+    0.0 - p.iter().filter(|&&p| p > 0.0).map(|p| p * p.ln()).sum::<f64>()
 }
 
 /// What the models say about a set of features `U`.

@@ -31,9 +31,9 @@ use std::sync::Once;
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{
-    mj_getPluginConfig, mjData, mjModel, mjp_defaultPlugin, mjp_getPluginAtSlot, mjp_registerPlugin,
-    mjpPlugin, mjtCatBit, mjtGeom, mjtNum, mjtObj, mjtPluginCapabilityBit, mjtSensor, mjtStage, mju_error,
-    mju_warning, mjv_initGeom, mjvOption, mjvScene,
+    mj_getPluginConfig, mjData, mjModel, mjp_defaultPlugin, mjp_getPlugin, mjp_getPluginAtSlot,
+    mjp_registerPlugin, mjpPlugin, mjtCatBit, mjtGeom, mjtNum, mjtObj, mjtPluginCapabilityBit, mjtSensor,
+    mjtStage, mju_error, mju_warning, mjv_initGeom, mjvOption, mjvScene,
 };
 
 use crate::pose::rotation_from_xmat;
@@ -68,8 +68,17 @@ static REGISTER: Once = Once::new();
 /// Registers the plugin with MuJoCo, once per process (later calls do nothing). Must run before
 /// any model using `taction.covering` is compiled; [`ensure_registered`] is the same call under
 /// the name scene builders use.
+///
+/// Two copies of this code can live in one process: the plugin library (`plugin/`, loaded by
+/// `mujoco.mj_loadPluginLibrary`) and the Python module, each registering on load. MuJoCo refuses a
+/// second plugin of the same name with other callbacks by `mju_error`, which ends the process, so
+/// a copy that finds `taction.covering` already registered leaves it: the first copy's callbacks
+/// serve every model.
 pub fn register() {
     REGISTER.call_once(|| {
+        if is_registered() {
+            return;
+        }
         // SAFETY: mjp_defaultPlugin fills a plain C struct; every pointer stored in it is 'static
         // and every callback has the signature MuJoCo declares. mjp_registerPlugin copies it.
         unsafe {
@@ -90,6 +99,14 @@ pub fn register() {
             mjp_registerPlugin(&plugin);
         }
     });
+}
+
+/// Whether MuJoCo already knows a plugin named `taction.covering` (this copy's or another's).
+fn is_registered() -> bool {
+    let mut slot: c_int = -1;
+    // SAFETY: the name is NUL-terminated; MuJoCo writes the slot and returns null or a pointer into
+    // its own table, which is only compared with null here.
+    unsafe { !mjp_getPlugin(PLUGIN_NAME_C.as_ptr(), &mut slot).is_null() }
 }
 
 /// Makes sure the plugin is registered before compiling a model that uses it.

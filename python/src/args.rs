@@ -1,0 +1,69 @@
+//! Arguments as Python passes them, parsed at the edge into what the library takes: a whole number
+//! that may not be negative, and the objects to touch as a list or a set's name. A value that is
+//! not one is a `TactionError` saying what it got (PyO3 adds a note naming the argument), not
+//! Python's `OverflowError` or a `TypeError` about Rust types.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use pyo3::types::PyString;
+
+use crate::error::refused;
+use crate::object::{Object, objects};
+
+/// A count, an index or a seed: a Python `int` from 0 to the type's largest value. A signature's
+/// default is then `Whole(1)`, which PyO3 shows as `...`, so those signatures spell out their
+/// `text_signature`.
+pub struct Whole<T>(pub T);
+
+macro_rules! whole {
+    ($t:ty) => {
+        impl<'a, 'py> FromPyObject<'a, 'py> for Whole<$t> {
+            type Error = PyErr;
+
+            fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+                obj.extract::<$t>().map(Whole).map_err(|_| {
+                    let shown = obj
+                        .repr()
+                        .map(|r| r.to_string())
+                        .unwrap_or_else(|_| "?".into());
+                    refused(format!(
+                        "{shown} is not a whole number from 0 to {}",
+                        <$t>::MAX
+                    ))
+                })
+            }
+        }
+    };
+}
+
+whole!(usize);
+whole!(u64);
+
+/// The objects to touch: a list of `taction.Object`s, or a set's name or folder as
+/// `taction.objects` takes it (built into objects here).
+pub struct Objects(pub Vec<Arc<taction::mesh::Object>>);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Objects {
+    type Error = PyErr;
+
+    fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let py = obj.py();
+        let is_path =
+            obj.is_instance_of::<PyString>() || obj.is_instance(&py.import("os")?.getattr("PathLike")?)?;
+        if is_path {
+            let set: PathBuf = obj.extract()?;
+            return Ok(Self(
+                objects(py, set, None)?.into_iter().map(|o| o.inner).collect(),
+            ));
+        }
+        let list: Vec<PyRef<'_, Object>> = obj.extract().map_err(|_| {
+            let shown = obj.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into());
+            refused(format!(
+                "{shown} is neither a list of taction.Object nor a set's name or folder"
+            ))
+        })?;
+        Ok(Self(list.iter().map(|o| Arc::clone(&o.inner)).collect()))
+    }
+}
