@@ -711,6 +711,26 @@ fn an_unknown_sim_to_real_label_is_named_with_its_line() {
         line.contains("real.csv: line 4: label 'banana' names no letter"),
         "{line}"
     );
+    // Frames of another grid than the simulated sensor's are refused before any collection.
+    let real = write(dir.path(), "real4.csv", &csv.replace("banana", "A"));
+    let line = fails_with(
+        &taction(&[
+            "experiment",
+            "sim-to-real",
+            "--real",
+            &real,
+            "--scale",
+            "0.01",
+            "--out",
+            &out,
+        ]),
+        1,
+    );
+    assert!(
+        line.contains("--real: the frames are 4x4 taxels but the simulated sensor is 6x6"),
+        "{line}"
+    );
+    assert!(!Path::new(&out).join("data").exists(), "nothing was collected");
 }
 
 #[test]

@@ -147,6 +147,14 @@ fn manifests_round_trip_and_resolve() {
         ObjectSet::resolve(&[PathBuf::from("chess")], None, None).unwrap(),
         ObjectSet::chess()
     );
+    // Several entries are mesh files; a set among them is named as one.
+    for set in [PathBuf::from("chess"), dir.path().to_path_buf(), manifest.clone()] {
+        let e = ObjectSet::resolve(&[paths[0].clone(), set.clone()], None, None).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!("'{}' is a set", set.display())),
+            "{e}"
+        );
+    }
 
     std::fs::write(&manifest, "{\"name\": \"x\",\n \"version\": \"one\"}").unwrap();
     let e = ObjectSet::load_manifest(&manifest).unwrap_err();

@@ -47,6 +47,9 @@ pub fn write_index(out: &Path) -> Result<PathBuf, ExperimentError> {
 fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Result<(), ExperimentError> {
     let name = dir.name();
     let _ = write!(text, "\n## {name}\n\n{}\n\n", manifest.spec.description);
+    if let Some(run) = run_line(dir) {
+        let _ = write!(text, "{run}\n\n");
+    }
     let missing = missing_units(dir, manifest).len();
     let csv = dir.csv();
     if missing > 0 || !csv.is_file() {
@@ -85,6 +88,27 @@ fn section(text: &mut String, dir: &ExperimentDir, manifest: &Manifest) -> Resul
         }
     }
     Ok(())
+}
+
+/// What the run used, from its `config.json`: scale, seed, object set and codebook, those it has
+/// (a quick look at scale 0.05 and the paper's 1.0 write the same files otherwise).
+fn run_line(dir: &ExperimentDir) -> Option<String> {
+    let config: serde_json::Value = read_json(&dir.config()).ok()?;
+    let field = |value: Option<&serde_json::Value>| match value? {
+        serde_json::Value::String(s) => Some(s.clone()),
+        v @ serde_json::Value::Number(_) => Some(v.to_string()),
+        _ => None,
+    };
+    let parts: Vec<String> = [
+        ("scale", field(config.get("scale"))),
+        ("seed", field(config.get("seed"))),
+        ("object set", field(config.get("object_set"))),
+        ("codebook", field(config.pointer("/training/codebook"))),
+    ]
+    .into_iter()
+    .filter_map(|(label, value)| Some(format!("{label} {}", value?)))
+    .collect();
+    (!parts.is_empty()).then(|| format!("Run: {}.", parts.join(", ")))
 }
 
 /// Adds the experiment's detail table `table` to the data line when it is assembled; whether it is.

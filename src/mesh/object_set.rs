@@ -348,7 +348,21 @@ impl ObjectSet {
                     )))
                 }
             }
-            many => Self::from_files("custom", many, diagonal_m),
+            many => {
+                // Several entries are mesh files; a set among them would be read as a file of an
+                // unknown format.
+                if let Some(set) = many.iter().find(|p| {
+                    BUILTIN_SETS.contains(&p.to_string_lossy().as_ref())
+                        || p.is_dir()
+                        || p.extension().is_some_and(|e| e == "json")
+                }) {
+                    return Err(set_error(format!(
+                        "'{}' is a set: give one set (a built-in set, a folder or a manifest) or several mesh files",
+                        set.display()
+                    )));
+                }
+                Self::from_files("custom", many, diagonal_m)
+            }
         }
     }
 

@@ -252,6 +252,23 @@ impl RecognitionSweep {
 
     /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
     /// by what they are (real sensor frames, or the synthetic example's).
+    /// Every setting's simulated sensor has the recorded frames' taxel grid: a model of another
+    /// grid cannot describe them.
+    fn check_real_grid(&self, real: &RealData) -> Result<(), BoxError> {
+        match self
+            .settings
+            .iter()
+            .find(|s| (s.sensor.rows, s.sensor.cols) != (real.rows, real.cols))
+        {
+            Some(s) => Err(format!(
+                "--real: the frames are {}x{} taxels but the simulated sensor is {}x{}",
+                real.rows, real.cols, s.sensor.rows, s.sensor.cols
+            )
+            .into()),
+            None => Ok(()),
+        }
+    }
+
     pub(crate) fn plot_title(&self, real: Option<&RealData>) -> String {
         match real {
             Some(real) => format!("{} {}", self.title, real.frames_words()),
@@ -280,12 +297,16 @@ impl RecognitionSweep {
             arm_calibration: self.arm_calibration(context, counts),
         };
         check_resumable(&context.options, &name, &config)?;
-        let dir = ExperimentDir::new(&context.options.out, &name);
-        prepare_pending(context, &objects, counts, &plans, &dir)?;
+        // The recorded frames are read, and their grid checked, before any dataset is collected.
         let real = match self.family {
             Family::RealLabels => Some(context.real_data()?),
             _ => None,
         };
+        if let Some(real) = &real {
+            self.check_real_grid(real)?;
+        }
+        let dir = ExperimentDir::new(&context.options.out, &name);
+        prepare_pending(context, &objects, counts, &plans, &dir)?;
         let experiment = Experiment {
             spec: ExperimentSpec {
                 name: name.clone(),
