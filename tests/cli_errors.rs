@@ -910,3 +910,74 @@ fn recognize_warns_of_a_sampler_calibration_on_the_arms_touches() {
         "{text}"
     );
 }
+
+/// `train` names the file at fault: a validation set of another sensor or of other objects, a
+/// training set with an object that has nothing to train on.
+#[test]
+fn training_data_that_cannot_train_is_named_by_its_flag_and_file() {
+    let dir = tempfile::tempdir().unwrap();
+    toy_model(dir.path());
+    let train = dir.path().join("train.csv").display().to_string();
+    let out = dir.path().join("m.json").display().to_string();
+    let big = SensorConfig {
+        rows: 14,
+        cols: 14,
+        ..recognize_toy::sensor()
+    };
+    let other_sensor = dir.path().join("big.csv");
+    flat_dataset(big, &recognize_toy::OBJECTS, 4)
+        .write(&other_sensor)
+        .unwrap();
+    let other_objects = dir.path().join("dragons.csv");
+    flat_dataset(recognize_toy::sensor(), &["dragon"], 4)
+        .write(&other_objects)
+        .unwrap();
+    for (validation, what) in [
+        (&other_sensor, "another sensor than --dataset"),
+        (&other_objects, "object 'dragon' is not one of --dataset"),
+    ] {
+        let validation = validation.display().to_string();
+        let line = fails_with(&train_vectorize(&train, &["--validation", &validation], &out), 1);
+        assert!(
+            line.contains(&format!("--validation {validation}: {what}")),
+            "{line}"
+        );
+    }
+    let toy = recognize_toy::dataset(4, 3);
+    let mut objects: Vec<String> = recognize_toy::OBJECTS.iter().map(|s| s.to_string()).collect();
+    objects.push("ghost".into());
+    let header = DatasetHeader::new(recognize_toy::sensor(), "toy", objects, "toy", 3);
+    let ghostly = dir.path().join("ghostly.csv");
+    Dataset::new(header, toy.readings().to_vec())
+        .unwrap()
+        .write(&ghostly)
+        .unwrap();
+    let ghostly = ghostly.display().to_string();
+    let line = fails_with(&train_vectorize(&ghostly, &[], &out), 1);
+    assert!(
+        line.contains(&format!(
+            "--dataset {ghostly}: object 'ghost' has no converged reading"
+        )),
+        "{line}"
+    );
+}
+
+/// A flag of the other collection mode would be ignored: it is refused, naming it.
+#[test]
+fn a_flag_of_the_other_collection_mode_is_refused() {
+    for (flags, named) in [
+        (&["--mode", "sampler", "--local-prob", "0.9"][..], "--local-prob"),
+        (
+            &["--mode", "sampler", "--max-iterations", "3"][..],
+            "--max-iterations",
+        ),
+        (&["--mode", "planner", "--reachable"][..], "--reachable"),
+        (
+            &["--mode", "planner", "--from-above", "--reachable"][..],
+            "--from-above, --reachable",
+        ),
+    ] {
+        let line = chess_collect_fails(flags, 2);
+        assert!(line.contains(&format!("{named}: not a flag of --mode")), "{line}");
+    }
+}

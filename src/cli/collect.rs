@@ -44,9 +44,9 @@ pub struct CollectArgs {
     /// Converged readings per object (at most 1000000; the paper trains on 1000).
     #[arg(long, default_value_t = 100, allow_hyphen_values = true)]
     pub readings: usize,
-    /// Planner: probability L of the local strategy.
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
-    pub local_prob: f64,
+    /// Planner: probability L of the local strategy [default: 0.5].
+    #[arg(long, allow_hyphen_values = true)]
+    pub local_prob: Option<f64>,
     /// Planner: iterations allowed per object before it gives up short of `--readings`
     /// [default: 200 per reading asked for, at least 20000]
     #[arg(long, allow_hyphen_values = true)]
@@ -143,6 +143,33 @@ fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
             format!("want 1 to {MAX_READINGS} per object"),
         ));
     }
+    // A flag of the other mode would be ignored without a word: the run would not be the one asked for.
+    let given = |flags: &[(&'static str, bool)]| -> Vec<&'static str> {
+        flags
+            .iter()
+            .filter(|(_, on)| *on)
+            .map(|(name, _)| *name)
+            .collect()
+    };
+    let (others, mode) = match args.mode {
+        Mode::Sampler => (
+            given(&[
+                ("--local-prob", args.local_prob.is_some()),
+                ("--max-iterations", args.max_iterations.is_some()),
+            ]),
+            "sampler",
+        ),
+        Mode::Planner => (
+            given(&[("--from-above", args.from_above), ("--reachable", args.reachable)]),
+            "planner",
+        ),
+    };
+    if !others.is_empty() {
+        return Err(UsageError(format!(
+            "{}: not a flag of --mode {mode} (the help says which mode each flag belongs to)",
+            others.join(", ")
+        )));
+    }
     if !(0.0..=180.0).contains(&args.perturb_deg) {
         return Err(flag_error(
             "perturb-deg",
@@ -179,7 +206,13 @@ fn collection(args: &CollectArgs, sensor: SensorConfig, objects: &[ObjectSpec]) 
         }
         Mode::Planner => Collect::planner(
             sensor,
-            PlannerConfig::for_collection(objects, args.readings, args.local_prob, args.max_iterations),
+            PlannerConfig::for_collection(
+                objects,
+                args.readings,
+                args.local_prob
+                    .unwrap_or(PlannerConfig::default().local_probability),
+                args.max_iterations,
+            ),
         ),
     }
 }

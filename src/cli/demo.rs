@@ -195,7 +195,14 @@ fn train_model(
     );
     let model = recipe.fit(&dataset, Some(&calibration))?;
     let t = model.tempering;
-    println!("posterior calibrated on the arm's explorations: {t}");
+    if calibration.converged_only().is_empty() {
+        eprintln!(
+            "warning: calibration: the arm's explorations gave no converged reading, so nothing calibrated \
+             the posterior ({t}): it counts the arm's correlated touches as independent evidence"
+        );
+    } else {
+        println!("posterior calibrated on the arm's explorations: {t}");
+    }
     Ok(model)
 }
 
@@ -321,9 +328,13 @@ fn explore_unknown(
         &mut |touch| shown.add(&touch.belief),
     )?;
     if run.touches.is_empty() {
+        let size = args
+            .object_size
+            .m
+            .map_or_else(String::new, |m| format!(" --object-size-m {m}"));
         return Err(format!(
             "the planner found no converged reading of '{}' after {} attempts; \
-             `taction collect --objects {} --mode planner` prints why its attempts fail, per object; \
+             `taction collect --objects {}{size} --mode planner` prints why its attempts fail, per object; \
              try another --seed or --object",
             unknown.spec.name,
             run.attempts,

@@ -9,7 +9,7 @@ use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
 use taction::recognize::{
     CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, Recognizer, Tempering,
-    TrainConfig, TrainProgress, TrainedModel, VarianceFraction,
+    TrainConfig, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
 };
 use taction::valid::Valid;
 
@@ -126,10 +126,11 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         None => config.with_grid_for_dataset(&training, args.validation.is_some()),
     };
     let validation = args.validation.as_deref().map(read_dataset).transpose()?;
+    check_datasets(args, &training, validation.as_ref())?;
     let config = Valid::new(config)?;
     let mut models = Vec::new();
     for &kind in args.descriptor.kinds() {
-        let model = fit_one(args, kind, &config, &training, validation.as_ref())?;
+        let model = fit_one(kind, &config, &training, validation.as_ref())?;
         print_selection(&model);
         models.push(model);
     }
@@ -179,8 +180,46 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// Trains the model of one descriptor, with a progress bar.
-fn fit_one(
+/// The training data has converged readings of every object, and the validation data is of the
+/// same sensor and objects: said here naming the files, rather than by the fit, which knows no file.
+fn check_datasets(
     args: &TrainArgs,
+    training: &Dataset,
+    validation: Option<&Dataset>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let train = args.dataset.display();
+    if let Some(empty) = training.shortfalls(1).first() {
+        return Err(format!(
+            "--dataset {train}: object '{}' has no converged reading to train on",
+            empty.object
+        )
+        .into());
+    }
+    let (Some(validation), Some(path)) = (validation, &args.validation) else {
+        return Ok(());
+    };
+    let path = path.display();
+    let sensors = (
+        (&training.header().sensor, "training"),
+        (&validation.header().sensor, "validation"),
+    );
+    if let Some(differences) = sensor_differences(sensors.0, sensors.1) {
+        return Err(
+            format!("--validation {path}: another sensor than --dataset {train}'s: {differences}").into(),
+        );
+    }
+    let known = &training.header().objects;
+    if let Some(stranger) = validation.header().objects.iter().find(|o| !known.contains(o)) {
+        return Err(format!(
+            "--validation {path}: object '{stranger}' is not one of --dataset {train}'s objects ({})",
+            known.join(", ")
+        )
+        .into());
+    }
+    Ok(())
+}
+
+fn fit_one(
     kind: DescriptorKind,
     config: &Valid<TrainConfig>,
     training: &Dataset,
@@ -206,11 +245,7 @@ fn fit_one(
         validation,
         descriptor.as_ref(),
         &mut on_progress,
-    )
-    .map_err(|e| match (&e, &args.validation) {
-        (RecognizeError::SensorMismatch { .. }, Some(path)) => format!("{}: {e}", path.display()),
-        _ => e.to_string(),
-    })?;
+    )?;
     bar.finish_and_clear();
     Ok(model)
 }

@@ -44,7 +44,9 @@ pub use bag::BagOfFeatures;
 pub use error::RecognizeError;
 pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, Recognizer};
 pub use labelled::LabelledFeatures;
-pub use model::{MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor};
+pub use model::{
+    MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor, sensor_differences,
+};
 
 // Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
 pub use codebook::{CodebookConfig, CodebookKind};

@@ -352,60 +352,72 @@ fn check_format_version(value: &serde_json::Value, origin: &str) -> Result<(), R
 /// every field must be equal except `noise_seed` (another noise stream of the same noise level is
 /// the same sensor). The error lists each differing field.
 pub fn check_same_sensor(model: &SensorConfig, data: &SensorConfig) -> Result<(), RecognizeError> {
-    let (m, d) = (model, data);
-    if *m
+    match sensor_differences((model, "model"), (data, "data")) {
+        None => Ok(()),
+        Some(differences) => Err(RecognizeError::SensorMismatch {
+            differences,
+            model: Box::new(*model),
+            data: Box::new(*data),
+        }),
+    }
+}
+
+/// The fields in which two sensors differ, `noise_seed` aside, each as `name A (a) vs B (b)` with
+/// the two sides' labels; `None` when they are the same sensor.
+pub fn sensor_differences(
+    (a, a_label): (&SensorConfig, &str),
+    (b, b_label): (&SensorConfig, &str),
+) -> Option<String> {
+    if *a
         == (SensorConfig {
-            noise_seed: m.noise_seed,
-            ..*d
+            noise_seed: a.noise_seed,
+            ..*b
         })
     {
-        return Ok(());
+        return None;
     }
-    let mut differences = Vec::new();
-    let mut differ = |name: &str, a: String, b: String| {
-        if a != b {
-            differences.push(format!("{name} {a} (model) vs {b} (data)"));
-        }
-    };
-    differ("rows", m.rows.to_string(), d.rows.to_string());
-    differ("cols", m.cols.to_string(), d.cols.to_string());
-    differ(
-        "pad_width_m",
-        m.pad_width_m.to_string(),
-        d.pad_width_m.to_string(),
-    );
-    differ(
-        "pad_height_m",
-        m.pad_height_m.to_string(),
-        d.pad_height_m.to_string(),
-    );
-    differ(
-        "thickness_m",
-        m.thickness_m.to_string(),
-        d.thickness_m.to_string(),
-    );
-    differ(
-        "psf_sigma_m",
-        m.psf_sigma_m.to_string(),
-        d.psf_sigma_m.to_string(),
-    );
-    differ(
-        "rays_per_taxel",
-        m.rays_per_taxel.to_string(),
-        d.rays_per_taxel.to_string(),
-    );
-    differ(
-        "noise_fraction",
-        m.noise_fraction.to_string(),
-        d.noise_fraction.to_string(),
-    );
-    if differences.is_empty() {
-        differences.push("a field differs".into());
-    }
-    Err(RecognizeError::SensorMismatch {
-        differences: differences.join(", "),
-        model: Box::new(*m),
-        data: Box::new(*d),
+    let SensorConfig {
+        rows,
+        cols,
+        pad_width_m,
+        pad_height_m,
+        thickness_m,
+        psf_sigma_m,
+        rays_per_taxel,
+        noise_fraction,
+        noise_seed: _,
+    } = a;
+    let fields: [(&str, String, String); 8] = [
+        ("rows", rows.to_string(), b.rows.to_string()),
+        ("cols", cols.to_string(), b.cols.to_string()),
+        ("pad_width_m", pad_width_m.to_string(), b.pad_width_m.to_string()),
+        (
+            "pad_height_m",
+            pad_height_m.to_string(),
+            b.pad_height_m.to_string(),
+        ),
+        ("thickness_m", thickness_m.to_string(), b.thickness_m.to_string()),
+        ("psf_sigma_m", psf_sigma_m.to_string(), b.psf_sigma_m.to_string()),
+        (
+            "rays_per_taxel",
+            rays_per_taxel.to_string(),
+            b.rays_per_taxel.to_string(),
+        ),
+        (
+            "noise_fraction",
+            noise_fraction.to_string(),
+            b.noise_fraction.to_string(),
+        ),
+    ];
+    let differences: Vec<String> = fields
+        .into_iter()
+        .filter(|(_, x, y)| x != y)
+        .map(|(name, x, y)| format!("{name} {x} ({a_label}) vs {y} ({b_label})"))
+        .collect();
+    Some(if differences.is_empty() {
+        "a field differs".into()
+    } else {
+        differences.join(", ")
     })
 }
 
