@@ -491,11 +491,13 @@ fn every_command_with_a_seed_documents_it_alike_with_one_default() {
         "demo",
         "experiment",
         "reproduce",
+        "scene export",
         "sense",
         "touch",
         "train",
     ] {
-        let help = String::from_utf8_lossy(&taction(&[command, "--help"]).stdout).into_owned();
+        let words: Vec<&str> = command.split(' ').chain(["--help"]).collect();
+        let help = String::from_utf8_lossy(&taction(&words).stdout).into_owned();
         let at = help
             .find("--seed <N>")
             .unwrap_or_else(|| panic!("{command} has no --seed: {help}"));

@@ -24,7 +24,7 @@ use taction::sim::{Section, comment, numbers};
 use taction::tactile::{SensorConfig, add_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, check_output_folder};
+use crate::cli::common::{ObjectSizeArg, SeedArg, check_output_folder};
 use crate::cli::plausible::{Carrier, check_mesh};
 use crate::cli::plugin_path::PLUGIN_LIBRARY;
 use crate::cli::sensor_args::SensorArgs;
@@ -57,9 +57,8 @@ pub struct ExportArgs {
     pub object_size: ObjectSizeArg,
     #[command(flatten)]
     pub sensor: SensorArgs,
-    /// Noise seed of the sensor.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub seed: SeedArg,
 }
 
 /// What can go wrong; each names the flag or file at fault.
@@ -190,7 +189,7 @@ fn with_touch_keyframe(
 /// Writes the scene and its mesh; returns the scene file's path.
 pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
     check_output_folder(&args.out, "out")?;
-    let config = args.sensor.config(args.seed)?;
+    let config = args.sensor.config(args.seed.seed)?;
     let built = resolve_object(&args.object, args.object_size.m)?;
     check_mesh(&format!("--object: {}", args.object), &built.mesh, Carrier::Arm)?;
     if !built.warnings.is_clean() {
