@@ -58,19 +58,37 @@ fn read_params(path: &Path, wanted: DescriptorKind) -> Result<DescriptorParams, 
         path: name.clone(),
         what: e.to_string(),
     })?;
-    let params: DescriptorParams =
-        serde_json::from_str(&text).map_err(|e| DescribeCommandError::ParamsFile {
-            path: name.clone(),
-            what: e.to_string(),
+    let file_error = |what: String| DescribeCommandError::ParamsFile {
+        path: name.clone(),
+        what,
+    };
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| file_error(e.to_string()))?;
+    // A trained model's file keeps its descriptor's parameters under "descriptor".
+    let value = match value.get("descriptor") {
+        Some(inner @ serde_json::Value::Object(_)) => inner.clone(),
+        _ => value,
+    };
+    // The descriptor is named before its fields are read: another descriptor's fields would
+    // otherwise be reported as unknown fields of this one.
+    let found = value
+        .get("descriptor")
+        .and_then(serde_json::Value::as_str)
+        .and_then(DescriptorKind::from_name)
+        .ok_or_else(|| {
+            file_error(
+                "want a JSON object naming its \"descriptor\" (e.g. {\"descriptor\": \"mr8\", \"stride_px\": 2}), \
+                 or a trained model's file"
+                    .into(),
+            )
         })?;
-    if params.kind() != wanted {
+    if found != wanted {
         return Err(DescribeCommandError::Mismatch {
             path: name,
-            found: params.kind().name(),
+            found: found.name(),
             wanted: wanted.name(),
         });
     }
-    Ok(params)
+    serde_json::from_value(value).map_err(|e| file_error(e.to_string()))
 }
 
 /// Writes `features` one per line, values comma-separated in shortest round-trip form.
@@ -156,6 +174,20 @@ mod tests {
         );
         let e = describe(&args(dir.path(), Some("{")), &mut Vec::new()).unwrap_err();
         assert!(e.to_string().contains("params.json"), "{e}");
+        // Another descriptor's fields: the descriptor named, not its fields reported unknown.
+        let e = describe(
+            &args(dir.path(), Some(r#"{"descriptor":"mr8","stride_px":2}"#)),
+            &mut Vec::new(),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("describes mr8"), "{e}");
+        let e = describe(&args(dir.path(), Some("[1]")), &mut Vec::new()).unwrap_err();
+        assert!(e.to_string().contains("naming its \"descriptor\""), "{e}");
+        // A trained model's file: its descriptor's parameters.
+        let model = r#"{"format_version": 9, "descriptor": {"descriptor": "vectorize"}, "bag": {}}"#;
+        let mut out = Vec::new();
+        describe(&args(dir.path(), Some(model)), &mut out).unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), "0,0.25,0.5,0.75,1,0\n");
         assert!(parse_kind("hog").unwrap_err().contains("moment-normalized"));
     }
 }
