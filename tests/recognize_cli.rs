@@ -338,6 +338,10 @@ fn recognize_plots_accuracy_with_its_band_and_chance_beside_the_csvs() {
             .collect::<Result<_, _>>()
             .unwrap();
     assert_eq!(rows.len(), 3 * 10);
+    assert!(
+        rows.iter().all(|r| r.seed == 3 && r.stream_seed == 3),
+        "the rows carry the test data's seed"
+    );
     let first: Vec<f64> = rows
         .iter()
         .filter(|r| r.n_readings == 1)

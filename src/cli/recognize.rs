@@ -257,8 +257,9 @@ fn trial_rows(
         descriptor: model.choice().name(),
         factors: Factors::none(),
         trial: trial as u32,
-        seed: 0,
-        stream_seed: 0,
+        // The test data's seed: recognition itself draws nothing.
+        seed: test.header().seed,
+        stream_seed: test.header().seed,
     };
     let lengths: Vec<usize> = test.converged_only().by_object().iter().map(Vec::len).collect();
     let rounds = lengths
