@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use pyo3::types::PyString;
+use pyo3::types::{PyBool, PyString};
 
 use crate::error::refused;
 use crate::object::{Object, objects};
@@ -23,7 +23,7 @@ macro_rules! whole {
             type Error = PyErr;
 
             fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-                obj.extract::<$t>().map(Whole).map_err(|_| {
+                let refusal = || {
                     let shown = obj
                         .repr()
                         .map(|r| r.to_string())
@@ -32,7 +32,12 @@ macro_rules! whole {
                         "{shown} is not a whole number from 0 to {}",
                         <$t>::MAX
                     ))
-                })
+                };
+                // Python's bool is an int; True as a count is a slip, not a 1.
+                if obj.is_instance_of::<PyBool>() {
+                    return Err(refusal());
+                }
+                obj.extract::<$t>().map(Whole).map_err(|_| refusal())
             }
         }
     };

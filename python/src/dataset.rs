@@ -15,6 +15,7 @@ use taction::tactile::SensorConfig;
 use crate::args::{Objects, Whole};
 use crate::array;
 use crate::error::{bad_argument, refused};
+use crate::object::spec_of;
 use crate::sensor::Sensor;
 
 /// Readings of a set of objects, with the header saying how they were made. Columns come out as
@@ -213,12 +214,13 @@ impl Dataset {
 ///   `readings` converged readings per object (`from_above`: approach only from above;
 ///   `reachable_by_arm`: only from starts the arm can take);
 /// - `mode="planner"`: the arm explores with the paper's planner (Sec. III-A), local with
-///   probability `local_probability`.
+///   probability `local_probability` (0.5 by default).
 ///
+/// An argument of the other mode is refused rather than ignored.
 /// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3). Same seed, same
 /// dataset, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python')")]
+#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python')")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
 pub fn collect(
     py: Python<'_>,
@@ -228,7 +230,7 @@ pub fn collect(
     seed: Whole<u64>,
     sensor: Option<PyRef<'_, Sensor>>,
     threads: Whole<usize>,
-    local_probability: f64,
+    local_probability: Option<f64>,
     perturb_deg: f64,
     perturb_frac: f64,
     from_above: bool,
@@ -238,6 +240,17 @@ pub fn collect(
     let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
+    // An argument of the other mode would be ignored: the dataset would not be the one asked for.
+    let other_mode = match mode {
+        "sampler" => local_probability.is_some().then_some("local_probability"),
+        "planner" => [("from_above", from_above), ("reachable_by_arm", reachable_by_arm)]
+            .into_iter()
+            .find_map(|(name, on)| on.then_some(name)),
+        _ => None,
+    };
+    if let Some(name) = other_mode {
+        return Err(bad_argument(name, format!("not an argument of mode='{mode}'")));
+    }
     let collect = match mode {
         "sampler" => {
             let c = Collect::sampler(sensor);
@@ -246,7 +259,12 @@ pub fn collect(
         }
         "planner" => Collect::planner(
             sensor,
-            PlannerConfig::for_collection(&specs, readings, local_probability, None),
+            PlannerConfig::for_collection(
+                &specs,
+                readings,
+                local_probability.unwrap_or(PlannerConfig::default().local_probability),
+                None,
+            ),
         ),
         other => {
             return Err(bad_argument(
@@ -320,13 +338,7 @@ fn touch_inputs(
         None => Sensor::paper_config()?,
     }
     .into_inner();
-    Ok((
-        sensor,
-        objects
-            .iter()
-            .map(|o| ObjectSpec::from(o.as_ref().clone()))
-            .collect(),
-    ))
+    Ok((sensor, objects.iter().map(|o| spec_of(o)).collect()))
 }
 
 /// A run that gathered fewer readings than asked says so, as a Python warning (the planner may run

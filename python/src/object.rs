@@ -40,8 +40,13 @@ impl Parts {
 
 impl Object {
     pub fn spec(&self) -> ObjectSpec {
-        ObjectSpec::from(self.inner.as_ref().clone())
+        spec_of(&self.inner)
     }
+}
+
+/// The library's specification of a built object, as the scenes take it.
+pub fn spec_of(object: &taction::mesh::Object) -> ObjectSpec {
+    ObjectSpec::from(object.clone())
 }
 
 #[pymethods]

@@ -93,3 +93,14 @@ def test_a_set_name_collects_its_objects_and_counts_are_whole_numbers(chess):
             taction.collect(chess, **bad)
     with pytest.raises(taction.TactionError, match="neither a list"):
         taction.collect(42)
+
+
+def test_an_argument_of_the_other_mode_is_refused(chess):
+    with pytest.raises(taction.TactionError, match="local_probability"):
+        taction.collect(chess, mode="sampler", readings=2, local_probability=0.9)
+    with pytest.raises(taction.TactionError, match="reachable_by_arm"):
+        taction.collect(chess, mode="planner", readings=2, reachable_by_arm=True)
+    with pytest.raises(taction.TactionError, match="from_above"):
+        taction.collect(chess, mode="planner", readings=2, from_above=True)
+    with pytest.raises(taction.TactionError, match="whole number"):
+        taction.collect(chess, readings=True)

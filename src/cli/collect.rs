@@ -165,8 +165,9 @@ fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
         ),
     };
     if !others.is_empty() {
+        let flags = if others.len() == 1 { "a flag" } else { "flags" };
         return Err(UsageError(format!(
-            "{}: not a flag of --mode {mode} (the help says which mode each flag belongs to)",
+            "{}: not {flags} of --mode {mode} (the help says which mode each flag belongs to)",
             others.join(", ")
         )));
     }

@@ -190,10 +190,16 @@ impl ControlArg {
                 let Some(fields) = value.as_object() else {
                     return Err(self.error("want a JSON object of the controllers' fields by name"));
                 };
-                if fields.contains_key("expected_noise_fraction") {
-                    return Err(self.error(
-                        "expected_noise_fraction is the sensor's noise (--noise), not the file's; leave it out",
-                    ));
+                // An experiment's config.json holds the field; a copy of it agrees with the sensor.
+                let expected = fields
+                    .get("expected_noise_fraction")
+                    .map(serde_json::Value::as_f64);
+                if let Some(value) = expected.filter(|v| *v != Some(noise_fraction)) {
+                    let shown = value.map_or_else(|| "not a number".to_string(), |v| v.to_string());
+                    return Err(self.error(format!(
+                        "expected_noise_fraction {shown} is not the sensor's --noise {noise_fraction}: the \
+                         controllers always expect the sensor's noise; leave the field out"
+                    )));
                 }
                 serde_json::from_value(value).map_err(|e| self.error(e))?
             }
@@ -235,7 +241,12 @@ pub fn flag_error(flag: &str, value: impl std::fmt::Display, what: impl std::fmt
 /// then fail on the write with the system's "Not a directory").
 pub fn check_output_file(path: &Path, flag: &str) -> Result<(), UsageError> {
     let shown = path.display();
-    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
+    if path.as_os_str().to_string_lossy().ends_with('/') {
+        return Err(UsageError(format!(
+            "--{flag} {shown}: ends in '/', which names a folder; give the file to write"
+        )));
+    }
+    if path.is_dir() {
         return Err(UsageError(format!(
             "--{flag} {shown}: is a folder; give the file to write"
         )));
@@ -252,6 +263,9 @@ pub fn check_output_file(path: &Path, flag: &str) -> Result<(), UsageError> {
 
 /// Checks, before any work, that `--{flag} PATH` can become the folder a command writes into.
 pub fn check_output_folder(path: &Path, flag: &str) -> Result<(), UsageError> {
+    // `FILE/` is the file `FILE`: `is_file` says no to it, and the write fails after the work.
+    let path: PathBuf = path.components().collect();
+    let path = path.as_path();
     match path.ancestors().find(|a| a.is_file()) {
         Some(file) if file == path => Err(UsageError(format!(
             "--{flag} {}: is a file; give the folder to write into",

@@ -197,7 +197,7 @@ fn train_model(
     let t = model.tempering;
     if calibration.converged_only().is_empty() {
         eprintln!(
-            "warning: calibration: the arm's explorations gave no converged reading, so nothing calibrated \
+            "taction demo: warning: calibration: the arm's explorations gave no converged reading, so nothing calibrated \
              the posterior ({t}): it counts the arm's correlated touches as independent evidence"
         );
     } else {
@@ -491,6 +491,7 @@ fn write_run_record(
     let guess = belief.guess();
     let record = serde_json::json!({
         "objects": args.objects.display().to_string(),
+        "object_size_m": args.object_size.m,
         "seed": args.seed.seed,
         "strategy": match args.strategy {
             DemoStrategy::Blind => "blind",

@@ -179,7 +179,6 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// Trains the model of one descriptor, with a progress bar.
 /// The training data has converged readings of every object, and the validation data is of the
 /// same sensor and objects: said here naming the files, rather than by the fit, which knows no file.
 fn check_datasets(
@@ -219,6 +218,7 @@ fn check_datasets(
     Ok(())
 }
 
+/// Trains the model of one descriptor, with a progress bar.
 fn fit_one(
     kind: DescriptorKind,
     config: &Valid<TrainConfig>,

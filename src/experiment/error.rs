@@ -26,7 +26,7 @@ pub enum ExperimentError {
     #[error("experiment '{experiment}' lists unit '{key}' twice")]
     DuplicateUnit { experiment: String, key: UnitKey },
     #[error(
-        "{} was written by an earlier run with different {what}; resuming would mix results: \
+        "{} was written by an earlier run with different {what}{differing}; resuming would mix results: \
          use another --out or delete {}",
         path.display(),
         dir.display()
@@ -35,6 +35,8 @@ pub enum ExperimentError {
         path: PathBuf,
         dir: PathBuf,
         what: &'static str,
+        /// ` (fields: a, b.c)`, the JSON fields that differ, when both sides are JSON.
+        differing: String,
     },
     #[error("{}: corrupt unit file ({what}); delete it to rerun that unit", path.display())]
     CorruptUnit { path: PathBuf, what: String },

@@ -89,6 +89,51 @@ pub fn write_or_check(
     Ok(())
 }
 
+/// ` (fields: a, b.c)`: the paths of the JSON fields in which `earlier` and `now` differ (at most
+/// five), or nothing when either is not JSON, so that a refusal says which setting changed.
+fn differing_fields(earlier: &[u8], now: &[u8]) -> String {
+    fn walk(a: &serde_json::Value, b: &serde_json::Value, at: &str, out: &mut Vec<String>) {
+        match (a, b) {
+            (serde_json::Value::Object(x), serde_json::Value::Object(y)) => {
+                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+                for key in keys {
+                    let null = serde_json::Value::Null;
+                    let path = if at.is_empty() {
+                        key.clone()
+                    } else {
+                        format!("{at}.{key}")
+                    };
+                    walk(
+                        x.get(key).unwrap_or(&null),
+                        y.get(key).unwrap_or(&null),
+                        &path,
+                        out,
+                    );
+                }
+            }
+            _ if a != b => out.push(if at.is_empty() {
+                "the whole file".into()
+            } else {
+                at.into()
+            }),
+            _ => {}
+        }
+    }
+    let (Ok(a), Ok(b)) = (
+        serde_json::from_slice::<serde_json::Value>(earlier),
+        serde_json::from_slice::<serde_json::Value>(now),
+    ) else {
+        return String::new();
+    };
+    let mut fields = Vec::new();
+    walk(&a, &b, "", &mut fields);
+    match fields.len() {
+        0 => String::new(),
+        n if n > 5 => format!(" (fields: {}, and {} more)", fields[..5].join(", "), n - 5),
+        _ => format!(" (fields: {})", fields.join(", ")),
+    }
+}
+
 /// Whether `path` exists holding exactly `bytes` (`false`: it does not exist); an error when it
 /// holds anything else (see [`write_or_check`]).
 pub fn check_unchanged(
@@ -99,10 +144,11 @@ pub fn check_unchanged(
 ) -> Result<bool, ExperimentError> {
     match std::fs::read(path) {
         Ok(existing) if existing == bytes => Ok(true),
-        Ok(_) => Err(ExperimentError::ChangedSinceLastRun {
+        Ok(existing) => Err(ExperimentError::ChangedSinceLastRun {
             path: path.to_path_buf(),
             dir: dir.to_path_buf(),
             what,
+            differing: differing_fields(&existing, bytes),
         }),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
         Err(source) => Err(ExperimentError::Io {
@@ -126,6 +172,7 @@ pub fn write_manifest(
             path: path.to_path_buf(),
             dir: dir.to_path_buf(),
             what: "units",
+            differing: String::new(),
         });
     }
     Ok(write_if_changed(path, bytes)?)

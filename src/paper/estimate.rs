@@ -7,7 +7,7 @@
 //! extends the last segment's power, held in [1, 3] (data collection grows linearly with the scale
 //! and codebook fitting faster); below 0.05 it extends the first segment's, held in [0, 1]: at
 //! small scales set-up (objects, scenes, one model per descriptor) outweighs the readings, so a run
-//! at 0.05 takes a third to a half of one at 0.2, not a quarter. Other thread counts scale it by
+//! at 0.05 takes about two thirds of one at 0.2 (132 against 205 s), not a quarter. Other thread counts scale it by
 //! `2 / threads`. During
 //! a run the remaining estimate is multiplied by the ratio of the time spent so far to the time
 //! estimated for it, which absorbs a faster or slower machine.

@@ -250,8 +250,6 @@ impl RecognitionSweep {
             .then(|| ArmCalibration::of(counts))
     }
 
-    /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
-    /// by what they are (real sensor frames, or the synthetic example's).
     /// Every setting's simulated sensor has the recorded frames' taxel grid: a model of another
     /// grid cannot describe them.
     fn check_real_grid(&self, real: &RealData) -> Result<(), BoxError> {
@@ -269,6 +267,8 @@ impl RecognitionSweep {
         }
     }
 
+    /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
+    /// by what they are (real sensor frames, or the synthetic example's).
     pub(crate) fn plot_title(&self, real: Option<&RealData>) -> String {
         match real {
             Some(real) => format!("{} {}", self.title, real.frames_words()),

@@ -127,6 +127,22 @@ pub fn is_covering_instance(m: &mjModel, instance: usize) -> bool {
     }
 }
 
+/// Whether covering instance `instance` of `m` runs this copy's callbacks (see [`instance_state`]).
+fn made_by_this_copy(m: &mjModel, instance: usize) -> bool {
+    // SAFETY: `instance` is a covering instance of `m` (checked by the caller), so its slot holds a
+    // registered plugin.
+    unsafe {
+        let plugin = mjp_getPluginAtSlot(*m.plugin.add(instance));
+        !plugin.is_null()
+            && (*plugin)
+                .init
+                .is_some_and(|registered| std::ptr::fn_addr_eq(registered, init as InitCallback))
+    }
+}
+
+/// The signature of a plugin's `init` callback.
+type InitCallback = unsafe extern "C" fn(*const mjModel, *mut mjData, c_int) -> c_int;
+
 /// The config of plugin instance `instance`, parsed and validated.
 pub fn instance_config(
     m: &mjModel,
@@ -268,12 +284,16 @@ unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int,
     }
 }
 
-/// The instance state behind plugin instance `instance` of `d`, when it is a covering instance.
+/// The instance state behind plugin instance `instance` of `d`, when it is a covering instance
+/// made by this copy of the plugin's code. When another copy registered `taction.covering` first
+/// ([`register`]: the plugin library loaded before the Python module), its instances hold that
+/// copy's `Covering`, whose layout this copy cannot vouch for: `None`, as for any other plugin
+/// (the readings in `sensordata` are the same either way).
 ///
 /// # Safety
 /// `d` must be data made for `m` by MuJoCo, with plugins initialised.
 pub unsafe fn instance_state<'d>(m: &mjModel, d: &'d mjData, instance: usize) -> Option<&'d Covering> {
-    if !is_covering_instance(m, instance) || d.plugin_data.is_null() {
+    if !is_covering_instance(m, instance) || !made_by_this_copy(m, instance) || d.plugin_data.is_null() {
         return None;
     }
     // SAFETY: plugin_data[instance] of a covering instance is null or a live Covering.
