@@ -696,38 +696,27 @@ fn an_unknown_sim_to_real_label_is_named_with_its_line() {
     );
     let real = write(dir.path(), "real.csv", &csv);
     let out = dir.path().join("results").display().to_string();
-    let line = fails_with(
-        &taction(&[
+    let sim_to_real = |real: &str| {
+        let args = [
             "experiment",
             "sim-to-real",
             "--real",
-            &real,
+            real,
             "--scale",
             "0.01",
             "--out",
             &out,
-        ]),
-        1,
-    );
+        ];
+        fails_with(&taction(&args), 1)
+    };
+    let line = sim_to_real(&real);
     assert!(
         line.contains("real.csv: line 4: label 'banana' names no letter"),
         "{line}"
     );
     // Frames of another grid than the simulated sensor's are refused before any collection.
     let real = write(dir.path(), "real4.csv", &csv.replace("banana", "A"));
-    let line = fails_with(
-        &taction(&[
-            "experiment",
-            "sim-to-real",
-            "--real",
-            &real,
-            "--scale",
-            "0.01",
-            "--out",
-            &out,
-        ]),
-        1,
-    );
+    let line = sim_to_real(&real);
     assert!(
         line.contains("--real: the frames are 4x4 taxels but the simulated sensor is 6x6"),
         "{line}"

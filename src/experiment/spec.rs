@@ -177,3 +177,29 @@ pub fn write_manifest(
     }
     Ok(write_if_changed(path, bytes)?)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_changed_configuration_names_its_fields() {
+        let dir = tempfile::tempdir().expect("a temporary folder");
+        let path = dir.path().join("config.json");
+        let earlier = br#"{"seed": 1, "real": {"path": "a.csv", "rows": 6}, "scale": 0.1}"#;
+        write_or_check(&path, earlier, dir.path(), "configuration").expect("the first run writes it");
+        assert!(write_or_check(&path, earlier, dir.path(), "configuration").is_ok());
+        let now = br#"{"seed": 1, "real": {"path": "b.csv", "rows": 8}, "scale": 0.1, "extra": true}"#;
+        let e = write_or_check(&path, now, dir.path(), "configuration").expect_err("a changed run");
+        assert!(
+            e.to_string()
+                .contains("different configuration (fields: extra, real.path, real.rows)"),
+            "{e}"
+        );
+        let many: Vec<String> = (0..7).map(|i| format!("\"f{i}\": {i}")).collect();
+        let many = format!("{{{}}}", many.join(", "));
+        let e = write_or_check(&path, many.as_bytes(), dir.path(), "configuration").expect_err("changed");
+        assert!(e.to_string().contains("and 5 more)"), "{e}");
+        assert_eq!(differing_fields(b"not json", b"{}"), "");
+    }
+}
