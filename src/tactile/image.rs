@@ -24,6 +24,8 @@ pub enum ImageError {
     OutOfRange { row: usize, col: usize, value: f64 },
     #[error("{path}: line {line}: {what}")]
     Parse { path: String, line: usize, what: String },
+    #[error("{path}: no rows of values (want rows of comma-separated values in [0, 1])")]
+    NoRows { path: String },
     #[error("{path}: {source}")]
     Io { path: String, source: std::io::Error },
     #[error("{path}: cannot encode PNG: {what}")]
@@ -196,7 +198,9 @@ impl TactileImage {
             }
             rows += 1;
         }
-        let cols = cols.ok_or_else(|| parse(0, "no values".to_string()))?;
+        let cols = cols.ok_or_else(|| ImageError::NoRows {
+            path: origin.to_string(),
+        })?;
         Self::new(rows, cols, values)
     }
 
@@ -381,5 +385,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("line 1"), "{e}");
+        for empty in ["", "\n  \n"] {
+            let e = TactileImage::parse_csv(empty, "f.csv").unwrap_err().to_string();
+            assert!(e.contains("f.csv: no rows of values"), "{e}");
+        }
     }
 }
