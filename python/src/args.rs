@@ -12,6 +12,11 @@ use pyo3::types::{PyBool, PyString};
 use crate::error::refused;
 use crate::object::{Object, objects};
 
+/// A value as Python prints it (`repr`), for a refusal's message.
+fn shown(obj: pyo3::Borrowed<'_, '_, PyAny>) -> String {
+    obj.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into())
+}
+
 /// A count, an index or a seed: a Python `int` from 0 to the type's largest value. A signature's
 /// default is then `Whole(1)`, which PyO3 shows as `...`, so those signatures spell out their
 /// `text_signature`.
@@ -24,12 +29,9 @@ macro_rules! whole {
 
             fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
                 let refusal = || {
-                    let shown = obj
-                        .repr()
-                        .map(|r| r.to_string())
-                        .unwrap_or_else(|_| "?".into());
                     refused(format!(
-                        "{shown} is not a whole number from 0 to {}",
+                        "{} is not a whole number from 0 to {}",
+                        shown(obj),
                         <$t>::MAX
                     ))
                 };
@@ -64,9 +66,9 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Objects {
             ));
         }
         let list: Vec<PyRef<'_, Object>> = obj.extract().map_err(|_| {
-            let shown = obj.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into());
             refused(format!(
-                "{shown} is neither a list of taction.Object nor a set's name or folder"
+                "{} is neither a list of taction.Object nor a set's name or folder",
+                shown(obj)
             ))
         })?;
         Ok(Self(list.iter().map(|o| Arc::clone(&o.inner)).collect()))

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use taction::mesh::{BUILTIN_SETS, BuildOptions, ObjectSet};
+use taction::mesh::{BuildOptions, ObjectSet, sizes_its_own_objects};
 use taction::sim::{ObjectSpec, PAD_SITE, SceneBuilder};
 use taction::tactile::add_sensor;
 
@@ -159,9 +159,7 @@ fn positive_size(size: f64) -> PyResult<()> {
 pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Vec<Object>> {
     if let Some(size) = size_m {
         positive_size(size)?;
-        let sized_by_set = BUILTIN_SETS.contains(&set.to_string_lossy().as_ref())
-            || set.extension().is_some_and(|e| e == "json");
-        if sized_by_set {
+        if sizes_its_own_objects(&set) {
             return Err(bad_argument(
                 "size_m",
                 format!(

@@ -42,6 +42,11 @@ def _objects_of(objects: Union[str, Sequence["taction.Object"]]) -> list:
     return list(objects)
 
 
+def _is_integer(value) -> bool:
+    """A Python or numpy integer; not a bool, which Python counts as one."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
 def default_model(objects, training_readings: int = 1000, seed: int = 1) -> "taction.Model":
     """The recogniser ``taction demo`` trains for the arm (``taction.train_for_arm``) on ``objects``
     (a set name or a list of objects), its posterior calibrated on the arm's own explorations
@@ -202,11 +207,7 @@ class ActiveTouchEnv(gymnasium.Env):
             index = int(self.np_random.integers(len(self.objects)))
         elif isinstance(index, str) and index in self.objects:
             index = self.objects.index(index)
-        elif (
-            isinstance(index, (int, np.integer))
-            and not isinstance(index, (bool, np.bool_))
-            and 0 <= index < len(self.objects)
-        ):
+        elif _is_integer(index) and 0 <= index < len(self.objects):
             index = int(index)
         else:
             raise taction.TactionError(
@@ -230,9 +231,9 @@ class ActiveTouchEnv(gymnasium.Env):
             raise taction.TactionError("step: call reset() first")
         if self._over:
             raise taction.TactionError("step: the episode has ended (declared or truncated); call reset()")
-        if not isinstance(action, (int, np.integer)) or isinstance(action, (bool, np.bool_)):
-            if not (isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu"):
-                raise taction.TactionError(f"action: {action!r} is not an integer of the action space")
+        scalar_array = isinstance(action, np.ndarray) and action.shape == () and action.dtype.kind in "iu"
+        if not (_is_integer(action) or scalar_array):
+            raise taction.TactionError(f"action: {action!r} is not an integer of the action space")
         action = int(action)
         if not 0 <= action < self.action_space.n:
             raise taction.TactionError(f"action: {action} is outside 0..{self.action_space.n - 1}")

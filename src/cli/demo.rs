@@ -16,7 +16,7 @@ use std::io::Write;
 use std::num::NonZeroUsize;
 use std::path::PathBuf;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use rand::RngExt;
 use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, TouchRun, explore_recognizing};
 use taction::control::sensor_reader;
@@ -29,7 +29,7 @@ use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
 use taction::recognize::Belief;
-use taction::recognize::{FusedModel, PosteriorRule, Recognizer};
+use taction::recognize::{FusedModel, Recognizer};
 use taction::rng;
 use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, Perturbation, PerturbationBounds, Scene, SceneBuilder};
@@ -493,16 +493,10 @@ fn write_run_record(
         "objects": args.objects.display().to_string(),
         "object_size_m": args.object_size.m,
         "seed": args.seed.seed,
-        "strategy": match args.strategy {
-            DemoStrategy::Blind => "blind",
-            DemoStrategy::Active => "active",
-        },
+        "strategy": args.strategy.to_possible_value().map(|v| v.get_name().to_string()),
         "stop_at_confidence": args.stop_at_confidence.map(f64::from),
         "stop_held_readings": args.stop_at_confidence.map(|_| args.stop_held_readings.get()),
-        "posterior": match args.posterior.rule {
-            PosteriorRule::Calibrated => "calibrated",
-            PosteriorRule::Eq15 => "eq15",
-        },
+        "posterior": args.posterior.rule.name(),
         "training_readings": args.training_readings,
         "object": unknown.spec.name,
         "object_position_m": pose.position_m.to_array(),

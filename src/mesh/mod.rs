@@ -46,7 +46,9 @@ pub use topology::{EdgeTopology, connected_components};
 pub use trimesh::TriMesh;
 
 // Object sets: named, versioned manifests that datasets and models refer to.
-pub use object_set::{BUILTIN_SETS, BuildOptions, NamedObject, ObjectSet, ObjectSetRef, ObjectSource};
+pub use object_set::{
+    BUILTIN_SETS, BuildOptions, NamedObject, ObjectSet, ObjectSetRef, ObjectSource, sizes_its_own_objects,
+};
 
 // The paper's objects: the CGAL meshes fetched from Debian, chess pieces as surfaces of
 // revolution, raised letters from a font.

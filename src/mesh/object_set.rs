@@ -32,6 +32,12 @@ pub const SHAPES_DIAGONAL_M: f64 = 0.12;
 /// Names of the built-in sets.
 pub const BUILTIN_SETS: [&str; 3] = ["shapes", "chess", "letters"];
 
+/// Whether a command line's `entry` names a set that sizes its own objects, a built-in set or a
+/// manifest (`.json`), which [`ObjectSet::resolve`] reads as such and a diagonal does not rescale.
+pub fn sizes_its_own_objects(entry: &Path) -> bool {
+    BUILTIN_SETS.contains(&entry.to_string_lossy().as_ref()) || entry.extension().is_some_and(|e| e == "json")
+}
+
 /// A pinned font: where it was found and what it contained.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FontRef {
@@ -351,11 +357,7 @@ impl ObjectSet {
             many => {
                 // Several entries are mesh files; a set among them would be read as a file of an
                 // unknown format.
-                if let Some(set) = many.iter().find(|p| {
-                    BUILTIN_SETS.contains(&p.to_string_lossy().as_ref())
-                        || p.is_dir()
-                        || p.extension().is_some_and(|e| e == "json")
-                }) {
+                if let Some(set) = many.iter().find(|p| sizes_its_own_objects(p) || p.is_dir()) {
                     return Err(set_error(format!(
                         "'{}' is a set: give one set (a built-in set, a folder or a manifest) or several mesh files",
                         set.display()
