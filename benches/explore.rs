@@ -44,7 +44,7 @@ use taction::pose::PadPose;
 use taction::recognize::PseudoCount;
 use taction::recognize::pipeline::{ClusterHistogram, ObjectModels};
 use taction::sim::{Execution, PAD_SITE};
-use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
+use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder, StartPose};
 use taction::tactile::SensorConfig;
 use taction::tactile::{CoveringSensor, add_sensor};
 use taction::valid::Valid;
@@ -209,6 +209,7 @@ fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
         perturbation: PerturbationBounds::NONE,
         readings_per_object: SHAPES_READINGS,
         seed,
+        start_pose: StartPose::Canonical,
     };
     plan.collect(objects, 1).expect("planner runs")
 }

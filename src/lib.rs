@@ -36,6 +36,7 @@ pub mod control;
 pub mod explore;
 
 pub mod describe;
+pub mod locate;
 pub mod recognize;
 
 pub mod active_touch;

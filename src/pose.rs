@@ -8,6 +8,11 @@
 //! `normal x up`, the viewer's right looking along the normal from behind the pad; a rotation needs
 //! the right-handed frame). [`PadPose::of_site`] and [`PadPose::site_pose`] are the one conversion
 //! between the two, and [`rotation_from_xmat`] the one reading of MuJoCo's `xmat`.
+//!
+//! [`StartPose`] says where an object starts before it is explored: the pose it was built in, or
+//! one drawn at random (the draw is the scene's, `sim::Scene::place_at_start`). It is plain data
+//! here, beside the poses, because both the world that draws it and the dataset header that
+//! records it (`dataset`, which knows no MuJoCo) name it.
 
 use glam::{DMat3, DQuat, DVec3};
 use serde::{Deserialize, Serialize};
@@ -95,6 +100,171 @@ impl Pose {
             DVec3::from_array(pos),
             DQuat::from_xyzw(quat[1], quat[2], quat[3], quat[0]),
         )
+    }
+}
+
+/// Where an object starts on the table before it is explored.
+///
+/// A recogniser learns whatever tells its training objects apart. Started at the pose its mesh was
+/// built in, every object stands at the same place in the same heading run after run, and "a
+/// model that uses contact positions could learn the canonical pose instead of the object": a
+/// random start, which the explorer is not told, leaves the pose nothing to teach. The draw
+/// (`sim::Scene::place_at_start`) is the demo's: a heading about the vertical through the
+/// object's bounding-box centre within [`MaxHeading`], then the perturbation of Sec. V-B4 (a tilt
+/// of up to 10 degrees about a random axis, a shift of up to 10% of the object's width), the
+/// object resting on the table.
+///
+/// Serialised as `"canonical"` or `{"random":{"max_heading_rad":...}}`; what records it (a
+/// collection plan, a dataset header) leaves a canonical start out, so that everything written
+/// before start poses existed reads, and is written, as it was.
+///
+/// ```
+/// use taction::pose::{MaxHeading, StartPose};
+///
+/// assert!(StartPose::default().is_canonical());
+/// let letters = StartPose::parse("random", MaxHeading::LETTERS).unwrap();
+/// assert_eq!(letters.name(), "random");
+/// assert_eq!(letters.max_heading(), Some(MaxHeading::LETTERS));
+/// assert_eq!(StartPose::parse("upside-down", MaxHeading::ANY), None);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StartPose {
+    /// The pose the object was built in (the identity): every run's start before start poses
+    /// existed, and still the default.
+    #[default]
+    Canonical,
+    /// A pose drawn from the run's seed, turned at most `max_heading` from the built heading.
+    Random {
+        #[serde(rename = "max_heading_rad")]
+        max_heading: MaxHeading,
+    },
+}
+
+impl StartPose {
+    /// The names [`name`](Self::name) gives and [`parse`](Self::parse) takes (the CLI's
+    /// `--start-pose` values).
+    pub const NAMES: [&'static str; 2] = ["canonical", "random"];
+
+    /// A random start turned at most `max_heading` about the vertical.
+    pub fn random(max_heading: MaxHeading) -> Self {
+        Self::Random { max_heading }
+    }
+
+    /// Whether this is [`Canonical`](Self::Canonical), the start a record leaves out.
+    pub fn is_canonical(&self) -> bool {
+        matches!(self, Self::Canonical)
+    }
+
+    /// `canonical` or `random`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Canonical => Self::NAMES[0],
+            Self::Random { .. } => Self::NAMES[1],
+        }
+    }
+
+    /// The start called `name` ([`NAMES`](Self::NAMES)), a random one turned at most
+    /// `max_heading`: the heading is the object set's to say ([`MaxHeading`]), not the name's.
+    pub fn parse(name: &str, max_heading: MaxHeading) -> Option<Self> {
+        match name {
+            "canonical" => Some(Self::Canonical),
+            "random" => Some(Self::random(max_heading)),
+            _ => None,
+        }
+    }
+
+    /// The largest turn about the vertical of a random start; `None` for the canonical one.
+    pub fn max_heading(&self) -> Option<MaxHeading> {
+        match self {
+            Self::Canonical => None,
+            Self::Random { max_heading } => Some(*max_heading),
+        }
+    }
+}
+
+impl std::fmt::Display for StartPose {
+    /// `canonical`, `random (any heading)` or `random (heading within 10 deg)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Canonical => f.write_str(self.name()),
+            Self::Random { max_heading } if max_heading.is_any() => {
+                write!(f, "{} (any heading)", self.name())
+            }
+            Self::Random { max_heading } => write!(
+                f,
+                "{} (heading within {} deg)",
+                self.name(),
+                crate::units::significant(max_heading.rad().to_degrees())
+            ),
+        }
+    }
+}
+
+/// The largest turn about the vertical a random [`StartPose`] gives an object, from the heading
+/// it was built in, in [0, pi] radians; pi is any heading.
+///
+/// How far is the object set's to say (`mesh::ObjectSet::start_heading`): an object that looks
+/// the same from every side, or whose identity does not change with where it faces, takes any
+/// heading; a raised letter does not, since its heading is part of its identity ('b' turned by
+/// 180 degrees about the vertical is 'q', 'd' is 'p', 'n' is 'u', 'M' is 'W'), so it keeps its
+/// face up and its heading within [`LETTERS`](Self::LETTERS).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct MaxHeading {
+    rad: f64,
+}
+
+impl MaxHeading {
+    /// Any heading: a turn drawn uniformly over the full turn.
+    pub const ANY: Self = Self {
+        rad: std::f64::consts::PI,
+    };
+    /// Objects whose heading is part of their identity, the raised letters: within 10 degrees,
+    /// the tilt of Sec. V-B4's perturbation, of the heading they were built in.
+    pub const LETTERS: Self = Self {
+        rad: 10.0_f64.to_radians(),
+    };
+
+    /// At most `deg` degrees either way, in [0, 180] (180: any heading); `None` outside it or not
+    /// finite.
+    pub fn from_deg(deg: f64) -> Option<Self> {
+        if deg == 180.0 {
+            Some(Self::ANY)
+        } else {
+            (0.0..180.0).contains(&deg).then(|| Self {
+                rad: deg.to_radians(),
+            })
+        }
+    }
+
+    /// The largest turn, radians.
+    pub fn rad(&self) -> f64 {
+        self.rad
+    }
+
+    /// Whether every heading can be drawn.
+    pub fn is_any(&self) -> bool {
+        self.rad >= std::f64::consts::PI
+    }
+}
+
+impl TryFrom<f64> for MaxHeading {
+    type Error = String;
+
+    /// Radians in [0, pi], as a plan or a header records it.
+    fn try_from(rad: f64) -> Result<Self, String> {
+        if (0.0..=std::f64::consts::PI).contains(&rad) {
+            Ok(Self { rad })
+        } else {
+            Err(format!("max_heading_rad {rad} is outside [0, pi]"))
+        }
+    }
+}
+
+impl From<MaxHeading> for f64 {
+    fn from(heading: MaxHeading) -> f64 {
+        heading.rad
     }
 }
 

@@ -13,8 +13,9 @@ use taction::explore::{
     ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, PlannerConfig,
     TouchScorer,
 };
+use taction::pose::Pose;
 use taction::recognize::{Recognizer, TrainConfig, TrainedModel};
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{MaxHeading, ObjectSpec, PerturbationBounds, SceneBuilder, StartPose};
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
@@ -172,6 +173,53 @@ fn an_episode_refuses_what_it_cannot_do() {
     );
 }
 
+/// An episode's object starts where its configuration says: where it was built by default, else
+/// at the pose the collection plan of the same seed draws for it (`CollectPlan::place_at_start`),
+/// resting on the table, and not the canonical one.
+#[test]
+fn an_episode_starts_its_object_where_its_config_says() {
+    let model = model();
+    let object = &objects()[1];
+    let fixed = TouchEpisode::new(Arc::clone(&model), object, &config(), 5).unwrap();
+    assert_eq!(fixed.scene().object_pose(), Some(Pose::IDENTITY));
+    let random = Valid::new(EpisodeConfig {
+        start_pose: StartPose::random(MaxHeading::ANY),
+        ..*config()
+    })
+    .unwrap();
+    let episode = TouchEpisode::new(Arc::clone(&model), object, &random, 5).unwrap();
+    let pose = episode.scene().object_pose().unwrap();
+    assert_ne!(pose, Pose::IDENTITY);
+    let lowest = object
+        .mesh
+        .vertices
+        .iter()
+        .map(|&v| pose.transform_point(v).z)
+        .fold(f64::INFINITY, f64::min);
+    assert!(lowest.abs() < 1e-9, "lowest vertex at z = {lowest}");
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(random.planner),
+        sensor: random.sensor,
+        control: Valid::default(),
+        perturbation: random.perturbation,
+        readings_per_object: 0,
+        seed: 5,
+        start_pose: random.start_pose,
+    };
+    let mut scene = SceneBuilder::with_arm_and_table()
+        .object(object.clone())
+        .build()
+        .unwrap();
+    plan.place_at_start(&mut scene, 1).unwrap();
+    assert_eq!(
+        scene.object_pose(),
+        Some(pose),
+        "the plan's draw for the object's index"
+    );
+    let again = TouchEpisode::new(model, object, &random, 5).unwrap();
+    assert_eq!(again.scene().object_pose(), Some(pose), "one seed, one start");
+}
+
 /// `touch_toward` the planner's own proposal, iteration after iteration, is `explore` (the plain
 /// planner: one proposal per iteration): the same readings, tree and counts.
 #[test]
@@ -184,6 +232,7 @@ fn touching_toward_the_planners_own_proposals_is_exploring() {
         perturbation: PerturbationBounds::new(10.0, 0.1).unwrap(),
         readings_per_object: usize::MAX,
         seed: 5,
+        start_pose: StartPose::Canonical,
     };
     let object = &objects()[0];
     let (mut scene, mut explorer) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
@@ -254,6 +303,7 @@ fn active_exploration_touches_about_as_often_as_blind_exploration() {
         perturbation: PerturbationBounds::NONE,
         readings_per_object: TOUCHES,
         seed: 5,
+        start_pose: StartPose::Canonical,
     };
     let object = &objects()[1];
     let (mut scene, mut blind) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();

@@ -14,7 +14,7 @@ const LEAVES: [&str; 8] = [
 
 /// The paper's modules in the order of the flow: world -> sensor -> hand-off -> control/explore ->
 /// descriptors -> recognizer.
-const DOMAIN: [&str; 8] = [
+const DOMAIN: [&str; 9] = [
     "mesh",
     "sim",
     "tactile",
@@ -22,6 +22,7 @@ const DOMAIN: [&str; 8] = [
     "control",
     "explore",
     "describe",
+    "locate",
     "recognize",
 ];
 
@@ -44,7 +45,9 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
         ("control", vec!["mesh", "sim", "tactile", "dataset"]),
         ("explore", vec!["mesh", "sim", "tactile", "dataset", "control"]),
         ("describe", vec!["tactile"]),
-        ("recognize", vec!["tactile", "dataset", "describe"]),
+        // Contact geometry: readings and meshes, nothing of MuJoCo.
+        ("locate", vec!["mesh", "tactile", "dataset"]),
+        ("recognize", vec!["tactile", "dataset", "describe", "locate"]),
         ("active_touch", DOMAIN.to_vec()),
         // The run framework: it knows the accuracy row it plots, nothing of MuJoCo or the paper.
         ("experiment", vec!["recognize"]),

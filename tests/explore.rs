@@ -8,7 +8,7 @@ use taction::dataset::ContactStatus;
 use taction::dataset::Strategy;
 use taction::explore::PlannerConfig;
 use taction::explore::{CollectMode, CollectPlan};
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{ObjectSpec, PerturbationBounds, StartPose};
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
@@ -35,6 +35,7 @@ fn plan(mode: CollectMode, readings: usize, perturbation: PerturbationBounds) ->
         perturbation,
         readings_per_object: readings,
         seed: 17,
+        start_pose: StartPose::Canonical,
     }
 }
 
@@ -937,4 +938,272 @@ fn a_format_2_dataset_from_collect_reads_in_the_tables_vocabulary() {
     ]
     .into();
     assert_eq!(table, expected);
+}
+
+/// The lowest point of `object`'s mesh at `pose` (world z, metres) and its tilt: the angle between
+/// its own vertical and the world's, degrees.
+fn rest_and_tilt(object: &ObjectSpec, pose: &taction::pose::Pose) -> (f64, f64) {
+    let lowest = object
+        .mesh
+        .vertices
+        .iter()
+        .map(|&v| pose.transform_point(v).z)
+        .fold(f64::INFINITY, f64::min);
+    let up = pose.transform_vector(DVec3::Z);
+    (lowest, up.z.clamp(-1.0, 1.0).acos().to_degrees())
+}
+
+/// The heading of `pose`: where its own x axis points in the horizontal plane, degrees in
+/// (-180, 180].
+fn heading_deg(pose: &taction::pose::Pose) -> f64 {
+    let x = pose.transform_vector(DVec3::X);
+    x.y.atan2(x.x).to_degrees()
+}
+
+/// The arm's scene with `object` where it was built, no sensor (placing needs none).
+fn arm_scene(object: &ObjectSpec) -> taction::sim::Scene {
+    taction::sim::SceneBuilder::with_arm_and_table()
+        .object(object.clone())
+        .build()
+        .unwrap()
+}
+
+/// A random start (`--start-pose random`) stands each object on the table, tilted at most 10
+/// degrees, at a pose drawn from its own stream: the same for the same seed and object, another
+/// for another object or seed; a canonical start leaves the object where it was built; the
+/// letters' heading stays within 10 degrees where the 3D objects take any; the full turn is the
+/// demo's draw, bit for bit; and the placed object stays inside the planner's workspace.
+#[test]
+fn a_random_start_stands_each_object_on_the_table_at_a_pose_of_its_own() {
+    use rand::RngExt;
+    use taction::mesh::ObjectSet;
+    use taction::pose::{MaxHeading, Pose};
+    use taction::sim::{Perturbation, PerturbationBounds};
+
+    let chess = ObjectSpec::all_of(&ObjectSet::chess()).unwrap();
+    let random = StartPose::random(MaxHeading::ANY);
+    let placed = |plan: &CollectPlan, object: &ObjectSpec, index: usize| -> Pose {
+        let mut scene = arm_scene(object);
+        plan.place_at_start(&mut scene, index).unwrap();
+        scene.object_pose().unwrap()
+    };
+    let mut random_plan = plan(
+        CollectMode::Planner(Valid::default()),
+        1,
+        PerturbationBounds::NONE,
+    );
+    random_plan.start_pose = random;
+    let canonical = plan(
+        CollectMode::Planner(Valid::default()),
+        1,
+        PerturbationBounds::NONE,
+    );
+    assert_eq!(placed(&canonical, &chess[0], 0), Pose::IDENTITY);
+    let first = placed(&random_plan, &chess[0], 0);
+    assert_eq!(placed(&random_plan, &chess[0], 0), first, "one seed, one pose");
+    assert_ne!(placed(&random_plan, &chess[0], 1), first, "each object its own");
+    let reseeded = CollectPlan {
+        seed: random_plan.seed + 1,
+        ..random_plan
+    };
+    assert_ne!(placed(&reseeded, &chess[0], 0), first, "each seed its own");
+
+    // Every start rests on the table, tilted at most 10 degrees, inside the planner's workspace
+    // (fitted to the objects where they were built; its floor is above the table by design).
+    let workspace = PlannerConfig::default().fitted_to(&chess);
+    let (lo, hi) = (workspace.workspace_min_m, workspace.workspace_max_m);
+    let mut letters = Vec::new();
+    let mut any = Vec::new();
+    for (index, object) in chess.iter().enumerate() {
+        for seed in 0..6 {
+            let at = |start_pose: StartPose| CollectPlan {
+                seed,
+                start_pose,
+                ..random_plan
+            };
+            for (start_pose, headings) in [
+                (random, &mut any),
+                (StartPose::random(MaxHeading::LETTERS), &mut letters),
+            ] {
+                let pose = placed(&at(start_pose), object, index);
+                assert_ne!(pose, Pose::IDENTITY);
+                let (lowest, tilt) = rest_and_tilt(object, &pose);
+                assert!(
+                    lowest.abs() < 1e-9,
+                    "{}: lowest vertex at z = {lowest}",
+                    object.name
+                );
+                assert!(tilt <= 10.0 + 1e-9, "{}: tilted {tilt} deg", object.name);
+                for v in &object.mesh.vertices {
+                    let p = pose.transform_point(*v);
+                    assert!(
+                        p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z,
+                        "{}: {p} outside the workspace {lo} .. {hi}",
+                        object.name
+                    );
+                }
+                headings.push(heading_deg(&pose));
+            }
+        }
+    }
+    // A heading within 10 degrees, tilted by at most 10 more, points its x axis within 10 +
+    // asin(sin 10 / cos 10) = 20.2 degrees of the built heading; any heading does not.
+    assert!(
+        letters.iter().all(|h| h.abs() <= 20.2),
+        "letters' headings {letters:?}"
+    );
+    assert!(any.iter().any(|h| h.abs() > 30.0), "any heading: {any:?}");
+
+    // The full turn is the demo's draw: a heading over [0, 2 pi) from the stream, then the
+    // perturbation of Sec. V-B4 (10 degrees, 10% of the width) from the same stream.
+    for seed in 0..4 {
+        let mut demo = arm_scene(&chess[1]);
+        let mut r = taction::rng::stream(seed, 0xDE30);
+        let width = demo.object_width_m().unwrap();
+        demo.perturb_object(&Perturbation {
+            axis: DVec3::Z,
+            angle_rad: r.random_range(0.0..std::f64::consts::TAU),
+            translation_m: DVec3::ZERO,
+        })
+        .unwrap();
+        let shuffle = PerturbationBounds::new(10.0, 0.1).unwrap().draw(width, &mut r);
+        let expected = demo.perturb_object(&shuffle).unwrap();
+        let mut library = arm_scene(&chess[1]);
+        let got = library
+            .place_at_start(&random, &mut taction::rng::stream(seed, 0xDE30))
+            .unwrap();
+        assert_eq!(got, expected, "seed {seed}");
+    }
+}
+
+/// A planner run from a random start records the placed pose in every reading, the object
+/// resting on the table where no reading of a canonical start is anything but the identity, and
+/// its header records the start, through the file and back; a canonical start's file has no
+/// `start_pose` in its header, as every file before start poses had none.
+#[test]
+fn a_collection_from_a_random_start_records_it_in_readings_and_header() {
+    use taction::dataset::Dataset;
+    use taction::mesh::ObjectSet;
+    use taction::pose::{MaxHeading, Pose};
+
+    let dir = tempfile::tempdir().unwrap();
+    let rook: Vec<ObjectSpec> = ObjectSpec::all_of(&ObjectSet::chess())
+        .unwrap()
+        .into_iter()
+        .filter(|o| o.name == "rook")
+        .collect();
+    assert_eq!(rook.len(), 1);
+    let config = PlannerConfig::for_collection(&rook, 2, 0.5, None);
+    let collected = |start_pose: StartPose, name: &str| {
+        let plan = CollectPlan {
+            start_pose,
+            ..plan(
+                CollectMode::Planner(Valid::new(config).unwrap()),
+                2,
+                PerturbationBounds::NONE,
+            )
+        };
+        let dataset = plan
+            .dataset_of("chess", &rook, plan.collect(&rook, 1).unwrap())
+            .unwrap();
+        let path = dir.path().join(name);
+        dataset.write(&path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let header_line = text.lines().nth(1).unwrap().to_string();
+        let back = Dataset::read(&path).unwrap();
+        assert_eq!(back, dataset, "{name}: the file reads back as written");
+        (back, header_line)
+    };
+
+    let start = StartPose::random(MaxHeading::ANY);
+    let (random, header) = collected(start, "random.csv");
+    assert_eq!(random.header().start_pose, start);
+    assert!(
+        header.contains(r#""start_pose":{"random":{"max_heading_rad":3.141592653589793}}"#),
+        "{header}"
+    );
+    assert!(random.converged().count() >= 2, "{:?}", random.summary());
+    let pose = random.readings()[0].object_pose;
+    assert_ne!(pose, Pose::IDENTITY);
+    let (lowest, tilt) = rest_and_tilt(&rook[0], &pose);
+    assert!(
+        lowest.abs() < 1e-9 && tilt <= 10.0 + 1e-9,
+        "z {lowest}, tilt {tilt}"
+    );
+    // Unperturbed, the object stays where it started.
+    assert!(random.readings().iter().all(|r| r.object_pose == pose));
+    assert!(
+        random
+            .summary()
+            .to_string()
+            .contains(", start pose random (any heading)\n")
+    );
+
+    let (canonical, header) = collected(StartPose::Canonical, "canonical.csv");
+    assert!(!header.contains("start_pose"), "{header}");
+    assert_eq!(canonical.header().start_pose, StartPose::Canonical);
+    assert!(
+        canonical
+            .readings()
+            .iter()
+            .all(|r| r.object_pose == Pose::IDENTITY)
+    );
+    assert!(!canonical.summary().to_string().contains("start pose"));
+}
+
+/// `taction collect --start-pose random` draws each object's start and says so in the dataset's
+/// header, which `dataset show` prints; an unknown start is refused by clap, naming both.
+#[test]
+fn collect_starts_the_objects_where_start_pose_says() {
+    use taction::dataset::Dataset;
+    use taction::pose::{MaxHeading, Pose};
+
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("block.obj");
+    taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.10, 0.08, 0.10)), &mesh, "block").unwrap();
+    let out = dir.path().join("random.csv");
+    let run = |start: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args([
+                "collect",
+                "--readings",
+                "2",
+                "--threads",
+                "1",
+                "--contact-sheet",
+                "0",
+            ])
+            .args(["--start-pose", start])
+            .arg("--objects")
+            .arg(&mesh)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let output = run("random");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let dataset = Dataset::read(&out).unwrap();
+    assert_eq!(dataset.header().start_pose, StartPose::random(MaxHeading::ANY));
+    assert!(dataset.readings().iter().all(|r| r.object_pose != Pose::IDENTITY));
+    let shown = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(["dataset", "show"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&shown.stdout);
+    assert!(text.contains(", start pose random (any heading)"), "{text}");
+
+    let refused = run("upside-down");
+    assert_eq!(refused.status.code(), Some(2));
+    let message = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        message.contains("invalid value 'upside-down' for '--start-pose <START>'")
+            && message.contains("[possible values: canonical, random]"),
+        "{message}"
+    );
 }

@@ -14,7 +14,7 @@ use taction::dataset::{ContactStatus, Dataset, Reading};
 use taction::explore::PlannerConfig;
 use taction::explore::{CollectMode, CollectPlan};
 use taction::mesh::{ObjectSet, TriMesh, write_obj};
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{ObjectSpec, PerturbationBounds, StartPose};
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
@@ -40,6 +40,7 @@ fn explore(local_probability: f64, perturbation: PerturbationBounds) -> (Vec<Obj
         perturbation,
         readings_per_object: READINGS,
         seed: 11,
+        start_pose: StartPose::Canonical,
     };
     let dataset = plan
         .collect_dataset(&set.id(), &objects, 0, &|| {})

@@ -228,3 +228,24 @@ fn cli_writes_letters_and_exports_sets() {
     assert!(!bad_font.status.success());
     assert!(String::from_utf8_lossy(&bad_font.stderr).contains("README.md"));
 }
+
+/// A random start may turn the 3D objects any way about the vertical, but a set with a raised
+/// letter in it only within 10 degrees: 'b' turned half round is 'q'.
+#[test]
+fn a_set_with_letters_keeps_its_heading_within_ten_degrees() {
+    use taction::pose::MaxHeading;
+    let letters = ObjectSet::default_letters(LetterStyle::default()).unwrap();
+    assert_eq!(letters.start_heading(), MaxHeading::LETTERS);
+    assert!((MaxHeading::LETTERS.rad().to_degrees() - 10.0).abs() < 1e-12);
+    assert_eq!(ObjectSet::shapes().start_heading(), MaxHeading::ANY);
+    assert_eq!(ObjectSet::chess().start_heading(), MaxHeading::ANY);
+    let mut chess_and_b = ObjectSet::chess();
+    chess_and_b
+        .objects
+        .extend(letters.objects.into_iter().filter(|o| o.name == "lower_b"));
+    assert_eq!(chess_and_b.objects.len(), 3);
+    assert_eq!(chess_and_b.start_heading(), MaxHeading::LETTERS);
+    let dir = tempfile::tempdir().unwrap();
+    let files = ObjectSet::from_files("boxes", &write_boxes(dir.path()), None).unwrap();
+    assert_eq!(files.start_heading(), MaxHeading::ANY);
+}

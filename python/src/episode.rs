@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use pyo3::prelude::*;
 use taction::active_touch::EpisodeConfig;
 use taction::explore::PlannerConfig;
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{MaxHeading, ObjectSpec, PerturbationBounds, StartPose};
 use taction::valid::Valid;
 
 use crate::args::Whole;
@@ -20,6 +20,9 @@ use crate::object::Object;
 /// `candidates` targets offered before every touch, drawn by the planner's rule with local
 /// probability `local_probability`, in a workspace fitted to `workspace` (all the objects that
 /// could be there, so that it tells nothing of which one is; default: `object` alone), the object
+/// starting at `start_pose` (`"canonical"`, where it was built, or `"random"`, a pose drawn from
+/// the seed that the planner is not told, turned at most `start_heading_deg` about the vertical:
+/// 180 for any heading, 10 for the raised letters, whose heading is part of their identity) and
 /// perturbed after every reading within `perturb_deg` / `perturb_frac`.
 ///
 /// Its touches release the GIL; one episode is used by one thread at a time (a lock).
@@ -49,7 +52,7 @@ fn planner_for(objects: &[ObjectSpec], local_probability: f64) -> PlannerConfig 
 #[pymethods]
 impl TouchEpisode {
     #[new]
-    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None)")]
+    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose="canonical", start_heading_deg=180.0), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose='canonical', start_heading_deg=180.0)")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each an episode parameter
     fn new(
         py: Python<'_>,
@@ -61,8 +64,22 @@ impl TouchEpisode {
         perturb_deg: f64,
         perturb_frac: f64,
         workspace: Option<Vec<PyRef<'_, Object>>>,
+        start_pose: &str,
+        start_heading_deg: f64,
     ) -> PyResult<Self> {
         let (Whole(seed), Whole(candidates)) = (seed, candidates);
+        let heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
+            bad_argument(
+                "start_heading_deg",
+                format!("{start_heading_deg} is outside [0, 180]"),
+            )
+        })?;
+        let start_pose = StartPose::parse(start_pose, heading).ok_or_else(|| {
+            bad_argument(
+                "start_pose",
+                format!("'{start_pose}' is none of {}", StartPose::NAMES.join(", ")),
+            )
+        })?;
         let spec = object.spec();
         let fitted_to: Vec<ObjectSpec> = match workspace {
             Some(objects) => {
@@ -85,6 +102,7 @@ impl TouchEpisode {
         let config = EpisodeConfig {
             planner: Valid::new(planner).map_err(refused)?,
             perturbation: PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?,
+            start_pose,
             candidates,
             ..EpisodeConfig::new(*model.inner.sensor())
         };

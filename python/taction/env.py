@@ -1,14 +1,16 @@
 """``taction/ActiveTouch-v0``: learn where to touch to recognise an unknown object.
 
-Each episode places one object of a set (drawn from the episode's seed, optionally perturbed after
-every reading) before the arm. The agent does not see the object; after every action it sees the
-last tactile image, where the pad is, how many touches it has made, the recogniser's belief over the
-objects, and the K targets the exploration planner (Sec. III-A of the paper) offers for the next
-touch. An action either touches toward one of those targets (one planner iteration: the arm moves
-toward it and, if the sensor meets the surface, the controllers of Algorithm 1 settle it and the
-reading updates the belief) or declares which object it is, which ends the episode. A right
-declaration pays ``right_reward``, a wrong one ``wrong_reward``, every touch costs ``touch_cost``; the
-episode is truncated after ``budget`` touches.
+Each episode places one object of a set (drawn from the episode's seed; with ``start_pose="random"``
+at a pose drawn from it too, turned at most ``start_heading_deg`` about the vertical, 10 for the
+raised letters; optionally perturbed after every reading) before the arm. The agent does not see
+the object; after every action it sees the last tactile image, where the pad is, how many touches
+it has made, the recogniser's belief over the objects, and the K targets the exploration planner
+(Sec. III-A of the paper) offers for the next touch. An action either touches toward one of those
+targets (one planner iteration: the arm moves toward it and, if the sensor meets the surface, the
+controllers of Algorithm 1 settle it and the reading updates the belief) or declares which object
+it is, which ends the episode. A right declaration pays ``right_reward``, a wrong one
+``wrong_reward``, every touch costs ``touch_cost``; the episode is truncated after ``budget``
+touches.
 
 The recogniser is ``model`` (a ``taction.Model`` or a model file), or by default the one
 ``taction demo`` trains for the arm's touches (``taction.train_for_arm`` on ``training_readings``
@@ -99,6 +101,8 @@ class ActiveTouchEnv(gymnasium.Env):
         local_probability: float = 0.5,
         perturb_deg: float = 0.0,
         perturb_frac: float = 0.0,
+        start_pose: str = "canonical",
+        start_heading_deg: float = 180.0,
         touch_cost: float = 0.01,
         right_reward: float = 1.0,
         wrong_reward: float = -1.0,
@@ -146,6 +150,8 @@ class ActiveTouchEnv(gymnasium.Env):
             local_probability=local_probability,
             perturb_deg=perturb_deg,
             perturb_frac=perturb_frac,
+            start_pose=start_pose,
+            start_heading_deg=start_heading_deg,
         )
         self.touch_cost = touch_cost
         self.right_reward = right_reward

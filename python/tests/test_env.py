@@ -145,6 +145,12 @@ def test_bad_arguments_raise(make, small_model):
     for bad in [dict(seed=-1), dict(candidates=-2)]:
         with pytest.raises(taction.TactionError, match="whole number"):
             taction.TouchEpisode(small_model, pawn, **bad)
+    with pytest.raises(taction.TactionError, match="start_pose: 'sideways' is none of canonical, random"):
+        taction.TouchEpisode(small_model, pawn, start_pose="sideways")
+    with pytest.raises(taction.TactionError, match=r"start_heading_deg: 200 is outside \[0, 180\]"):
+        taction.TouchEpisode(small_model, pawn, start_pose="random", start_heading_deg=200.0)
+    turned = taction.TouchEpisode(small_model, pawn, seed=3, start_pose="random", start_heading_deg=10.0)
+    assert turned.candidates.shape == episode.candidates.shape
 
 
 def test_a_finished_episode_takes_no_more_steps(make):

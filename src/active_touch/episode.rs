@@ -5,7 +5,8 @@
 //!
 //! The scene and the planner are built as the `active` experiment builds them
 //! ([`CollectPlan::planner_for`]: the object's own random and sensor-noise streams of the seed, the
-//! object perturbed after every reading within the configured bounds), so an episode's touches are
+//! object at the configured start, perturbed after every reading within the configured bounds), so
+//! an episode's touches are
 //! those the experiment's planner would make given the same choices. The model is shared
 //! (`Arc<Recognizer>`), not borrowed, so that an episode can live as long as its caller wants (a
 //! Python object); the recogniser's state is the images observed so far, replayed through a fresh
@@ -23,7 +24,7 @@ use crate::dataset::{Reading, Strategy};
 use crate::explore::{CollectMode, CollectPlan, DEFAULT_CANDIDATES, Planner, PlannerConfig, SensorReader};
 use crate::pose::PadPose;
 use crate::recognize::{Belief, Recognizer, check_same_sensor};
-use crate::sim::{Arm, ObjectSpec, PerturbationBounds, Scene, SimError};
+use crate::sim::{Arm, ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
@@ -49,6 +50,11 @@ pub struct EpisodeConfig {
     pub planner: Valid<PlannerConfig>,
     /// How far the object is moved after every reading (Sec. V-B4); `NONE`: it stays put.
     pub perturbation: PerturbationBounds,
+    /// Where the object starts: where it was built (the default), or at a pose drawn from the
+    /// episode's seed that neither the planner nor the policy is told, so that a policy cannot
+    /// learn the canonical pose instead of the object. Left out of the JSON when canonical.
+    #[serde(default, skip_serializing_if = "StartPose::is_canonical")]
+    pub start_pose: StartPose,
     /// K: candidate targets offered before every touch, at least 1.
     pub candidates: usize,
     /// Readings within this distance of a candidate predict what a touch there shows, metres
@@ -58,7 +64,8 @@ pub struct EpisodeConfig {
 
 impl EpisodeConfig {
     /// The `active` experiment's settings for `sensor`: the default planner (L = 0.5), the object
-    /// fixed, [`DEFAULT_CANDIDATES`] candidates, the neighbourhood one grid cell of the planner.
+    /// fixed where it was built, [`DEFAULT_CANDIDATES`] candidates, the neighbourhood one grid cell
+    /// of the planner.
     pub fn new(sensor: SensorConfig) -> Self {
         let planner = Valid::<PlannerConfig>::default();
         Self {
@@ -66,6 +73,7 @@ impl EpisodeConfig {
             neighbourhood_m: planner.grid_cell_m,
             planner,
             perturbation: PerturbationBounds::NONE,
+            start_pose: StartPose::Canonical,
             candidates: DEFAULT_CANDIDATES,
         }
     }
@@ -85,6 +93,7 @@ impl Check for EpisodeConfig {
             // Checked where they were built.
             planner: _,
             perturbation: _,
+            start_pose: _,
             candidates,
             neighbourhood_m,
         } = *self;
@@ -154,8 +163,8 @@ pub struct TouchEpisode {
 }
 
 impl TouchEpisode {
-    /// The arm before `object` on the table (perturbed after every reading within
-    /// `config.perturbation`), the planner at its start and the first candidates drawn, the belief
+    /// The arm before `object` on the table (at `config.start_pose`, perturbed after every reading
+    /// within `config.perturbation`), the planner at its start and the first candidates drawn, the belief
     /// uniform. `object` must be one of the model's objects (its index there selects its random
     /// streams, as in the `active` experiment), and `config.sensor` the model's sensor.
     pub fn new(
@@ -326,7 +335,7 @@ impl TouchEpisode {
 }
 
 /// The collection plan whose planner the episode drives: the `active` experiment's (the default
-/// controllers, the configured sensor, planner and perturbation), seeded with `seed`.
+/// controllers, the configured sensor, planner, perturbation and start), seeded with `seed`.
 fn plan(config: &EpisodeConfig, seed: u64) -> CollectPlan {
     CollectPlan {
         mode: CollectMode::Planner(config.planner),
@@ -335,5 +344,6 @@ fn plan(config: &EpisodeConfig, seed: u64) -> CollectPlan {
         perturbation: config.perturbation,
         readings_per_object: 0,
         seed,
+        start_pose: config.start_pose,
     }
 }

@@ -66,7 +66,7 @@ use crate::recognize::{
     CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer, Tempering,
     TrainConfig, TrainedModel,
 };
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene};
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::{RangeError, Valid};
 
@@ -286,6 +286,17 @@ impl<'a> ActiveRecognition<'a> {
         match model {
             Recognizer::Single(m) => Self::new(m, neighbourhood_m),
             Recognizer::Fused(f) => Self::fused(f, neighbourhood_m),
+            // The gain predicts the appearance of a touch (the first appearance model's); the
+            // belief is the fused one, contacts included.
+            Recognizer::Geometric(g) => {
+                let bag = &g.appearance().parts()[0].bag;
+                Ok(Self::with(
+                    bag,
+                    model.posterior()?,
+                    g.tempering(),
+                    neighbourhood_m,
+                ))
+            }
         }
     }
 
@@ -305,7 +316,7 @@ impl<'a> ActiveRecognition<'a> {
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
         let features = self.posterior.describe(image);
-        let belief = self.posterior.observe_features(&features)?;
+        let belief = self.posterior.observe_described(image, features.clone())?;
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
         // The gain predicts by Bayes' rule, which the tempered belief follows and its confidence
@@ -375,6 +386,7 @@ impl ArmTrainingRecipe {
             perturbation: PerturbationBounds::NONE,
             readings_per_object: self.readings_per_object,
             seed: self.seed,
+            start_pose: StartPose::Canonical,
         })
     }
 
@@ -415,6 +427,7 @@ impl ArmTrainingRecipe {
             perturbation: PerturbationBounds::NONE,
             readings_per_object: readings,
             seed: crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM),
+            start_pose: StartPose::Canonical,
         })
     }
 

@@ -4,12 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
+use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::explore::{Collect, ExplorationReport, PlannerConfig};
 use taction::mesh::ObjectSet;
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{ObjectSpec, PerturbationBounds, StartPose};
 use taction::tactile::SensorConfig;
 use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
@@ -64,6 +65,12 @@ pub struct CollectArgs {
     /// Perturb the object after every reading: largest translation, fraction of its width, in [0, 1].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_frac: f64,
+    /// Where each object starts: canonical (as it was built) or random (a pose drawn per object
+    /// from the seed, not told to the explorer: any heading about the vertical, within 10 degrees
+    /// for the raised letters, whose heading is part of their identity, then a tilt of up to 10
+    /// degrees and a shift of up to 10% of the width; the dataset's header records it).
+    #[arg(long, value_name = "START", default_value = "canonical", value_parser = PossibleValuesParser::new(StartPose::NAMES))]
+    pub start_pose: String,
     #[command(flatten)]
     pub seed: SeedArg,
     #[command(flatten)]
@@ -96,9 +103,18 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         Mode::Planner => Carrier::Arm,
     };
     let objects = build_objects(&set, "collect", carrier)?;
+    // The set says how far a random start may turn its objects (the letters: 10 degrees).
+    let start_pose = StartPose::parse(&args.start_pose, set.start_heading()).ok_or_else(|| {
+        flag_error(
+            "start-pose",
+            &args.start_pose,
+            format!("want one of {}", StartPose::NAMES.join(", ")),
+        )
+    })?;
     let collect = collection(args, sensor, &objects)
         .control(args.control.valid(sensor.noise_fraction)?)
         .perturbation(perturbation)
+        .start_pose(start_pose)
         .per_object(args.readings)
         .seed(args.seed.seed)
         .threads(args.threads.count().get());

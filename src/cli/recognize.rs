@@ -14,8 +14,9 @@ use taction::experiment::{AccuracyCurve, AccuracyRow, Factors, PlotSpec, SafeNam
 use taction::experiment::{build_figure, reliability_figure};
 use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError, Recognizer, Tempering};
 
-use crate::cli::common::{PosteriorArg, check_output_folder};
+use crate::cli::common::{PosteriorArg, check_output_folder, flag_error};
 use crate::cli::dataset::read_dataset;
+use taction::locate::ContactNoise;
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
@@ -41,11 +42,30 @@ pub struct RecognizeArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub posterior: PosteriorArg,
+    /// With a model of appearance and contact geometry (`train --objects`): the error added to
+    /// every contact before it is matched, as a multiple of the documented arm's (1 mm per axis
+    /// and 2 deg; 0: the simulator's exact contacts).
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "FACTOR",
+        allow_hyphen_values = true
+    )]
+    pub contact_noise_scale: f64,
 }
 
 pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_output_folder(&args.out, "out")?;
-    let model = Recognizer::load(&args.model)?.with_posterior(args.posterior.rule);
+    if !(0.0..=10.0).contains(&args.contact_noise_scale) {
+        return Err(flag_error("contact-noise-scale", args.contact_noise_scale, "want 0 to 10").into());
+    }
+    let model = match Recognizer::load(&args.model)?.with_posterior(args.posterior.rule) {
+        Recognizer::Geometric(g) => {
+            let noise = ContactNoise::ARM.scaled(args.contact_noise_scale);
+            Recognizer::Geometric(Box::new(g.with_contact_noise(noise)))
+        }
+        other => other,
+    };
     let test = read_dataset(&args.dataset)?;
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));

@@ -7,14 +7,17 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
+use taction::locate::{GeometryModel, GeometryParams};
+use taction::mesh::ObjectSet;
 use taction::recognize::{
-    CodebookKind, DescriptorChoice, FusedModel, PseudoCount, RecognizeError, Recognizer, Tempering,
-    TrainConfig, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
+    Appearance, CodebookKind, DescriptorChoice, FusedModel, GeometricFusion, PseudoCount, RecognizeError,
+    Recognizer, Tempering, TrainConfig, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
 };
 use taction::valid::Valid;
 
-use crate::cli::common::{SeedArg, UsageError, check_output_file, flag_error, parse_codebook};
+use crate::cli::common::{ObjectSizeArg, SeedArg, UsageError, check_output_file, flag_error, parse_codebook};
 use crate::cli::dataset::read_dataset;
+use crate::cli::plausible::{Carrier, build_objects};
 
 #[derive(Debug, Args)]
 pub struct TrainArgs {
@@ -69,6 +72,15 @@ pub struct TrainArgs {
     /// readings in the calibration dataset as one trial].
     #[arg(long, value_name = "N", requires = "calibration")]
     pub calibration_trial_readings: Option<usize>,
+    /// The object set the dataset was collected on (as `collect --objects` took it): the model
+    /// then also knows where each touch landed, matching the contacts of the touches so far
+    /// against every object's surface at a pose it is not told (`locate`), fused with the
+    /// appearance model. The fusion's weight is fitted on `--calibration` (else `--validation`),
+    /// explorations the appearance model was not trained on.
+    #[arg(long, value_name = "SET|DIR|FILE...", num_args = 1..)]
+    pub objects: Vec<PathBuf>,
+    #[command(flatten)]
+    pub object_size: ObjectSizeArg,
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
@@ -98,6 +110,14 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         return Err(flag_error("calibration-trial-readings", 0, "want 1 or more").into());
     }
     check_output_file(&args.out, "out")?;
+    if !args.objects.is_empty() && args.calibration.is_empty() && args.validation.is_none() {
+        return Err(UsageError(
+            "--objects: the fusion of appearance and contact geometry is weighed on explorations the \
+             appearance model was not trained on: give --calibration (the arm's explorations) or --validation"
+                .into(),
+        )
+        .into());
+    }
     let variance_kept = match args.variance_kept {
         Some(fraction) => VarianceFraction::new(fraction).map_err(named_by_flag)?,
         None => args.codebook.default_variance_kept(),
@@ -142,6 +162,23 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         let model = models.into_iter().next().ok_or("no descriptor to train")?;
         Recognizer::Single(Box::new(model))
     };
+    let model = match geometry_of(args, &training)? {
+        None => model,
+        Some(geometry) => {
+            let fused = GeometricFusion::new(Appearance::try_from(model)?, geometry)?;
+            let model = Recognizer::Geometric(Box::new(fused));
+            match (&validation, args.calibration.is_empty()) {
+                // Weighed on the calibration explorations below.
+                (_, false) => model,
+                (Some(v), true) => {
+                    let model = model.calibrate_on_all(&[v], config.trial_readings)?;
+                    print_geometry(&model, "validation");
+                    model
+                }
+                (None, true) => model,
+            }
+        }
+    };
     let model = if args.calibration.is_empty() {
         model
     } else {
@@ -163,13 +200,14 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
             &format!("{} ({trials})", names.join(" + ")),
             model.tempering(),
         );
+        print_geometry(&model, &names.join(" + "));
         model
     };
     model.save(&args.out)?;
-    let kind = if args.descriptor.is_fused() {
-        "fused model"
-    } else {
-        "model"
+    let kind = match (&model, args.descriptor.is_fused()) {
+        (Recognizer::Geometric(_), _) => "model of appearance and contact geometry",
+        (_, true) => "fused model",
+        (_, false) => "model",
     };
     println!(
         "{kind} ({}) written to {}",
@@ -303,4 +341,48 @@ fn print_tempering(name: &str, on: &str, t: Tempering) {
         t.effective_readings(10),
         t.effective_readings(30)
     );
+}
+
+/// The geometric model of `--objects`, when given: the set the training data was collected on
+/// (its id is the dataset header's), every object's surface in its canonical frame.
+fn geometry_of(
+    args: &TrainArgs,
+    training: &Dataset,
+) -> Result<Option<GeometryModel>, Box<dyn std::error::Error>> {
+    if args.objects.is_empty() {
+        return Ok(None);
+    }
+    let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
+    let recorded = &training.header().object_set;
+    if &set.id() != recorded {
+        return Err(format!(
+            "--objects: set '{}' (id {}) is not the set --dataset {} was collected on (id {recorded}); \
+             give the --objects and --object-size-m that collect was given",
+            set.name,
+            set.id(),
+            args.dataset.display()
+        )
+        .into());
+    }
+    let objects = build_objects(&set, "train", Carrier::FreePad)?;
+    let params = GeometryParams {
+        max_heading: set.start_heading(),
+        ..GeometryParams::default()
+    };
+    let geometry = GeometryModel::build(
+        objects.iter().map(|o| (o.name.clone(), &o.mesh)),
+        Valid::new(params)?,
+    )?;
+    Ok(Some(geometry))
+}
+
+/// The fitted weight of the geometric evidence, and what it was fitted on.
+fn print_geometry(model: &Recognizer, on: &str) {
+    if let Recognizer::Geometric(g) = model {
+        println!(
+            "contact geometry weighed on {on}: lambda = {} (0: appearance alone), posterior {}",
+            g.geometry_weight(),
+            g.tempering()
+        );
+    }
 }

@@ -44,6 +44,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::FileError;
+use crate::pose::StartPose;
 use crate::tactile::{ConfigError, SensorConfig};
 use crate::valid::Check;
 
@@ -101,6 +102,31 @@ impl From<FileError> for DatasetError {
     }
 }
 
+/// The bounds of the perturbation after every reading (Sec. V-B4) as a dataset records them: a
+/// turn of up to `max_rotation_deg` about a random axis, a shift of up to
+/// `max_translation_fraction` of the object's width (`sim::PerturbationBounds` draws them).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Perturbed {
+    pub max_rotation_deg: f64,
+    pub max_translation_fraction: f64,
+}
+
+impl Perturbed {
+    /// The object stays where it stands.
+    pub const FIXED: Self = Self {
+        max_rotation_deg: 0.0,
+        max_translation_fraction: 0.0,
+    };
+
+    pub fn is_fixed(&self) -> bool {
+        self.max_rotation_deg == 0.0 && self.max_translation_fraction == 0.0
+    }
+
+    fn is_valid(&self) -> bool {
+        (0.0..=180.0).contains(&self.max_rotation_deg) && (0.0..=1.0).contains(&self.max_translation_fraction)
+    }
+}
+
 /// What a dataset holds and how it was made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetHeader {
@@ -117,6 +143,16 @@ pub struct DatasetHeader {
     pub generator: String,
     /// The run's seed.
     pub seed: u64,
+    /// Where each object started ([`StartPose`]): written in the file only when not canonical,
+    /// so that a file of a canonical start is byte for byte what it was before start poses
+    /// existed, and a file without it (every earlier one) reads as canonical.
+    #[serde(default, skip_serializing_if = "StartPose::is_canonical")]
+    pub start_pose: StartPose,
+    /// How far the object was moved after every reading (Sec. V-B4), what a recogniser of
+    /// contact positions must discount: written only when it moved, so that every file of a fixed
+    /// object is what it was, and a file without it reads as fixed.
+    #[serde(default, skip_serializing_if = "Perturbed::is_fixed")]
+    pub perturbation: Perturbed,
 }
 
 impl DatasetHeader {
@@ -135,7 +171,19 @@ impl DatasetHeader {
             objects,
             generator: generator.into(),
             seed,
+            start_pose: StartPose::Canonical,
+            perturbation: Perturbed::FIXED,
         }
+    }
+
+    /// This header for readings whose objects started at `start_pose`.
+    pub fn with_start_pose(self, start_pose: StartPose) -> Self {
+        Self { start_pose, ..self }
+    }
+
+    /// This header for readings of an object moved by `perturbation` after every reading.
+    pub fn with_perturbation(self, perturbation: Perturbed) -> Self {
+        Self { perturbation, ..self }
     }
 
     /// Index of `object` in [`objects`](Self::objects).
@@ -155,6 +203,8 @@ pub enum HeaderError {
     EmptyObjectName { index: usize },
     #[error("object '{name}' is listed twice")]
     DuplicateObject { name: String },
+    #[error("perturbation {0:?} is outside [0, 180] deg and [0, 1] of the width")]
+    Perturbation(Perturbed),
 }
 
 impl HeaderError {
@@ -164,6 +214,7 @@ impl HeaderError {
             Self::FormatVersion { .. } => "format_version",
             Self::Sensor(_) => "sensor",
             Self::EmptyObjectName { .. } | Self::DuplicateObject { .. } => "objects",
+            Self::Perturbation(_) => "perturbation",
         }
     }
 }
@@ -180,7 +231,13 @@ impl Check for DatasetHeader {
             objects,
             generator: _,
             seed: _,
+            // Its heading was checked where it was made (serde included).
+            start_pose: _,
+            perturbation,
         } = self;
+        if !perturbation.is_valid() {
+            return Err(HeaderError::Perturbation(*perturbation));
+        }
         if *format_version != FORMAT_VERSION {
             return Err(HeaderError::FormatVersion {
                 found: *format_version,

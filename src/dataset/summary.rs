@@ -56,11 +56,16 @@ impl DatasetSummary {
 impl fmt::Display for DatasetSummary {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let h = &self.header;
-        writeln!(
+        write!(
             f,
             "format version {}, object set '{}', generator '{}', seed {}",
             h.format_version, h.object_set, h.generator, h.seed
         )?;
+        // Only a random start is said: a canonical one is every dataset's before start poses.
+        if !h.start_pose.is_canonical() {
+            write!(f, ", start pose {}", h.start_pose)?;
+        }
+        writeln!(f)?;
         self.write_sensor(f)?;
         let width = h
             .objects

@@ -4,6 +4,11 @@
 //! object's index ([`crate::rng::stream`]); the sensor's noise stream likewise. Runs go to a rayon pool
 //! of the requested size and come back in object order, so the readings do not depend on the number of
 //! threads or on scheduling.
+//!
+//! Each object starts where [`CollectPlan::start_pose`] says: where it was built, or at a pose
+//! drawn from a stream of its own ([`START_POSE_STREAM`]), so that the sampler's and the planner's
+//! streams, and with them every dataset of a canonical start, are what they were before start
+//! poses existed.
 
 use std::sync::{Mutex, PoisonError};
 
@@ -11,14 +16,15 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::control::{ControlConfig, ControlError, FreePad, ReadTactile};
-use crate::dataset::{Dataset, DatasetError, DatasetHeader};
+use crate::dataset::{Dataset, DatasetError, DatasetHeader, Perturbed};
 use crate::explore::planner::{Planner, PlannerConfig};
 use crate::explore::report::ExplorationReport;
 use crate::explore::sampler::{SamplerConfig, TrainingSampler};
 use crate::explore::setup::TouchSetup;
+use crate::pose::StartPose;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder};
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder, SimError};
 use crate::tactile::SensorConfig;
 use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
 use crate::valid::{RangeError, Valid};
@@ -62,6 +68,11 @@ pub enum CollectError {
     Config(#[from] RangeError),
 }
 
+/// The id of the random stream an object's start pose is drawn from, under the object's own
+/// stream of the run's seed (`rng::stream(rng::substream(seed, index), START_POSE_STREAM)`): a
+/// stream of its own, so that drawing a start takes nothing from the planner's or the sampler's.
+pub const START_POSE_STREAM: u64 = 0x57A7;
+
 /// Everything that determines a collection run (besides the objects).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CollectPlan {
@@ -72,6 +83,11 @@ pub struct CollectPlan {
     /// Converged readings wanted per object.
     pub readings_per_object: usize,
     pub seed: u64,
+    /// Where each object starts (a random start is drawn per object from [`START_POSE_STREAM`]).
+    /// Left out of the plan's JSON when canonical, so that every plan written before start poses
+    /// existed (an experiment's `config.json`, its cache keys) is written as it was.
+    #[serde(default, skip_serializing_if = "StartPose::is_canonical")]
+    pub start_pose: StartPose,
 }
 
 /// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
@@ -100,6 +116,13 @@ impl CollectPlan {
         }
     }
 
+    /// Puts object `index` of this plan at its start in `scene` ([`Scene::place_at_start`]), from
+    /// the object's own start-pose stream; a canonical start leaves it where it was built.
+    pub fn place_at_start(&self, scene: &mut Scene, index: usize) -> Result<(), SimError> {
+        let mut rng = rng::stream(rng::substream(self.seed, index as u64), START_POSE_STREAM);
+        scene.place_at_start(&self.start_pose, &mut rng).map(drop)
+    }
+
     /// Collects the readings of object `index` (its name is the object's name).
     pub fn collect_object(
         &self,
@@ -123,6 +146,7 @@ impl CollectPlan {
                 let setup = self.setup_for(index);
                 let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
                 let mut pad = FreePad::new(object.clone(), &sensor)?;
+                self.place_at_start(pad.scene_mut(), index)?;
                 TrainingSampler::new(config, setup, rng).sample_reporting(
                     &mut pad,
                     &object.name,
@@ -137,9 +161,9 @@ impl CollectPlan {
         }
     }
 
-    /// The arm's scene with `object` and the planner that explores it as object `index` of this
-    /// plan (its sensor noise stream and random stream), for callers that drive the planner
-    /// themselves (active exploration, `active_touch`).
+    /// The arm's scene with `object` at its start and the planner that explores it as object
+    /// `index` of this plan (its start, sensor noise stream and random stream), for callers that
+    /// drive the planner themselves (active exploration, `active_touch`).
     pub fn planner_for(
         &self,
         object: &ObjectSpec,
@@ -149,7 +173,8 @@ impl CollectPlan {
         let setup = self.setup_for(index);
         let builder = SceneBuilder::with_arm_and_table().object(object.clone());
         let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
-        let scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
+        let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
+        self.place_at_start(&mut scene, index)?;
         let reader: SensorReader = Box::new(sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?));
         let planner = Planner::new(
             &scene,
@@ -216,7 +241,13 @@ impl CollectPlan {
             objects.iter().map(|o| o.name.clone()).collect(),
             self.mode.generator_name(),
             self.seed,
-        );
+        )
+        .with_start_pose(self.start_pose)
+        .with_perturbation(Perturbed {
+            // Degrees as given: the bound was made from degrees, and the file should say 10, not 10.000000000000002.
+            max_rotation_deg: (self.perturbation.max_rotation_rad().to_degrees() * 1e9).round() / 1e9,
+            max_translation_fraction: self.perturbation.max_translation_fraction(),
+        });
         Dataset::new(header, reports.into_iter().flat_map(|r| r.readings).collect())
     }
 }
@@ -326,7 +357,8 @@ enum Procedure {
 
 /// A collection run, set up step by step: the procedure (the training sampler of Sec. V-A3 or the
 /// exploration planner of Sec. III-A) and the sensor, then how many converged readings per
-/// object, the seed, the controllers, the perturbation, the threads and a progress callback.
+/// object, the seed, the controllers, the perturbation, the objects' start, the threads and a
+/// progress callback.
 /// [`run`](Self::run) checks the procedure's parameters once and collects every object; the
 /// readings depend on the seed only, not on the threads.
 ///
@@ -354,6 +386,7 @@ pub struct Collect<'p> {
     sensor: SensorConfig,
     control: Valid<ControlConfig>,
     perturbation: PerturbationBounds,
+    start_pose: StartPose,
     per_object: usize,
     seed: u64,
     threads: usize,
@@ -362,7 +395,8 @@ pub struct Collect<'p> {
 
 impl Collect<'static> {
     /// The training sampler with the paper's parameters ([`SamplerConfig::default`]), 100
-    /// readings per object, seed 0, the default controllers, no perturbation, all cores.
+    /// readings per object, seed 0, the default controllers, no perturbation, the objects where
+    /// they were built, all cores.
     pub fn sampler(sensor: SensorConfig) -> Self {
         Self::with(Procedure::Sampler(SamplerConfig::default()), sensor)
     }
@@ -382,6 +416,7 @@ impl Collect<'static> {
         Self {
             control: plan.control,
             perturbation: plan.perturbation,
+            start_pose: plan.start_pose,
             per_object: plan.readings_per_object,
             seed: plan.seed,
             ..Self::with(procedure, plan.sensor)
@@ -394,6 +429,7 @@ impl Collect<'static> {
             sensor,
             control: Valid::default(),
             perturbation: PerturbationBounds::NONE,
+            start_pose: StartPose::Canonical,
             per_object: 100,
             seed: 0,
             threads: 0,
@@ -429,6 +465,12 @@ impl<'p> Collect<'p> {
     /// How far the object is moved after every reading.
     pub fn perturbation(self, perturbation: PerturbationBounds) -> Self {
         Self { perturbation, ..self }
+    }
+
+    /// Where each object starts: where it was built, or at a pose drawn per object that the
+    /// explorer is not told ([`StartPose`]).
+    pub fn start_pose(self, start_pose: StartPose) -> Self {
+        Self { start_pose, ..self }
     }
 
     /// The sampler's parameters (a planner run ignores them).
@@ -471,6 +513,7 @@ impl<'p> Collect<'p> {
             sensor: self.sensor,
             control: self.control,
             perturbation: self.perturbation,
+            start_pose: self.start_pose,
             per_object: self.per_object,
             seed: self.seed,
             threads: self.threads,
@@ -490,6 +533,7 @@ impl<'p> Collect<'p> {
             perturbation: self.perturbation,
             readings_per_object: self.per_object,
             seed: self.seed,
+            start_pose: self.start_pose,
         })
     }
 
@@ -542,8 +586,32 @@ mod tests {
             perturbation: PerturbationBounds::new(5.0, 0.05).unwrap(),
             readings_per_object: 7,
             seed: 3,
+            start_pose: StartPose::random(crate::pose::MaxHeading::LETTERS),
         };
         assert_eq!(Collect::from_plan(plan).plan().unwrap(), plan);
+        // A random start is in the plan's JSON; a canonical one is not, so that a plan written
+        // before start poses existed (an experiment's cache key) is written as it was.
+        let json = serde_json::to_string(&plan).unwrap();
+        assert!(
+            json.ends_with(r#","start_pose":{"random":{"max_heading_rad":0.17453292519943295}}}"#),
+            "{json}"
+        );
+        assert_eq!(serde_json::from_str::<CollectPlan>(&json).unwrap(), plan);
+        let canonical = CollectPlan {
+            start_pose: StartPose::Canonical,
+            ..plan
+        };
+        let json = serde_json::to_string(&canonical).unwrap();
+        assert!(json.ends_with(r#""seed":3}"#), "{json}");
+        assert_eq!(serde_json::from_str::<CollectPlan>(&json).unwrap(), canonical);
+        let beyond = json.replace(
+            r#""seed":3}"#,
+            r#""seed":3,"start_pose":{"random":{"max_heading_rad":4}}}"#,
+        );
+        let error = serde_json::from_str::<CollectPlan>(&beyond)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("max_heading_rad 4 is outside [0, pi]"), "{error}");
         let bad = PlannerConfig {
             max_iterations: 0,
             ..PlannerConfig::default()

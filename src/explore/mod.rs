@@ -14,7 +14,8 @@ pub(crate) mod tree;
 
 // Collecting a dataset: the sampler or the exploring arm, over a set of objects.
 pub use collect::{
-    BatchDataset, Collect, CollectError, CollectMode, CollectPlan, SensorReader, collect_datasets,
+    BatchDataset, Collect, CollectError, CollectMode, CollectPlan, START_POSE_STREAM, SensorReader,
+    collect_datasets,
 };
 pub use grid::ReadingGrid;
 pub use setup::TouchSetup;

@@ -14,6 +14,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::pose::MaxHeading;
+
 use super::cgal::{CGAL_MESHES, ObjectCache};
 use super::checksum::{sha256_file, sha256_hex};
 use super::chess::ChessPiece;
@@ -388,6 +390,21 @@ impl ObjectSet {
             name: self.name.clone(),
             version: self.version,
             id: self.id(),
+        }
+    }
+
+    /// How far a random start (`pose::StartPose::Random`) may turn this set's objects about the
+    /// vertical: [`MaxHeading::LETTERS`] when any of them is a raised letter, whose heading is part
+    /// of its identity ('b' turned half round is 'q'), else [`MaxHeading::ANY`].
+    pub fn start_heading(&self) -> MaxHeading {
+        let letters = self
+            .objects
+            .iter()
+            .any(|o| matches!(o.source, ObjectSource::Letter { .. }));
+        if letters {
+            MaxHeading::LETTERS
+        } else {
+            MaxHeading::ANY
         }
     }
 

@@ -35,7 +35,7 @@ use crate::recognize::{
     Trial, evaluate, make_trials,
 };
 use crate::rng;
-use crate::sim::PerturbationBounds;
+use crate::sim::{PerturbationBounds, StartPose};
 use crate::tactile::SensorConfig;
 use crate::valid::{RangeError, Valid};
 
@@ -569,6 +569,7 @@ impl<'a> SettingData<'a> {
                 perturbation: PerturbationBounds::NONE,
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
+                start_pose: StartPose::Canonical,
             },
         ))
     }
@@ -603,6 +604,7 @@ impl<'a> SettingData<'a> {
                 perturbation,
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
+                start_pose: StartPose::Canonical,
             },
         ))
     }

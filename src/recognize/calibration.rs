@@ -271,8 +271,14 @@ impl Tempering {
     /// every prefix of `trials` (module docs). Without any evidence (no trial with a reading) it
     /// is [`EQ15`](Self::EQ15). Deterministic: a fixed grid and a fixed number of steps.
     pub fn fit(trials: &[EvidencePath]) -> Self {
+        Self::fit_scored(trials).0
+    }
+
+    /// [`fit`](Self::fit) and the mean log loss it reaches (infinite without evidence): what
+    /// comparing two kinds of evidence by how well their fitted posteriors predict needs.
+    pub(crate) fn fit_scored(trials: &[EvidencePath]) -> (Self, f64) {
         if trials.iter().all(|t| t.log_likelihoods.is_empty()) {
-            return Self::EQ15;
+            return (Self::EQ15, f64::INFINITY);
         }
         let prefixes = Prefixes::of(trials);
         // Each grid point's search is independent: they run in parallel, and the best is taken
@@ -300,7 +306,7 @@ impl Tempering {
                 best = (loss, tempering);
             }
         }
-        best.1
+        (best.1, best.0)
     }
 
     /// [`fit`](Self::fit), then the [`ConfidenceMap`] of the fitted tempering's top probability
@@ -308,7 +314,13 @@ impl Tempering {
     /// `MAP_MIN_PREFIXES`, 100, prefixes). For calibration trials of the kind the model will be
     /// judged on: the arm's explorations.
     pub fn fit_with_confidence_map(trials: &[EvidencePath]) -> Self {
-        let tempering = Self::fit(trials);
+        Self::fit(trials).with_confidence_map_of(trials)
+    }
+
+    /// This tempering with the [`ConfidenceMap`] of its top probability onto the right guesses
+    /// over every prefix of `trials` ([`fit_with_confidence_map`](Self::fit_with_confidence_map)).
+    pub(crate) fn with_confidence_map_of(self, trials: &[EvidencePath]) -> Self {
+        let tempering = self;
         let beliefs = trials
             .iter()
             .flat_map(|t| {

@@ -27,6 +27,7 @@ pub(crate) mod evaluate;
 pub(crate) mod exp;
 pub(crate) mod features;
 pub(crate) mod fusion;
+pub(crate) mod geometric;
 pub(crate) mod gmm;
 pub(crate) mod gmm_products;
 pub(crate) mod kmeans;
@@ -36,17 +37,21 @@ pub(crate) mod neighbours;
 pub(crate) mod object_model;
 pub(crate) mod pca;
 pub(crate) mod posterior;
+pub(crate) mod recognizer;
 pub(crate) mod reliability;
 pub(crate) mod selection;
 
 // The model: trained, saved and loaded, one descriptor or several fused.
 pub use bag::BagOfFeatures;
 pub use error::RecognizeError;
-pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel, Recognizer};
+pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel};
+pub use geometric::{Appearance, GeometricFusion, Weighing, motion_of};
 pub use labelled::LabelledFeatures;
 pub use model::{
     MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor, sensor_differences,
 };
+pub use posterior::{GeometricPosterior, TouchReading};
+pub use recognizer::Recognizer;
 
 // Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
 pub use codebook::{CodebookConfig, CodebookKind};

@@ -444,3 +444,19 @@ pub(crate) fn save_json<T: serde::Serialize>(value: &T, path: &Path) -> Result<(
     write_atomic(path, &json)?;
     Ok(())
 }
+
+/// The model file's `format_version` is this build's.
+pub(crate) fn check_version(value: &serde_json::Value, origin: &str) -> Result<(), RecognizeError> {
+    match value.get("format_version").and_then(serde_json::Value::as_u64) {
+        Some(v) if v == u64::from(MODEL_FORMAT_VERSION) => Ok(()),
+        Some(found) => Err(RecognizeError::Version {
+            path: origin.to_string(),
+            found,
+            expected: MODEL_FORMAT_VERSION,
+        }),
+        None => Err(RecognizeError::NotAModel {
+            path: origin.to_string(),
+            what: "no unsigned 'format_version' field".into(),
+        }),
+    }
+}

@@ -3,12 +3,13 @@
 //! [`ModelPosterior`] takes tactile images and describes them as the model's training did.
 
 use crate::describe::{Descriptor, Feature};
+use crate::locate::{Contact, ContactNoise, GeometryPosterior, Touch};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::calibration::Tempering;
 use crate::recognize::decision::Decision;
 use crate::recognize::object_model::ClusterHistogram;
-use crate::tactile::TactileImage;
+use crate::tactile::{SensorConfig, TactileImage};
 
 impl BagOfFeatures {
     /// A posterior over the objects that takes readings one at a time. (Defined here, beside the
@@ -179,6 +180,7 @@ pub struct ModelPosterior<'a> {
 enum Beliefs<'a> {
     Single(OnlinePosterior<'a>),
     Fused(FusedPosterior<'a>),
+    Geometric(Box<GeometricPosterior<'a>>),
 }
 
 impl<'a> ModelPosterior<'a> {
@@ -198,6 +200,18 @@ impl<'a> ModelPosterior<'a> {
         }
     }
 
+    /// The posterior of appearance fused with contact geometry; `descriptors[m]` describes images
+    /// for its appearance model `m`.
+    pub(crate) fn geometric(
+        posterior: GeometricPosterior<'a>,
+        descriptors: Vec<Box<dyn Descriptor>>,
+    ) -> Self {
+        Self {
+            descriptors,
+            beliefs: Beliefs::Geometric(Box::new(posterior)),
+        }
+    }
+
     /// The features of `image` under each of the model's descriptors, in the model's order.
     pub fn describe(&self, image: &TactileImage) -> Vec<Vec<Feature>> {
         self.descriptors.iter().map(|d| d.describe(image)).collect()
@@ -206,7 +220,23 @@ impl<'a> ModelPosterior<'a> {
     /// Describes one reading's image, adds it and returns the belief after it.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
         let features = self.describe(image);
-        self.observe_features(&features)
+        self.observe_described(image, features)
+    }
+
+    /// Adds one reading already described ([`describe`](Self::describe)): a model that knows
+    /// where it touched also reads the contact of `image`.
+    pub fn observe_described(
+        &mut self,
+        image: &TactileImage,
+        features: Vec<Vec<Feature>>,
+    ) -> Result<Belief, RecognizeError> {
+        match &mut self.beliefs {
+            Beliefs::Geometric(p) => {
+                let touch = p.touch_of(image);
+                p.observe(&(features, touch))
+            }
+            _ => self.observe_features(&features),
+        }
     }
 
     /// Adds one reading already described: `features[m]` its features under descriptor `m` (one
@@ -222,6 +252,14 @@ impl<'a> ModelPosterior<'a> {
                 }),
             },
             Beliefs::Fused(p) => p.observe(features),
+            // Described features carry no pad pose: a touch without a contact.
+            Beliefs::Geometric(p) => {
+                let touch = Touch {
+                    contact: None,
+                    attempt: p.readings(),
+                };
+                p.observe(&(features.to_vec(), touch))
+            }
         }
     }
 
@@ -230,6 +268,7 @@ impl<'a> ModelPosterior<'a> {
         match &self.beliefs {
             Beliefs::Single(p) => p.belief(),
             Beliefs::Fused(p) => p.belief(),
+            Beliefs::Geometric(p) => p.belief(),
         }
     }
 
@@ -244,6 +283,73 @@ impl<'a> ModelPosterior<'a> {
         match &self.beliefs {
             Beliefs::Single(p) => p.readings(),
             Beliefs::Fused(p) => p.readings(),
+            Beliefs::Geometric(p) => p.readings(),
+        }
+    }
+}
+
+/// One reading as the fused recogniser of appearance and contact geometry takes it
+/// (`recognize::geometric`): its features under every appearance model's descriptor, and its
+/// touch.
+pub type TouchReading = (Vec<Vec<Feature>>, Touch);
+
+/// The belief of appearance fused with contact geometry after each reading
+/// (`recognize::geometric`): the tempered softmax of `A + lambda G`.
+#[derive(Debug, Clone)]
+pub struct GeometricPosterior<'a> {
+    pub(crate) appearance: FusedPosterior<'a>,
+    pub(crate) geometry: GeometryPosterior<'a>,
+    pub(crate) geometry_weight: f64,
+    pub(crate) tempering: Tempering,
+    pub(crate) contact_noise: ContactNoise,
+    pub(crate) sensor: SensorConfig,
+    pub(crate) readings: usize,
+}
+
+impl GeometricPosterior<'_> {
+    /// Adds one described reading and its touch. On error (features that do not fit the
+    /// appearance models) the state is unchanged.
+    pub fn observe(&mut self, (features, touch): &TouchReading) -> Result<Belief, RecognizeError> {
+        self.appearance.observe(features)?;
+        self.geometry.observe(*touch);
+        self.readings += 1;
+        Ok(self.belief())
+    }
+
+    /// The touch of `image`, the `readings`-th reading of its exploration: its contact, with the
+    /// model's noise (none when the image has no pad pose).
+    pub fn touch_of(&self, image: &TactileImage) -> Touch {
+        Touch {
+            contact: Contact::of_image(image, &self.sensor).map(|c| c.with_noise(&self.contact_noise)),
+            attempt: self.readings,
+        }
+    }
+
+    /// `A + lambda G` for every object.
+    pub fn log_likelihoods(&self) -> Vec<f64> {
+        let g = self.geometry.log_likelihoods();
+        self.appearance
+            .log_likelihoods()
+            .iter()
+            .zip(g)
+            .map(|(a, g)| a + self.geometry_weight * g)
+            .collect()
+    }
+
+    pub fn readings(&self) -> usize {
+        self.readings
+    }
+
+    pub fn belief(&self) -> Belief {
+        let features = self
+            .appearance
+            .parts
+            .iter()
+            .map(|p| p.histogram().features())
+            .sum();
+        Belief {
+            readings: self.readings,
+            decision: Decision::calibrated(self.log_likelihoods(), features, self.tempering, self.readings),
         }
     }
 }

@@ -9,6 +9,7 @@ pub(crate) mod mjcf;
 pub(crate) mod object;
 pub(crate) mod perturb;
 pub(crate) mod scene;
+pub(crate) mod start_pose;
 pub(crate) mod twin;
 
 // The world: built from objects and the arm, stepped, saved and restored.
@@ -25,7 +26,9 @@ pub use twin::ArmTwin;
 // Kinematic motions' samples cleared of contacts without MuJoCo's collision detection.
 pub use contact_screen::{CLEARANCE_M, Screened};
 
-// The object perturbed between readings (Sec. V-B4).
+// The object perturbed between readings (Sec. V-B4), and placed at its start
+// (`Scene::place_at_start`; the start itself is plain data of the `pose` leaf).
+pub use crate::pose::{MaxHeading, StartPose};
 pub use perturb::{Perturbation, PerturbationBounds};
 
 // MJCF text for code that adds bodies to the world: its sections, the collision group, numbers.

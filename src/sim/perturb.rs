@@ -30,6 +30,13 @@ impl PerturbationBounds {
         max_translation_fraction: 0.0,
     };
 
+    /// The paper's bounds (Sec. V-B4): up to 10 degrees of rotation and 10% of the object's width
+    /// of translation, what [`PerturbationBounds::new`]`(10.0, 0.1)` gives.
+    pub const PAPER: Self = Self {
+        max_rotation_rad: 10.0_f64.to_radians(),
+        max_translation_fraction: 0.1,
+    };
+
     /// Rotation at most `max_rotation_deg` (0..=180) and translation at most
     /// `max_translation_fraction` (0..=1) of the object's bounding width.
     pub fn new(max_rotation_deg: f64, max_translation_fraction: f64) -> Result<Self, SimError> {

@@ -17,7 +17,7 @@ use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::paper::context::{Family, PaperContext};
 use crate::paper::figures::default_sensor;
 use crate::rng;
-use crate::sim::{ObjectSpec, PerturbationBounds};
+use crate::sim::{ObjectSpec, PerturbationBounds, StartPose};
 use crate::valid::Valid;
 
 mod render;
@@ -108,6 +108,7 @@ fn figure_plan(object: &ObjectSpec, seed: u64) -> Result<CollectPlan, BoxError> 
         perturbation: PerturbationBounds::NONE,
         readings_per_object: READINGS,
         seed: rng::substream(seed, STREAM),
+        start_pose: StartPose::Canonical,
     })
 }
 

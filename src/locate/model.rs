@@ -1,0 +1,507 @@
+//! The geometric recogniser: for every known object, a few pose hypotheses fitted to the contacts so
+//! far; the evidence for the object is how well its best poses explain them.
+//!
+//! `ln p(contacts | O_j)` is approximated by the log of the mean, over the object's hypotheses, of
+//! the likelihood at each hypothesis's fitted pose: the hypotheses start at headings spread over
+//! the range the object may stand at (any heading, or a few degrees for the letters), each is
+//! refined by Gauss-Newton after every contact (`pose_fit`), so the mean over them stands for the
+//! integral over the unknown heading. Nothing of the object's true pose is read: only contacts.
+
+use serde::{Deserialize, Serialize};
+
+use crate::locate::contact::{Contact, Touch};
+use crate::locate::pose_fit::{Hypothesis, Likelihood, Observation, PosePrior};
+use crate::locate::surface::ObjectSurface;
+use crate::mesh::TriMesh;
+use crate::pose::{MaxHeading, Pose};
+use crate::valid::{Check, FieldChecks, RangeError, Valid};
+
+/// What the geometric recogniser assumes of contacts and of where objects stand. The defaults
+/// are the documented arm and start pose; each is a spread, not a bound, so a pose or contact a
+/// little beyond it costs likelihood rather than being refused.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeometryParams {
+    /// Spread of a contact point about the surface along its normal, metres: the contact noise
+    /// (1.7 mm RMS) and the image's estimate of the contact (the covering's blur).
+    pub sigma_point_m: f64,
+    /// Spread of the contact normal about the surface normal, degrees: Orient's alignment
+    /// (Algorithm 1) on a surface curved under the pad, and the 2 deg of noise.
+    pub sigma_normal_deg: f64,
+    /// Share of contacts no pose of the object explains.
+    pub outlier_fraction: f64,
+    /// Spread of the object's tilt from upright at the start, degrees (start poses tilt up to 10).
+    pub tilt_sigma_deg: f64,
+    /// Spread of the object's horizontal shift at the start, as a fraction of its width (start
+    /// poses shift up to 10%).
+    pub shift_sigma_fraction: f64,
+    /// Spread of the height of the object's centre, metres (a tilt of an object resting on the
+    /// table raises or lowers it).
+    pub height_sigma_m: f64,
+    /// The heading range objects stand at (the object set's, `mesh::ObjectSet::start_heading`):
+    /// any heading, or within a few degrees of the canonical one for the letters, whose heading is
+    /// part of their identity.
+    pub max_heading: MaxHeading,
+    /// Pose hypotheses per object, at headings spread evenly over the range.
+    pub hypotheses: usize,
+    /// Gauss-Newton steps per hypothesis after each contact.
+    pub iterations: usize,
+}
+
+impl Default for GeometryParams {
+    fn default() -> Self {
+        Self {
+            sigma_point_m: 0.0025,
+            sigma_normal_deg: 12.0,
+            outlier_fraction: 0.05,
+            tilt_sigma_deg: 6.0,
+            shift_sigma_fraction: 0.05,
+            height_sigma_m: 0.01,
+            max_heading: MaxHeading::ANY,
+            hypotheses: 36,
+            iterations: 3,
+        }
+    }
+}
+
+impl Check for GeometryParams {
+    type Error = RangeError;
+
+    fn check(&self) -> Result<(), RangeError> {
+        let Self {
+            sigma_point_m,
+            sigma_normal_deg,
+            outlier_fraction,
+            tilt_sigma_deg,
+            shift_sigma_fraction,
+            height_sigma_m,
+            max_heading: _,
+            hypotheses,
+            iterations,
+        } = *self;
+        let positive = |v: f64| v > 0.0;
+        FieldChecks::of("geometry params")
+            .real(
+                "sigma_point_m",
+                sigma_point_m,
+                positive(sigma_point_m) && sigma_point_m <= 0.1,
+                "(0, 0.1]",
+            )
+            .real(
+                "sigma_normal_deg",
+                sigma_normal_deg,
+                positive(sigma_normal_deg) && sigma_normal_deg <= 90.0,
+                "(0, 90]",
+            )
+            .real(
+                "outlier_fraction",
+                outlier_fraction,
+                positive(outlier_fraction) && outlier_fraction < 1.0,
+                "(0, 1)",
+            )
+            .real(
+                "tilt_sigma_deg",
+                tilt_sigma_deg,
+                positive(tilt_sigma_deg) && tilt_sigma_deg <= 90.0,
+                "(0, 90]",
+            )
+            .real(
+                "shift_sigma_fraction",
+                shift_sigma_fraction,
+                positive(shift_sigma_fraction) && shift_sigma_fraction <= 1.0,
+                "(0, 1]",
+            )
+            .real(
+                "height_sigma_m",
+                height_sigma_m,
+                positive(height_sigma_m) && height_sigma_m <= 1.0,
+                "(0, 1]",
+            )
+            .count(
+                "hypotheses",
+                hypotheses,
+                (1..=720).contains(&hypotheses),
+                "1 to 720",
+            )
+            .count(
+                "iterations",
+                iterations,
+                (1..=50).contains(&iterations),
+                "1 to 50",
+            )
+            .finish()
+    }
+}
+
+/// How far the object moves between touches: Sec. V-B4's perturbation after every reading (a turn
+/// of up to `max_rotation_rad` about a random axis, a shift of up to `max_shift_fraction` of the
+/// width), or nothing. The geometric recogniser discounts older contacts by the spread the moves
+/// since have added to where they now lie, and widens its prior over the pose by the same.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ObjectMotion {
+    pub max_rotation_rad: f64,
+    pub max_shift_fraction: f64,
+}
+
+impl ObjectMotion {
+    /// The object stays where it stands.
+    pub const FIXED: Self = Self {
+        max_rotation_rad: 0.0,
+        max_shift_fraction: 0.0,
+    };
+
+    pub fn is_fixed(&self) -> bool {
+        self.max_rotation_rad == 0.0 && self.max_shift_fraction == 0.0
+    }
+
+    /// Mean square turn of one move (uniform angle up to the bound).
+    fn turn_var_rad2(&self) -> f64 {
+        self.max_rotation_rad.powi(2) / 3.0
+    }
+
+    /// Variance one move adds to a contact's distance from the surface, along its normal: the turn
+    /// at half the object's width, and the shift (uniform over a disc, a quarter of its square
+    /// per axis).
+    fn point_var_m2(&self, width_m: f64) -> f64 {
+        let lever = 0.5 * width_m;
+        self.turn_var_rad2() * lever * lever / 3.0 + (self.max_shift_fraction * width_m).powi(2) / 4.0
+    }
+}
+
+/// Why a geometric model could not be built or read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GeometryError {
+    #[error(transparent)]
+    Params(#[from] RangeError),
+    #[error("object '{0}': its mesh has no triangle of positive area to match contacts against")]
+    EmptySurface(String),
+    #[error("the geometric model knows {found} objects, the appearance model {expected}")]
+    Objects { found: usize, expected: usize },
+}
+
+/// Every known object's surface, and what the recogniser assumes (the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GeometryModel {
+    pub params: Valid<GeometryParams>,
+    objects: Vec<String>,
+    surfaces: Vec<ObjectSurface>,
+}
+
+impl GeometryModel {
+    /// The surfaces of `objects` (name and mesh in its canonical frame, metres, as the object
+    /// stands at the identity pose).
+    pub fn build<'m>(
+        objects: impl IntoIterator<Item = (String, &'m TriMesh)>,
+        params: Valid<GeometryParams>,
+    ) -> Result<Self, GeometryError> {
+        let (names, surfaces) = objects
+            .into_iter()
+            .map(|(name, mesh)| match ObjectSurface::of_mesh(mesh) {
+                Some(s) => Ok((name, s)),
+                None => Err(GeometryError::EmptySurface(name)),
+            })
+            .collect::<Result<(Vec<_>, Vec<_>), _>>()?;
+        Ok(Self {
+            params,
+            objects: names,
+            surfaces,
+        })
+    }
+
+    pub fn objects(&self) -> &[String] {
+        &self.objects
+    }
+
+    pub fn surfaces(&self) -> &[ObjectSurface] {
+        &self.surfaces
+    }
+
+    /// A posterior with no contact yet, for an object that moves as `motion` says between touches.
+    pub fn posterior(&self, motion: ObjectMotion) -> GeometryPosterior<'_> {
+        let hypotheses = self
+            .surfaces
+            .iter()
+            .map(|s| {
+                self.headings()
+                    .into_iter()
+                    .map(|h| Hypothesis::at_heading(s, h))
+                    .collect()
+            })
+            .collect();
+        GeometryPosterior {
+            model: self,
+            motion,
+            hypotheses,
+            contacts: Vec::new(),
+            latest: 0,
+            log_likelihoods: vec![0.0; self.objects.len()],
+        }
+    }
+
+    /// The hypotheses' starting headings: evenly over the full turn, or over `+-max` (both ends).
+    fn headings(&self) -> Vec<f64> {
+        let n = self.params.hypotheses;
+        let max = self.params.max_heading;
+        if max.is_any() {
+            (0..n)
+                .map(|k| std::f64::consts::TAU * k as f64 / n as f64)
+                .collect()
+        } else if n > 1 {
+            (0..n)
+                .map(|k| max.rad() * (2.0 * k as f64 / (n - 1) as f64 - 1.0))
+                .collect()
+        } else {
+            vec![0.0]
+        }
+    }
+
+    fn likelihood(&self) -> Likelihood {
+        Likelihood {
+            sigma_point_m: self.params.sigma_point_m,
+            sigma_normal_rad: self.params.sigma_normal_deg.to_radians(),
+            outlier: self.params.outlier_fraction,
+        }
+    }
+}
+
+/// The geometric evidence after each touch (the module docs): `observe` a touch, read
+/// `log_likelihoods`.
+#[derive(Debug, Clone)]
+pub struct GeometryPosterior<'a> {
+    model: &'a GeometryModel,
+    motion: ObjectMotion,
+    /// Per object, its pose hypotheses.
+    hypotheses: Vec<Vec<Hypothesis>>,
+    /// Every contact so far and the attempt it was taken at.
+    contacts: Vec<(Contact, usize)>,
+    /// The latest attempt observed.
+    latest: usize,
+    log_likelihoods: Vec<f64>,
+}
+
+impl GeometryPosterior<'_> {
+    /// Adds one touch (a touch without a contact adds no evidence, but its attempt still counts
+    /// the object's moves). Returns `ln p(contacts | O_j)` for every object, up to one constant.
+    pub fn observe(&mut self, touch: Touch) -> &[f64] {
+        self.latest = self.latest.max(touch.attempt);
+        if let Some(c) = touch.contact {
+            self.contacts.push((c, touch.attempt));
+            self.refit();
+        }
+        &self.log_likelihoods
+    }
+
+    /// `ln p(contacts | O_j)` for every object (0 before any contact).
+    pub fn log_likelihoods(&self) -> &[f64] {
+        &self.log_likelihoods
+    }
+
+    /// Object `object`'s most likely pose now (mesh frame in the world), from its best
+    /// hypothesis: where the recogniser believes it stands if it is that object.
+    pub fn best_pose(&self, object: usize) -> Option<Pose> {
+        let surface = self.model.surfaces.get(object)?;
+        let best = self
+            .hypotheses
+            .get(object)?
+            .iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score))?;
+        // p = R (q - c) + c_w = R q + (c_w - R c).
+        Some(Pose::new(
+            best.center_w - best.rotation * surface.center_m(),
+            best.rotation,
+        ))
+    }
+
+    fn refit(&mut self) {
+        let model = self.model;
+        let likelihood = model.likelihood();
+        let iterations = model.params.iterations;
+        for (j, surface) in model.surfaces.iter().enumerate() {
+            let observations = self.observations(surface.width_m());
+            let prior = self.prior(surface.width_m());
+            let hypotheses = &mut self.hypotheses[j];
+            for h in hypotheses.iter_mut() {
+                h.refine(surface, &observations, &likelihood, &prior, iterations);
+            }
+            let best = hypotheses
+                .iter()
+                .map(|h| h.score)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let sum: f64 = hypotheses.iter().map(|h| (h.score - best).exp()).sum();
+            self.log_likelihoods[j] = best + (sum / hypotheses.len() as f64).ln();
+        }
+    }
+
+    /// The contacts as the fit sees them now: each older one spread by the moves since.
+    fn observations(&self, width_m: f64) -> Vec<Observation> {
+        let point_var = self.motion.point_var_m2(width_m);
+        let normal_var = self.motion.turn_var_rad2() * 2.0 / 3.0;
+        self.contacts
+            .iter()
+            .map(|&(contact, attempt)| {
+                let moves = self.latest.saturating_sub(attempt) as f64;
+                Observation {
+                    contact,
+                    point_var_m2: moves * point_var,
+                    normal_var_rad2: moves * normal_var,
+                }
+            })
+            .collect()
+    }
+
+    /// Where the object may stand now: the start pose's spread, widened by the moves so far.
+    fn prior(&self, width_m: f64) -> PosePrior {
+        let p = &self.model.params;
+        let moves = self.latest as f64;
+        let turn_var = moves * self.motion.turn_var_rad2() / 3.0;
+        let shift_var = moves * (self.motion.max_shift_fraction * width_m).powi(2) / 4.0;
+        PosePrior {
+            tilt_sigma_rad: (p.tilt_sigma_deg.to_radians().powi(2) + turn_var).sqrt(),
+            shift_sigma_m: ((p.shift_sigma_fraction * width_m).powi(2) + shift_var).sqrt(),
+            height_sigma_m: (p.height_sigma_m.powi(2) + shift_var).sqrt(),
+            // Half the range: a uniform draw within +-max has a spread of max / sqrt(3).
+            heading_sigma_rad: (!p.max_heading.is_any())
+                .then(|| ((0.5 * p.max_heading.rad()).powi(2).max(1e-6) + turn_var).sqrt()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DQuat, DVec3};
+
+    use super::*;
+
+    /// A box 12 x 6 x 4 cm resting on z = 0, centred on the vertical axis: no turn about the
+    /// vertical but the half turn maps it onto itself.
+    fn slab() -> TriMesh {
+        TriMesh::cuboid(DVec3::new(0.06, 0.03, 0.02)).translated(DVec3::new(0.0, 0.0, 0.02))
+    }
+
+    /// A cube of 8 cm resting on z = 0.
+    fn cube() -> TriMesh {
+        TriMesh::cuboid(DVec3::splat(0.04)).translated(DVec3::new(0.0, 0.0, 0.04))
+    }
+
+    fn model() -> GeometryModel {
+        let (slab, cube) = (slab(), cube());
+        GeometryModel::build(
+            [("slab".to_string(), &slab), ("cube".to_string(), &cube)],
+            Valid::default(),
+        )
+        .expect("two boxes")
+    }
+
+    /// Contacts on the slab's sides and top (the faces an arm from above reaches) at `pose`.
+    fn slab_contacts(pose: &Pose) -> Vec<Contact> {
+        let local = [
+            (DVec3::new(0.06, 0.01, 0.02), DVec3::X),
+            (DVec3::new(-0.02, 0.03, 0.01), DVec3::Y),
+            (DVec3::new(0.03, -0.01, 0.04), DVec3::Z),
+            (DVec3::new(-0.06, -0.02, 0.03), -DVec3::X),
+            (DVec3::new(0.01, -0.03, 0.02), -DVec3::Y),
+            (DVec3::new(-0.04, 0.02, 0.04), DVec3::Z),
+        ];
+        local
+            .iter()
+            .map(|&(p, n)| Contact {
+                point_m: pose.transform_point(p),
+                normal: pose.transform_vector(n),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn contacts_on_an_object_at_an_untold_pose_name_it_and_find_its_pose() {
+        let model = model();
+        let pose = Pose::new(DVec3::new(0.004, -0.003, 0.0), DQuat::from_rotation_z(0.7));
+        let mut posterior = model.posterior(ObjectMotion::FIXED);
+        for (attempt, contact) in slab_contacts(&pose).into_iter().enumerate() {
+            posterior.observe(Touch {
+                contact: Some(contact),
+                attempt,
+            });
+        }
+        let l = posterior.log_likelihoods();
+        assert!(l[0] > l[1] + 10.0, "slab {} vs cube {}", l[0], l[1]);
+        let found = posterior.best_pose(0).expect("a pose");
+        // The slab is the same turned half round: either heading is right.
+        let turn = (found.rotation * pose.rotation.inverse()).to_axis_angle().1;
+        let off = turn.min((turn - std::f64::consts::PI).abs());
+        assert!(off < 0.03, "heading off by {off} rad");
+        assert!((found.position_m - pose.position_m).length() < 0.03);
+    }
+
+    #[test]
+    fn a_touch_without_a_contact_adds_no_evidence() {
+        let model = model();
+        let mut posterior = model.posterior(ObjectMotion::FIXED);
+        let l = posterior
+            .observe(Touch {
+                contact: None,
+                attempt: 0,
+            })
+            .to_vec();
+        assert_eq!(l, vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_moving_object_discounts_its_older_contacts() {
+        let model = model();
+        let pose = Pose::new(DVec3::ZERO, DQuat::from_rotation_z(0.3));
+        let contacts = slab_contacts(&pose);
+        let gap = |motion| {
+            let mut posterior = model.posterior(motion);
+            for (attempt, contact) in contacts.iter().enumerate() {
+                posterior.observe(Touch {
+                    contact: Some(*contact),
+                    attempt,
+                });
+            }
+            let l = posterior.log_likelihoods();
+            l[0] - l[1]
+        };
+        let moving = ObjectMotion {
+            max_rotation_rad: 10f64.to_radians(),
+            max_shift_fraction: 0.1,
+        };
+        let (fixed, moved) = (gap(ObjectMotion::FIXED), gap(moving));
+        assert!(moved > 0.0 && moved < fixed, "fixed {fixed}, moving {moved}");
+    }
+
+    #[test]
+    fn the_same_contacts_give_the_same_bits() {
+        let model = model();
+        let pose = Pose::new(DVec3::ZERO, DQuat::from_rotation_z(2.0));
+        let run = || {
+            let mut posterior = model.posterior(ObjectMotion::FIXED);
+            for (attempt, contact) in slab_contacts(&pose).into_iter().enumerate() {
+                posterior.observe(Touch {
+                    contact: Some(contact),
+                    attempt,
+                });
+            }
+            posterior.log_likelihoods().to_vec()
+        };
+        assert_eq!(run(), run());
+    }
+
+    #[test]
+    fn a_model_file_round_trips() {
+        let model = model();
+        let json = serde_json::to_string(&model).expect("encodes");
+        let back: GeometryModel = serde_json::from_str(&json).expect("decodes");
+        assert_eq!(back, model);
+    }
+
+    #[test]
+    fn params_out_of_range_are_refused_by_name() {
+        let bad = GeometryParams {
+            outlier_fraction: 1.5,
+            ..GeometryParams::default()
+        };
+        let e = Valid::new(bad).expect_err("refused");
+        assert_eq!(e.field, "outlier_fraction");
+        assert!(Valid::new(GeometryParams::default()).is_ok());
+    }
+}

@@ -1,0 +1,254 @@
+//! One pose hypothesis of one object, fitted to the contacts so far (Petrovskaya and Khatib's
+//! contact likelihood, refined by Gauss-Newton as point-to-plane ICP refines a pose): the object
+//! stands on the table at a heading the recogniser is not told, tilted a little and moved a little
+//! from where objects are put (the start pose of `sim::StartPose`), and every contact should lie on
+//! its surface with the surface's normal.
+//!
+//! A pose is a rotation `R` about the object's bounding-box centre `c` and where that centre is in
+//! the world, `c_w`: a world point `p` is the object point `R^T (p - c_w) + c`. A step turns by a
+//! small world rotation `w` about `c_w` and moves `c_w` by `d`.
+
+use glam::{DMat3, DQuat, DVec3};
+use nalgebra::{Matrix6, Vector6};
+
+use crate::locate::contact::Contact;
+use crate::locate::surface::ObjectSurface;
+
+/// What the likelihood of a contact assumes (documented defaults in [`crate::locate::GeometryParams`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Likelihood {
+    /// The contact point's spread about the surface along its normal, metres.
+    pub sigma_point_m: f64,
+    /// The contact normal's spread about the surface normal, radians.
+    pub sigma_normal_rad: f64,
+    /// The share of contacts no pose explains (a slip, a reading of an edge).
+    pub outlier: f64,
+}
+
+/// The prior over where the object stands, and how far it moves between touches.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PosePrior {
+    /// Spread of the tilt of the object's up axis from the vertical, radians (each horizontal
+    /// component of the up axis).
+    pub tilt_sigma_rad: f64,
+    /// Spread of the bounding-box centre about where it stands at the canonical pose, horizontal,
+    /// metres.
+    pub shift_sigma_m: f64,
+    /// The same, vertical (a tilt raises or lowers the centre of an object resting on the table).
+    pub height_sigma_m: f64,
+    /// Spread of the heading about the canonical one, radians; `None`: any heading.
+    pub heading_sigma_rad: Option<f64>,
+}
+
+/// A contact as the fit sees it: its world point and normal, and how much the object may have
+/// moved since it was taken (variances added to the likelihood's).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Observation {
+    pub contact: Contact,
+    pub point_var_m2: f64,
+    pub normal_var_rad2: f64,
+}
+
+/// A pose of one object and its log-likelihood (with the prior) given the contacts so far.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Hypothesis {
+    pub rotation: DQuat,
+    pub center_w: DVec3,
+    pub score: f64,
+}
+
+/// Everything one pass over the contacts gives at one pose.
+struct Linearised {
+    score: f64,
+    hessian: Matrix6<f64>,
+    gradient: Vector6<f64>,
+}
+
+/// A contact anywhere in a 0.2 m cube, with any normal: the density an outlier has, per cubic
+/// metre and steradian.
+const OUTLIER_DENSITY: f64 = 1.0 / (0.008 * 4.0 * std::f64::consts::PI);
+
+/// Damping of a Gauss-Newton step: a turn of more than about 0.2 rad or a move of more than about
+/// a centimetre needs contacts to ask for it.
+const DAMPING_ROTATION: f64 = 1.0 / (0.2 * 0.2);
+const DAMPING_TRANSLATION: f64 = 1.0 / (0.01 * 0.01);
+
+impl Hypothesis {
+    /// The object at heading `heading_rad` about the vertical through its centre, where it stands
+    /// at the canonical pose.
+    pub fn at_heading(surface: &ObjectSurface, heading_rad: f64) -> Self {
+        Self {
+            rotation: DQuat::from_rotation_z(heading_rad),
+            center_w: surface.center_m(),
+            score: 0.0,
+        }
+    }
+
+    /// Refines the pose by up to `iterations` Gauss-Newton steps on the contacts and the prior,
+    /// keeping a step only when it raises the score, and leaves the score of the pose kept.
+    pub fn refine(
+        &mut self,
+        surface: &ObjectSurface,
+        observations: &[Observation],
+        likelihood: &Likelihood,
+        prior: &PosePrior,
+        iterations: usize,
+    ) {
+        let mut current = self.linearise(surface, observations, likelihood, prior);
+        for _ in 0..iterations {
+            let Some(step) = solve(&current) else { break };
+            let trial = self.stepped(&step);
+            let next = trial.linearise(surface, observations, likelihood, prior);
+            if next.score.partial_cmp(&current.score) != Some(std::cmp::Ordering::Greater) {
+                break;
+            }
+            *self = trial;
+            current = next;
+            if step.norm() < 1e-7 {
+                break;
+            }
+        }
+        self.score = current.score;
+    }
+
+    fn stepped(&self, step: &Vector6<f64>) -> Self {
+        let turn = DVec3::new(step[0], step[1], step[2]);
+        Self {
+            rotation: (DQuat::from_scaled_axis(turn) * self.rotation).normalize(),
+            center_w: self.center_w + DVec3::new(step[3], step[4], step[5]),
+            score: self.score,
+        }
+    }
+
+    /// The score (log-likelihood of every contact, robust, plus the log-prior up to a constant)
+    /// and its Gauss-Newton approximation at this pose. Each contact's weight in the step is the
+    /// probability that it is not an outlier (EM's responsibility), so a contact the pose cannot
+    /// explain stops pulling on it.
+    fn linearise(
+        &self,
+        surface: &ObjectSurface,
+        observations: &[Observation],
+        likelihood: &Likelihood,
+        prior: &PosePrior,
+    ) -> Linearised {
+        let mut out = Linearised {
+            score: 0.0,
+            hessian: Matrix6::zeros(),
+            gradient: Vector6::zeros(),
+        };
+        let to_object = self.rotation.inverse();
+        let density_scale = (1.0 - likelihood.outlier) / surface.area_m2();
+        for o in observations {
+            let a = o.contact.point_m - self.center_w;
+            let q = to_object * a + surface.center_m();
+            let point_var = likelihood.sigma_point_m.powi(2) + o.point_var_m2;
+            let normal_var = likelihood.sigma_normal_rad.powi(2) + o.normal_var_rad2;
+            let outlier = likelihood.outlier * OUTLIER_DENSITY;
+            let Some(nearest) = surface.nearest(q) else {
+                out.score += outlier.ln();
+                continue;
+            };
+            let g = self.rotation * surface.normals()[nearest.index];
+            let r = nearest.signed_distance_m;
+            let kappa = 1.0 / normal_var;
+            let cos = g.dot(o.contact.normal).clamp(-1.0, 1.0);
+            let log_inlier =
+                density_scale.ln() - 0.5 * r * r / point_var - 0.5 * (std::f64::consts::TAU * point_var).ln()
+                    + kappa * (cos - 1.0)
+                    + (kappa / std::f64::consts::TAU).ln();
+            let log_total = log_sum_exp(log_inlier, outlier.ln());
+            out.score += log_total;
+            let w = (log_inlier - log_total).exp();
+            // Point-to-plane: dr/dw = -(a x g), dr/dd = -g.
+            let j = Vector6::from_column_slice(&[
+                -(a.cross(g)).x,
+                -(a.cross(g)).y,
+                -(a.cross(g)).z,
+                -g.x,
+                -g.y,
+                -g.z,
+            ]);
+            out.hessian += j * j.transpose() * (w / point_var);
+            out.gradient += j * (w * r / point_var);
+            // Normal: e = g - n, de/dw = -[g]x.
+            let e = g - o.contact.normal;
+            let gx = cross_matrix(g);
+            let h = (gx.transpose() * gx) * (w / normal_var);
+            let grad = g.cross(e) * (w / normal_var);
+            add_rotation_block(&mut out, h, grad);
+        }
+        self.add_prior(surface, prior, &mut out);
+        out
+    }
+
+    /// The prior's residuals: the up axis's horizontal components, the centre's shift, the heading
+    /// when it is bounded.
+    fn add_prior(&self, surface: &ObjectSurface, prior: &PosePrior, out: &mut Linearised) {
+        let u = self.rotation * DVec3::Z;
+        let tilt_var = prior.tilt_sigma_rad.powi(2);
+        // d(u)/dw = -[u]x: the rows for u.x and u.y.
+        let rows = [DVec3::new(0.0, u.z, -u.y), DVec3::new(-u.z, 0.0, u.x)];
+        for (residual, row) in [u.x, u.y].into_iter().zip(rows) {
+            add_rotation_residual(out, residual, row, tilt_var);
+        }
+        let shift = self.center_w - surface.center_m();
+        let sigmas = [prior.shift_sigma_m, prior.shift_sigma_m, prior.height_sigma_m];
+        for (k, sigma) in sigmas.into_iter().enumerate() {
+            let var = sigma * sigma;
+            out.score -= 0.5 * shift[k] * shift[k] / var;
+            out.hessian[(3 + k, 3 + k)] += 1.0 / var;
+            out.gradient[3 + k] += shift[k] / var;
+        }
+        if let Some(sigma) = prior.heading_sigma_rad {
+            let v = self.rotation * DVec3::X;
+            let horizontal = (v.x * v.x + v.y * v.y).max(1e-12);
+            let heading = v.y.atan2(v.x);
+            let row = DVec3::new(-v.x * v.z, -v.y * v.z, horizontal) / horizontal;
+            add_rotation_residual(out, heading, row, sigma * sigma);
+        }
+    }
+}
+
+/// Adds a scalar residual `r` of variance `var` whose derivative by the turn is `row`.
+fn add_rotation_residual(out: &mut Linearised, r: f64, row: DVec3, var: f64) {
+    out.score -= 0.5 * r * r / var;
+    let h = DMat3::from_cols(row * row.x, row * row.y, row * row.z) / var;
+    add_rotation_block(out, h, row * (r / var));
+}
+
+fn add_rotation_block(out: &mut Linearised, h: DMat3, gradient: DVec3) {
+    for i in 0..3 {
+        for k in 0..3 {
+            out.hessian[(i, k)] += h.col(k)[i];
+        }
+        out.gradient[i] += gradient[i];
+    }
+}
+
+/// The damped Gauss-Newton step `-(H + D)^-1 g`, or `None` when it cannot be solved.
+fn solve(at: &Linearised) -> Option<Vector6<f64>> {
+    let mut h = at.hessian;
+    for k in 0..3 {
+        h[(k, k)] += DAMPING_ROTATION;
+        h[(3 + k, 3 + k)] += DAMPING_TRANSLATION;
+    }
+    let step = h.cholesky()?.solve(&(-at.gradient));
+    step.iter().all(|x| x.is_finite()).then_some(step)
+}
+
+/// `[v]x`, the matrix of `v x .`.
+fn cross_matrix(v: DVec3) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.0, v.z, -v.y),
+        DVec3::new(-v.z, 0.0, v.x),
+        DVec3::new(v.y, -v.x, 0.0),
+    )
+}
+
+pub(crate) fn log_sum_exp(a: f64, b: f64) -> f64 {
+    let m = a.max(b);
+    if m == f64::NEG_INFINITY {
+        return m;
+    }
+    m + ((a - m).exp() + (b - m).exp()).ln()
+}

@@ -1,0 +1,166 @@
+//! The recogniser that knows where it touched (`locate`, `recognize::geometric`): contacts of the
+//! toy readings placed on three real meshes at a pose the model is not told, so that appearance
+//! alone cannot tell the objects apart and contact geometry must; its model file round-trips, and
+//! nothing of a reading's `object_pose` reaches a posterior.
+
+mod recognize_toy;
+
+use glam::{DQuat, DVec3};
+use taction::dataset::{Dataset, Reading};
+use taction::locate::{GeometryModel, GeometryParams, ObjectSurface};
+use taction::mesh::TriMesh;
+use taction::pose::{PadPose, Pose};
+use taction::recognize::{Appearance, GeometricFusion, ReadingRange, Recognizer, TrainConfig, TrainedModel};
+use taction::valid::Valid;
+
+/// The three toy objects' shapes, resting on z = 0: a cube, a long slab, a tall post.
+fn meshes() -> [TriMesh; 3] {
+    let resting = |half: DVec3| TriMesh::cuboid(half).translated(DVec3::new(0.0, 0.0, half.z));
+    [
+        resting(DVec3::splat(0.04)),
+        resting(DVec3::new(0.06, 0.03, 0.02)),
+        resting(DVec3::new(0.02, 0.02, 0.06)),
+    ]
+}
+
+/// `per_object` readings of each toy object, every image flat (appearance tells nothing), each
+/// taken on the upper half of its object's surface, the object turned by `heading_rad` and moved
+/// by `shift_m`; `object_pose` records that pose.
+fn dataset(per_object: usize, seed: u64, heading_rad: f64, shift_m: DVec3) -> Dataset {
+    let flat = recognize_toy::dataset(per_object, seed);
+    let pose = Pose::new(shift_m, DQuat::from_rotation_z(heading_rad));
+    let surfaces: Vec<ObjectSurface> = meshes()
+        .iter()
+        .map(|m| ObjectSurface::of_mesh(m).expect("a box"))
+        .collect();
+    let sensor = flat.header().sensor;
+    let mut counts = [0usize; 3];
+    let readings = flat
+        .readings()
+        .iter()
+        .map(|r| {
+            let j = recognize_toy::OBJECTS
+                .iter()
+                .position(|o| *o == r.object)
+                .expect("a toy object");
+            let mut rng = taction::rng::stream(seed, (1000 * j + counts[j]) as u64);
+            counts[j] += 1;
+            let s = &surfaces[j];
+            let image = recognize_toy::image(2, &mut rng);
+            // A point of the upper half, as an arm from above reaches.
+            let top = s.points().iter().map(|p| p.z).fold(0.0, f64::max);
+            let upper: Vec<usize> = (0..s.points().len())
+                .filter(|&i| s.points()[i].z > 0.5 * top)
+                .collect();
+            let i = upper[(counts[j] * 7919 + seed as usize) % upper.len()];
+            let (point, outward) = (
+                pose.transform_point(s.points()[i]),
+                pose.transform_vector(s.normals()[i]),
+            );
+            let depth = sensor.thickness_m * (1.0 - image.mean());
+            let pad = PadPose::new(
+                point + outward * depth,
+                -outward,
+                outward.any_orthonormal_vector(),
+            )
+            .expect("a pad pose");
+            Reading {
+                image: image.with_pose(pad),
+                object_pose: pose,
+                ..r.clone()
+            }
+        })
+        .collect();
+    Dataset::new(flat.header().clone(), readings).expect("the toy header")
+}
+
+fn model(calibration: &Dataset) -> Recognizer {
+    let config = Valid::new(TrainConfig {
+        ks: vec![4],
+        restarts: 1,
+        seed: 5,
+        ..TrainConfig::default()
+    })
+    .expect("a config");
+    let training = recognize_toy::dataset(30, 8);
+    let descriptor = taction::describe::DescriptorKind::Mnti.build();
+    let appearance =
+        TrainedModel::fit(&config, &training, None, descriptor.as_ref(), &mut |_| {}).expect("trains");
+    let meshes = meshes();
+    let geometry = GeometryModel::build(
+        recognize_toy::OBJECTS.iter().map(|o| o.to_string()).zip(&meshes),
+        Valid::new(GeometryParams::default()).expect("defaults"),
+    )
+    .expect("three boxes");
+    let fused =
+        GeometricFusion::new(Appearance::Single(Box::new(appearance)), geometry).expect("same objects");
+    Recognizer::Geometric(Box::new(fused))
+        .calibrate_on_all(&[calibration], 6)
+        .expect("calibrates")
+}
+
+fn accuracy_at(model: &Recognizer, test: &Dataset, n: usize) -> f64 {
+    let (evaluation, _) = model
+        .evaluate(test, ReadingRange::new(1, 6).expect("a range"))
+        .expect("evaluates");
+    evaluation.accuracy_at(n).expect("a point")
+}
+
+#[test]
+fn contacts_tell_apart_objects_that_feel_the_same() {
+    let calibration = dataset(12, 21, 0.4, DVec3::new(0.003, 0.0, 0.0));
+    let model = model(&calibration);
+    let Recognizer::Geometric(g) = &model else {
+        panic!("a geometric model");
+    };
+    assert!(g.geometry_weight() > 0.0, "the calibration weighed geometry at 0");
+    let test = dataset(12, 22, 2.1, DVec3::new(-0.004, 0.005, 0.0));
+    // Every image is flat: appearance alone is at chance (1/3).
+    assert!(
+        accuracy_at(&model, &test, 6) >= 0.9,
+        "{}",
+        accuracy_at(&model, &test, 6)
+    );
+}
+
+#[test]
+fn no_object_pose_reaches_a_posterior_and_the_model_file_round_trips() {
+    let model = model(&dataset(12, 21, 0.4, DVec3::ZERO));
+    let test = dataset(6, 23, 1.0, DVec3::ZERO);
+    let range = ReadingRange::new(1, 6).expect("a range");
+    let (before, _) = model.evaluate(&test, range).expect("evaluates");
+    let lied: Vec<Reading> = test
+        .readings()
+        .iter()
+        .map(|r| Reading {
+            object_pose: Pose::new(DVec3::new(1.0, 2.0, 3.0), DQuat::from_rotation_x(1.0)),
+            ..r.clone()
+        })
+        .collect();
+    let lied = Dataset::new(test.header().clone(), lied).expect("the same header");
+    let (after, _) = model.evaluate(&lied, range).expect("evaluates");
+    assert_eq!(before.posterior_long_csv(), after.posterior_long_csv());
+    let bytes = model.to_json().expect("encodes");
+    let back = Recognizer::from_json(&bytes, "memory").expect("decodes");
+    assert_eq!(back, model);
+    assert_eq!(back.to_json().expect("encodes"), bytes);
+    let (again, _) = back.evaluate(&test, range).expect("evaluates");
+    assert_eq!(again.posterior_long_csv(), before.posterior_long_csv());
+}
+
+#[test]
+fn a_corrupt_geometric_model_file_is_named() {
+    let model = model(&dataset(6, 21, 0.0, DVec3::ZERO));
+    let mut value: serde_json::Value =
+        serde_json::from_slice(&model.to_json().expect("encodes")).expect("json");
+    value["geometry_weight"] = serde_json::json!(-1.0);
+    let e = Recognizer::from_json(&serde_json::to_vec(&value).expect("json"), "m.json").expect_err("refused");
+    assert!(
+        e.to_string().contains("m.json") && e.to_string().contains("geometry_weight"),
+        "{e}"
+    );
+    value["geometry_weight"] = serde_json::json!(0.5);
+    value["geometry"]["surfaces"][0]["points"] = serde_json::json!([]);
+    let e = Recognizer::from_json(&serde_json::to_vec(&value).expect("json"), "m.json").expect_err("refused");
+    assert!(e.to_string().contains("m.json"), "{e}");
+}
