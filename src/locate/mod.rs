@@ -16,5 +16,5 @@ pub(crate) mod pose_fit;
 pub(crate) mod surface;
 
 pub use contact::{Contact, ContactNoise, Touch};
-pub use model::{GeometryError, GeometryModel, GeometryParams, GeometryPosterior, ObjectMotion};
+pub use model::{GeometryError, GeometryModel, GeometryParams, GeometryPosterior};
 pub use surface::{ObjectSurface, SURFACE_SPACING_M};

@@ -9,6 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::dataset::Perturbed;
 use crate::locate::contact::{Contact, Touch};
 use crate::locate::pose_fit::{Hypothesis, Likelihood, Observation, PosePrior};
 use crate::locate::surface::ObjectSurface;
@@ -133,39 +134,27 @@ impl Check for GeometryParams {
     }
 }
 
-/// How far the object moves between touches: Sec. V-B4's perturbation after every reading (a turn
-/// of up to `max_rotation_rad` about a random axis, a shift of up to `max_shift_fraction` of the
-/// width), or nothing. The geometric recogniser discounts older contacts by the spread the moves
-/// since have added to where they now lie, and widens its prior over the pose by the same.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct ObjectMotion {
-    pub max_rotation_rad: f64,
-    pub max_shift_fraction: f64,
+// How far the object moves between touches is a `dataset::Perturbed`, what a dataset's header
+// records (Sec. V-B4's perturbation after every reading, or nothing). The geometric recogniser
+// discounts older contacts by the spread the moves since have added to where they now lie, and
+// widens its prior over the pose by the same.
+
+/// Mean square turn of one move (a uniform angle up to the bound).
+fn turn_var_rad2(motion: &Perturbed) -> f64 {
+    motion.max_rotation_deg.to_radians().powi(2) / 3.0
 }
 
-impl ObjectMotion {
-    /// The object stays where it stands.
-    pub const FIXED: Self = Self {
-        max_rotation_rad: 0.0,
-        max_shift_fraction: 0.0,
-    };
+/// Variance one move adds to a contact's distance from the surface, along its normal: the turn at
+/// half the object's width, and the shift (uniform over a disc, a quarter of its square per
+/// axis).
+fn point_var_m2(motion: &Perturbed, width_m: f64) -> f64 {
+    let lever = 0.5 * width_m;
+    turn_var_rad2(motion) * lever * lever / 3.0 + shift_var_m2(motion, width_m)
+}
 
-    pub fn is_fixed(&self) -> bool {
-        self.max_rotation_rad == 0.0 && self.max_shift_fraction == 0.0
-    }
-
-    /// Mean square turn of one move (uniform angle up to the bound).
-    fn turn_var_rad2(&self) -> f64 {
-        self.max_rotation_rad.powi(2) / 3.0
-    }
-
-    /// Variance one move adds to a contact's distance from the surface, along its normal: the turn
-    /// at half the object's width, and the shift (uniform over a disc, a quarter of its square
-    /// per axis).
-    fn point_var_m2(&self, width_m: f64) -> f64 {
-        let lever = 0.5 * width_m;
-        self.turn_var_rad2() * lever * lever / 3.0 + (self.max_shift_fraction * width_m).powi(2) / 4.0
-    }
+/// Variance one move adds to the object's horizontal place, per axis.
+fn shift_var_m2(motion: &Perturbed, width_m: f64) -> f64 {
+    (motion.max_translation_fraction * width_m).powi(2) / 4.0
 }
 
 /// Why a geometric model could not be built or read.
@@ -217,7 +206,7 @@ impl GeometryModel {
     }
 
     /// A posterior with no contact yet, for an object that moves as `motion` says between touches.
-    pub fn posterior(&self, motion: ObjectMotion) -> GeometryPosterior<'_> {
+    pub fn posterior(&self, motion: Perturbed) -> GeometryPosterior<'_> {
         let hypotheses = self
             .surfaces
             .iter()
@@ -269,7 +258,7 @@ impl GeometryModel {
 #[derive(Debug, Clone)]
 pub struct GeometryPosterior<'a> {
     model: &'a GeometryModel,
-    motion: ObjectMotion,
+    motion: Perturbed,
     /// Per object, its pose hypotheses.
     hypotheses: Vec<Vec<Hypothesis>>,
     /// Every contact so far and the attempt it was taken at.
@@ -334,8 +323,8 @@ impl GeometryPosterior<'_> {
 
     /// The contacts as the fit sees them now: each older one spread by the moves since.
     fn observations(&self, width_m: f64) -> Vec<Observation> {
-        let point_var = self.motion.point_var_m2(width_m);
-        let normal_var = self.motion.turn_var_rad2() * 2.0 / 3.0;
+        let point_var = point_var_m2(&self.motion, width_m);
+        let normal_var = turn_var_rad2(&self.motion) * 2.0 / 3.0;
         self.contacts
             .iter()
             .map(|&(contact, attempt)| {
@@ -353,8 +342,8 @@ impl GeometryPosterior<'_> {
     fn prior(&self, width_m: f64) -> PosePrior {
         let p = &self.model.params;
         let moves = self.latest as f64;
-        let turn_var = moves * self.motion.turn_var_rad2() / 3.0;
-        let shift_var = moves * (self.motion.max_shift_fraction * width_m).powi(2) / 4.0;
+        let turn_var = moves * turn_var_rad2(&self.motion) / 3.0;
+        let shift_var = moves * shift_var_m2(&self.motion, width_m);
         PosePrior {
             tilt_sigma_rad: (p.tilt_sigma_deg.to_radians().powi(2) + turn_var).sqrt(),
             shift_sigma_m: ((p.shift_sigma_fraction * width_m).powi(2) + shift_var).sqrt(),
@@ -415,7 +404,7 @@ mod tests {
     fn contacts_on_an_object_at_an_untold_pose_name_it_and_find_its_pose() {
         let model = model();
         let pose = Pose::new(DVec3::new(0.004, -0.003, 0.0), DQuat::from_rotation_z(0.7));
-        let mut posterior = model.posterior(ObjectMotion::FIXED);
+        let mut posterior = model.posterior(Perturbed::FIXED);
         for (attempt, contact) in slab_contacts(&pose).into_iter().enumerate() {
             posterior.observe(Touch {
                 contact: Some(contact),
@@ -435,7 +424,7 @@ mod tests {
     #[test]
     fn a_touch_without_a_contact_adds_no_evidence() {
         let model = model();
-        let mut posterior = model.posterior(ObjectMotion::FIXED);
+        let mut posterior = model.posterior(Perturbed::FIXED);
         let l = posterior
             .observe(Touch {
                 contact: None,
@@ -461,11 +450,11 @@ mod tests {
             let l = posterior.log_likelihoods();
             l[0] - l[1]
         };
-        let moving = ObjectMotion {
-            max_rotation_rad: 10f64.to_radians(),
-            max_shift_fraction: 0.1,
+        let moving = Perturbed {
+            max_rotation_deg: 10.0,
+            max_translation_fraction: 0.1,
         };
-        let (fixed, moved) = (gap(ObjectMotion::FIXED), gap(moving));
+        let (fixed, moved) = (gap(Perturbed::FIXED), gap(moving));
         assert!(moved > 0.0 && moved < fixed, "fixed {fixed}, moving {moved}");
     }
 
@@ -474,7 +463,7 @@ mod tests {
         let model = model();
         let pose = Pose::new(DVec3::ZERO, DQuat::from_rotation_z(2.0));
         let run = || {
-            let mut posterior = model.posterior(ObjectMotion::FIXED);
+            let mut posterior = model.posterior(Perturbed::FIXED);
             for (attempt, contact) in slab_contacts(&pose).into_iter().enumerate() {
                 posterior.observe(Touch {
                     contact: Some(contact),

@@ -22,9 +22,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::dataset::Dataset;
+use crate::dataset::{Dataset, Perturbed};
 use crate::describe::{Descriptor, Feature};
-use crate::locate::{ContactNoise, GeometryModel, ObjectMotion, Touch};
+use crate::locate::{ContactNoise, GeometryModel, Touch};
 use crate::recognize::RecognizeError;
 use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
 use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
@@ -126,7 +126,7 @@ impl GeometricFusion {
 
     /// The weighing used for an object that moves as `motion` says: a moving object's own, or
     /// appearance alone when none was fitted.
-    fn weighing_for(&self, motion: ObjectMotion) -> Weighing {
+    fn weighing_for(&self, motion: Perturbed) -> Weighing {
         if motion.is_fixed() {
             return Weighing {
                 geometry_weight: self.geometry_weight,
@@ -168,14 +168,16 @@ impl GeometricFusion {
     /// The same model with `lambda` and the tempering fitted on the explorations of every dataset
     /// of `data`, each object's converged readings cut into trials of `trial_readings` (the
     /// module docs); a perturbed dataset's contacts are discounted as its header's perturbation
-    /// says.
+    /// says, and its explorations weigh a moving object's evidence apart.
     pub fn calibrate_on_all(
         mut self,
         data: &[&Dataset],
         trial_readings: usize,
     ) -> Result<Self, RecognizeError> {
-        let (fixed, moving): (Vec<&Dataset>, Vec<&Dataset>) =
-            data.iter().copied().partition(|d| motion_of(d).is_fixed());
+        let (fixed, moving): (Vec<&Dataset>, Vec<&Dataset>) = data
+            .iter()
+            .copied()
+            .partition(|d| d.header().perturbation.is_fixed());
         if let Some(w) = self.weighing_on(&fixed, trial_readings)? {
             self.geometry_weight = w.geometry_weight;
             self.tempering = w.tempering;
@@ -194,7 +196,7 @@ impl GeometricFusion {
     ) -> Result<Option<Weighing>, RecognizeError> {
         let mut paths = Vec::new();
         for dataset in data {
-            let motion = motion_of(dataset);
+            let motion = dataset.header().perturbation;
             for trial in self.trials(dataset, trial_readings)? {
                 paths.push(self.evidence_parts(&trial, motion)?);
             }
@@ -268,7 +270,7 @@ impl GeometricFusion {
         &self,
         trials: &[Trial<TouchReading>],
         range: ReadingRange,
-        motion: ObjectMotion,
+        motion: Perturbed,
     ) -> Result<Evaluation, RecognizeError> {
         evaluate_with(self.objects(), trials, range, || {
             let mut posterior = self.posterior(motion);
@@ -285,7 +287,7 @@ impl GeometricFusion {
     }
 
     /// A posterior over described readings and their touches.
-    pub fn posterior(&self, motion: ObjectMotion) -> GeometricPosterior<'_> {
+    pub fn posterior(&self, motion: Perturbed) -> GeometricPosterior<'_> {
         let weighing = self.weighing_for(motion);
         GeometricPosterior {
             appearance: appearance_posterior(&self.appearance),
@@ -383,7 +385,7 @@ impl GeometricFusion {
     fn evidence_parts(
         &self,
         trial: &Trial<TouchReading>,
-        motion: ObjectMotion,
+        motion: Perturbed,
     ) -> Result<EvidenceParts, RecognizeError> {
         let mut appearance = appearance_posterior(&self.appearance);
         let mut geometry = self.geometry.posterior(motion);
@@ -398,16 +400,6 @@ impl GeometricFusion {
             parts.geometry.push(geometry.observe(*touch).to_vec());
         }
         Ok(parts)
-    }
-}
-
-/// The motion a dataset's header says its objects had: Sec. V-B4's perturbation after every
-/// reading, or none.
-pub fn motion_of(dataset: &Dataset) -> ObjectMotion {
-    let p = dataset.header().perturbation;
-    ObjectMotion {
-        max_rotation_rad: p.max_rotation_deg.to_radians(),
-        max_shift_fraction: p.max_translation_fraction,
     }
 }
 

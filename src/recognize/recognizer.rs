@@ -4,13 +4,12 @@
 
 use std::path::Path;
 
-use crate::dataset::Dataset;
-use crate::locate::ObjectMotion;
+use crate::dataset::{Dataset, Perturbed};
 use crate::recognize::RecognizeError;
 use crate::recognize::calibration::{PosteriorRule, Tempering};
 use crate::recognize::evaluate::{Evaluation, ReadingRange};
 use crate::recognize::fusion::{DescriptorChoice, FusedModel};
-use crate::recognize::geometric::{Appearance, GeometricFusion, motion_of};
+use crate::recognize::geometric::{Appearance, GeometricFusion};
 use crate::recognize::model::{TrainedModel, check_version, encode_json, read_model_file};
 use crate::recognize::posterior::ModelPosterior;
 use crate::tactile::SensorConfig;
@@ -140,7 +139,7 @@ impl Recognizer {
             Self::Single(m) => m.posterior(),
             Self::Fused(f) => f.image_posterior(),
             Self::Geometric(g) => Ok(ModelPosterior::geometric(
-                g.posterior(ObjectMotion::FIXED),
+                g.posterior(Perturbed::FIXED),
                 g.descriptors()?,
             )),
         }
@@ -161,7 +160,10 @@ impl Recognizer {
             }
             Self::Geometric(g) => {
                 let trials = g.trials(dataset, range.last())?;
-                Ok((g.evaluate(&trials, range, motion_of(dataset))?, trials.len()))
+                Ok((
+                    g.evaluate(&trials, range, dataset.header().perturbation)?,
+                    trials.len(),
+                ))
             }
         }
     }
