@@ -167,15 +167,15 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(geometry) => {
             let fused = GeometricFusion::new(Appearance::try_from(model)?, geometry)?;
             let model = Recognizer::Geometric(Box::new(fused));
+            // Weighed on the calibration explorations below when there are any; else on the
+            // validation data (one of the two is given: checked before training).
             match (&validation, args.calibration.is_empty()) {
-                // Weighed on the calibration explorations below.
-                (_, false) => model,
                 (Some(v), true) => {
                     let model = model.calibrate_on_all(&[v], config.trial_readings)?;
                     print_geometry(&model, "validation");
                     model
                 }
-                (None, true) => model,
+                _ => model,
             }
         }
     };

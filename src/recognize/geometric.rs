@@ -206,7 +206,7 @@ impl GeometricFusion {
         }
         // Sec. V-B1's model selection: the best accuracy (over every prefix of every trial),
         // ties broken by reliability (here the fitted posterior's log loss).
-        let mut best: Option<(usize, f64, f64, Tempering)> = None;
+        let mut best: Option<(usize, f64, f64, Tempering, Vec<EvidencePath>)> = None;
         for weight in GEOMETRY_WEIGHTS {
             let combined: Vec<EvidencePath> = paths.iter().map(|p| p.combined(weight)).collect();
             let right = combined
@@ -215,16 +215,16 @@ impl GeometricFusion {
                 .filter(|&r| r)
                 .count();
             let (tempering, loss) = Tempering::fit_scored(&combined);
-            if best.is_none_or(|(r, l, _, _)| right > r || (right == r && loss < l)) {
-                best = Some((right, loss, weight, tempering));
+            if best
+                .as_ref()
+                .is_none_or(|(r, l, ..)| right > *r || (right == *r && loss < *l))
+            {
+                best = Some((right, loss, weight, tempering, combined));
             }
         }
-        Ok(best.map(|(_, _, weight, tempering)| {
-            let combined: Vec<EvidencePath> = paths.iter().map(|p| p.combined(weight)).collect();
-            Weighing {
-                geometry_weight: weight,
-                tempering: tempering.with_confidence_map_of(&combined),
-            }
+        Ok(best.map(|(_, _, weight, tempering, combined)| Weighing {
+            geometry_weight: weight,
+            tempering: tempering.with_confidence_map_of(&combined),
         }))
     }
 

@@ -139,9 +139,14 @@ impl FusedPosterior<'_> {
         self.parts.first().map_or(0, OnlinePosterior::readings)
     }
 
+    /// Features observed so far, over every model.
+    pub fn features(&self) -> usize {
+        self.parts.iter().map(|p| p.histogram().features()).sum()
+    }
+
     /// The fused belief now: the tempered softmax of the summed log-likelihoods.
     pub fn belief(&self) -> Belief {
-        let features = self.parts.iter().map(|p| p.histogram().features()).sum();
+        let features = self.features();
         let readings = self.readings();
         Belief {
             readings,
@@ -341,15 +346,14 @@ impl GeometricPosterior<'_> {
     }
 
     pub fn belief(&self) -> Belief {
-        let features = self
-            .appearance
-            .parts
-            .iter()
-            .map(|p| p.histogram().features())
-            .sum();
         Belief {
             readings: self.readings,
-            decision: Decision::calibrated(self.log_likelihoods(), features, self.tempering, self.readings),
+            decision: Decision::calibrated(
+                self.log_likelihoods(),
+                self.appearance.features(),
+                self.tempering,
+                self.readings,
+            ),
         }
     }
 }
