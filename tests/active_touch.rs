@@ -190,12 +190,7 @@ fn an_episode_starts_its_object_where_its_config_says() {
     let episode = TouchEpisode::new(Arc::clone(&model), object, &random, 5).unwrap();
     let pose = episode.scene().object_pose().unwrap();
     assert_ne!(pose, Pose::IDENTITY);
-    let lowest = object
-        .mesh
-        .vertices
-        .iter()
-        .map(|&v| pose.transform_point(v).z)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = object.mesh.lowest_z_at(&pose).expect("a mesh with vertices");
     assert!(lowest.abs() < 1e-9, "lowest vertex at z = {lowest}");
     let plan = CollectPlan {
         mode: CollectMode::Planner(random.planner),

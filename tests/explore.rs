@@ -943,12 +943,7 @@ fn a_format_2_dataset_from_collect_reads_in_the_tables_vocabulary() {
 /// The lowest point of `object`'s mesh at `pose` (world z, metres) and its tilt: the angle between
 /// its own vertical and the world's, degrees.
 fn rest_and_tilt(object: &ObjectSpec, pose: &taction::pose::Pose) -> (f64, f64) {
-    let lowest = object
-        .mesh
-        .vertices
-        .iter()
-        .map(|&v| pose.transform_point(v).z)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = object.mesh.lowest_z_at(pose).expect("a mesh with vertices");
     let up = pose.transform_vector(DVec3::Z);
     (lowest, up.z.clamp(-1.0, 1.0).acos().to_degrees())
 }

@@ -1,6 +1,8 @@
 //! An indexed triangle mesh in metres.
 
 use glam::DVec3;
+
+use crate::pose::Pose;
 use serde::{Deserialize, Serialize};
 
 /// Vertices (metres) and triangles as vertex indices, counter-clockwise seen from outside.
@@ -53,6 +55,15 @@ impl TriMesh {
     pub fn triangle_area(&self, t: usize) -> f64 {
         let [a, b, c] = self.corners(t);
         0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// The lowest world z of the mesh placed at `pose` (where it would rest on a table at z = 0);
+    /// `None` for a mesh with no vertices.
+    pub fn lowest_z_at(&self, pose: &Pose) -> Option<f64> {
+        self.vertices
+            .iter()
+            .map(|&v| pose.transform_point(v).z)
+            .reduce(f64::min)
     }
 
     /// Axis-aligned bounds (min, max); `None` for a mesh with no vertices.

@@ -668,13 +668,7 @@ impl Scene {
 
     /// Lowest world z of the object's mesh at `pose`.
     pub fn object_lowest_z(&self, pose: &Pose) -> Option<f64> {
-        let object = self.object.as_ref()?;
-        object
-            .mesh
-            .vertices
-            .iter()
-            .map(|&v| pose.transform_point(v).z)
-            .reduce(f64::min)
+        self.object.as_ref()?.mesh.lowest_z_at(pose)
     }
 
     /// Centre of the object's bounding box in the world, at its current pose.
