@@ -547,18 +547,18 @@ fn collect_writes_contact_sheets_beside_the_dataset() {
     assert!(!dir.path().join("none.block.png").exists());
 }
 
-/// A `--from-above` dataset says so in its header: the CLI names its generator by the one
-/// definition (`CollectMode::generator_name`), as the experiments do (it wrote `sampler`).
-#[test]
-fn a_from_above_dataset_says_so_in_its_header() {
-    let dir = tempfile::tempdir().unwrap();
-    let mesh = dir.path().join("block.obj");
+/// `taction collect` of two sampler readings of a 10 x 8 x 10 cm block written into `dir`, one
+/// thread, no contact sheet, with `extra` flags, into `out`.
+fn collect_two_readings_of_a_block(
+    dir: &std::path::Path,
+    extra: &[&str],
+    out: &std::path::Path,
+) -> std::process::Output {
+    let mesh = dir.join("block.obj");
     taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.10, 0.08, 0.10)), &mesh, "block").unwrap();
-    let out = dir.path().join("above.csv");
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+    std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
         .args([
             "collect",
-            "--from-above",
             "--readings",
             "2",
             "--threads",
@@ -566,12 +566,22 @@ fn a_from_above_dataset_says_so_in_its_header() {
             "--contact-sheet",
             "0",
         ])
+        .args(extra)
         .arg("--objects")
         .arg(&mesh)
         .arg("--out")
-        .arg(&out)
+        .arg(out)
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// A `--from-above` dataset says so in its header: the CLI names its generator by the one
+/// definition (`CollectMode::generator_name`), as the experiments do (it wrote `sampler`).
+#[test]
+fn a_from_above_dataset_says_so_in_its_header() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("above.csv");
+    let output = collect_two_readings_of_a_block(dir.path(), &["--from-above"], &out);
     assert!(
         output.status.success(),
         "{}",
@@ -1154,28 +1164,8 @@ fn collect_starts_the_objects_where_start_pose_says() {
     use taction::pose::{MaxHeading, Pose};
 
     let dir = tempfile::tempdir().unwrap();
-    let mesh = dir.path().join("block.obj");
-    taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.10, 0.08, 0.10)), &mesh, "block").unwrap();
     let out = dir.path().join("random.csv");
-    let run = |start: &str| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
-            .args([
-                "collect",
-                "--readings",
-                "2",
-                "--threads",
-                "1",
-                "--contact-sheet",
-                "0",
-            ])
-            .args(["--start-pose", start])
-            .arg("--objects")
-            .arg(&mesh)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap()
-    };
+    let run = |start: &str| collect_two_readings_of_a_block(dir.path(), &["--start-pose", start], &out);
     let output = run("random");
     assert!(
         output.status.success(),
