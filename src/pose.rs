@@ -114,7 +114,8 @@ impl Pose {
 /// of up to 10 degrees about a random axis, a shift of up to 10% of the object's width), the
 /// object resting on the table.
 ///
-/// Serialised as `"canonical"` or `{"random":{"max_heading_rad":...}}`; what records it (a
+/// Serialised as `"canonical"`, `{"random":{"max_heading_rad":...}}` or
+/// `{"turned":{"heading_rad":...}}`; what records it (a
 /// collection plan, a dataset header) leaves a canonical start out, so that everything written
 /// before start poses existed reads, and is written, as it was.
 ///
@@ -125,6 +126,10 @@ impl Pose {
 /// let letters = StartPose::parse("random", MaxHeading::LETTERS).unwrap();
 /// assert_eq!(letters.name(), "random");
 /// assert_eq!(letters.max_heading(), Some(MaxHeading::LETTERS));
+/// let quarter = StartPose::parse("turned:90", MaxHeading::ANY).unwrap();
+/// assert_eq!(quarter.to_string(), "turned (heading 90 deg)");
+/// // A letter turned by 90 degrees is not the letter any more.
+/// assert_eq!(StartPose::parse("turned:90", MaxHeading::LETTERS), None);
 /// assert_eq!(StartPose::parse("upside-down", MaxHeading::ANY), None);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -139,12 +144,67 @@ pub enum StartPose {
         #[serde(rename = "max_heading_rad")]
         max_heading: MaxHeading,
     },
+    /// A random start at one fixed heading: the same tilt and shift as [`Random`](Self::Random),
+    /// drawn from the seed, every object turned by `heading` about the vertical. The control that
+    /// shows whether a recogniser of contact positions learnt the canonical heading: its accuracy
+    /// must not change when every object faces one way, whichever.
+    Turned {
+        #[serde(rename = "heading_rad")]
+        heading: Heading,
+    },
+}
+
+/// A turn about the vertical in (-pi, pi] radians, finite: the heading of
+/// [`StartPose::Turned`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct Heading {
+    rad: f64,
+}
+
+impl Heading {
+    /// `deg` degrees, wrapped into (-180, 180]; `None` when not finite.
+    pub fn from_deg(deg: f64) -> Option<Self> {
+        deg.is_finite().then(|| {
+            let wrapped = -(180.0 - deg).rem_euclid(360.0) + 180.0;
+            Self {
+                rad: wrapped.to_radians(),
+            }
+        })
+    }
+
+    pub fn rad(&self) -> f64 {
+        self.rad
+    }
+
+    pub fn deg(&self) -> f64 {
+        self.rad.to_degrees()
+    }
+}
+
+impl TryFrom<f64> for Heading {
+    type Error = String;
+
+    /// Radians in [-pi, pi], as a plan or a header records it.
+    fn try_from(rad: f64) -> Result<Self, String> {
+        if (-std::f64::consts::PI..=std::f64::consts::PI).contains(&rad) {
+            Ok(Self { rad })
+        } else {
+            Err(format!("heading_rad {rad} is outside [-pi, pi]"))
+        }
+    }
+}
+
+impl From<Heading> for f64 {
+    fn from(heading: Heading) -> f64 {
+        heading.rad
+    }
 }
 
 impl StartPose {
     /// The names [`name`](Self::name) gives and [`parse`](Self::parse) takes (the CLI's
-    /// `--start-pose` values).
-    pub const NAMES: [&'static str; 2] = ["canonical", "random"];
+    /// `--start-pose` values); a turned start is written `turned:DEG`.
+    pub const NAMES: [&'static str; 3] = ["canonical", "random", "turned:DEG"];
 
     /// A random start turned at most `max_heading` about the vertical.
     pub fn random(max_heading: MaxHeading) -> Self {
@@ -156,38 +216,52 @@ impl StartPose {
         matches!(self, Self::Canonical)
     }
 
-    /// `canonical` or `random`.
+    /// `canonical`, `random` or `turned`.
     pub fn name(&self) -> &'static str {
         match self {
             Self::Canonical => Self::NAMES[0],
             Self::Random { .. } => Self::NAMES[1],
+            Self::Turned { .. } => "turned",
         }
     }
 
-    /// The start called `name` ([`NAMES`](Self::NAMES)), a random one turned at most
-    /// `max_heading`: the heading is the object set's to say ([`MaxHeading`]), not the name's.
+    /// The start called `name` ([`NAMES`](Self::NAMES)): a random one turned at most
+    /// `max_heading` (the heading is the object set's to say, [`MaxHeading`], not the name's), or
+    /// `turned:DEG`, which must lie within `max_heading` too (a raised letter turned further is
+    /// another letter).
     pub fn parse(name: &str, max_heading: MaxHeading) -> Option<Self> {
         match name {
             "canonical" => Some(Self::Canonical),
             "random" => Some(Self::random(max_heading)),
-            _ => None,
+            _ => {
+                let deg: f64 = name.strip_prefix("turned:")?.trim().parse().ok()?;
+                let heading = Heading::from_deg(deg)?;
+                (heading.rad().abs() <= max_heading.rad() + 1e-12).then_some(Self::Turned { heading })
+            }
         }
     }
 
     /// The largest turn about the vertical of a random start; `None` for the canonical one.
     pub fn max_heading(&self) -> Option<MaxHeading> {
         match self {
-            Self::Canonical => None,
+            Self::Canonical | Self::Turned { .. } => None,
             Self::Random { max_heading } => Some(*max_heading),
         }
     }
 }
 
 impl std::fmt::Display for StartPose {
-    /// `canonical`, `random (any heading)` or `random (heading within 10 deg)`.
+    /// `canonical`, `random (any heading)`, `random (heading within 10 deg)` or
+    /// `turned (heading 90 deg)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::Canonical => f.write_str(self.name()),
+            Self::Turned { heading } => write!(
+                f,
+                "{} (heading {} deg)",
+                self.name(),
+                crate::units::significant(heading.deg())
+            ),
             Self::Random { max_heading } if max_heading.is_any() => {
                 write!(f, "{} (any heading)", self.name())
             }

@@ -1157,7 +1157,8 @@ fn a_collection_from_a_random_start_records_it_in_readings_and_header() {
 }
 
 /// `taction collect --start-pose random` draws each object's start and says so in the dataset's
-/// header, which `dataset show` prints; an unknown start is refused by clap, naming both.
+/// header, which `dataset show` prints; `turned:90` faces every object one way; an unknown start
+/// is refused, naming the flag and the starts there are.
 #[test]
 fn collect_starts_the_objects_where_start_pose_says() {
     use taction::dataset::Dataset;
@@ -1166,29 +1167,53 @@ fn collect_starts_the_objects_where_start_pose_says() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("random.csv");
     let run = |start: &str| collect_two_readings_of_a_block(dir.path(), &["--start-pose", start], &out);
-    let output = run("random");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let dataset = Dataset::read(&out).unwrap();
+    // The dataset `start` collects, and what `dataset show` says of its start.
+    let collected = |start: &str| {
+        let output = run(start);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let shown = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args(["dataset", "show"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        (
+            Dataset::read(&out).unwrap(),
+            String::from_utf8_lossy(&shown.stdout).into_owned(),
+        )
+    };
+    let (dataset, text) = collected("random");
     assert_eq!(dataset.header().start_pose, StartPose::random(MaxHeading::ANY));
     assert!(dataset.readings().iter().all(|r| r.object_pose != Pose::IDENTITY));
-    let shown = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args(["dataset", "show"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&shown.stdout);
     assert!(text.contains(", start pose random (any heading)"), "{text}");
 
-    let refused = run("upside-down");
-    assert_eq!(refused.status.code(), Some(2));
-    let message = String::from_utf8_lossy(&refused.stderr);
-    assert!(
-        message.contains("invalid value 'upside-down' for '--start-pose <START>'")
-            && message.contains("[possible values: canonical, random]"),
-        "{message}"
-    );
+    let (turned, text) = collected("turned:90");
+    let StartPose::Turned { heading } = turned.header().start_pose else {
+        panic!("{:?}", turned.header().start_pose);
+    };
+    assert!((heading.deg() - 90.0).abs() < 1e-9);
+    // The random start's tilt and shift, the heading the one asked for.
+    for r in turned.readings() {
+        assert!(
+            (heading_deg(&r.object_pose) - 90.0).abs() <= 10.2 + 1e-9,
+            "{:?}",
+            r.object_pose
+        );
+    }
+    assert!(text.contains(", start pose turned (heading 90 deg)"), "{text}");
+
+    for bad in ["upside-down", "turned:north"] {
+        let refused = run(bad);
+        assert_eq!(refused.status.code(), Some(2));
+        let message = String::from_utf8_lossy(&refused.stderr);
+        assert!(
+            message.contains(&format!(
+                "--start-pose {bad}: want one of canonical, random, turned:DEG"
+            )),
+            "{message}"
+        );
+    }
 }

@@ -10,7 +10,9 @@ use taction::dataset::{Dataset, Reading};
 use taction::locate::{GeometryModel, GeometryParams, ObjectSurface};
 use taction::mesh::TriMesh;
 use taction::pose::{PadPose, Pose};
-use taction::recognize::{Appearance, GeometricFusion, ReadingRange, Recognizer, TrainConfig, TrainedModel};
+use taction::recognize::{
+    Appearance, Evidence, GeometricFusion, ReadingRange, Recognizer, TrainConfig, TrainedModel,
+};
 use taction::valid::Valid;
 
 /// The three toy objects' shapes, resting on z = 0: a cube, a long slab, a tall post.
@@ -120,6 +122,52 @@ fn contacts_tell_apart_objects_that_feel_the_same() {
         accuracy_at(&model, &test, 6) >= 0.9,
         "{}",
         accuracy_at(&model, &test, 6)
+    );
+}
+
+/// The model weighing `evidence` alone.
+fn weighing(model: &Recognizer, evidence: Evidence) -> Recognizer {
+    let Recognizer::Geometric(g) = model else {
+        panic!("a geometric model");
+    };
+    Recognizer::Geometric(Box::new((**g).clone().with_evidence(evidence)))
+}
+
+#[test]
+fn each_part_of_the_evidence_weighs_alone() {
+    let model = model(&dataset(12, 21, 0.4, DVec3::new(0.003, 0.0, 0.0)));
+    let Recognizer::Geometric(g) = &model else {
+        panic!("a geometric model");
+    };
+    let alone = g.alone().expect("calibration fits each part alone");
+    let test = dataset(12, 22, 2.1, DVec3::new(-0.004, 0.005, 0.0));
+    // The contacts alone name the boxes whose images are all flat.
+    let contacts = weighing(&model, Evidence::Contacts);
+    assert_eq!(contacts.tempering(), alone.contacts);
+    assert!(
+        accuracy_at(&contacts, &test, 6) >= 0.9,
+        "{}",
+        accuracy_at(&contacts, &test, 6)
+    );
+    // Appearance alone is the bag of features: its guesses are the appearance model's own, the
+    // belief tempered as the calibration fitted it for appearance alone.
+    let appearance = weighing(&model, Evidence::Appearance);
+    assert_eq!(appearance.tempering(), alone.appearance);
+    let single = Recognizer::Single(Box::new(g.appearance().parts()[0].clone()));
+    let range = ReadingRange::new(1, 6).expect("a range");
+    let outcomes = |m: &Recognizer| {
+        let (evaluation, _) = m.evaluate(&test, range).expect("evaluates");
+        evaluation.accuracy
+    };
+    let (a, s) = (outcomes(&appearance), outcomes(&single));
+    assert_eq!(
+        a.iter().map(|r| r.correct).collect::<Vec<_>>(),
+        s.iter().map(|r| r.correct).collect::<Vec<_>>()
+    );
+    // Which evidence is weighed is a choice of use: the model file is the same.
+    assert_eq!(
+        appearance.to_json().expect("encodes"),
+        model.to_json().expect("encodes")
     );
 }
 

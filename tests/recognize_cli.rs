@@ -263,6 +263,54 @@ fn toy_model(dir: &std::path::Path) {
     assert!(ok, "{stderr}");
 }
 
+/// `--evidence` weighs a part of a model of appearance and contacts (`train --objects`); a
+/// model of appearance alone has no contacts to weigh and says so, naming the flag, and its
+/// appearance is what it weighs anyway.
+#[test]
+fn evidence_of_contacts_needs_a_model_that_knows_them() {
+    let dir = tempfile::tempdir().unwrap();
+    toy_model(dir.path());
+    recognize_toy::dataset(10, 3)
+        .write(&dir.path().join("test.csv"))
+        .unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    let with = |evidence: &str, out: &str| {
+        taction(&[
+            "recognize",
+            "--model",
+            &p("model.json"),
+            "--dataset",
+            &p("test.csv"),
+            "--readings",
+            "10",
+            "--evidence",
+            evidence,
+            "--out",
+            &p(out),
+        ])
+    };
+    let (ok, _, stderr) = with("contacts", "contacts");
+    assert!(
+        !ok && stderr.contains("--evidence contacts")
+            && stderr.contains("model.json knows appearance alone")
+            && stderr.contains("train --objects"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("contacts").exists());
+    let (ok, stdout, stderr) = with("appearance", "appearance");
+    assert!(ok, "{stderr}");
+    let (ok, plain, stderr) = recognise(&p("model.json"), &p("test.csv"), "10", &p("plain"));
+    assert!(ok, "{stderr}");
+    let accuracy = |out: &str| std::fs::read_to_string(dir.path().join(out).join("accuracy.csv")).unwrap();
+    assert_eq!(accuracy("appearance"), accuracy("plain"));
+    assert_eq!(stdout.lines().next(), plain.lines().next());
+    let (ok, _, stderr) = with("touch", "touch");
+    assert!(
+        !ok && stderr.contains("'touch'") && stderr.contains("fused, appearance, contacts"),
+        "{stderr}"
+    );
+}
+
 /// `--readings 50` on 20 readings per object: the files say 20, the readings used, and stderr
 /// says the request went beyond the data (confusion.csv once said 50).
 #[test]

@@ -4,7 +4,6 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
@@ -68,8 +67,10 @@ pub struct CollectArgs {
     /// Where each object starts: canonical (as it was built) or random (a pose drawn per object
     /// from the seed, not told to the explorer: any heading about the vertical, within 10 degrees
     /// for the raised letters, whose heading is part of their identity, then a tilt of up to 10
-    /// degrees and a shift of up to 10% of the width; the dataset's header records it).
-    #[arg(long, value_name = "START", default_value = "canonical", value_parser = PossibleValuesParser::new(StartPose::NAMES))]
+    /// degrees and a shift of up to 10% of the width; the dataset's header records it), or
+    /// turned:DEG (as random, but every object at heading DEG about the vertical; at most 10 for
+    /// the letters).
+    #[arg(long, value_name = "START", default_value = "canonical")]
     pub start_pose: String,
     #[command(flatten)]
     pub seed: SeedArg,
@@ -108,7 +109,11 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         flag_error(
             "start-pose",
             &args.start_pose,
-            format!("want one of {}", StartPose::NAMES.join(", ")),
+            format!(
+                "want one of {} (a turn of at most {} deg for this set)",
+                StartPose::NAMES.join(", "),
+                taction::units::significant(set.start_heading().rad().to_degrees())
+            ),
         )
     })?;
     let collect = collection(args, sensor, &objects)

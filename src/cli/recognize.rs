@@ -16,7 +16,10 @@ use taction::recognize::{AccuracyPoint, Evaluation, ReadingRange, RecognizeError
 
 use crate::cli::common::{PosteriorArg, check_output_folder, flag_error};
 use crate::cli::dataset::read_dataset;
+use clap::builder::PossibleValuesParser;
 use taction::locate::ContactNoise;
+use taction::recognize::Evidence;
+use taction::units;
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
@@ -52,6 +55,12 @@ pub struct RecognizeArgs {
         allow_hyphen_values = true
     )]
     pub contact_noise_scale: f64,
+    /// With a model of appearance and contact geometry: what its posterior weighs, fused (the
+    /// product: appearance plus the fitted weight of the contacts), appearance (the bag of
+    /// features alone) or contacts (the contact geometry alone); each with the tempering fitted
+    /// for it on the model's calibration explorations. Default: fused.
+    #[arg(long, value_name = "EVIDENCE", value_parser = PossibleValuesParser::new(Evidence::NAMES))]
+    pub evidence: Option<String>,
 }
 
 pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -59,10 +68,25 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     if !(0.0..=10.0).contains(&args.contact_noise_scale) {
         return Err(flag_error("contact-noise-scale", args.contact_noise_scale, "want 0 to 10").into());
     }
+    let evidence = args.evidence.as_deref().and_then(Evidence::parse);
     let model = match Recognizer::load(&args.model)?.with_posterior(args.posterior.rule) {
         Recognizer::Geometric(g) => {
             let noise = ContactNoise::ARM.scaled(args.contact_noise_scale);
-            Recognizer::Geometric(Box::new(g.with_contact_noise(noise)))
+            let g = g
+                .with_contact_noise(noise)
+                .with_evidence(evidence.unwrap_or_default());
+            Recognizer::Geometric(Box::new(g))
+        }
+        _ if evidence.is_some_and(|e| e != Evidence::Appearance) => {
+            return Err(flag_error(
+                "evidence",
+                args.evidence.as_deref().unwrap_or_default(),
+                format!(
+                    "{} knows appearance alone; a model of contacts too is trained with `train --objects`",
+                    args.model.display()
+                ),
+            )
+            .into());
         }
         other => other,
     };
@@ -167,6 +191,25 @@ fn print_summary(model: &Recognizer, evaluation: &Evaluation, trials: usize, use
         model.choice().name(),
         posterior_words(model.tempering())
     );
+    if let Recognizer::Geometric(g) = model {
+        let weighs = match g.evidence() {
+            Evidence::Fused => format!(
+                "appearance + {} x contacts for an object that stays, {} for one that moves",
+                g.geometry_weight(),
+                g.moving().map_or("appearance alone".to_string(), |m| format!(
+                    "appearance + {} x contacts",
+                    m.geometry_weight
+                ))
+            ),
+            Evidence::Appearance => "appearance alone".to_string(),
+            Evidence::Contacts => "contacts alone".to_string(),
+        };
+        println!(
+            "evidence: {weighs}; contact error {} mm, {} deg RMS",
+            units::significant(g.contact_noise().position_sigma_m * 1e3),
+            units::significant(g.contact_noise().angle_sigma_rad.to_degrees())
+        );
+    }
     for n in [1, 10, 30, 100] {
         if let Some(row) = evaluation.accuracy.iter().find(|r| r.n_readings == n) {
             println!(
@@ -331,7 +374,11 @@ fn plot_title(args: &RecognizeArgs) -> String {
             |n| n.to_string_lossy().into_owned(),
         )
     };
-    format!("{} recognised by {}", name(&args.dataset), name(&args.model))
+    let title = format!("{} recognised by {}", name(&args.dataset), name(&args.model));
+    match &args.evidence {
+        Some(evidence) => format!("{title} ({evidence})"),
+        None => title,
+    }
 }
 
 /// Writes `rows` as accuracy_trials.csv and plots them as accuracy.svg and accuracy.png in `dir`

@@ -195,12 +195,15 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         let model = model
             .calibrate_on_all(&data.iter().collect::<Vec<_>>(), trial_readings)
             .map_err(|e| format!("--calibration {}: {e}", names.join(", ")))?;
-        print_tempering(
-            &args.descriptor.name(),
-            &format!("{} ({trials})", names.join(" + ")),
-            model.tempering(),
-        );
-        print_geometry(&model, &names.join(" + "));
+        // A model of contacts too weighs them on the calibration, and says so itself.
+        if !matches!(model, Recognizer::Geometric(_)) {
+            print_tempering(
+                &args.descriptor.name(),
+                &format!("{} ({trials})", names.join(" + ")),
+                model.tempering(),
+            );
+        }
+        print_geometry(&model, &format!("{} ({trials})", names.join(" + ")));
         model
     };
     model.save(&args.out)?;
@@ -379,8 +382,13 @@ fn geometry_of(
 /// The fitted weight of the geometric evidence, and what it was fitted on.
 fn print_geometry(model: &Recognizer, on: &str) {
     if let Recognizer::Geometric(g) = model {
+        let moving = g.moving().map_or(
+            "appearance alone (no perturbed exploration given)".to_string(),
+            |m| format!("lambda = {}, posterior {}", m.geometry_weight, m.tempering),
+        );
         println!(
-            "contact geometry weighed on {on}: lambda = {} (0: appearance alone), posterior {}",
+            "appearance + lambda x contacts weighed on {on}: for an object that stays lambda = {} (0: appearance \
+             alone), posterior {}; for one that moves {moving}",
             g.geometry_weight(),
             g.tempering()
         );

@@ -14,6 +14,7 @@ pub(crate) mod contact;
 pub(crate) mod model;
 pub(crate) mod pose_fit;
 pub(crate) mod surface;
+pub(crate) mod track;
 
 pub use contact::{Contact, ContactNoise, Touch};
 pub use model::{GeometryError, GeometryModel, GeometryParams, GeometryPosterior};

@@ -11,8 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::dataset::Perturbed;
 use crate::locate::contact::{Contact, Touch};
-use crate::locate::pose_fit::{Hypothesis, Likelihood, Observation, PosePrior};
+use crate::locate::pose_fit::{Hypothesis, Likelihood, PosePrior};
 use crate::locate::surface::ObjectSurface;
+use crate::locate::track::{MoveSpread, StartSpread, Track};
 use crate::mesh::TriMesh;
 use crate::pose::{MaxHeading, Pose};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
@@ -135,26 +136,29 @@ impl Check for GeometryParams {
 }
 
 // How far the object moves between touches is a `dataset::Perturbed`, what a dataset's header
-// records (Sec. V-B4's perturbation after every reading, or nothing). The geometric recogniser
-// discounts older contacts by the spread the moves since have added to where they now lie, and
-// widens its prior over the pose by the same.
+// records (Sec. V-B4's perturbation after every reading, or nothing); `track` follows a moving
+// object through the spread each move adds to its pose.
 
 /// Mean square turn of one move (a uniform angle up to the bound).
 fn turn_var_rad2(motion: &Perturbed) -> f64 {
     motion.max_rotation_deg.to_radians().powi(2) / 3.0
 }
 
-/// Variance one move adds to a contact's distance from the surface, along its normal: the turn at
-/// half the object's width, and the shift (uniform over a disc, a quarter of its square per
-/// axis).
-fn point_var_m2(motion: &Perturbed, width_m: f64) -> f64 {
-    let lever = 0.5 * width_m;
-    turn_var_rad2(motion) * lever * lever / 3.0 + shift_var_m2(motion, width_m)
-}
-
 /// Variance one move adds to the object's horizontal place, per axis.
 fn shift_var_m2(motion: &Perturbed, width_m: f64) -> f64 {
     (motion.max_translation_fraction * width_m).powi(2) / 4.0
+}
+
+/// How one move spreads the pose of an object `width_m` wide, per axis: a third of the turn's
+/// mean square about each axis; the shift; and the rise or fall of its centre as it comes to rest
+/// again, the turn at half its width.
+fn move_spread(motion: &Perturbed, width_m: f64) -> MoveSpread {
+    let turn_var_rad2 = turn_var_rad2(motion) / 3.0;
+    MoveSpread {
+        turn_var_rad2,
+        shift_var_m2: shift_var_m2(motion, width_m),
+        height_var_m2: turn_var_rad2 * (0.5 * width_m).powi(2),
+    }
 }
 
 /// Why a geometric model could not be built or read.
@@ -205,25 +209,53 @@ impl GeometryModel {
         &self.surfaces
     }
 
-    /// A posterior with no contact yet, for an object that moves as `motion` says between touches.
+    /// A posterior with no contact yet, for an object that moves as `motion` says between touches:
+    /// pose hypotheses fitted to every contact at once for an object that stays where it stands,
+    /// followed through the moves (`track`) for one that moves.
     pub fn posterior(&self, motion: Perturbed) -> GeometryPosterior<'_> {
-        let hypotheses = self
-            .surfaces
-            .iter()
-            .map(|s| {
-                self.headings()
-                    .into_iter()
-                    .map(|h| Hypothesis::at_heading(s, h))
-                    .collect()
-            })
-            .collect();
+        let hypotheses = self.surfaces.iter().map(|s| {
+            self.headings()
+                .into_iter()
+                .map(|h| Hypothesis::at_heading(s, h))
+                .collect::<Vec<_>>()
+        });
+        let fits = if motion.is_fixed() {
+            Fits::Batch(hypotheses.collect())
+        } else {
+            Fits::Tracked(
+                hypotheses
+                    .zip(&self.surfaces)
+                    .map(|(hs, s)| {
+                        let spread = self.start_spread(s.width_m());
+                        hs.into_iter().map(|h| Track::start(h, &spread)).collect()
+                    })
+                    .collect(),
+            )
+        };
         GeometryPosterior {
             model: self,
             motion,
-            hypotheses,
+            fits,
             contacts: Vec::new(),
-            latest: 0,
             log_likelihoods: vec![0.0; self.objects.len()],
+        }
+    }
+
+    /// The spread of a start pose about a hypothesis, for an object `width_m` wide: the prior's
+    /// tilt, shift and height, and half the gap between neighbouring hypotheses' headings (or the
+    /// prior's heading spread for a set whose heading is bounded).
+    fn start_spread(&self, width_m: f64) -> StartSpread {
+        let p = &self.params;
+        let heading_sigma_rad = if p.max_heading.is_any() {
+            std::f64::consts::PI / p.hypotheses as f64
+        } else {
+            (0.5 * p.max_heading.rad()).max(1e-3)
+        };
+        StartSpread {
+            tilt_sigma_rad: p.tilt_sigma_deg.to_radians(),
+            heading_sigma_rad,
+            shift_sigma_m: p.shift_sigma_fraction * width_m,
+            height_sigma_m: p.height_sigma_m,
         }
     }
 
@@ -253,18 +285,23 @@ impl GeometryModel {
     }
 }
 
+/// Per object, its pose hypotheses: fitted to every contact at once (an object that stays where
+/// it stands), or each followed through the moves (one that moves).
+#[derive(Debug, Clone)]
+enum Fits {
+    Batch(Vec<Vec<Hypothesis>>),
+    Tracked(Vec<Vec<Track>>),
+}
+
 /// The geometric evidence after each touch (the module docs): `observe` a touch, read
 /// `log_likelihoods`.
 #[derive(Debug, Clone)]
 pub struct GeometryPosterior<'a> {
     model: &'a GeometryModel,
     motion: Perturbed,
-    /// Per object, its pose hypotheses.
-    hypotheses: Vec<Vec<Hypothesis>>,
-    /// Every contact so far and the attempt it was taken at.
-    contacts: Vec<(Contact, usize)>,
-    /// The latest attempt observed.
-    latest: usize,
+    fits: Fits,
+    /// Every contact so far.
+    contacts: Vec<Contact>,
     log_likelihoods: Vec<f64>,
 }
 
@@ -272,10 +309,12 @@ impl GeometryPosterior<'_> {
     /// Adds one touch (a touch without a contact adds no evidence, but its attempt still counts
     /// the object's moves). Returns `ln p(contacts | O_j)` for every object, up to one constant.
     pub fn observe(&mut self, touch: Touch) -> &[f64] {
-        self.latest = self.latest.max(touch.attempt);
         if let Some(c) = touch.contact {
-            self.contacts.push((c, touch.attempt));
-            self.refit();
+            self.contacts.push(c);
+            match &self.fits {
+                Fits::Batch(_) => self.refit(),
+                Fits::Tracked(_) => self.track(c, touch.attempt),
+            }
         }
         &self.log_likelihoods
     }
@@ -289,11 +328,11 @@ impl GeometryPosterior<'_> {
     /// hypothesis: where the recogniser believes it stands if it is that object.
     pub fn best_pose(&self, object: usize) -> Option<Pose> {
         let surface = self.model.surfaces.get(object)?;
-        let best = self
-            .hypotheses
-            .get(object)?
-            .iter()
-            .max_by(|a, b| a.score.total_cmp(&b.score))?;
+        let poses: Vec<&Hypothesis> = match &self.fits {
+            Fits::Batch(h) => h.get(object)?.iter().collect(),
+            Fits::Tracked(t) => t.get(object)?.iter().map(|t| &t.pose).collect(),
+        };
+        let best = poses.into_iter().max_by(|a, b| a.score.total_cmp(&b.score))?;
         // p = R (q - c) + c_w = R q + (c_w - R c).
         Some(Pose::new(
             best.center_w - best.rotation * surface.center_m(),
@@ -301,58 +340,59 @@ impl GeometryPosterior<'_> {
         ))
     }
 
+    /// Refits every hypothesis of a fixed object to all the contacts so far.
     fn refit(&mut self) {
         let model = self.model;
         let likelihood = model.likelihood();
         let iterations = model.params.iterations;
         for (j, surface) in model.surfaces.iter().enumerate() {
-            let observations = self.observations(surface.width_m());
             let prior = self.prior(surface.width_m());
-            let hypotheses = &mut self.hypotheses[j];
+            let Fits::Batch(hypotheses) = &mut self.fits else {
+                return;
+            };
+            let hypotheses = &mut hypotheses[j];
             for h in hypotheses.iter_mut() {
-                h.refine(surface, &observations, &likelihood, &prior, iterations);
+                h.refine(surface, &self.contacts, &likelihood, &prior, iterations);
             }
-            let best = hypotheses
-                .iter()
-                .map(|h| h.score)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let sum: f64 = hypotheses.iter().map(|h| (h.score - best).exp()).sum();
-            self.log_likelihoods[j] = best + (sum / hypotheses.len() as f64).ln();
+            self.log_likelihoods[j] = log_mean_exp(hypotheses.iter().map(|h| h.score));
         }
     }
 
-    /// The contacts as the fit sees them now: each older one spread by the moves since.
-    fn observations(&self, width_m: f64) -> Vec<Observation> {
-        let point_var = point_var_m2(&self.motion, width_m);
-        let normal_var = turn_var_rad2(&self.motion) * 2.0 / 3.0;
-        self.contacts
-            .iter()
-            .map(|&(contact, attempt)| {
-                let moves = self.latest.saturating_sub(attempt) as f64;
-                Observation {
-                    contact,
-                    point_var_m2: moves * point_var,
-                    normal_var_rad2: moves * normal_var,
-                }
-            })
-            .collect()
+    /// Moves every track of a moving object on to `attempt` and updates it with `contact`.
+    fn track(&mut self, contact: Contact, attempt: usize) {
+        let model = self.model;
+        let likelihood = model.likelihood();
+        let iterations = model.params.iterations;
+        let Fits::Tracked(tracks) = &mut self.fits else {
+            return;
+        };
+        for ((surface, tracks), l) in model.surfaces.iter().zip(tracks).zip(&mut self.log_likelihoods) {
+            let moves = move_spread(&self.motion, surface.width_m());
+            for t in tracks.iter_mut() {
+                t.observe(surface, contact, attempt, &likelihood, &moves, iterations);
+            }
+            *l = log_mean_exp(tracks.iter().map(Track::evidence));
+        }
     }
 
-    /// Where the object may stand now: the start pose's spread, widened by the moves so far.
+    /// Where a fixed object may stand: the start pose's spread.
     fn prior(&self, width_m: f64) -> PosePrior {
         let p = &self.model.params;
-        let moves = self.latest as f64;
-        let turn_var = moves * turn_var_rad2(&self.motion) / 3.0;
-        let shift_var = moves * shift_var_m2(&self.motion, width_m);
         PosePrior {
-            tilt_sigma_rad: (p.tilt_sigma_deg.to_radians().powi(2) + turn_var).sqrt(),
-            shift_sigma_m: ((p.shift_sigma_fraction * width_m).powi(2) + shift_var).sqrt(),
-            height_sigma_m: (p.height_sigma_m.powi(2) + shift_var).sqrt(),
+            tilt_sigma_rad: p.tilt_sigma_deg.to_radians(),
+            shift_sigma_m: p.shift_sigma_fraction * width_m,
+            height_sigma_m: p.height_sigma_m,
             // Half the range: a uniform draw within +-max has a spread of max / sqrt(3).
-            heading_sigma_rad: (!p.max_heading.is_any())
-                .then(|| ((0.5 * p.max_heading.rad()).powi(2).max(1e-6) + turn_var).sqrt()),
+            heading_sigma_rad: (!p.max_heading.is_any()).then(|| (0.5 * p.max_heading.rad()).max(1e-3)),
         }
     }
+}
+
+/// `ln (mean of exp(x))` over `scores`, without overflow.
+fn log_mean_exp(scores: impl Iterator<Item = f64> + Clone) -> f64 {
+    let best = scores.clone().fold(f64::NEG_INFINITY, f64::max);
+    let (sum, n) = scores.fold((0.0, 0usize), |(s, n), x| (s + (x - best).exp(), n + 1));
+    best + (sum / n as f64).ln()
 }
 
 #[cfg(test)]
@@ -435,27 +475,58 @@ mod tests {
     }
 
     #[test]
-    fn a_moving_object_discounts_its_older_contacts() {
+    fn a_moving_object_is_followed_through_its_moves() {
         let model = model();
-        let pose = Pose::new(DVec3::ZERO, DQuat::from_rotation_z(0.3));
-        let contacts = slab_contacts(&pose);
-        let gap = |motion| {
-            let mut posterior = model.posterior(motion);
-            for (attempt, contact) in contacts.iter().enumerate() {
-                posterior.observe(Touch {
-                    contact: Some(*contact),
-                    attempt,
-                });
-            }
-            let l = posterior.log_likelihoods();
-            l[0] - l[1]
-        };
         let moving = Perturbed {
             max_rotation_deg: 10.0,
             max_translation_fraction: 0.1,
         };
-        let (fixed, moved) = (gap(Perturbed::FIXED), gap(moving));
-        assert!(moved > 0.0 && moved < fixed, "fixed {fixed}, moving {moved}");
+        // The slab is touched on four of its faces at each of three poses, moved between them by
+        // a perturbation's size (8 deg about a tilted axis, 9 mm).
+        let poses: Vec<Pose> = (0..3)
+            .map(|k| {
+                let turn = DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 1.0).normalize(), 0.14 * k as f64);
+                Pose::new(
+                    DVec3::new(0.008, -0.004, 0.0) * k as f64,
+                    turn * DQuat::from_rotation_z(0.3),
+                )
+            })
+            .collect();
+        let contacts: Vec<(usize, Contact)> = poses
+            .iter()
+            .enumerate()
+            .flat_map(|(k, pose)| {
+                let faces = slab_contacts(pose);
+                (0..4).map(move |i| (4 * k + i, faces[(2 * k + i) % faces.len()]))
+            })
+            .collect();
+        let mut posterior = model.posterior(moving);
+        for &(attempt, contact) in &contacts {
+            posterior.observe(Touch {
+                contact: Some(contact),
+                attempt,
+            });
+        }
+        let l = posterior.log_likelihoods();
+        assert!(l[0] > l[1] + 5.0, "slab {} vs cube {}", l[0], l[1]);
+        // Where the slab stands now, not where it started.
+        let found = posterior.best_pose(0).expect("a pose");
+        let now = poses[2];
+        let turn = (found.rotation * now.rotation.inverse()).to_axis_angle().1;
+        let off = turn.min((turn - std::f64::consts::PI).abs());
+        let start_off = (poses[0].rotation * now.rotation.inverse()).to_axis_angle().1;
+        assert!(
+            off < 0.5 * start_off,
+            "turn off by {off} rad (the start is {start_off} rad away)"
+        );
+        let (d, start_d) = (
+            (found.position_m - now.position_m).length(),
+            (poses[0].position_m - now.position_m).length(),
+        );
+        assert!(
+            d < start_d,
+            "{d} m from where it stands (the start is {start_d} m away)"
+        );
     }
 
     #[test]

@@ -25,7 +25,7 @@ pub(crate) struct Likelihood {
     pub outlier: f64,
 }
 
-/// The prior over where the object stands, and how far it moves between touches.
+/// The prior over where the object stands.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PosePrior {
     /// Spread of the tilt of the object's up axis from the vertical, radians (each horizontal
@@ -40,15 +40,6 @@ pub(crate) struct PosePrior {
     pub heading_sigma_rad: Option<f64>,
 }
 
-/// A contact as the fit sees it: its world point and normal, and how much the object may have
-/// moved since it was taken (variances added to the likelihood's).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Observation {
-    pub contact: Contact,
-    pub point_var_m2: f64,
-    pub normal_var_rad2: f64,
-}
-
 /// A pose of one object and its log-likelihood (with the prior) given the contacts so far.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Hypothesis {
@@ -57,11 +48,12 @@ pub(crate) struct Hypothesis {
     pub score: f64,
 }
 
-/// Everything one pass over the contacts gives at one pose.
-struct Linearised {
-    score: f64,
-    hessian: Matrix6<f64>,
-    gradient: Vector6<f64>,
+/// Everything one pass over the contacts gives at one pose: the score, and the Hessian and
+/// gradient of its negative (the cost a step lowers).
+pub(crate) struct Linearised {
+    pub score: f64,
+    pub hessian: Matrix6<f64>,
+    pub gradient: Vector6<f64>,
 }
 
 /// A contact anywhere in a 0.2 m cube, with any normal: the density an outlier has, per cubic
@@ -89,16 +81,31 @@ impl Hypothesis {
     pub fn refine(
         &mut self,
         surface: &ObjectSurface,
-        observations: &[Observation],
+        contacts: &[Contact],
         likelihood: &Likelihood,
         prior: &PosePrior,
         iterations: usize,
     ) {
-        let mut current = self.linearise(surface, observations, likelihood, prior);
+        let fitted = self.fitted(iterations, |h| {
+            let mut at = h.linearise(surface, contacts, likelihood);
+            h.add_prior(surface, prior, &mut at);
+            at
+        });
+        self.score = fitted.score;
+    }
+
+    /// Up to `iterations` damped Gauss-Newton steps on the score `linearise` gives at a pose, each
+    /// kept only when it raises the score; returns the linearisation at the pose kept.
+    pub(crate) fn fitted(
+        &mut self,
+        iterations: usize,
+        linearise: impl Fn(&Self) -> Linearised,
+    ) -> Linearised {
+        let mut current = linearise(self);
         for _ in 0..iterations {
             let Some(step) = solve(&current) else { break };
             let trial = self.stepped(&step);
-            let next = trial.linearise(surface, observations, likelihood, prior);
+            let next = linearise(&trial);
             if next.score.partial_cmp(&current.score) != Some(std::cmp::Ordering::Greater) {
                 break;
             }
@@ -108,7 +115,7 @@ impl Hypothesis {
                 break;
             }
         }
-        self.score = current.score;
+        current
     }
 
     fn stepped(&self, step: &Vector6<f64>) -> Self {
@@ -120,16 +127,14 @@ impl Hypothesis {
         }
     }
 
-    /// The score (log-likelihood of every contact, robust, plus the log-prior up to a constant)
-    /// and its Gauss-Newton approximation at this pose. Each contact's weight in the step is the
-    /// probability that it is not an outlier (EM's responsibility), so a contact the pose cannot
-    /// explain stops pulling on it.
-    fn linearise(
+    /// The score (log-likelihood of every contact, robust) and its Gauss-Newton approximation at
+    /// this pose. Each contact's weight in the step is the probability that it is not an outlier
+    /// (EM's responsibility), so a contact the pose cannot explain stops pulling on it.
+    pub(crate) fn linearise(
         &self,
         surface: &ObjectSurface,
-        observations: &[Observation],
+        contacts: &[Contact],
         likelihood: &Likelihood,
-        prior: &PosePrior,
     ) -> Linearised {
         let mut out = Linearised {
             score: 0.0,
@@ -138,11 +143,11 @@ impl Hypothesis {
         };
         let to_object = self.rotation.inverse();
         let density_scale = (1.0 - likelihood.outlier) / surface.area_m2();
-        for o in observations {
-            let a = o.contact.point_m - self.center_w;
+        let point_var = likelihood.sigma_point_m.powi(2);
+        let normal_var = likelihood.sigma_normal_rad.powi(2);
+        for contact in contacts {
+            let a = contact.point_m - self.center_w;
             let q = to_object * a + surface.center_m();
-            let point_var = likelihood.sigma_point_m.powi(2) + o.point_var_m2;
-            let normal_var = likelihood.sigma_normal_rad.powi(2) + o.normal_var_rad2;
             let outlier = likelihood.outlier * OUTLIER_DENSITY;
             let Some(nearest) = surface.nearest(q) else {
                 out.score += outlier.ln();
@@ -151,7 +156,7 @@ impl Hypothesis {
             let g = self.rotation * surface.normals()[nearest.index];
             let r = nearest.signed_distance_m;
             let kappa = 1.0 / normal_var;
-            let cos = g.dot(o.contact.normal).clamp(-1.0, 1.0);
+            let cos = g.dot(contact.normal).clamp(-1.0, 1.0);
             let log_inlier =
                 density_scale.ln() - 0.5 * r * r / point_var - 0.5 * (std::f64::consts::TAU * point_var).ln()
                     + kappa * (cos - 1.0)
@@ -171,13 +176,12 @@ impl Hypothesis {
             out.hessian += j * j.transpose() * (w / point_var);
             out.gradient += j * (w * r / point_var);
             // Normal: e = g - n, de/dw = -[g]x.
-            let e = g - o.contact.normal;
+            let e = g - contact.normal;
             let gx = cross_matrix(g);
             let h = (gx.transpose() * gx) * (w / normal_var);
             let grad = g.cross(e) * (w / normal_var);
             add_rotation_block(&mut out, h, grad);
         }
-        self.add_prior(surface, prior, &mut out);
         out
     }
 

@@ -31,12 +31,45 @@ use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with}
 use crate::recognize::fusion::{DescriptorChoice, FusedModel};
 use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_version, encode_json, save_json};
 use crate::recognize::object_model::guess_of;
-use crate::recognize::posterior::{FusedPosterior, GeometricPosterior, TouchReading};
+use crate::recognize::posterior::{EvidenceWeights, FusedPosterior, GeometricPosterior, TouchReading};
 use crate::tactile::SensorConfig;
 
 /// The weights of the geometric evidence tried when fitting (`lambda`, the module docs); 0 is
 /// appearance alone, so the fit can never do worse on its calibration data than appearance.
 const GEOMETRY_WEIGHTS: [f64; 12] = [0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0];
+
+/// The evidence a geometric model's posterior weighs: both (the product), or one of its two
+/// parts alone, each with the tempering fitted for it on the same calibration explorations (what
+/// an experiment comparing them, and a check that the contacts learnt no pose, need).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Evidence {
+    /// `A + lambda G` (the module docs).
+    #[default]
+    Fused,
+    /// The bag of features alone, `A`: the paper's recogniser.
+    Appearance,
+    /// The contacts alone, `G`.
+    Contacts,
+}
+
+impl Evidence {
+    /// The names [`name`](Self::name) gives and [`parse`](Self::parse) takes.
+    pub const NAMES: [&'static str; 3] = ["fused", "appearance", "contacts"];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Fused => Self::NAMES[0],
+            Self::Appearance => Self::NAMES[1],
+            Self::Contacts => Self::NAMES[2],
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Self> {
+        [Self::Fused, Self::Appearance, Self::Contacts]
+            .into_iter()
+            .find(|e| e.name() == name)
+    }
+}
 
 /// An appearance model and a geometric model of the same objects, fused (the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -55,6 +88,12 @@ pub struct GeometricFusion {
     /// The error added to every simulated contact before it is matched (`locate::ContactNoise`):
     /// the arm's, so that the model does not lean on the simulator's exactness.
     contact_noise: ContactNoise,
+    /// The temperings of appearance alone and of the contacts alone, fitted beside the fused
+    /// weighing (`None` for a model calibrated before they were).
+    alone: Option<AloneTemperings>,
+    /// What the posterior weighs ([`Evidence::Fused`] unless [`with_evidence`](Self::with_evidence)
+    /// says otherwise); a choice of use, not part of the model file.
+    evidence: Evidence,
 }
 
 /// A weight of the geometric evidence and the tempering fitted at it.
@@ -62,6 +101,18 @@ pub struct GeometricFusion {
 pub struct Weighing {
     pub geometry_weight: f64,
     pub tempering: Tempering,
+}
+
+/// The tempering of each part of the evidence alone ([`Evidence`]), for an object that stays
+/// where it stands and, when perturbed explorations calibrated the model, for a moving one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AloneTemperings {
+    pub appearance: Tempering,
+    pub contacts: Tempering,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moving_appearance: Option<Tempering>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moving_contacts: Option<Tempering>,
 }
 
 /// The model file: the appearance model's own file as a field.
@@ -75,6 +126,8 @@ struct GeometricFile {
     #[serde(default)]
     moving: Option<Weighing>,
     contact_noise: ContactNoise,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    alone: Option<AloneTemperings>,
 }
 
 impl GeometricFusion {
@@ -99,6 +152,8 @@ impl GeometricFusion {
             tempering,
             moving: None,
             contact_noise: ContactNoise::ARM,
+            alone: None,
+            evidence: Evidence::Fused,
         })
     }
 
@@ -115,8 +170,10 @@ impl GeometricFusion {
         self.geometry_weight
     }
 
+    /// The tempering of the evidence weighed ([`evidence`](Self::evidence)) for an object that
+    /// stays where it stands: the fused one unless one part alone was asked for.
     pub fn tempering(&self) -> Tempering {
-        self.tempering
+        self.weighing_for(Perturbed::FIXED).1
     }
 
     /// The weighing of a moving object's evidence, when perturbed explorations calibrated it.
@@ -124,19 +181,58 @@ impl GeometricFusion {
         self.moving
     }
 
-    /// The weighing used for an object that moves as `motion` says: a moving object's own, or
-    /// appearance alone when none was fitted.
-    fn weighing_for(&self, motion: Perturbed) -> Weighing {
-        if motion.is_fixed() {
-            return Weighing {
-                geometry_weight: self.geometry_weight,
-                tempering: self.tempering,
-            };
+    /// The temperings of each part of the evidence alone, when calibrated.
+    pub fn alone(&self) -> Option<AloneTemperings> {
+        self.alone
+    }
+
+    pub fn evidence(&self) -> Evidence {
+        self.evidence
+    }
+
+    /// The same model weighing `evidence` ([`Evidence`]).
+    pub fn with_evidence(self, evidence: Evidence) -> Self {
+        Self { evidence, ..self }
+    }
+
+    /// The weights and tempering used for an object that moves as `motion` says, for the
+    /// evidence asked for. A moving object without a weighing of its own is recognised by
+    /// appearance alone; a part alone without a fitted tempering takes Eq. 15's (the guesses are
+    /// the same, the beliefs untempered).
+    fn weighing_for(&self, motion: Perturbed) -> (EvidenceWeights, Tempering) {
+        let fixed = motion.is_fixed();
+        let alone = self.alone;
+        match self.evidence {
+            Evidence::Fused if fixed => (EvidenceWeights::fused(self.geometry_weight), self.tempering),
+            Evidence::Fused => match self.moving {
+                Some(m) => (EvidenceWeights::fused(m.geometry_weight), m.tempering),
+                None => (EvidenceWeights::fused(0.0), self.appearance_tempering(motion)),
+            },
+            Evidence::Appearance => (EvidenceWeights::fused(0.0), self.appearance_tempering(motion)),
+            Evidence::Contacts => {
+                let fitted = alone.and_then(|a| {
+                    if fixed {
+                        Some(a.contacts)
+                    } else {
+                        a.moving_contacts
+                    }
+                });
+                (EvidenceWeights::CONTACTS, fitted.unwrap_or(Tempering::EQ15))
+            }
         }
-        self.moving.unwrap_or(Weighing {
-            geometry_weight: 0.0,
-            tempering: self.appearance.tempering(),
-        })
+    }
+
+    /// Appearance alone's tempering for an object that moves as `motion` says: fitted on the
+    /// calibration explorations of its kind, else the appearance model's own.
+    fn appearance_tempering(&self, motion: Perturbed) -> Tempering {
+        let fitted = self.alone.and_then(|a| {
+            if motion.is_fixed() {
+                Some(a.appearance)
+            } else {
+                a.moving_appearance
+            }
+        });
+        fitted.unwrap_or(self.appearance.tempering())
     }
 
     pub fn contact_noise(&self) -> ContactNoise {
@@ -154,11 +250,18 @@ impl GeometricFusion {
 
     /// The same model with the posterior `rule` applies.
     pub fn with_posterior(self, rule: PosteriorRule) -> Self {
+        let t = |t: Tempering| rule.tempering(t);
         Self {
-            tempering: rule.tempering(self.tempering),
+            tempering: t(self.tempering),
             moving: self.moving.map(|m| Weighing {
-                tempering: rule.tempering(m.tempering),
+                tempering: t(m.tempering),
                 ..m
+            }),
+            alone: self.alone.map(|a| AloneTemperings {
+                appearance: t(a.appearance),
+                contacts: t(a.contacts),
+                moving_appearance: a.moving_appearance.map(t),
+                moving_contacts: a.moving_contacts.map(t),
             }),
             appearance: self.appearance.with_posterior(rule),
             ..self
@@ -178,22 +281,34 @@ impl GeometricFusion {
             .iter()
             .copied()
             .partition(|d| d.header().perturbation.is_fixed());
-        if let Some(w) = self.weighing_on(&fixed, trial_readings)? {
+        if let Some((w, alone)) = self.weighing_on(&fixed, trial_readings)? {
             self.geometry_weight = w.geometry_weight;
             self.tempering = w.tempering;
+            self.alone = Some(AloneTemperings {
+                appearance: alone.appearance,
+                contacts: alone.contacts,
+                moving_appearance: None,
+                moving_contacts: None,
+            });
         }
-        if let Some(w) = self.weighing_on(&moving, trial_readings)? {
+        if let Some((w, moving)) = self.weighing_on(&moving, trial_readings)? {
             self.moving = Some(w);
+            self.alone = self.alone.map(|a| AloneTemperings {
+                moving_appearance: Some(moving.appearance),
+                moving_contacts: Some(moving.contacts),
+                ..a
+            });
         }
         Ok(self)
     }
 
-    /// The weighing fitted on the explorations of `data` (the module docs), `None` without any.
+    /// The weighing fitted on the explorations of `data` (the module docs) and the temperings of
+    /// each part alone (only their `appearance` and `contacts` set), `None` without any.
     fn weighing_on(
         &self,
         data: &[&Dataset],
         trial_readings: usize,
-    ) -> Result<Option<Weighing>, RecognizeError> {
+    ) -> Result<Option<(Weighing, AloneTemperings)>, RecognizeError> {
         let mut paths = Vec::new();
         for dataset in data {
             let motion = dataset.header().perturbation;
@@ -208,7 +323,10 @@ impl GeometricFusion {
         // ties broken by reliability (here the fitted posterior's log loss).
         let mut best: Option<(usize, f64, f64, Tempering, Vec<EvidencePath>)> = None;
         for weight in GEOMETRY_WEIGHTS {
-            let combined: Vec<EvidencePath> = paths.iter().map(|p| p.combined(weight)).collect();
+            let combined: Vec<EvidencePath> = paths
+                .iter()
+                .map(|p| p.combined(EvidenceWeights::fused(weight)))
+                .collect();
             let right = combined
                 .iter()
                 .flat_map(|p| p.log_likelihoods.iter().map(move |l| guess_of(l) == p.object))
@@ -222,9 +340,24 @@ impl GeometricFusion {
                 best = Some((right, loss, weight, tempering, combined));
             }
         }
-        Ok(best.map(|(_, _, weight, tempering, combined)| Weighing {
-            geometry_weight: weight,
-            tempering: tempering.with_confidence_map_of(&combined),
+        let alone = |weights: EvidenceWeights| {
+            let combined: Vec<EvidencePath> = paths.iter().map(|p| p.combined(weights)).collect();
+            Tempering::fit_scored(&combined)
+                .0
+                .with_confidence_map_of(&combined)
+        };
+        let alone = AloneTemperings {
+            appearance: alone(EvidenceWeights::fused(0.0)),
+            contacts: alone(EvidenceWeights::CONTACTS),
+            moving_appearance: None,
+            moving_contacts: None,
+        };
+        Ok(best.map(|(_, _, weight, tempering, combined)| {
+            let weighing = Weighing {
+                geometry_weight: weight,
+                tempering: tempering.with_confidence_map_of(&combined),
+            };
+            (weighing, alone)
         }))
     }
 
@@ -288,12 +421,12 @@ impl GeometricFusion {
 
     /// A posterior over described readings and their touches.
     pub fn posterior(&self, motion: Perturbed) -> GeometricPosterior<'_> {
-        let weighing = self.weighing_for(motion);
+        let (weights, tempering) = self.weighing_for(motion);
         GeometricPosterior {
             appearance: appearance_posterior(&self.appearance),
             geometry: self.geometry.posterior(motion),
-            geometry_weight: weighing.geometry_weight,
-            tempering: weighing.tempering,
+            weights,
+            tempering,
             contact_noise: self.contact_noise,
             sensor: *self.sensor(),
             readings: 0,
@@ -333,6 +466,7 @@ impl GeometricFusion {
             tempering: self.tempering,
             moving: self.moving,
             contact_noise: self.contact_noise,
+            alone: self.alone,
         })
     }
 
@@ -377,6 +511,7 @@ impl GeometricFusion {
             tempering: file.tempering,
             moving: file.moving,
             contact_noise: noise,
+            alone: file.alone,
             ..fused
         })
     }
@@ -517,14 +652,14 @@ struct EvidenceParts {
 }
 
 impl EvidenceParts {
-    fn combined(&self, weight: f64) -> EvidencePath {
+    fn combined(&self, weights: EvidenceWeights) -> EvidencePath {
         EvidencePath {
             object: self.object,
             log_likelihoods: self
                 .appearance
                 .iter()
                 .zip(&self.geometry)
-                .map(|(a, g)| a.iter().zip(g).map(|(a, g)| a + weight * g).collect())
+                .map(|(a, g)| weights.sum(a, g))
                 .collect(),
         }
     }

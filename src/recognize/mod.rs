@@ -45,7 +45,7 @@ pub(crate) mod selection;
 pub use bag::BagOfFeatures;
 pub use error::RecognizeError;
 pub use fusion::{DescriptorChoice, DescriptorChoiceError, FusedModel};
-pub use geometric::{Appearance, GeometricFusion, Weighing};
+pub use geometric::{AloneTemperings, Appearance, Evidence, GeometricFusion, Weighing};
 pub use labelled::LabelledFeatures;
 pub use model::{
     MODEL_FORMAT_VERSION, TrainedModel, TrainingProvenance, check_same_sensor, sensor_differences,

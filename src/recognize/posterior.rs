@@ -304,7 +304,7 @@ pub type TouchReading = (Vec<Vec<Feature>>, Touch);
 pub struct GeometricPosterior<'a> {
     pub(crate) appearance: FusedPosterior<'a>,
     pub(crate) geometry: GeometryPosterior<'a>,
-    pub(crate) geometry_weight: f64,
+    pub(crate) weights: EvidenceWeights,
     pub(crate) tempering: Tempering,
     pub(crate) contact_noise: ContactNoise,
     pub(crate) sensor: SensorConfig,
@@ -330,15 +330,12 @@ impl GeometricPosterior<'_> {
         }
     }
 
-    /// `A + lambda G` for every object.
+    /// `A + lambda G` for every object (or one part alone, `recognize::Evidence`).
     pub fn log_likelihoods(&self) -> Vec<f64> {
-        let g = self.geometry.log_likelihoods();
-        self.appearance
-            .log_likelihoods()
-            .iter()
-            .zip(g)
-            .map(|(a, g)| a + self.geometry_weight * g)
-            .collect()
+        self.weights.sum(
+            &self.appearance.log_likelihoods(),
+            self.geometry.log_likelihoods(),
+        )
     }
 
     pub fn readings(&self) -> usize {
@@ -355,5 +352,34 @@ impl GeometricPosterior<'_> {
                 self.readings,
             ),
         }
+    }
+}
+
+/// How the parts of the evidence are summed: `appearance A + geometry G`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EvidenceWeights {
+    pub(crate) appearance: f64,
+    pub(crate) geometry: f64,
+}
+
+impl EvidenceWeights {
+    pub(crate) fn fused(geometry_weight: f64) -> Self {
+        Self {
+            appearance: 1.0,
+            geometry: geometry_weight,
+        }
+    }
+
+    pub(crate) const CONTACTS: Self = Self {
+        appearance: 0.0,
+        geometry: 1.0,
+    };
+
+    /// `appearance A_j + geometry G_j` for every object `j`.
+    pub(crate) fn sum(&self, a: &[f64], g: &[f64]) -> Vec<f64> {
+        a.iter()
+            .zip(g)
+            .map(|(a, g)| self.appearance * a + self.geometry * g)
+            .collect()
     }
 }

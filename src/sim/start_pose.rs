@@ -34,22 +34,28 @@ impl Scene {
     /// 12 cm objects of the built-in sets, within the 3 cm margin by which the planner's workspace
     /// (`explore::PlannerConfig::fitted_to`) exceeds each object's bounding sphere, which the
     /// heading, a turn about the centre, does not leave.
+    ///
+    /// [`StartPose::Turned`] is the same draw at one fixed heading: its tilt and shift, nothing
+    /// drawn for the heading.
     pub fn place_at_start(&mut self, start: &StartPose, rng: &mut Rng) -> Result<Pose, SimError> {
-        let StartPose::Random { max_heading } = start else {
-            return self.object_pose().ok_or(SimError::NoObject);
+        let angle_rad = match start {
+            StartPose::Canonical => return self.object_pose().ok_or(SimError::NoObject),
+            StartPose::Turned { heading } => heading.rad(),
+            // The full turn is drawn as the demo always drew it, so that its runs stay as they were.
+            StartPose::Random { max_heading } if max_heading.is_any() => rng.random_range(0.0..TAU),
+            StartPose::Random { max_heading } => rng.random_range(-max_heading.rad()..=max_heading.rad()),
         };
         let width = self.object_width_m().ok_or(SimError::NoObject)?;
-        // The full turn is drawn as the demo always drew it, so that its runs stay as they were.
-        let angle_rad = if max_heading.is_any() {
-            rng.random_range(0.0..TAU)
-        } else {
-            rng.random_range(-max_heading.rad()..=max_heading.rad())
-        };
+        self.turn_object(angle_rad)?;
+        self.perturb_object(&PerturbationBounds::PAPER.draw(width, rng))
+    }
+
+    /// Turns the object by `angle_rad` about the vertical through its bounding-box centre.
+    fn turn_object(&mut self, angle_rad: f64) -> Result<Pose, SimError> {
         self.perturb_object(&Perturbation {
             axis: DVec3::Z,
             angle_rad,
             translation_m: DVec3::ZERO,
-        })?;
-        self.perturb_object(&PerturbationBounds::PAPER.draw(width, rng))
+        })
     }
 }
