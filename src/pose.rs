@@ -421,6 +421,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_turned_start_wraps_its_heading_and_reads_back_from_a_header() {
+        let deg = |d: f64| Heading::from_deg(d).map(|h| (h.deg() * 1e9).round() / 1e9);
+        assert_eq!(deg(270.0), Some(-90.0));
+        assert_eq!(deg(-180.0), Some(180.0));
+        assert_eq!(deg(540.0), Some(180.0));
+        assert_eq!(deg(f64::NAN), None);
+        let turned = StartPose::parse("turned:-45", MaxHeading::ANY).expect("a turn");
+        let json = serde_json::to_string(&turned).expect("encodes");
+        assert!(
+            json.starts_with(r#"{"turned":{"heading_rad":-0.785398"#),
+            "{json}"
+        );
+        assert_eq!(serde_json::from_str::<StartPose>(&json).expect("decodes"), turned);
+        let beyond = r#"{"turned":{"heading_rad":4.0}}"#;
+        let e = serde_json::from_str::<StartPose>(beyond).expect_err("refused");
+        assert!(
+            e.to_string().contains("heading_rad 4 is outside [-pi, pi]"),
+            "{e}"
+        );
+        // A letter turned within its 10 degrees is still the letter; further, another one.
+        assert!(StartPose::parse("turned:10", MaxHeading::LETTERS).is_some());
+        assert_eq!(StartPose::parse("turned:11", MaxHeading::LETTERS), None);
+    }
+
+    #[test]
     fn inverse_and_compose_round_trip() {
         let a = Pose::new(
             DVec3::new(0.1, -0.2, 0.3),

@@ -1,17 +1,18 @@
-//! The geometric recogniser: for every known object, a few pose hypotheses fitted to the contacts so
-//! far; the evidence for the object is how well its best poses explain them.
+//! The geometric recogniser: for every known object, a few pose hypotheses followed through the
+//! contacts so far; the evidence for the object is how well they predicted them.
 //!
-//! `ln p(contacts | O_j)` is approximated by the log of the mean, over the object's hypotheses, of
-//! the likelihood at each hypothesis's fitted pose: the hypotheses start at headings spread over
-//! the range the object may stand at (any heading, or a few degrees for the letters), each is
-//! refined by Gauss-Newton after every contact (`pose_fit`), so the mean over them stands for the
-//! integral over the unknown heading. Nothing of the object's true pose is read: only contacts.
+//! `ln p(contacts | O_j)` is the log of the mean, over the object's hypotheses, of each
+//! hypothesis's evidence: the hypotheses start at headings spread over the range the object may
+//! stand at (any heading, or a few degrees for the letters), each a Gaussian belief over the pose
+//! that every contact updates (`track`: one Gauss-Newton fit of the new contact against the belief
+//! so far, its predictive likelihood the evidence), so the mean over them stands for the integral
+//! over the unknown pose. Nothing of the object's true pose is read: only contacts.
 
 use serde::{Deserialize, Serialize};
 
 use crate::dataset::Perturbed;
 use crate::locate::contact::{Contact, Touch};
-use crate::locate::pose_fit::{Hypothesis, Likelihood, PosePrior};
+use crate::locate::pose_fit::{Hypothesis, Likelihood};
 use crate::locate::surface::ObjectSurface;
 use crate::locate::track::{MoveSpread, StartSpread, Track};
 use crate::mesh::TriMesh;
@@ -209,34 +210,24 @@ impl GeometryModel {
         &self.surfaces
     }
 
-    /// A posterior with no contact yet, for an object that moves as `motion` says between touches:
-    /// pose hypotheses fitted to every contact at once for an object that stays where it stands,
-    /// followed through the moves (`track`) for one that moves.
+    /// A posterior with no contact yet, for an object that moves as `motion` says between touches
+    /// (not at all, for `Perturbed::FIXED`).
     pub fn posterior(&self, motion: Perturbed) -> GeometryPosterior<'_> {
-        let hypotheses = self.surfaces.iter().map(|s| {
-            self.headings()
-                .into_iter()
-                .map(|h| Hypothesis::at_heading(s, h))
-                .collect::<Vec<_>>()
-        });
-        let fits = if motion.is_fixed() {
-            Fits::Batch(hypotheses.collect())
-        } else {
-            Fits::Tracked(
-                hypotheses
-                    .zip(&self.surfaces)
-                    .map(|(hs, s)| {
-                        let spread = self.start_spread(s.width_m());
-                        hs.into_iter().map(|h| Track::start(h, &spread)).collect()
-                    })
-                    .collect(),
-            )
-        };
+        let tracks = self
+            .surfaces
+            .iter()
+            .map(|s| {
+                let spread = self.start_spread(s.width_m());
+                self.headings()
+                    .into_iter()
+                    .map(|h| Track::start(Hypothesis::at_heading(s, h), &spread))
+                    .collect()
+            })
+            .collect();
         GeometryPosterior {
             model: self,
             motion,
-            fits,
-            contacts: Vec::new(),
+            tracks,
             log_likelihoods: vec![0.0; self.objects.len()],
         }
     }
@@ -285,23 +276,14 @@ impl GeometryModel {
     }
 }
 
-/// Per object, its pose hypotheses: fitted to every contact at once (an object that stays where
-/// it stands), or each followed through the moves (one that moves).
-#[derive(Debug, Clone)]
-enum Fits {
-    Batch(Vec<Vec<Hypothesis>>),
-    Tracked(Vec<Vec<Track>>),
-}
-
 /// The geometric evidence after each touch (the module docs): `observe` a touch, read
 /// `log_likelihoods`.
 #[derive(Debug, Clone)]
 pub struct GeometryPosterior<'a> {
     model: &'a GeometryModel,
     motion: Perturbed,
-    fits: Fits,
-    /// Every contact so far.
-    contacts: Vec<Contact>,
+    /// Per object, its pose hypotheses.
+    tracks: Vec<Vec<Track>>,
     log_likelihoods: Vec<f64>,
 }
 
@@ -310,11 +292,7 @@ impl GeometryPosterior<'_> {
     /// the object's moves). Returns `ln p(contacts | O_j)` for every object, up to one constant.
     pub fn observe(&mut self, touch: Touch) -> &[f64] {
         if let Some(c) = touch.contact {
-            self.contacts.push(c);
-            match &self.fits {
-                Fits::Batch(_) => self.refit(),
-                Fits::Tracked(_) => self.track(c, touch.attempt),
-            }
+            self.track(c, touch.attempt);
         }
         &self.log_likelihoods
     }
@@ -328,11 +306,12 @@ impl GeometryPosterior<'_> {
     /// hypothesis: where the recogniser believes it stands if it is that object.
     pub fn best_pose(&self, object: usize) -> Option<Pose> {
         let surface = self.model.surfaces.get(object)?;
-        let poses: Vec<&Hypothesis> = match &self.fits {
-            Fits::Batch(h) => h.get(object)?.iter().collect(),
-            Fits::Tracked(t) => t.get(object)?.iter().map(|t| &t.pose).collect(),
-        };
-        let best = poses.into_iter().max_by(|a, b| a.score.total_cmp(&b.score))?;
+        let best = self
+            .tracks
+            .get(object)?
+            .iter()
+            .map(|t| &t.pose)
+            .max_by(|a, b| a.score.total_cmp(&b.score))?;
         // p = R (q - c) + c_w = R q + (c_w - R c).
         Some(Pose::new(
             best.center_w - best.rotation * surface.center_m(),
@@ -340,50 +319,19 @@ impl GeometryPosterior<'_> {
         ))
     }
 
-    /// Refits every hypothesis of a fixed object to all the contacts so far.
-    fn refit(&mut self) {
-        let model = self.model;
-        let likelihood = model.likelihood();
-        let iterations = model.params.iterations;
-        for (j, surface) in model.surfaces.iter().enumerate() {
-            let prior = self.prior(surface.width_m());
-            let Fits::Batch(hypotheses) = &mut self.fits else {
-                return;
-            };
-            let hypotheses = &mut hypotheses[j];
-            for h in hypotheses.iter_mut() {
-                h.refine(surface, &self.contacts, &likelihood, &prior, iterations);
-            }
-            self.log_likelihoods[j] = log_mean_exp(hypotheses.iter().map(|h| h.score));
-        }
-    }
-
-    /// Moves every track of a moving object on to `attempt` and updates it with `contact`.
+    /// Moves every track on to `attempt` (the moves since its last contact, for a moving object)
+    /// and updates it with `contact`.
     fn track(&mut self, contact: Contact, attempt: usize) {
         let model = self.model;
         let likelihood = model.likelihood();
         let iterations = model.params.iterations;
-        let Fits::Tracked(tracks) = &mut self.fits else {
-            return;
-        };
+        let tracks = self.tracks.iter_mut();
         for ((surface, tracks), l) in model.surfaces.iter().zip(tracks).zip(&mut self.log_likelihoods) {
             let moves = move_spread(&self.motion, surface.width_m());
             for t in tracks.iter_mut() {
                 t.observe(surface, contact, attempt, &likelihood, &moves, iterations);
             }
             *l = log_mean_exp(tracks.iter().map(Track::evidence));
-        }
-    }
-
-    /// Where a fixed object may stand: the start pose's spread.
-    fn prior(&self, width_m: f64) -> PosePrior {
-        let p = &self.model.params;
-        PosePrior {
-            tilt_sigma_rad: p.tilt_sigma_deg.to_radians(),
-            shift_sigma_m: p.shift_sigma_fraction * width_m,
-            height_sigma_m: p.height_sigma_m,
-            // Half the range: a uniform draw within +-max has a spread of max / sqrt(3).
-            heading_sigma_rad: (!p.max_heading.is_any()).then(|| (0.5 * p.max_heading.rad()).max(1e-3)),
         }
     }
 }

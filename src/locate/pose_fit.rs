@@ -1,8 +1,6 @@
-//! One pose hypothesis of one object, fitted to the contacts so far (Petrovskaya and Khatib's
-//! contact likelihood, refined by Gauss-Newton as point-to-plane ICP refines a pose): the object
-//! stands on the table at a heading the recogniser is not told, tilted a little and moved a little
-//! from where objects are put (the start pose of `sim::StartPose`), and every contact should lie on
-//! its surface with the surface's normal.
+//! One pose of one object fitted to contacts (Petrovskaya and Khatib's contact likelihood, refined
+//! by Gauss-Newton as point-to-plane ICP refines a pose): every contact should lie on the object's
+//! surface with the surface's normal. `track` adds the belief so far as a Gaussian prior.
 //!
 //! A pose is a rotation `R` about the object's bounding-box centre `c` and where that centre is in
 //! the world, `c_w`: a world point `p` is the object point `R^T (p - c_w) + c`. A step turns by a
@@ -25,22 +23,7 @@ pub(crate) struct Likelihood {
     pub outlier: f64,
 }
 
-/// The prior over where the object stands.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct PosePrior {
-    /// Spread of the tilt of the object's up axis from the vertical, radians (each horizontal
-    /// component of the up axis).
-    pub tilt_sigma_rad: f64,
-    /// Spread of the bounding-box centre about where it stands at the canonical pose, horizontal,
-    /// metres.
-    pub shift_sigma_m: f64,
-    /// The same, vertical (a tilt raises or lowers the centre of an object resting on the table).
-    pub height_sigma_m: f64,
-    /// Spread of the heading about the canonical one, radians; `None`: any heading.
-    pub heading_sigma_rad: Option<f64>,
-}
-
-/// A pose of one object and its log-likelihood (with the prior) given the contacts so far.
+/// A pose of one object and its log-evidence given the contacts so far (`track`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Hypothesis {
     pub rotation: DQuat,
@@ -74,24 +57,6 @@ impl Hypothesis {
             center_w: surface.center_m(),
             score: 0.0,
         }
-    }
-
-    /// Refines the pose by up to `iterations` Gauss-Newton steps on the contacts and the prior,
-    /// keeping a step only when it raises the score, and leaves the score of the pose kept.
-    pub fn refine(
-        &mut self,
-        surface: &ObjectSurface,
-        contacts: &[Contact],
-        likelihood: &Likelihood,
-        prior: &PosePrior,
-        iterations: usize,
-    ) {
-        let fitted = self.fitted(iterations, |h| {
-            let mut at = h.linearise(surface, contacts, likelihood);
-            h.add_prior(surface, prior, &mut at);
-            at
-        });
-        self.score = fitted.score;
     }
 
     /// Up to `iterations` damped Gauss-Newton steps on the score `linearise` gives at a pose, each
@@ -184,40 +149,6 @@ impl Hypothesis {
         }
         out
     }
-
-    /// The prior's residuals: the up axis's horizontal components, the centre's shift, the heading
-    /// when it is bounded.
-    fn add_prior(&self, surface: &ObjectSurface, prior: &PosePrior, out: &mut Linearised) {
-        let u = self.rotation * DVec3::Z;
-        let tilt_var = prior.tilt_sigma_rad.powi(2);
-        // d(u)/dw = -[u]x: the rows for u.x and u.y.
-        let rows = [DVec3::new(0.0, u.z, -u.y), DVec3::new(-u.z, 0.0, u.x)];
-        for (residual, row) in [u.x, u.y].into_iter().zip(rows) {
-            add_rotation_residual(out, residual, row, tilt_var);
-        }
-        let shift = self.center_w - surface.center_m();
-        let sigmas = [prior.shift_sigma_m, prior.shift_sigma_m, prior.height_sigma_m];
-        for (k, sigma) in sigmas.into_iter().enumerate() {
-            let var = sigma * sigma;
-            out.score -= 0.5 * shift[k] * shift[k] / var;
-            out.hessian[(3 + k, 3 + k)] += 1.0 / var;
-            out.gradient[3 + k] += shift[k] / var;
-        }
-        if let Some(sigma) = prior.heading_sigma_rad {
-            let v = self.rotation * DVec3::X;
-            let horizontal = (v.x * v.x + v.y * v.y).max(1e-12);
-            let heading = v.y.atan2(v.x);
-            let row = DVec3::new(-v.x * v.z, -v.y * v.z, horizontal) / horizontal;
-            add_rotation_residual(out, heading, row, sigma * sigma);
-        }
-    }
-}
-
-/// Adds a scalar residual `r` of variance `var` whose derivative by the turn is `row`.
-fn add_rotation_residual(out: &mut Linearised, r: f64, row: DVec3, var: f64) {
-    out.score -= 0.5 * r * r / var;
-    let h = DMat3::from_cols(row * row.x, row * row.y, row * row.z) / var;
-    add_rotation_block(out, h, row * (r / var));
 }
 
 fn add_rotation_block(out: &mut Linearised, h: DMat3, gradient: DVec3) {

@@ -1,16 +1,17 @@
-//! Following an object that moves between touches (Sec. V-B4: "the object pose is perturbed by a
-//! small amount ... each time a sensor reading is taken"): each pose hypothesis becomes a Gaussian
-//! belief over the pose, predicted through the moves and updated by each new contact, an iterated
-//! extended Kalman filter on the pose (Petrovskaya and Khatib's contact likelihood as its
-//! measurement).
+//! One pose hypothesis followed through the touches: a Gaussian belief over the object's pose,
+//! predicted through the moves between touches (Sec. V-B4: "the object pose is perturbed by a
+//! small amount ... each time a sensor reading is taken"; none for an object that stays) and
+//! updated by each new contact, an iterated extended Kalman filter on the pose with Petrovskaya
+//! and Khatib's contact likelihood as its measurement. The hypothesis's evidence is the product of
+//! each contact's predictive likelihood given those before it (Laplace's approximation about the
+//! updated pose), so a hypothesis pays for the pose it had to learn.
 //!
 //! The object moves rigidly, so contacts taken before the same move keep their places relative to
 //! one another on the object: what a move blurs is the object's pose, not the shape the contacts
-//! trace. Discounting each older contact by the moves since, as independent noise on each, throws
-//! that shape away; the filter keeps it in the belief's covariance. The
-//! evidence for the object is the product of each contact's predictive likelihood given those
-//! before it (Laplace's approximation about the updated pose), summed over the hypotheses as
-//! `model` sums the batch fit's.
+//! trace. Discounting each older contact by the moves since, as independent noise on each (the
+//! first design), threw that shape away; the filter keeps it in the belief's covariance. One
+//! contact per update also keeps a touch's cost the same however many came before (refitting every
+//! contact so far, the first design's fixed objects, grew with them).
 
 use nalgebra::{Matrix6, Vector6};
 
@@ -106,7 +107,8 @@ impl Track {
 
     /// The information after `moves` more moves: the covariance grows by each move's spread.
     fn predicted(&self, moves: usize, spread: &MoveSpread) -> Matrix6<f64> {
-        if moves == 0 {
+        let still = spread.turn_var_rad2 == 0.0 && spread.shift_var_m2 == 0.0 && spread.height_var_m2 == 0.0;
+        if moves == 0 || still {
             return self.information;
         }
         let Some(covariance) = self.information.try_inverse() else {
