@@ -169,8 +169,6 @@ pub enum GeometryError {
     Params(#[from] RangeError),
     #[error("object '{0}': its mesh has no triangle of positive area to match contacts against")]
     EmptySurface(String),
-    #[error("the geometric model knows {found} objects, the appearance model {expected}")]
-    Objects { found: usize, expected: usize },
 }
 
 /// Every known object's surface, and what the recogniser assumes (the module docs).
@@ -213,14 +211,15 @@ impl GeometryModel {
     /// A posterior with no contact yet, for an object that moves as `motion` says between touches
     /// (not at all, for `Perturbed::FIXED`).
     pub fn posterior(&self, motion: Perturbed) -> GeometryPosterior<'_> {
+        let headings = self.headings();
         let tracks = self
             .surfaces
             .iter()
             .map(|s| {
                 let spread = self.start_spread(s.width_m());
-                self.headings()
-                    .into_iter()
-                    .map(|h| Track::start(Hypothesis::at_heading(s, h), &spread))
+                headings
+                    .iter()
+                    .map(|&h| Track::start(Hypothesis::at_heading(s, h), &spread))
                     .collect()
             })
             .collect();
@@ -325,8 +324,8 @@ impl GeometryPosterior<'_> {
         let model = self.model;
         let likelihood = model.likelihood();
         let iterations = model.params.iterations;
-        let tracks = self.tracks.iter_mut();
-        for ((surface, tracks), l) in model.surfaces.iter().zip(tracks).zip(&mut self.log_likelihoods) {
+        let objects = model.surfaces.iter().zip(&mut self.tracks);
+        for ((surface, tracks), l) in objects.zip(&mut self.log_likelihoods) {
             let moves = move_spread(&self.motion, surface.width_m());
             for t in tracks.iter_mut() {
                 t.observe(surface, contact, attempt, &likelihood, &moves, iterations);

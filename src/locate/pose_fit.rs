@@ -180,7 +180,7 @@ fn cross_matrix(v: DVec3) -> DMat3 {
     )
 }
 
-pub(crate) fn log_sum_exp(a: f64, b: f64) -> f64 {
+fn log_sum_exp(a: f64, b: f64) -> f64 {
     let m = a.max(b);
     if m == f64::NEG_INFINITY {
         return m;

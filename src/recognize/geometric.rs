@@ -115,6 +115,19 @@ pub struct AloneTemperings {
     pub moving_contacts: Option<Tempering>,
 }
 
+impl AloneTemperings {
+    /// The tempering fitted for `part` alone (appearance unless [`Evidence::Contacts`]) of an
+    /// object that stays (`fixed`) or moves; `None` where no perturbed exploration fitted one.
+    fn of(&self, part: Evidence, fixed: bool) -> Option<Tempering> {
+        match (part, fixed) {
+            (Evidence::Contacts, true) => Some(self.contacts),
+            (Evidence::Contacts, false) => self.moving_contacts,
+            (_, true) => Some(self.appearance),
+            (_, false) => self.moving_appearance,
+        }
+    }
+}
+
 /// The model file: the appearance model's own file as a field.
 #[derive(Serialize, Deserialize)]
 struct GeometricFile {
@@ -201,7 +214,6 @@ impl GeometricFusion {
     /// the same, the beliefs untempered).
     fn weighing_for(&self, motion: Perturbed) -> (EvidenceWeights, Tempering) {
         let fixed = motion.is_fixed();
-        let alone = self.alone;
         match self.evidence {
             Evidence::Fused if fixed => (EvidenceWeights::fused(self.geometry_weight), self.tempering),
             Evidence::Fused => match self.moving {
@@ -210,13 +222,7 @@ impl GeometricFusion {
             },
             Evidence::Appearance => (EvidenceWeights::fused(0.0), self.appearance_tempering(motion)),
             Evidence::Contacts => {
-                let fitted = alone.and_then(|a| {
-                    if fixed {
-                        Some(a.contacts)
-                    } else {
-                        a.moving_contacts
-                    }
-                });
+                let fitted = self.alone.and_then(|a| a.of(Evidence::Contacts, fixed));
                 (EvidenceWeights::CONTACTS, fitted.unwrap_or(Tempering::EQ15))
             }
         }
@@ -225,14 +231,9 @@ impl GeometricFusion {
     /// Appearance alone's tempering for an object that moves as `motion` says: fitted on the
     /// calibration explorations of its kind, else the appearance model's own.
     fn appearance_tempering(&self, motion: Perturbed) -> Tempering {
-        let fitted = self.alone.and_then(|a| {
-            if motion.is_fixed() {
-                Some(a.appearance)
-            } else {
-                a.moving_appearance
-            }
-        });
-        fitted.unwrap_or(self.appearance.tempering())
+        self.alone
+            .and_then(|a| a.of(Evidence::Appearance, motion.is_fixed()))
+            .unwrap_or(self.appearance.tempering())
     }
 
     pub fn contact_noise(&self) -> ContactNoise {
@@ -281,21 +282,21 @@ impl GeometricFusion {
             .iter()
             .copied()
             .partition(|d| d.header().perturbation.is_fixed());
-        if let Some((w, alone)) = self.weighing_on(&fixed, trial_readings)? {
+        if let Some((w, [appearance, contacts])) = self.weighing_on(&fixed, trial_readings)? {
             self.geometry_weight = w.geometry_weight;
             self.tempering = w.tempering;
             self.alone = Some(AloneTemperings {
-                appearance: alone.appearance,
-                contacts: alone.contacts,
+                appearance,
+                contacts,
                 moving_appearance: None,
                 moving_contacts: None,
             });
         }
-        if let Some((w, moving)) = self.weighing_on(&moving, trial_readings)? {
+        if let Some((w, [appearance, contacts])) = self.weighing_on(&moving, trial_readings)? {
             self.moving = Some(w);
             self.alone = self.alone.map(|a| AloneTemperings {
-                moving_appearance: Some(moving.appearance),
-                moving_contacts: Some(moving.contacts),
+                moving_appearance: Some(appearance),
+                moving_contacts: Some(contacts),
                 ..a
             });
         }
@@ -303,12 +304,12 @@ impl GeometricFusion {
     }
 
     /// The weighing fitted on the explorations of `data` (the module docs) and the temperings of
-    /// each part alone (only their `appearance` and `contacts` set), `None` without any.
+    /// appearance alone and of the contacts alone, `None` without any.
     fn weighing_on(
         &self,
         data: &[&Dataset],
         trial_readings: usize,
-    ) -> Result<Option<(Weighing, AloneTemperings)>, RecognizeError> {
+    ) -> Result<Option<(Weighing, [Tempering; 2])>, RecognizeError> {
         let mut paths = Vec::new();
         for dataset in data {
             let motion = dataset.header().perturbation;
@@ -346,12 +347,10 @@ impl GeometricFusion {
                 .0
                 .with_confidence_map_of(&combined)
         };
-        let alone = AloneTemperings {
-            appearance: alone(EvidenceWeights::fused(0.0)),
-            contacts: alone(EvidenceWeights::CONTACTS),
-            moving_appearance: None,
-            moving_contacts: None,
-        };
+        let alone = [
+            alone(EvidenceWeights::fused(0.0)),
+            alone(EvidenceWeights::CONTACTS),
+        ];
         Ok(best.map(|(_, _, weight, tempering, combined)| {
             let weighing = Weighing {
                 geometry_weight: weight,
