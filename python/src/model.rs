@@ -8,10 +8,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use taction::active_touch::ArmTrainingRecipe;
 use taction::describe::Feature;
+use taction::locate::GeometryModel;
+use taction::mesh::TriMesh;
 use taction::recognize::{
-    Belief, CodebookKind, DescriptorChoice, FusedModel, PseudoCount, Recognizer, TrainConfig, TrainedModel,
-    VarianceFraction,
+    Appearance, Belief, CodebookKind, DescriptorChoice, FusedModel, GeometricFusion, PseudoCount,
+    RecognizeError, Recognizer, TrainConfig, TrainedModel, VarianceFraction,
 };
+use taction::sim::MaxHeading;
 use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
@@ -19,6 +22,7 @@ use crate::args::Whole;
 use crate::array;
 use crate::dataset::Dataset;
 use crate::error::{bad_argument, refused};
+use crate::object::Object;
 
 /// A trained recogniser: one descriptor's model, or several fused (`"mnti+sift"`). Files are the
 /// ones `taction train` writes and `taction recognize` reads.
@@ -159,8 +163,9 @@ impl Model {
 #[pyclass(module = "taction")]
 pub struct Posterior {
     model: Arc<Recognizer>,
-    /// Every observed reading's features under each of the model's descriptors.
-    observed: Vec<Vec<Vec<Feature>>>,
+    /// Every observed reading (its image, with its pad pose when given) and its features under
+    /// each of the model's descriptors.
+    observed: Vec<(TactileImage, Vec<Vec<Feature>>)>,
     /// The belief after them; `None` before any (uniform).
     belief: Option<Belief>,
 }
@@ -168,8 +173,17 @@ pub struct Posterior {
 #[pymethods]
 impl Posterior {
     /// Adds one tactile image (an array `(rows, cols)` of the model's sensor) and returns the
-    /// probabilities after it.
-    fn observe<'py>(&mut self, py: Python<'py>, image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    /// probabilities after it. `pad_pose` (the nine numbers of a dataset's `pad_pose` row: centre
+    /// in metres, normal, up) says where the touch landed: a model trained with `objects` weighs
+    /// that contact too (an object that stays where it is); without it, or for a model of
+    /// appearance alone, only the image counts.
+    #[pyo3(signature = (image, pad_pose=None), text_signature = "($self, image, pad_pose=None)")]
+    fn observe<'py>(
+        &mut self,
+        py: Python<'py>,
+        image: &Bound<'py, PyAny>,
+        pad_pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let (shape, values) = array::to_f64(image, "image")?;
         let sensor = self.model.sensor();
         if shape[..] != [sensor.rows, sensor.cols] {
@@ -181,19 +195,24 @@ impl Posterior {
                 ),
             ));
         }
-        let image =
+        let mut image =
             TactileImage::new(sensor.rows, sensor.cols, values).map_err(|e| bad_argument("image", e))?;
-        // The posterior borrows the model, so it is rebuilt from the observed features: adding a
+        if let Some(pose) = pad_pose {
+            image = image.with_pose(crate::sensor::pad_pose(pose)?);
+        }
+        // The posterior borrows the model, so it is rebuilt from the observed readings: adding a
         // reading's features is cheap next to describing its image, which happens once.
         let mut posterior = self.model.posterior().map_err(refused)?;
         let features = posterior.describe(&image);
-        for earlier in &self.observed {
-            posterior.observe_features(earlier).map_err(refused)?;
+        for (earlier, described) in &self.observed {
+            posterior
+                .observe_described(earlier, described.clone())
+                .map_err(refused)?;
         }
         let belief = posterior
-            .observe_features(&features)
+            .observe_described(&image, features.clone())
             .map_err(|e| bad_argument("image", e))?;
-        self.observed.push(features);
+        self.observed.push((image, features));
         self.belief = Some(belief);
         self.probabilities(py)
     }
@@ -234,7 +253,7 @@ impl Posterior {
 /// or `knn`; the codebook size chosen among `ks` (default: a grid sized to the data) on
 /// `validation` (default: the last 1/11 of each object's readings).
 #[pyfunction]
-#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10)), text_signature = "(dataset, descriptor='mnti', codebook='gmm', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10)")]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0), text_signature = "(dataset, descriptor='mnti', codebook='gmm', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
 pub fn train(
     py: Python<'_>,
@@ -248,6 +267,9 @@ pub fn train(
     variance_kept: Option<f64>,
     pseudo_count: f64,
     trial_readings: Whole<usize>,
+    objects: Option<Vec<PyRef<'_, Object>>>,
+    calibration: Option<Vec<PyRef<'_, Dataset>>>,
+    start_heading_deg: f64,
 ) -> PyResult<Model> {
     let (Whole(restarts), Whole(seed), Whole(trial_readings)) = (restarts, seed, trial_readings);
     let ks: Option<Vec<usize>> = ks.map(|ks| ks.into_iter().map(|Whole(k)| k).collect());
@@ -270,14 +292,99 @@ pub fn train(
         None => config.with_grid_for_dataset(&dataset.inner, validation.is_some()),
     };
     let config = Valid::new(config).map_err(refused)?;
+    let geometry = objects
+        .map(|objects| ContactGeometry::of(&objects, calibration, validation.is_some(), start_heading_deg))
+        .transpose()?;
     let validation = validation.map(|v| v.inner.clone());
     let training = dataset.inner.clone();
     let model = py
-        .detach(|| fit(&config, &training, validation.as_deref(), &choice))
+        .detach(|| {
+            let appearance = fit(&config, &training, validation.as_deref(), &choice)?;
+            match geometry {
+                None => Ok(appearance),
+                Some(geometry) => geometry.fuse(appearance, validation.as_deref(), config.trial_readings),
+            }
+        })
         .map_err(refused)?;
     Ok(Model {
         inner: Arc::new(model),
     })
+}
+
+/// What `train(objects=...)` fuses appearance with: the objects' meshes, the arm's explorations
+/// its weighing is fitted on, the headings the objects stand at (`taction train --objects`).
+struct ContactGeometry {
+    meshes: Vec<(String, TriMesh)>,
+    calibration: Vec<Arc<taction::dataset::Dataset>>,
+    max_heading: MaxHeading,
+}
+
+impl ContactGeometry {
+    /// Checks the arguments: the weighing needs explorations the appearance model was not trained
+    /// on (`calibration`, else the validation data).
+    fn of(
+        objects: &[PyRef<'_, Object>],
+        calibration: Option<Vec<PyRef<'_, Dataset>>>,
+        has_validation: bool,
+        start_heading_deg: f64,
+    ) -> PyResult<Self> {
+        let calibration: Vec<_> = calibration
+            .unwrap_or_default()
+            .iter()
+            .map(|d| d.inner.clone())
+            .collect();
+        if calibration.is_empty() && !has_validation {
+            return Err(bad_argument(
+                "objects",
+                "the fusion of appearance and contact geometry is weighed on explorations the appearance \
+                 model was not trained on: give calibration (the arm's explorations) or validation",
+            ));
+        }
+        let max_heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
+            bad_argument(
+                "start_heading_deg",
+                format!("{start_heading_deg} is outside [0, 180]"),
+            )
+        })?;
+        Ok(Self {
+            meshes: objects
+                .iter()
+                .map(|o| (o.inner.name.clone(), o.inner.mesh.clone()))
+                .collect(),
+            calibration,
+            max_heading,
+        })
+    }
+
+    /// `appearance` fused with the objects' contact geometry, weighed on the calibration
+    /// explorations (each object's readings one trial), else on `validation` in trials of
+    /// `trial_readings`.
+    fn fuse(
+        self,
+        appearance: Recognizer,
+        validation: Option<&taction::dataset::Dataset>,
+        trial_readings: usize,
+    ) -> Result<Recognizer, RecognizeError> {
+        let appearance = Appearance::try_from(appearance)?;
+        let meshes: Vec<(String, &TriMesh)> = self.meshes.iter().map(|(n, m)| (n.clone(), m)).collect();
+        let geometry =
+            GeometryModel::of_named(appearance.objects(), &meshes, self.max_heading).map_err(|e| {
+                RecognizeError::InvalidParameter {
+                    name: "objects",
+                    what: e.to_string(),
+                }
+            })?;
+        let fused = GeometricFusion::new(appearance, geometry)?;
+        let fused = match validation {
+            Some(v) if self.calibration.is_empty() => fused.calibrate_on_all(&[v], trial_readings)?,
+            _ => {
+                let data: Vec<&taction::dataset::Dataset> =
+                    self.calibration.iter().map(AsRef::as_ref).collect();
+                fused.calibrate_on_all(&data, usize::MAX)?
+            }
+        };
+        Ok(Recognizer::Geometric(Box::new(fused)))
+    }
 }
 
 fn fit(

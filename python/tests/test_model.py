@@ -1,9 +1,12 @@
 """Training and recognising from Python: the posterior after each reading, files, errors."""
 
+import csv
+
 import numpy as np
 import pytest
 
 import taction
+from conftest import taction_cli
 
 
 def test_the_posterior_moves_toward_the_touched_object(small_model, small_dataset):
@@ -176,3 +179,44 @@ def test_the_arm_calibration_is_the_recipes_exploration_and_calibrates_the_arm_m
 def test_the_arm_calibration_rejects_no_objects():
     with pytest.raises(taction.TactionError, match="objects: no object to touch"):
         taction.collect_arm_calibration([])
+
+
+def test_a_model_that_knows_where_it_touched_reads_each_pad_pose_and_round_trips(chess, small_dataset, tmp_path):
+    explorations = taction.collect(chess, mode="planner", readings=8, local_probability=0.5, seed=11)
+    with pytest.raises(taction.TactionError, match="objects: .*give calibration"):
+        taction.train(small_dataset, descriptor="mnti", codebook="knn", ks=[5], objects=chess)
+    with pytest.raises(taction.TactionError, match="start_heading_deg"):
+        taction.train(small_dataset, objects=chess, calibration=[explorations], start_heading_deg=270.0)
+    model = taction.train(
+        small_dataset, descriptor="mnti", codebook="knn", ks=[5], restarts=1, seed=2,
+        objects=chess, calibration=[explorations],
+    )
+    appearance = taction.train(small_dataset, descriptor="mnti", codebook="knn", ks=[5], restarts=1, seed=2)
+    test = taction.collect(chess, mode="planner", readings=6, local_probability=0.5, seed=12)
+    rook = (test.object == "rook") & (test.status == "converged")
+    images, poses = test.images[rook], test.pad_pose[rook]
+    model_path = tmp_path / "model.json"
+    model.save(model_path)
+    again = taction.Model.load(model_path)
+    touched, read_back, unplaced, alone = (m.posterior() for m in (model, again, model, appearance))
+    for image, pose in zip(images, poses):
+        p = touched.observe(image, pad_pose=pose)
+        p_again = read_back.observe(image, pad_pose=pose)
+        q = unplaced.observe(image)
+        r = alone.observe(image)
+    # The model file holds the model: the same beliefs, bit for bit.
+    assert np.array_equal(p, p_again)
+    # Without its pad pose a touch is appearance alone; with it, the contacts move the belief.
+    assert np.argmax(q) == np.argmax(r)
+    assert not np.allclose(np.log(p), np.log(q))
+    # The CLI recognises the same readings with the model file to the same guess (its images are
+    # the dataset's float64 taxels, Python's float32, so the beliefs differ in the last digits and
+    # the contacts' seeded noise with them).
+    test_path, out = tmp_path / "test.csv", tmp_path / "run"
+    test.save(test_path)
+    taction_cli("recognize", "--model", str(model_path), "--dataset", str(test_path), "--readings", "6", "--out", str(out))
+    rows = [r for r in csv.DictReader(open(out / "posterior_long.csv")) if r["object_true"] == "rook" and r["n_readings"] == "6"]
+    cli = {r["object"]: float(r["probability"]) for r in rows}
+    assert model.objects[int(np.argmax(p))] == max(cli, key=cli.get) == "rook"
+    with pytest.raises(taction.TactionError, match="pad_pose"):
+        model.posterior().observe(images[0], pad_pose=[0.0, 0.0, 0.1])

@@ -7,8 +7,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use taction::dataset::Dataset;
 use taction::describe::DescriptorKind;
-use taction::locate::{GeometryModel, GeometryParams};
-use taction::mesh::ObjectSet;
+use taction::locate::GeometryModel;
+use taction::mesh::{ObjectSet, TriMesh};
 use taction::recognize::{
     Appearance, CodebookKind, DescriptorChoice, FusedModel, GeometricFusion, PseudoCount, RecognizeError,
     Recognizer, Tempering, TrainConfig, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
@@ -162,7 +162,7 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         let model = models.into_iter().next().ok_or("no descriptor to train")?;
         Recognizer::Single(Box::new(model))
     };
-    let model = match geometry_of(args, &training)? {
+    let model = match geometry_of(args, &training, model.objects())? {
         None => model,
         Some(geometry) => {
             let fused = GeometricFusion::new(Appearance::try_from(model)?, geometry)?;
@@ -347,10 +347,12 @@ fn print_tempering(name: &str, on: &str, t: Tempering) {
 }
 
 /// The geometric model of `--objects`, when given: the set the training data was collected on
-/// (its id is the dataset header's), every object's surface in its canonical frame.
+/// (its id is the dataset header's), the surface of each of the appearance model's objects
+/// (`names`, in its order) in its canonical frame.
 fn geometry_of(
     args: &TrainArgs,
     training: &Dataset,
+    names: &[String],
 ) -> Result<Option<GeometryModel>, Box<dyn std::error::Error>> {
     if args.objects.is_empty() {
         return Ok(None);
@@ -368,14 +370,8 @@ fn geometry_of(
         .into());
     }
     let objects = build_objects(&set, "train", Carrier::FreePad)?;
-    let params = GeometryParams {
-        max_heading: set.start_heading(),
-        ..GeometryParams::default()
-    };
-    let geometry = GeometryModel::build(
-        objects.iter().map(|o| (o.name.clone(), &o.mesh)),
-        Valid::new(params)?,
-    )?;
+    let meshes: Vec<(String, &TriMesh)> = objects.iter().map(|o| (o.name.clone(), &o.mesh)).collect();
+    let geometry = GeometryModel::of_named(names, &meshes, set.start_heading())?;
     Ok(Some(geometry))
 }
 

@@ -68,6 +68,31 @@ impl DetailRow for PerObjectRow {
     const TABLE: Option<&'static str> = Some("per_object");
 }
 
+/// One point of one recognition curve counted in the arm's touch attempts rather than in its
+/// converged readings: what a touch that met nothing, ended in a collision or did not settle costs
+/// the recogniser (it reads converged readings only, Algorithm 1).
+///
+/// | column | meaning |
+/// |---|---|
+/// | `experiment`, `descriptor`, factor columns, `trial` | as in [`AccuracyRow`] |
+/// | `n_attempts` | touch attempts the arm made on each object so far, converged or not (1-based) |
+/// | `accuracy` | fraction of test objects whose most probable identity after the converged readings of their first `n_attempts` attempts is right; an object with none is not identified |
+/// | `reliability` | mean posterior probability on the right object (1 / objects for an object with no converged reading yet) |
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttemptRow {
+    pub experiment: String,
+    pub descriptor: String,
+    pub factors: Factors,
+    pub trial: u32,
+    pub n_attempts: u32,
+    pub accuracy: f64,
+    pub reliability: f64,
+}
+
+impl DetailRow for AttemptRow {
+    const TABLE: Option<&'static str> = Some("attempts");
+}
+
 /// One confidence bin of one curve's reliability table, pooled over all the curve's trials
 /// (`recognize::ReliabilityTable`: every belief after every number of readings of every trial is a
 /// prediction; its confidence is its top probability). A curve's rows are its table's 10 bins, all
@@ -252,13 +277,63 @@ impl AccuracyCurve {
     }
 }
 
+impl AccuracyCurve {
+    /// The curve counted in touch attempts: `attempts[i]` says, attempt by attempt, whether trial
+    /// `i` of `evaluation` (trials in the same order) converged there; after `n` attempts a trial
+    /// holds the belief of its converged readings so far (`evaluation`'s point at that count), an
+    /// object not yet read the uniform prior, and a trial past its last attempt keeps its last
+    /// belief. One row per attempt count from 1 to `last` (the longest trial of every repetition
+    /// of the curve, so that the plot averages each count over every repetition).
+    pub fn attempt_rows(
+        &self,
+        evaluation: &Evaluation,
+        attempts: &[Vec<bool>],
+        last: usize,
+    ) -> Result<Vec<AttemptRow>, String> {
+        let prior = 1.0 / evaluation.objects.len().max(1) as f64;
+        let mut read = vec![0usize; attempts.len()];
+        let mut rows = Vec::with_capacity(last);
+        for n in 1..=last {
+            let (mut correct, mut p_true) = (0usize, 0.0);
+            for (i, trial) in attempts.iter().enumerate() {
+                read[i] += usize::from(trial.get(n - 1) == Some(&true));
+                if read[i] == 0 {
+                    p_true += prior;
+                    continue;
+                }
+                let outcome = evaluation
+                    .accuracy
+                    .iter()
+                    .find(|p| p.n_readings == read[i])
+                    .and_then(|p| p.outcomes.get(i))
+                    .ok_or_else(|| {
+                        format!(
+                            "{}, trial {}: attempt log {i} has more converged readings than its evaluation",
+                            self.factors, self.trial
+                        )
+                    })?;
+                correct += usize::from(outcome.correct);
+                p_true += outcome.p_true;
+            }
+            let trials = attempts.len().max(1) as f64;
+            rows.push(AttemptRow {
+                experiment: self.experiment.clone(),
+                descriptor: self.descriptor.clone(),
+                factors: self.factors.clone(),
+                trial: self.trial,
+                n_attempts: n as u32,
+                accuracy: correct as f64 / trials,
+                reliability: p_true / trials,
+            });
+        }
+        Ok(rows)
+    }
+}
+
 impl AccuracyRow {
     /// The columns, in order, into a row that may add its own after them (`active` does).
     pub(crate) fn serialize_columns<S: SerializeStruct>(&self, row: &mut S) -> Result<(), S::Error> {
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(row)?;
-        row.serialize_field("trial", &self.trial)?;
+        serialize_trial_head(row, &self.experiment, &self.descriptor, &self.factors, self.trial)?;
         row.serialize_field("n_readings", &self.n_readings)?;
         row.serialize_field("accuracy", &self.accuracy)?;
         row.serialize_field("reliability", &self.reliability)?;
@@ -273,11 +348,12 @@ impl AccuracyRow {
 
     /// The row in `record`; columns after the accuracy ones (`active`'s) are left there.
     pub(crate) fn from_record(record: &TidyRecord) -> Result<Self, String> {
+        let (experiment, descriptor, factors, trial) = record.trial_head()?;
         Ok(Self {
-            experiment: record.text("experiment")?,
-            descriptor: record.text("descriptor")?,
-            factors: record.factors_before("trial")?,
-            trial: record.number("trial")?,
+            experiment,
+            descriptor,
+            factors,
+            trial,
             n_readings: record.number("n_readings")?,
             accuracy: record.number("accuracy")?,
             reliability: record.number("reliability")?,
@@ -285,6 +361,21 @@ impl AccuracyRow {
             stream_seed: record.number("stream_seed")?,
         })
     }
+}
+
+/// The columns every row of a curve's trial starts with: `experiment`, `descriptor`, the factor
+/// columns and `trial`.
+fn serialize_trial_head<S: SerializeStruct>(
+    row: &mut S,
+    experiment: &str,
+    descriptor: &str,
+    factors: &Factors,
+    trial: u32,
+) -> Result<(), S::Error> {
+    row.serialize_field("experiment", experiment)?;
+    row.serialize_field("descriptor", descriptor)?;
+    factors.serialize_columns(row)?;
+    row.serialize_field("trial", &trial)
 }
 
 impl Serialize for AccuracyRow {
@@ -304,10 +395,13 @@ impl<'de> Deserialize<'de> for AccuracyRow {
 impl Serialize for PerObjectRow {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let mut row = serializer.serialize_struct("PerObjectRow", 7 + self.factors.len())?;
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(&mut row)?;
-        row.serialize_field("trial", &self.trial)?;
+        serialize_trial_head(
+            &mut row,
+            &self.experiment,
+            &self.descriptor,
+            &self.factors,
+            self.trial,
+        )?;
         row.serialize_field("object", &self.object)?;
         row.serialize_field("n_readings", &self.n_readings)?;
         row.serialize_field("correct", &u8::from(self.correct))?;
@@ -320,11 +414,12 @@ impl<'de> Deserialize<'de> for PerObjectRow {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let record = TidyRecord::deserialize(deserializer)?;
         let row = || -> Result<Self, String> {
+            let (experiment, descriptor, factors, trial) = record.trial_head()?;
             Ok(Self {
-                experiment: record.text("experiment")?,
-                descriptor: record.text("descriptor")?,
-                factors: record.factors_before("trial")?,
-                trial: record.number("trial")?,
+                experiment,
+                descriptor,
+                factors,
+                trial,
                 object: record.text("object")?,
                 n_readings: record.number("n_readings")?,
                 correct: match record.number::<u8>("correct")? {
@@ -333,6 +428,42 @@ impl<'de> Deserialize<'de> for PerObjectRow {
                     other => return Err(format!("column 'correct': {other} is not 0 or 1")),
                 },
                 p_true: record.number("p_true")?,
+            })
+        };
+        row().map_err(de::Error::custom)
+    }
+}
+
+impl Serialize for AttemptRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut row = serializer.serialize_struct("AttemptRow", 6 + self.factors.len())?;
+        serialize_trial_head(
+            &mut row,
+            &self.experiment,
+            &self.descriptor,
+            &self.factors,
+            self.trial,
+        )?;
+        row.serialize_field("n_attempts", &self.n_attempts)?;
+        row.serialize_field("accuracy", &self.accuracy)?;
+        row.serialize_field("reliability", &self.reliability)?;
+        row.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for AttemptRow {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let record = TidyRecord::deserialize(deserializer)?;
+        let row = || -> Result<Self, String> {
+            let (experiment, descriptor, factors, trial) = record.trial_head()?;
+            Ok(Self {
+                experiment,
+                descriptor,
+                factors,
+                trial,
+                n_attempts: record.number("n_attempts")?,
+                accuracy: record.number("accuracy")?,
+                reliability: record.number("reliability")?,
             })
         };
         row().map_err(de::Error::custom)
@@ -375,6 +506,16 @@ impl TidyRecord {
             "" => Ok(None),
             _ => self.number(column).map(Some),
         }
+    }
+
+    /// The columns every row of a curve's trial starts with ([`serialize_trial_head`]).
+    fn trial_head(&self) -> Result<(String, String, Factors, u32), String> {
+        Ok((
+            self.text("experiment")?,
+            self.text("descriptor")?,
+            self.factors_before("trial")?,
+            self.number("trial")?,
+        ))
     }
 
     /// The columns between `descriptor` and `end` (`trial`, or `bin` in a reliability table), each
@@ -576,5 +717,40 @@ mod tests {
         let mut twice = evaluation;
         twice.accuracy[0].outcomes[1].object = 0;
         assert!(curve().object_rows(&twice).is_err());
+    }
+
+    #[test]
+    fn attempt_rows_hold_each_objects_belief_between_its_converged_attempts() {
+        let objects = ["a", "b", "c", "d", "e"].map(String::from).to_vec();
+        let evaluation = Evaluation {
+            objects: objects.clone(),
+            touches: Vec::new(),
+            accuracy: vec![point(1, 1, 0.3), point(2, 4, 0.7)],
+            confusion: crate::recognize::ConfusionMatrix::new(objects, 2),
+        };
+        // Object a misses its first attempt, b converges once, c-e converge twice in a row.
+        let (t, f) = (true, false);
+        let logs = vec![vec![f, t, t], vec![t], vec![t, t], vec![t, t], vec![t, t]];
+        let rows = curve().attempt_rows(&evaluation, &logs, 4).unwrap();
+        let points: Vec<(u32, f64, f64)> = rows
+            .iter()
+            .map(|r| (r.n_attempts, r.accuracy, r.reliability))
+            .collect();
+        let expected = [(1, 0.0, 0.28), (2, 0.6, 0.54), (3, 0.6, 0.62), (4, 0.6, 0.62)];
+        for ((n, accuracy, reliability), (n_, accuracy_, reliability_)) in points.into_iter().zip(expected) {
+            assert_eq!((n, accuracy), (n_, accuracy_));
+            assert!((reliability - reliability_).abs() < 1e-12, "{n}: {reliability}");
+        }
+        assert_eq!(rows.len(), 4);
+        let text = csv_of(&rows);
+        assert!(
+            text.starts_with("experiment,descriptor,noise_fraction,trial,n_attempts,accuracy,reliability\n"),
+            "{text}"
+        );
+        assert_eq!(read::<AttemptRow>(&text).unwrap(), rows);
+        // A log with more converged attempts than the evaluation has readings is refused.
+        let mut long = logs;
+        long[1] = vec![t, t, t];
+        assert!(curve().attempt_rows(&evaluation, &long, 3).is_err());
     }
 }

@@ -19,6 +19,7 @@ use serde::{Serialize, Serializer};
 /// | `training_readings` | training readings per object at scale 1 (`--scale` scales them) | `training-size` |
 /// | `training` | `paper` (sampler readings from every direction) or `reachable` (ours: three times as many, from the starts the arm can reach) | `end-to-end` |
 /// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) | `active` |
+/// | `evidence` | what the recogniser weighs: `appearance` (the tactile images' bag of features), `contacts` (where each touch landed, against each object's surface at a pose it is not told) or `fused` (both) | `fusion` |
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Factor {
     Data,
@@ -30,10 +31,11 @@ pub enum Factor {
     TrainingReadings,
     Training,
     Strategy,
+    Evidence,
 }
 
 impl Factor {
-    pub const ALL: [Factor; 9] = [
+    pub const ALL: [Factor; 10] = [
         Self::Data,
         Self::Resolution,
         Self::LocalProbability,
@@ -43,6 +45,7 @@ impl Factor {
         Self::TrainingReadings,
         Self::Training,
         Self::Strategy,
+        Self::Evidence,
     ];
 
     /// The column's name.
@@ -57,6 +60,7 @@ impl Factor {
             Self::TrainingReadings => "training_readings",
             Self::Training => "training",
             Self::Strategy => "strategy",
+            Self::Evidence => "evidence",
         }
     }
 

@@ -59,8 +59,9 @@ pub struct Figure {
     pub panels: Vec<Panel>,
 }
 
-/// Line colours: the Tableau 10 palette, distinct for the up-to-ten lines of a panel.
-const PALETTE: [RGBColor; 10] = [
+/// Line colours: the Tableau 10 palette, then black and a dark teal, distinct for the up-to-twelve
+/// lines of a panel (`fusion`'s three kinds of evidence at two L, fixed and perturbed).
+const PALETTE: [RGBColor; 12] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -71,6 +72,8 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(0, 95, 115),
 ];
 
 impl Figure {

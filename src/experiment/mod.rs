@@ -53,7 +53,7 @@ pub use spec::{ExperimentSpec, Manifest};
 pub use unit::{BoxError, DetailRow, DetailTables, NoDetail, Unit};
 
 // Its rows: recognition curves, per-object detail and reliability tables.
-pub use accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, RepeatedObject};
+pub use accuracy::{AccuracyCurve, AccuracyRow, AttemptRow, PerObjectRow, ReliabilityRow, RepeatedObject};
 
 // Its outputs on disk: the layout, the assembled tables, the index.
 pub use assemble::Finished;

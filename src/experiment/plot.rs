@@ -745,8 +745,10 @@ fn line_panel(x: &Axis, y: &Axis, y_count: usize, acc: Ordered<String, Means>, b
         y_label: y.label.clone(),
         x_range: padded(xmin, xmax, false),
         y_range: padded(ymin.min(0.0), ymax.max(0.0), true),
+        // A marker at every point while they are few, as the accuracy plots do: on a curve of a
+        // hundred points they hide the line.
+        markers: series.iter().all(|s| s.points.len() <= 12),
         series,
-        markers: true,
         legend,
         integer_x: false,
         reference: None,

@@ -32,7 +32,7 @@ impl DetailRow for NoDetail {
 }
 
 /// The further tables of an experiment: none ([`NoDetail`]), one ([`DetailRow`] `D`, whose rows are
-/// `Vec<D>`), or two (`(D, E)`, whose rows are `(Vec<D>, Vec<E>)`).
+/// `Vec<D>`), two (`(D, E)`, whose rows are `(Vec<D>, Vec<E>)`) or three (`(D, E, F)`).
 pub trait DetailTables {
     /// What a unit's work gives besides its main rows.
     type Rows;
@@ -68,6 +68,22 @@ impl<D: DetailRow, E: DetailRow> DetailTables for (D, E) {
     fn encode((d, e): &(Vec<D>, Vec<E>), paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String> {
         let mut tables = D::encode(d, paths.get(..1).unwrap_or_default())?;
         tables.extend(E::encode(e, paths.get(tables.len()..).unwrap_or_default())?);
+        Ok(tables)
+    }
+}
+
+impl<D: DetailRow, E: DetailRow, F: DetailRow> DetailTables for (D, E, F) {
+    type Rows = (Vec<D>, Vec<E>, Vec<F>);
+
+    fn names() -> Vec<&'static str> {
+        <(D, E)>::names().into_iter().chain(F::TABLE).collect()
+    }
+
+    fn encode((d, e, f): &(Vec<D>, Vec<E>, Vec<F>), paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String> {
+        let mut tables = D::encode(d, paths.get(..1).unwrap_or_default())?;
+        let next = tables.len();
+        tables.extend(E::encode(e, paths.get(next..next + 1).unwrap_or_default())?);
+        tables.extend(F::encode(f, paths.get(tables.len()..).unwrap_or_default())?);
         Ok(tables)
     }
 }

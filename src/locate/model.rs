@@ -169,6 +169,8 @@ pub enum GeometryError {
     Params(#[from] RangeError),
     #[error("object '{0}': its mesh has no triangle of positive area to match contacts against")]
     EmptySurface(String),
+    #[error("no mesh of object '{object}' among the objects given ({})", given.join(", "))]
+    NoMesh { object: String, given: Vec<String> },
 }
 
 /// Every known object's surface, and what the recogniser assumes (the module docs).
@@ -198,6 +200,32 @@ impl GeometryModel {
             objects: names,
             surfaces,
         })
+    }
+
+    /// The surfaces of the objects `names` (a recogniser's, in its order) picked by name from
+    /// `meshes` (any order, more allowed), with the default assumptions for objects that stand
+    /// within `max_heading` of their canonical heading: what `taction train --objects`, Python's
+    /// `train(objects=...)` and the `fusion` experiment build.
+    pub fn of_named(
+        names: &[String],
+        meshes: &[(String, &TriMesh)],
+        max_heading: MaxHeading,
+    ) -> Result<Self, GeometryError> {
+        let picked = names
+            .iter()
+            .map(|name| match meshes.iter().find(|(n, _)| n == name) {
+                Some(&(_, mesh)) => Ok((name.clone(), mesh)),
+                None => Err(GeometryError::NoMesh {
+                    object: name.clone(),
+                    given: meshes.iter().map(|(n, _)| n.clone()).collect(),
+                }),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let params = Valid::new(GeometryParams {
+            max_heading,
+            ..GeometryParams::default()
+        })?;
+        Self::build(picked, params)
     }
 
     pub fn objects(&self) -> &[String] {

@@ -85,17 +85,22 @@ impl ObjectSurface {
         Self::new(points, normals, mesh.total_area())
     }
 
-    /// A surface of given points and unit normals; `None` when there are none, a count differs,
-    /// or a value is not finite.
+    /// A surface of given points and unit normals, both rounded to 1e-6 (a rounding that leaves
+    /// rounded values as they are, so a surface read back from its file is the surface written,
+    /// bit for bit; normalising again after the rounding would move the last digit); `None` when
+    /// there are none, a count differs, a value is not finite or a normal is not of unit length.
     pub fn new(points: Vec<DVec3>, normals: Vec<DVec3>, area_m2: f64) -> Option<Self> {
         let micrometre = |v: DVec3| (v * 1e6).round() / 1e6;
         let points: Vec<DVec3> = points.into_iter().map(micrometre).collect();
-        let normals: Vec<DVec3> = normals
-            .iter()
-            .map(|n| micrometre(n.normalize_or_zero()))
-            .collect();
+        let normals: Vec<DVec3> = normals.into_iter().map(micrometre).collect();
         let finite = points.iter().chain(&normals).all(|p| p.is_finite());
-        if points.is_empty() || points.len() != normals.len() || !finite || area_m2.is_nan() || area_m2 <= 0.0
+        let unit = normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5);
+        if points.is_empty()
+            || points.len() != normals.len()
+            || !finite
+            || !unit
+            || area_m2.is_nan()
+            || area_m2 <= 0.0
         {
             return None;
         }
@@ -266,7 +271,7 @@ impl TryFrom<SurfaceFile> for ObjectSurface {
             .map(|r| (DVec3::new(r[0], r[1], r[2]), DVec3::new(r[3], r[4], r[5])))
             .unzip();
         Self::new(points, normals, f.area_m2).ok_or_else(|| {
-            "a surface needs at least one point, finite values and a positive area".to_string()
+            "a surface needs at least one point, finite values, unit normals and a positive area".to_string()
         })
     }
 }
@@ -322,6 +327,30 @@ mod tests {
         assert!((n.signed_distance_m - 0.003).abs() < 2e-6);
         let inside = s.nearest(DVec3::new(0.0, 0.0, 0.018)).expect("under the top");
         assert!((inside.signed_distance_m + 0.002).abs() < 2e-6);
+    }
+
+    #[test]
+    fn a_surface_read_back_is_the_surface_written_bit_for_bit() {
+        // A tetrahedron: its slanted face's normal has no exact decimal form.
+        let mesh = TriMesh {
+            vertices: vec![
+                DVec3::ZERO,
+                DVec3::new(0.03, 0.0, 0.0),
+                DVec3::new(0.0, 0.02, 0.0),
+                DVec3::new(0.0, 0.0, 0.025),
+            ],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        };
+        let written = ObjectSurface::of_mesh(&mesh).expect("a tetrahedron");
+        let json = serde_json::to_string(&written).expect("encodes");
+        let read: ObjectSurface = serde_json::from_str(&json).expect("decodes");
+        assert_eq!(read.points(), written.points());
+        assert_eq!(read.normals(), written.normals());
+        assert_eq!(serde_json::to_string(&read).expect("encodes"), json);
+        // A normal that is not of unit length is refused, not silently normalised.
+        let mut value: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+        value["points"][0][3] = serde_json::json!(2.0);
+        assert!(serde_json::from_value::<ObjectSurface>(value).is_err());
     }
 
     #[test]

@@ -19,6 +19,7 @@
 //! | `training-size` | beyond | training readings per object (100, 300, 1000, 3000, 10,000) |
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //! | `end-to-end` | beyond | the arm's blind touches recognised by the paper's training and ours (L, fixed/perturbed) |
+//! | `fusion` | beyond | appearance, contact geometry and their fusion at random start poses (L, fixed/perturbed), against readings and touch attempts (`fusion.rs`) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` (`data.rs`, [`read_shortfalls`]).
@@ -30,6 +31,7 @@ pub(crate) mod data;
 pub(crate) mod estimate;
 pub(crate) mod figure1;
 pub(crate) mod figures;
+pub(crate) mod fusion;
 pub(crate) mod headline;
 pub(crate) mod real_frames;
 pub(crate) mod real_frames_options;
@@ -94,12 +96,13 @@ pub enum PaperExperiment {
     TrainingSize,
     Active,
     EndToEnd,
+    Fusion,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
     /// experiments beyond the paper).
-    pub const ALL: [PaperExperiment; 15] = [
+    pub const ALL: [PaperExperiment; 16] = [
         Self::Exploration,
         Self::Descriptors,
         Self::Strategy,
@@ -115,6 +118,7 @@ impl PaperExperiment {
         Self::TrainingSize,
         Self::Active,
         Self::EndToEnd,
+        Self::Fusion,
     ];
 
     /// The recognition figure's sweep; `None` for Fig. 1, a picture, Fig. 14, which is not a
@@ -129,7 +133,9 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
-            Self::Exploration | Self::Convergence | Self::RealFrames | Self::Active => return None,
+            Self::Exploration | Self::Convergence | Self::RealFrames | Self::Active | Self::Fusion => {
+                return None;
+            }
             Self::Letters => figures::letters(),
             Self::SimToReal => figures::sim_to_real(),
             Self::TrainingSize => figures::training_size(),
@@ -146,7 +152,7 @@ impl PaperExperiment {
     /// [`ArmTrainingRecipe::CODEBOOK`]: crate::active_touch::ArmTrainingRecipe::CODEBOOK
     pub fn default_codebook(self) -> CodebookKind {
         match self {
-            Self::Active | Self::EndToEnd => crate::active_touch::ArmTrainingRecipe::CODEBOOK,
+            Self::Active | Self::EndToEnd | Self::Fusion => crate::active_touch::ArmTrainingRecipe::CODEBOOK,
             _ => CodebookKind::Gmm,
         }
     }
@@ -164,6 +170,7 @@ impl PaperExperiment {
             Self::Exploration => figure1::EXPERIMENT_NAME,
             Self::RealFrames => real_frames::EXPERIMENT_NAME,
             Self::Active => active::EXPERIMENT_NAME,
+            Self::Fusion => fusion::EXPERIMENT_NAME,
             _ => self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name),
         }
     }
@@ -173,6 +180,7 @@ impl PaperExperiment {
             Self::Exploration => return figure1::DESCRIPTION,
             Self::RealFrames => return real_frames::DESCRIPTION,
             Self::Active => return active::DESCRIPTION,
+            Self::Fusion => return fusion::DESCRIPTION,
             _ => {}
         }
         self.sweep().map_or(
@@ -196,6 +204,9 @@ impl PaperExperiment {
             }
             None if self == Self::Active => {
                 PaperOutput::Run(Box::new(active::run_active(context, codebook)?))
+            }
+            None if self == Self::Fusion => {
+                PaperOutput::Run(Box::new(fusion::run_fusion(context, codebook)?))
             }
             None => PaperOutput::Run(Box::new(run_convergence(context)?)),
         })

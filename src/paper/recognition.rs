@@ -47,10 +47,10 @@ const MODEL_STREAM: u64 = 3;
 const NOISE_STREAM: u64 = 4;
 const ORDERING_STREAM: u64 = 5;
 /// Test trial `t` draws from stream `TEST_STREAM + t`.
-const TEST_STREAM: u64 = 100;
+pub(super) const TEST_STREAM: u64 = 100;
 /// Calibration exploration `t` at the `i`-th of [`CALIBRATION_LOCAL_PROBABILITIES`] draws from
 /// stream `CALIBRATION_STREAM + 100 i + t`.
-const CALIBRATION_STREAM: u64 = 200;
+pub(super) const CALIBRATION_STREAM: u64 = 200;
 
 /// The blind strategies (local probability L) whose explorations calibrate a posterior that will
 /// judge the arm's touches ([`SettingData::calibration_requests`]).
@@ -583,11 +583,13 @@ impl<'a> SettingData<'a> {
     }
 
     /// The planner exploring each object blind with the arm at L = `local_probability`, the object
-    /// perturbed within `perturbation`, `readings` per object, seeded by the run's `stream`.
+    /// starting at `start_pose` and perturbed within `perturbation`, `readings` per object, seeded
+    /// by the run's `stream`.
     fn planner_request(
         &self,
         local_probability: f64,
         perturbation: PerturbationBounds,
+        start_pose: StartPose,
         readings: usize,
         stream: u64,
     ) -> Result<DataRequest, RangeError> {
@@ -604,7 +606,7 @@ impl<'a> SettingData<'a> {
                 perturbation,
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
-                start_pose: StartPose::Canonical,
+                start_pose,
             },
         ))
     }
@@ -628,6 +630,7 @@ impl<'a> SettingData<'a> {
             requests.extend(self.planner_trials(
                 local_probability,
                 PerturbationBounds::NONE,
+                StartPose::Canonical,
                 self.counts.validation_per_object,
                 CALIBRATION_STREAM + 100 * i as u64,
             )?);
@@ -637,15 +640,24 @@ impl<'a> SettingData<'a> {
 
     /// One planner dataset per trial, `readings` per object, trial `t` on stream
     /// `first_stream + t`.
-    fn planner_trials(
+    pub(super) fn planner_trials(
         &self,
         local_probability: f64,
         perturbation: PerturbationBounds,
+        start_pose: StartPose,
         readings: usize,
         first_stream: u64,
     ) -> Result<Vec<DataRequest>, RangeError> {
         (0..self.counts.trials)
-            .map(|t| self.planner_request(local_probability, perturbation, readings, first_stream + t as u64))
+            .map(|t| {
+                self.planner_request(
+                    local_probability,
+                    perturbation,
+                    start_pose,
+                    readings,
+                    first_stream + t as u64,
+                )
+            })
             .collect()
     }
 
@@ -663,6 +675,7 @@ impl<'a> SettingData<'a> {
             } => self.planner_trials(
                 local_probability,
                 perturbation,
+                StartPose::Canonical,
                 self.counts.test_per_object,
                 TEST_STREAM,
             ),

@@ -1,0 +1,469 @@
+//! Beyond the paper: where each touch landed. The product's recogniser weighs two kinds of
+//! evidence (`recognize::geometric`): the tactile images' appearance (the bag of features of
+//! Sec. IV, here MNTI and SIFT fused, the product's recipe) and the contacts (each converged
+//! touch's point and normal against every object's known surface at a pose it is not told,
+//! `locate`). This experiment measures each alone and their fusion on the arm's blind
+//! explorations of the 3D set at L = 0.5 and L = 1 (Sec. III-A), the object fixed or perturbed
+//! after every reading (Sec. V-B4), every object starting at a random pose (any heading, a tilt of
+//! up to 10 degrees, a shift of up to 10% of its width; `sim::start_pose`), so that the contacts
+//! cannot learn where the objects stand.
+//!
+//! The model is the product's: appearance trained on the end-to-end recipe's readings (three
+//! times the scale's sampler readings per object, from the starts the arm can reach), the
+//! contacts' weight and every posterior's tempering fitted on the arm's own explorations at random
+//! start poses (L = 0.5 and 1 with the object fixed, L = 0.5 perturbed; a moving object's
+//! evidence is weighed apart), never on a test exploration. Each curve recognises the same test
+//! explorations with one kind of evidence (`evidence`), so the three are compared on the same
+//! touches.
+//!
+//! Besides the accuracy table, `fusion_attempts.csv` counts the same curves in touch attempts
+//! ([`AttemptRow`]): a touch that met nothing, collided or did not settle costs a touch but gives
+//! no reading.
+
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use super::context::{Family, PaperContext};
+use super::data::{DataRequest, Objects};
+use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
+use super::recognition::{
+    CALIBRATION_STREAM, CalibratedOn, Setting, SettingData, TEST_STREAM, training_config,
+};
+use super::scale::DataCounts;
+use crate::dataset::{Dataset, Perturbed};
+use crate::describe::DescriptorKind;
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, AttemptRow, PerObjectRow, ReliabilityRow};
+use crate::experiment::factor::{Factor, Factors};
+use crate::experiment::layout::ExperimentDir;
+use crate::experiment::name::SafeName;
+use crate::experiment::plot::{Axis, PlotSpec};
+use crate::experiment::runner::{Experiment, RunReport, run};
+use crate::experiment::spec::ExperimentSpec;
+use crate::experiment::unit::{BoxError, DetailRow, Unit};
+use crate::explore::SamplerConfig;
+use crate::locate::{ContactNoise, GeometryModel, GeometryParams};
+use crate::mesh::TriMesh;
+use crate::pose::StartPose;
+use crate::recognize::{
+    Appearance, CodebookKind, DescriptorChoice, Evidence, FusedModel, GeometricFusion, PosteriorRule,
+    ReadingRange, ReliabilityTable, TouchReading, TrainConfig, Trial,
+};
+use crate::sim::PerturbationBounds;
+
+pub const EXPERIMENT_NAME: &str = "fusion";
+pub const DESCRIPTION: &str = "Beyond the paper: appearance, contact geometry and their fusion (MNTI+SIFT; 3D set at random start poses, blind L = 0.5 and 1, fixed and perturbed), against readings and touch attempts";
+
+/// The appearance descriptors: the product's recipe (`taction train --descriptor mnti+sift`).
+const DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
+
+/// The evidence each curve weighs, in the order of the legend.
+const EVIDENCE: [Evidence; 3] = [Evidence::Appearance, Evidence::Contacts, Evidence::Fused];
+
+/// The blind strategies explored (L).
+const LOCAL_PROBABILITIES: [f64; 2] = [0.5, 1.0];
+
+/// L of the perturbed calibration explorations, which weigh a moving object's evidence.
+const MOVING_CALIBRATION_L: f64 = 0.5;
+
+/// The legend's name of a curve.
+const CURVE_LABEL: &str = "{evidence} L={local_probability} {object_motion}";
+
+/// A curve's levels: the `evidence` weighed, L = `local_probability`, the object `motion`.
+fn levels(evidence: Evidence, local_probability: f64, motion: &str) -> Factors {
+    Factors::new([
+        (Factor::Evidence, evidence.name().to_string()),
+        (Factor::LocalProbability, local_probability.to_string()),
+        (Factor::ObjectMotion, motion.to_string()),
+    ])
+}
+
+fn object_states() -> [(&'static str, PerturbationBounds); 2] {
+    [
+        ("fixed", PerturbationBounds::NONE),
+        ("perturbed", PerturbationBounds::PAPER),
+    ]
+}
+
+/// The training data's setting: the end-to-end recipe's (`paper::figures::end_to_end`,
+/// "reachable"). Its appearance models are calibrated on their validation readings only because
+/// the fusion fits its own temperings on the arm's explorations ([`FusionData::calibration`]).
+fn setting() -> Setting {
+    Setting {
+        label: EXPERIMENT_NAME.into(),
+        sensor: default_sensor(),
+        sampler: SamplerConfig {
+            reachable_by_arm: true,
+            ..SamplerConfig::default()
+        },
+        training_fraction: END_TO_END_TRAINING_FRACTION,
+        calibrated_on: CalibratedOn::Validation,
+        curves: Vec::new(),
+    }
+}
+
+/// What the calibration explorations are, as `config.json` records them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+struct FusionCalibration {
+    /// L of the explorations with the object fixed.
+    fixed_local_probabilities: [f64; 2],
+    /// L of the explorations with the object perturbed after every reading.
+    perturbed_local_probability: f64,
+    /// Explorations of each object at each of them, each on a random stream of its own.
+    explorations: usize,
+    readings_per_object: usize,
+    /// Readings per calibration trial: a test run's.
+    trial_readings: usize,
+}
+
+/// Everything the rows depend on, written as the run's `config.json`.
+#[derive(Serialize)]
+struct FusionConfig<'a> {
+    setting: &'a Setting,
+    descriptor: String,
+    evidence: Vec<&'static str>,
+    local_probabilities: [f64; 2],
+    start_pose: StartPose,
+    geometry: GeometryParams,
+    contact_noise: ContactNoise,
+    calibration: FusionCalibration,
+    posterior: PosteriorRule,
+    scale: f64,
+    counts: DataCounts,
+    seed: u64,
+    object_set_id: String,
+    objects: Vec<String>,
+    training: TrainConfig,
+}
+
+/// The test explorations of one (L, motion), one per repetition.
+type TestExplorations = (f64, &'static str, Vec<DataRequest>);
+
+/// The unit's rows: accuracy, and the per-object, reliability and attempt rows.
+type Rows = (
+    Vec<AccuracyRow>,
+    (Vec<PerObjectRow>, Vec<ReliabilityRow>, Vec<AttemptRow>),
+);
+
+/// Runs the experiment in `context` (one unit: the model, then every curve).
+pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
+    let setting = setting();
+    let objects = context.objects(Family::Shapes)?;
+    let counts = setting.counts(context.scale.counts());
+    let training = training_config(context, codebook, counts, objects.specs.len());
+    let start_pose = StartPose::Random {
+        max_heading: objects.set.start_heading(),
+    };
+    let name = SafeName::new(EXPERIMENT_NAME)?;
+    let choice = DescriptorChoice::fused(DESCRIPTORS.to_vec())?;
+    let key = SafeName::builder(choice.name()).build()?;
+    let dir = ExperimentDir::new(&context.options.out, &name);
+    let work = FusionUnit {
+        data: SettingData::new(context, &objects, &setting, counts),
+        objects: Arc::clone(&objects),
+        training: training.clone(),
+        start_pose,
+    };
+    if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
+        context.store.prepare(&work.requests()?, dir.root())?;
+    }
+    let config = FusionConfig {
+        setting: &setting,
+        descriptor: choice.name(),
+        evidence: EVIDENCE.iter().map(Evidence::name).collect(),
+        local_probabilities: LOCAL_PROBABILITIES,
+        start_pose,
+        geometry: GeometryParams {
+            max_heading: objects.set.start_heading(),
+            ..GeometryParams::default()
+        },
+        contact_noise: ContactNoise::default(),
+        calibration: work.calibration_record(),
+        posterior: context.posterior(),
+        scale: context.scale.fraction(),
+        counts,
+        seed: context.seed,
+        object_set_id: objects.set.id(),
+        objects: objects.names(),
+        training,
+    };
+    let title = "Appearance, contact geometry and their fusion (random start poses)";
+    let plot = PlotSpec::accuracy(name.clone(), title)
+        .with_chance(objects.specs.len())
+        .with_legend(CURVE_LABEL);
+    let mut attempts = PlotSpec::lines(
+        SafeName::new(format!("{EXPERIMENT_NAME}-attempts"))?,
+        "Accuracy against touch attempts (converged or not)",
+        Axis::new("n_attempts", "touch attempts per object"),
+        vec![Axis::new("accuracy", "accuracy")],
+        &["evidence", "local_probability", "object_motion"],
+    )
+    .with_legend(CURVE_LABEL);
+    attempts.table = AttemptRow::TABLE.map(SafeName::new).transpose()?;
+    let experiment = Experiment {
+        spec: ExperimentSpec {
+            name: name.clone(),
+            description: DESCRIPTION.to_string(),
+            plots: vec![
+                plot,
+                PlotSpec::reliability(
+                    SafeName::new(format!("{EXPERIMENT_NAME}-reliability"))?,
+                    &format!("Calibration: {title}"),
+                )?
+                .with_legend(CURVE_LABEL),
+                attempts,
+            ],
+        },
+        config,
+        units: vec![
+            Unit::<_, (PerObjectRow, ReliabilityRow, AttemptRow)>::with_detail(key, move || work.rows()),
+        ],
+    };
+    Ok(run(&experiment, &context.options)?)
+}
+
+/// What the experiment's one unit works from.
+struct FusionUnit<'a> {
+    data: SettingData<'a>,
+    objects: Arc<Objects>,
+    training: TrainConfig,
+    start_pose: StartPose,
+}
+
+impl FusionUnit<'_> {
+    /// The explorations at `l`, the object `perturbation`-moved, one per trial, `readings` per
+    /// object, from `first_stream`.
+    fn explorations(
+        &self,
+        l: f64,
+        perturbation: PerturbationBounds,
+        readings: usize,
+        first_stream: u64,
+    ) -> Result<Vec<DataRequest>, BoxError> {
+        Ok(self
+            .data
+            .planner_trials(l, perturbation, self.start_pose, readings, first_stream)?)
+    }
+
+    /// The arm's explorations the fusion is weighed on: at each L of [`LOCAL_PROBABILITIES`] with
+    /// the object fixed, and at [`MOVING_CALIBRATION_L`] perturbed, each on streams of its own
+    /// (those of the arm calibration of the other experiments, whose explorations start at the
+    /// canonical pose and so are other datasets, and past them for the perturbed ones).
+    fn calibration(&self) -> Result<Vec<DataRequest>, BoxError> {
+        let readings = self.data.counts.validation_per_object;
+        let mut requests = Vec::new();
+        for (i, l) in LOCAL_PROBABILITIES.into_iter().enumerate() {
+            requests.extend(self.explorations(
+                l,
+                PerturbationBounds::NONE,
+                readings,
+                CALIBRATION_STREAM + 100 * i as u64,
+            )?);
+        }
+        let moving = CALIBRATION_STREAM + 100 * LOCAL_PROBABILITIES.len() as u64;
+        requests.extend(self.explorations(
+            MOVING_CALIBRATION_L,
+            PerturbationBounds::PAPER,
+            readings,
+            moving,
+        )?);
+        Ok(requests)
+    }
+
+    fn calibration_record(&self) -> FusionCalibration {
+        FusionCalibration {
+            fixed_local_probabilities: LOCAL_PROBABILITIES,
+            perturbed_local_probability: MOVING_CALIBRATION_L,
+            explorations: self.data.counts.trials,
+            readings_per_object: self.data.counts.validation_per_object,
+            trial_readings: self.data.counts.test_per_object,
+        }
+    }
+
+    /// The test explorations of each (L, motion): L = 0.5 then 1, each fixed then perturbed.
+    fn tests(&self) -> Result<Vec<TestExplorations>, BoxError> {
+        let mut tests = Vec::new();
+        for l in LOCAL_PROBABILITIES {
+            for (motion, perturbation) in object_states() {
+                let requests =
+                    self.explorations(l, perturbation, self.data.counts.test_per_object, TEST_STREAM)?;
+                tests.push((l, motion, requests));
+            }
+        }
+        Ok(tests)
+    }
+
+    /// Every dataset the unit reads.
+    fn requests(&self) -> Result<Vec<DataRequest>, BoxError> {
+        let mut requests = vec![self.data.training_request()?, self.data.validation_request()?];
+        requests.extend(self.calibration()?);
+        for (.., tests) in self.tests()? {
+            requests.extend(tests);
+        }
+        Ok(requests)
+    }
+
+    /// The product's model: MNTI and SIFT fused (each trained and chosen as every figure's model,
+    /// the fusion's tempering fitted on the validation readings), then fused with the contact
+    /// geometry of every object's mesh, weighed on the arm's explorations.
+    fn model(&self) -> Result<GeometricFusion, BoxError> {
+        let store = &self.data.context.store;
+        let (training, validation) = (self.data.training_request()?, self.data.validation_request()?);
+        let parts = DESCRIPTORS
+            .iter()
+            .map(|kind| store.model(&training, &validation, kind.build().as_ref(), &self.training))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (training_data, validation_data) = (store.dataset(&training)?, store.dataset(&validation)?);
+        let appearance =
+            FusedModel::new(parts)?.calibrated(&self.training, &training_data, Some(&validation_data))?;
+        let meshes: Vec<(String, &TriMesh)> = self
+            .objects
+            .specs
+            .iter()
+            .map(|o| (o.name.clone(), &o.mesh))
+            .collect();
+        let geometry =
+            GeometryModel::of_named(appearance.objects(), &meshes, self.objects.set.start_heading())?;
+        let calibration = self
+            .calibration()?
+            .iter()
+            .map(|request| store.dataset(request))
+            .collect::<Result<Vec<_>, _>>()?;
+        let calibration: Vec<&Dataset> = calibration.iter().map(AsRef::as_ref).collect();
+        let model = store.clock.training(|| {
+            GeometricFusion::new(Appearance::Fused(Box::new(appearance)), geometry)?
+                .calibrate_on_all(&calibration, self.data.counts.test_per_object)
+        })?;
+        Ok(model.with_posterior(self.data.context.posterior()))
+    }
+
+    /// The model, then each (L, motion)'s test explorations, described once, recognised with each
+    /// evidence.
+    fn rows(&self) -> Result<Rows, BoxError> {
+        let model = self.model()?;
+        let mut rows: Rows = Default::default();
+        for (l, motion, requests) in self.tests()? {
+            let mut tests = Vec::new();
+            for request in &requests {
+                let test = self.data.context.store.dataset(request)?;
+                let trials = model.trials(&test, usize::MAX)?;
+                let attempts = attempt_logs(model.objects(), &test, &trials)?;
+                tests.push(TestRun {
+                    stream_seed: request.plan.seed,
+                    motion: test.header().perturbation,
+                    trials,
+                    attempts,
+                });
+            }
+            for evidence in EVIDENCE {
+                let judge = model.clone().with_evidence(evidence);
+                let (accuracy, (per_object, reliability, attempts)) =
+                    self.curve_rows(&judge, &levels(evidence, l, motion), &tests)?;
+                rows.0.extend(accuracy);
+                rows.1.0.extend(per_object);
+                rows.1.1.extend(reliability);
+                rows.1.2.extend(attempts);
+            }
+        }
+        Ok(rows)
+    }
+
+    /// One curve: `model` recognising each test exploration (one repetition per dataset, each
+    /// object's readings one sequence) at every reading count and every attempt count.
+    fn curve_rows(
+        &self,
+        model: &GeometricFusion,
+        factors: &Factors,
+        tests: &[TestRun],
+    ) -> Result<Rows, BoxError> {
+        let mut rows: Rows = Default::default();
+        let mut table = ReliabilityTable::default();
+        let mut meta = AccuracyCurve {
+            experiment: EXPERIMENT_NAME.to_string(),
+            descriptor: model.appearance().choice().name(),
+            factors: factors.clone(),
+            trial: 0,
+            seed: self.data.context.seed,
+            stream_seed: 0,
+        };
+        let last = tests
+            .iter()
+            .flat_map(|t| &t.attempts)
+            .map(Vec::len)
+            .max()
+            .unwrap_or(0);
+        for (trial, test) in tests.iter().enumerate() {
+            (meta.trial, meta.stream_seed) = (trial as u32, test.stream_seed);
+            let longest = test.trials.iter().map(|t| t.readings.len()).max().unwrap_or(0);
+            if longest == 0 {
+                return Err(format!(
+                    "curve '{factors}', trial {trial}: no converged test reading of any object"
+                )
+                .into());
+            }
+            let evaluation = model.evaluate(&test.trials, ReadingRange::new(1, longest)?, test.motion)?;
+            rows.0.extend(meta.rows(&evaluation.accuracy));
+            rows.1.0.extend(meta.object_rows(&evaluation)?);
+            rows.1
+                .2
+                .extend(meta.attempt_rows(&evaluation, &test.attempts, last)?);
+            table.merge(&evaluation.reliability());
+        }
+        rows.1.1 = meta.reliability_rows(&table);
+        Ok(rows)
+    }
+}
+
+/// One test exploration, described: each object's readings with their touches, and each object's
+/// attempts (whether each converged), in the same order.
+struct TestRun {
+    stream_seed: u64,
+    motion: Perturbed,
+    trials: Vec<Trial<TouchReading>>,
+    attempts: Vec<Vec<bool>>,
+}
+
+/// Each of `trials`' object's attempts in `test` (names: the model's objects): whether each
+/// converged.
+fn attempt_logs(
+    names: &[String],
+    test: &Dataset,
+    trials: &[Trial<TouchReading>],
+) -> Result<Vec<Vec<bool>>, BoxError> {
+    let by_object = test.by_object();
+    trials
+        .iter()
+        .map(|t| {
+            let name = &names[t.object];
+            let j = test
+                .header()
+                .object_index(name)
+                .ok_or_else(|| format!("object '{name}' is not in the test data"))?;
+            Ok(by_object[j].iter().map(|r| r.is_converged()).collect())
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_curve_has_the_same_factor_columns_and_a_level_of_each() {
+        let mut names = std::collections::BTreeSet::new();
+        for evidence in EVIDENCE {
+            for l in LOCAL_PROBABILITIES {
+                for (motion, _) in object_states() {
+                    let factors = levels(evidence, l, motion);
+                    factors.check().unwrap_or_else(|e| panic!("{e}"));
+                    assert_eq!(
+                        factors.factors().collect::<Vec<_>>(),
+                        [Factor::Evidence, Factor::LocalProbability, Factor::ObjectMotion]
+                    );
+                    names.insert(factors.to_string());
+                }
+            }
+        }
+        assert_eq!(names.len(), 12, "twelve distinct curves");
+    }
+}
