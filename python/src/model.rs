@@ -85,6 +85,13 @@ impl Model {
         self.inner.choice().name()
     }
 
+    /// Whether the model also weighs where each touch landed (trained with `objects`): its
+    /// posterior's `observe` then reads a `pad_pose`.
+    #[getter]
+    fn contacts(&self) -> bool {
+        matches!(*self.inner, Recognizer::Geometric(_))
+    }
+
     /// The sensor's `(rows, cols)`: the shape of the images it recognises.
     #[getter]
     fn sensor_shape(&self) -> (usize, usize) {
@@ -151,8 +158,9 @@ impl Model {
 
     fn __repr__(&self) -> String {
         format!(
-            "Model({}, k={:?}, objects={:?})",
+            "Model({}{}, k={:?}, objects={:?})",
             self.inner.choice().name(),
+            if self.contacts() { " with contacts" } else { "" },
             self.inner.chosen_ks(),
             self.inner.objects()
         )

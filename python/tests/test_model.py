@@ -192,6 +192,8 @@ def test_a_model_that_knows_where_it_touched_reads_each_pad_pose_and_round_trips
         objects=chess, calibration=[explorations],
     )
     appearance = taction.train(small_dataset, descriptor="mnti", codebook="knn", ks=[5], restarts=1, seed=2)
+    assert model.contacts and not appearance.contacts
+    assert repr(model).startswith("Model(mnti with contacts, k=[5]")
     test = taction.collect(chess, mode="planner", readings=6, local_probability=0.5, seed=12)
     rook = (test.object == "rook") & (test.status == "converged")
     images, poses = test.images[rook], test.pad_pose[rook]

@@ -316,9 +316,9 @@ impl<'a> ActiveRecognition<'a> {
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
         let features = self.posterior.describe(image);
-        let belief = self.posterior.observe_described(image, features.clone())?;
         let mut reading = ClusterHistogram::new(self.bag.models().clusters());
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
+        let belief = self.posterior.observe_described(image, features)?;
         // The gain predicts by Bayes' rule, which the tempered belief follows and its confidence
         // map does not (`recognize::calibration`): it starts from the belief before the map.
         self.gain.record(

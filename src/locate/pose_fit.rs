@@ -92,13 +92,15 @@ impl Hypothesis {
         }
     }
 
-    /// The score (log-likelihood of every contact, robust) and its Gauss-Newton approximation at
-    /// this pose. Each contact's weight in the step is the probability that it is not an outlier
-    /// (EM's responsibility), so a contact the pose cannot explain stops pulling on it.
+    /// The score (the contact's log-likelihood, robust) and its Gauss-Newton approximation at
+    /// this pose. The contact's weight in the step is the probability that it is not an outlier
+    /// (EM's responsibility), so a contact the pose cannot explain stops pulling on it. One
+    /// contact: the filter (`locate::track`) takes each as it comes, the belief so far standing
+    /// for the ones before.
     pub(crate) fn linearise(
         &self,
         surface: &ObjectSurface,
-        contacts: &[Contact],
+        contact: &Contact,
         likelihood: &Likelihood,
     ) -> Linearised {
         let mut out = Linearised {
@@ -110,43 +112,41 @@ impl Hypothesis {
         let density_scale = (1.0 - likelihood.outlier) / surface.area_m2();
         let point_var = likelihood.sigma_point_m.powi(2);
         let normal_var = likelihood.sigma_normal_rad.powi(2);
-        for contact in contacts {
-            let a = contact.point_m - self.center_w;
-            let q = to_object * a + surface.center_m();
-            let outlier = likelihood.outlier * OUTLIER_DENSITY;
-            let Some(nearest) = surface.nearest(q) else {
-                out.score += outlier.ln();
-                continue;
-            };
-            let g = self.rotation * surface.normals()[nearest.index];
-            let r = nearest.signed_distance_m;
-            let kappa = 1.0 / normal_var;
-            let cos = g.dot(contact.normal).clamp(-1.0, 1.0);
-            let log_inlier =
-                density_scale.ln() - 0.5 * r * r / point_var - 0.5 * (std::f64::consts::TAU * point_var).ln()
-                    + kappa * (cos - 1.0)
-                    + (kappa / std::f64::consts::TAU).ln();
-            let log_total = log_sum_exp(log_inlier, outlier.ln());
-            out.score += log_total;
-            let w = (log_inlier - log_total).exp();
-            // Point-to-plane: dr/dw = -(a x g), dr/dd = -g.
-            let j = Vector6::from_column_slice(&[
-                -(a.cross(g)).x,
-                -(a.cross(g)).y,
-                -(a.cross(g)).z,
-                -g.x,
-                -g.y,
-                -g.z,
-            ]);
-            out.hessian += j * j.transpose() * (w / point_var);
-            out.gradient += j * (w * r / point_var);
-            // Normal: e = g - n, de/dw = -[g]x.
-            let e = g - contact.normal;
-            let gx = cross_matrix(g);
-            let h = (gx.transpose() * gx) * (w / normal_var);
-            let grad = g.cross(e) * (w / normal_var);
-            add_rotation_block(&mut out, h, grad);
-        }
+        let a = contact.point_m - self.center_w;
+        let q = to_object * a + surface.center_m();
+        let outlier = likelihood.outlier * OUTLIER_DENSITY;
+        let Some(nearest) = surface.nearest(q) else {
+            out.score += outlier.ln();
+            return out;
+        };
+        let g = self.rotation * surface.normals()[nearest.index];
+        let r = nearest.signed_distance_m;
+        let kappa = 1.0 / normal_var;
+        let cos = g.dot(contact.normal).clamp(-1.0, 1.0);
+        let log_inlier =
+            density_scale.ln() - 0.5 * r * r / point_var - 0.5 * (std::f64::consts::TAU * point_var).ln()
+                + kappa * (cos - 1.0)
+                + (kappa / std::f64::consts::TAU).ln();
+        let log_total = log_sum_exp(log_inlier, outlier.ln());
+        out.score += log_total;
+        let w = (log_inlier - log_total).exp();
+        // Point-to-plane: dr/dw = -(a x g), dr/dd = -g.
+        let j = Vector6::from_column_slice(&[
+            -(a.cross(g)).x,
+            -(a.cross(g)).y,
+            -(a.cross(g)).z,
+            -g.x,
+            -g.y,
+            -g.z,
+        ]);
+        out.hessian += j * j.transpose() * (w / point_var);
+        out.gradient += j * (w * r / point_var);
+        // Normal: e = g - n, de/dw = -[g]x.
+        let e = g - contact.normal;
+        let gx = cross_matrix(g);
+        let h = (gx.transpose() * gx) * (w / normal_var);
+        let grad = g.cross(e) * (w / normal_var);
+        add_rotation_block(&mut out, h, grad);
         out
     }
 }

@@ -90,7 +90,7 @@ impl Track {
         let mean = self.pose;
         let evidence = self.pose.score;
         let fitted = self.pose.fitted(iterations, |h| {
-            let mut at = h.linearise(surface, &[contact], likelihood);
+            let mut at = h.linearise(surface, &contact, likelihood);
             add_gaussian_prior(&mut at, &offset(h, &mean), &predicted);
             at
         });
