@@ -257,11 +257,11 @@ impl Posterior {
 }
 
 /// Trains a recogniser on `dataset` as `taction train` does: `descriptor` one of `vectorize`,
-/// `sift`, `mr8`, `mn`, `pf`, `mnti` or several joined by `+` (fused), `codebook` `gmm`, `kmeans`
-/// or `knn`; the codebook size chosen among `ks` (default: a grid sized to the data) on
+/// `sift`, `mr8`, `mn`, `pf`, `mnti` or several joined by `+` (fused), `codebook` `knn` (the
+/// default, the product's), `gmm` (the paper's) or `kmeans`; the codebook size chosen among `ks` (default: a grid sized to the data) on
 /// `validation` (default: the last 1/11 of each object's readings).
 #[pyfunction]
-#[pyo3(signature = (dataset, descriptor="mnti", codebook="gmm", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0), text_signature = "(dataset, descriptor='mnti', codebook='gmm', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0)")]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook="knn", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0), text_signature = "(dataset, descriptor='mnti', codebook='knn', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
 pub fn train(
     py: Python<'_>,
