@@ -17,7 +17,7 @@ use taction::sim::ObjectSpec;
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
-/// Touches (planner iterations) the episode makes.
+/// Touch actions the episode makes (guarded touches, the episode's default).
 const TOUCHES: usize = 60;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

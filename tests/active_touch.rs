@@ -7,7 +7,8 @@ mod common;
 use std::sync::Arc;
 
 use glam::DVec3;
-use taction::active_touch::{EpisodeConfig, Touch, TouchEpisode, TouchError};
+use taction::active_touch::{EpisodeConfig, Touch, TouchAction, TouchEpisode, TouchError};
+use taction::dataset::{ContactStatus, Strategy};
 use taction::describe::DescriptorKind;
 use taction::explore::{
     ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, PlannerConfig,
@@ -337,4 +338,99 @@ fn active_exploration_touches_about_as_often_as_blind_exploration() {
         "active {iterations} iterations, blind {} for {TOUCHES} readings",
         blind.iterations
     );
+}
+
+/// Every guarded touch is one reading attempt with a status, most of them converged on these two
+/// simple objects, where planner iterations toward the same kind of candidates mostly meet
+/// nothing; the episode's touches of one seed are the same touches again.
+#[test]
+fn every_guarded_touch_is_one_attempt_and_most_land() {
+    const TOUCHES: usize = 12;
+    let model = model();
+    let guarded = |object: &ObjectSpec, touch: TouchAction| {
+        let config = Valid::new(EpisodeConfig {
+            touch,
+            start_pose: StartPose::random(MaxHeading::ANY),
+            ..*config()
+        })
+        .unwrap();
+        let mut episode = TouchEpisode::new(Arc::clone(&model), object, &config, 21).unwrap();
+        let mut statuses = Vec::new();
+        for step in 0..TOUCHES {
+            let attempts = episode.attempts();
+            let touched = episode.touch(step % 4).unwrap();
+            if touch == TouchAction::Guarded {
+                assert_eq!(episode.attempts(), attempts + 1, "one attempt a touch");
+            }
+            let status = episode.last_attempt().map(|r| r.status);
+            assert_eq!(touched.is_some(), status == Some(ContactStatus::Converged));
+            statuses.push(status);
+        }
+        (statuses, episode)
+    };
+    for object in &objects() {
+        let (statuses, episode) = guarded(object, TouchAction::Guarded);
+        let iterations = guarded(object, TouchAction::Iteration).1;
+        eprintln!(
+            "{}: guarded {} of {TOUCHES} converged ({statuses:?}); iterations {}",
+            object.name,
+            episode.touches(),
+            iterations.touches()
+        );
+        assert!(episode.touches() >= 9, "{}: {statuses:?}", object.name);
+        assert!(episode.touches() > iterations.touches());
+        // Where the last touch met the surface: on the object's side of the pad, the normal out.
+        let contact = episode.last_contact().expect("a converged touch");
+        let pad = episode.last_image().and_then(|i| i.pose().copied()).unwrap();
+        assert!((contact.normal + pad.normal).length() < 1e-9);
+        assert!((contact.point_m - pad.center_m).dot(pad.normal) > 0.0);
+        let (again, _) = guarded(object, TouchAction::Guarded);
+        assert_eq!(statuses, again, "one seed, one episode");
+    }
+}
+
+/// A guarded ray that meets nothing ends one covering thickness above the table as `no_contact`,
+/// its pad pose recorded; a target the ray cannot descend through is `unreachable` and moves
+/// nothing.
+#[test]
+fn a_guarded_touch_says_when_it_meets_nothing() {
+    let beside = Valid::new(PlannerConfig {
+        workspace_min_m: DVec3::new(0.12, 0.12, 0.02),
+        workspace_max_m: DVec3::new(0.2, 0.2, 0.12),
+        ..PlannerConfig::default()
+    })
+    .unwrap();
+    let plan = CollectPlan {
+        mode: CollectMode::Planner(beside),
+        sensor: sensor(),
+        control: Valid::default(),
+        perturbation: PerturbationBounds::NONE,
+        readings_per_object: 0,
+        seed: 5,
+        start_pose: StartPose::Canonical,
+    };
+    let (mut scene, mut planner) = plan.planner_for(&objects()[1], 0, beside).unwrap();
+    let axis = DVec3::new(0.16, 0.16, 0.08);
+    let report = planner
+        .guarded_touch(&mut scene, "ball", (Strategy::Global, axis))
+        .unwrap();
+    assert_eq!(report.readings.len(), 1);
+    let reading = &report.readings[0];
+    assert_eq!(reading.status, ContactStatus::NoContact, "{:?}", reading.cause);
+    assert_eq!(reading.cause, None);
+    assert_eq!(reading.image.max(), 0.0);
+    let pose = reading.image.pose().unwrap();
+    assert!((pose.center_m.z - sensor().thickness_m).abs() < 1e-3, "{pose:?}");
+    assert!(pose.normal.dot(DVec3::NEG_Z) > 0.99, "{pose:?}");
+
+    let before = planner.tree().vertices().len();
+    let low = planner
+        .guarded_touch(
+            &mut scene,
+            "ball",
+            (Strategy::Global, DVec3::new(0.16, 0.16, 0.0005)),
+        )
+        .unwrap();
+    assert_eq!(low.readings[0].status, ContactStatus::Unreachable);
+    assert_eq!(planner.tree().vertices().len(), before, "nothing moved");
 }

@@ -1,11 +1,12 @@
 //! One active-touch episode (beyond the paper; its Sec. VI): the arm explores an unknown object one
 //! touch at a time toward a target the caller picks among the planner's candidates, and the
-//! recogniser's belief follows every converged reading. `taction/ActiveTouch-v0` steps it.
+//! recogniser's belief follows every converged reading. `taction/ActiveTouch-v1` (and `-v0`)
+//! step it.
 
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::prelude::*;
-use taction::active_touch::EpisodeConfig;
+use taction::active_touch::{EpisodeConfig, TouchAction};
 use taction::explore::PlannerConfig;
 use taction::sim::{MaxHeading, ObjectSpec, PerturbationBounds, StartPose};
 use taction::valid::Valid;
@@ -23,7 +24,9 @@ use crate::object::Object;
 /// starting at `start_pose` (`"canonical"`, where it was built, or `"random"`, a pose drawn from
 /// the seed that the planner is not told, turned at most `start_heading_deg` about the vertical:
 /// 180 for any heading, 10 for the raised letters, whose heading is part of their identity) and
-/// perturbed after every reading within `perturb_deg` / `perturb_frac`.
+/// perturbed after every reading within `perturb_deg` / `perturb_frac`. A touch is `touch`:
+/// `"guarded"` (the pad moved along a ray through the candidate until it meets a surface, then
+/// settled: one reading attempt every touch) or `"iteration"` (one planner iteration toward it).
 ///
 /// Its touches release the GIL; one episode is used by one thread at a time (a lock).
 #[pyclass(module = "taction")]
@@ -52,7 +55,7 @@ fn planner_for(objects: &[ObjectSpec], local_probability: f64) -> PlannerConfig 
 #[pymethods]
 impl TouchEpisode {
     #[new]
-    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose="canonical", start_heading_deg=180.0), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose='canonical', start_heading_deg=180.0)")]
+    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose="canonical", start_heading_deg=180.0, touch="guarded"), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose='canonical', start_heading_deg=180.0, touch='guarded')")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each an episode parameter
     fn new(
         py: Python<'_>,
@@ -66,6 +69,7 @@ impl TouchEpisode {
         workspace: Option<Vec<PyRef<'_, Object>>>,
         start_pose: &str,
         start_heading_deg: f64,
+        touch: &str,
     ) -> PyResult<Self> {
         let (Whole(seed), Whole(candidates)) = (seed, candidates);
         let heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
@@ -78,6 +82,12 @@ impl TouchEpisode {
             bad_argument(
                 "start_pose",
                 format!("'{start_pose}' is none of {}", StartPose::NAMES.join(", ")),
+            )
+        })?;
+        let touch = TouchAction::parse(touch).ok_or_else(|| {
+            bad_argument(
+                "touch",
+                format!("'{touch}' is none of {}", TouchAction::NAMES.join(", ")),
             )
         })?;
         let spec = object.spec();
@@ -104,6 +114,7 @@ impl TouchEpisode {
             perturbation: PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?,
             start_pose,
             candidates,
+            touch,
             ..EpisodeConfig::new(*model.inner.sensor())
         };
         let config = Valid::new(config).map_err(refused)?;
@@ -149,8 +160,9 @@ impl TouchEpisode {
         array::from_f64(py, &gains, &[gains.len()], "float64")
     }
 
-    /// One planner iteration toward candidate `index`; `True` when it ended in a converged reading
-    /// (the belief now includes it). New candidates are drawn either way.
+    /// One touch toward candidate `index` (guarded, or one planner iteration, as the episode was
+    /// made); `True` when it ended in a converged reading (the belief now includes it). New
+    /// candidates are drawn either way.
     fn touch(&self, py: Python<'_>, index: Whole<usize>) -> PyResult<bool> {
         let Whole(index) = index;
         let mut episode = self.episode()?;
@@ -179,6 +191,35 @@ impl TouchEpisode {
         let p = self.episode()?.pad_pose();
         let values = [p.center_m, p.normal, p.up].map(|v| v.to_array()).concat();
         array::from_f64(py, &values, &[9], "float64")
+    }
+
+    /// Where the last converged touch met the surface: `(6,)` float64, the contact point (m) and
+    /// the outward surface normal; zeros before one.
+    #[getter]
+    fn contact<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let values = match self.episode()?.last_contact() {
+            Some(c) => [c.point_m.to_array(), c.normal.to_array()].concat(),
+            None => vec![0.0; 6],
+        };
+        array::from_f64(py, &values, &[6], "float64")
+    }
+
+    /// How the last touch's reading attempt ended, in the dataset's vocabulary (`"converged"`,
+    /// `"no_contact"`, `"collision"`, `"unreachable"`, ...); `None` before any attempt (and after
+    /// a planner iteration that met nothing, which makes none).
+    #[getter]
+    fn last_status(&self) -> PyResult<Option<&'static str>> {
+        Ok(self.episode()?.last_attempt().map(|r| r.status.name()))
+    }
+
+    /// What ended the last attempt short of convergence, where its status does not say alone
+    /// (`"arm_on_table"`, `"covering_on_table"`, ...); `None` otherwise.
+    #[getter]
+    fn last_cause(&self) -> PyResult<Option<&'static str>> {
+        Ok(self
+            .episode()?
+            .last_attempt()
+            .and_then(|r| r.cause.as_ref().map(|c| c.name())))
     }
 
     /// P(object | readings so far), in the model's object order.

@@ -2,8 +2,8 @@
 
 A Python face of the Rust library (Pezzementi et al., *Tactile Object Recognition From Appearance
 Information*, IEEE T-RO 2011): objects, the covering sensor, datasets, recognisers and their
-posterior, all speaking numpy; and the Gymnasium environment ``taction/ActiveTouch-v0``, registered on
-import. Importing the package also registers the ``taction.covering`` sensor plugin with stock
+posterior, all speaking numpy; and the Gymnasium environments ``taction/ActiveTouch-v1`` (and
+``-v0``), registered on import. Importing the package also registers the ``taction.covering`` sensor plugin with stock
 ``mujoco``, so ``mujoco.MjModel.from_xml_string(taction.scene(obj))`` compiles (unless the plugin
 library ``target/release/libtaction_covering.so`` registered it first; either serves).
 
@@ -51,6 +51,11 @@ def _register_environments() -> None:
         gymnasium.register(
             id="taction/ActiveTouch-v0",
             entry_point="taction.env:ActiveTouchEnv",
+        )
+    if "taction/ActiveTouch-v1" not in gymnasium.registry:
+        gymnasium.register(
+            id="taction/ActiveTouch-v1",
+            entry_point="taction.env:GuardedTouchEnv",
         )
 
 

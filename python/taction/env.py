@@ -1,4 +1,4 @@
-"""``taction/ActiveTouch-v0``: learn where to touch to recognise an unknown object.
+"""``taction/ActiveTouch-v1`` and ``-v0``: learn where to touch to recognise an unknown object.
 
 Each episode places one object of a set (drawn from the episode's seed; with ``start_pose="random"``
 at a pose drawn from it too, turned at most ``start_heading_deg`` about the vertical, 10 for the
@@ -16,6 +16,13 @@ The recogniser is ``model`` (a ``taction.Model`` or a model file), or by default
 ``taction demo`` trains for the arm's touches (``taction.train_for_arm`` on ``training_readings``
 sampler readings per object from starts the arm can reach, its posterior calibrated on the arm's
 own explorations, ``taction.collect_arm_calibration``), trained once per process and set.
+
+``taction/ActiveTouch-v1`` (``GuardedTouchEnv``) makes every touch action a guarded touch: the arm
+moves the pad along a ray through the chosen candidate until its covering meets a surface, and the
+controllers settle it there, so nearly every action yields a reading; every episode starts the
+object at a random pose; the observation adds where the last touch met the surface (``contact``);
+the default budget is 30 touches. ``taction/ActiveTouch-v0`` (``ActiveTouchEnv``) is kept as it
+was: an action is one planner iteration toward the candidate, and most meet nothing.
 """
 
 from __future__ import annotations
@@ -32,6 +39,10 @@ import taction
 #: How far the pad's centre can be from the world origin, metres: the arm (mjcf/arm.xml) has its
 #: shoulder 0.30 m above a base at x = -0.35 m and reaches 0.69 m from it, so at most 1.04 m.
 PAD_REACH_M = 1.5
+
+#: The raised letters' start headings stay within this many degrees of upright: b/q, d/p, n/u and
+#: M/W are one another turned half a circle.
+LETTERS_HEADING_DEG = 10.0
 
 #: Models trained by default, per (set, readings, seed): one training per process serves every
 #: environment of a vector env.
@@ -85,12 +96,17 @@ class ActiveTouchEnv(gymnasium.Env):
       - ``candidates``: Box((K, 3), float32), the targets the next touch may go toward (m).
     Action: Discrete(K + objects): ``a < K`` touches toward candidate ``a``; ``a >= K`` declares
     object ``a - K`` (``env.unwrapped.objects`` names them).
-    ``info`` holds ``converged`` (whether the touch gave a reading), ``attempts``, ``readings`` (the
-    converged ones, which the belief includes) and,
-    when the episode ends, ``object`` (the truth) and ``declared``.
+    ``info`` holds ``converged`` (whether the touch gave a reading), ``reading`` (how the touch's
+    reading attempt ended, in the dataset's vocabulary: ``"converged"``, ``"no_contact"``,
+    ``"collision"``, ...; ``None`` for a declaration, or a planner iteration that made no attempt),
+    ``cause`` (what ended it short, ``"arm_on_table"``, ...; else ``None``), ``attempts``,
+    ``readings`` (the converged ones, which the belief includes) and, when the episode ends,
+    ``object`` (the truth) and ``declared``.
     """
 
     metadata = {"render_modes": []}
+    #: Whether the observation carries ``contact`` (``taction/ActiveTouch-v1``).
+    _contact_in_observation = False
 
     def __init__(
         self,
@@ -108,6 +124,7 @@ class ActiveTouchEnv(gymnasium.Env):
         wrong_reward: float = -1.0,
         training_readings: int = 1000,
         training_seed: int = 1,
+        touch: str = "iteration",
     ):
         if budget < 1:
             raise taction.TactionError(f"budget: {budget} is not 1 or more")
@@ -152,6 +169,7 @@ class ActiveTouchEnv(gymnasium.Env):
             perturb_frac=perturb_frac,
             start_pose=start_pose,
             start_heading_deg=start_heading_deg,
+            touch=touch,
         )
         self.touch_cost = touch_cost
         self.right_reward = right_reward
@@ -159,20 +177,21 @@ class ActiveTouchEnv(gymnasium.Env):
         rows, cols = model.sensor_shape
         reach = np.array([PAD_REACH_M] * 3 + [1.0] * 6, dtype=np.float32)
         workspace = taction.TouchEpisode.workspace_m(self._episode_objects).astype(np.float32)
-        self.observation_space = spaces.Dict(
-            {
-                "image": spaces.Box(0.0, 1.0, (rows, cols), np.float32),
-                "pad_pose": spaces.Box(-reach, reach, (9,), np.float32),
-                "touches": spaces.Discrete(budget + 1),
-                "belief": spaces.Box(0.0, 1.0, (len(self.objects),), np.float32),
-                "candidates": spaces.Box(
-                    np.tile(workspace[0], (candidates, 1)),
-                    np.tile(workspace[1], (candidates, 1)),
-                    (candidates, 3),
-                    np.float32,
-                ),
-            }
-        )
+        observed = {
+            "image": spaces.Box(0.0, 1.0, (rows, cols), np.float32),
+            "pad_pose": spaces.Box(-reach, reach, (9,), np.float32),
+            "touches": spaces.Discrete(budget + 1),
+            "belief": spaces.Box(0.0, 1.0, (len(self.objects),), np.float32),
+            "candidates": spaces.Box(
+                np.tile(workspace[0], (candidates, 1)),
+                np.tile(workspace[1], (candidates, 1)),
+                (candidates, 3),
+                np.float32,
+            ),
+        }
+        if self._contact_in_observation:
+            observed["contact"] = spaces.Box(-reach[:6], reach[:6], (6,), np.float32)
+        self.observation_space = spaces.Dict(observed)
         self.action_space = spaces.Discrete(candidates + len(self.objects))
         self._episode: Optional[taction.TouchEpisode] = None
         self._touches = 0
@@ -185,13 +204,16 @@ class ActiveTouchEnv(gymnasium.Env):
 
     def _observation(self) -> dict:
         e = self._episode
-        return {
+        observation = {
             "image": e.image.astype(np.float32),
             "pad_pose": e.pad_pose.astype(np.float32),
             "touches": self._touches,
             "belief": np.clip(e.probabilities, 0.0, 1.0).astype(np.float32),
             "candidates": self._candidates().astype(np.float32),
         }
+        if self._contact_in_observation:
+            observation["contact"] = e.contact.astype(np.float32)
+        return observation
 
     def gains(self) -> np.ndarray:
         """The expected information gain (nats) of a touch toward each of the K candidates: what a
@@ -253,8 +275,11 @@ class ActiveTouchEnv(gymnasium.Env):
             terminated = True
             info["declared"] = self.objects[declared]
             info["converged"] = False
+            info["reading"] = info["cause"] = None
         else:
             info["converged"] = e.touch(action % len(e.candidates))
+            info["reading"] = e.last_status
+            info["cause"] = e.last_cause
             self._touches += 1
             reward = -self.touch_cost
             truncated = self._touches >= self.budget
@@ -264,3 +289,45 @@ class ActiveTouchEnv(gymnasium.Env):
             info["object"] = e.object
             self._over = True
         return self._observation(), float(reward), terminated, truncated, info
+
+
+class GuardedTouchEnv(ActiveTouchEnv):
+    """``taction/ActiveTouch-v1``: every action a guarded touch, the object at a random pose.
+
+    As ``ActiveTouchEnv`` (its docs list the observation, the actions and ``info``), with:
+      - a touch action moves the pad along a ray through the chosen candidate, descending toward
+        the workspace's vertical axis, until the covering meets a surface, where the controllers
+        settle it: nearly every action yields a reading, and ``info["reading"]`` says how each
+        ended;
+      - every episode starts the object at a pose drawn from the episode's seed (any heading; at
+        most 10 degrees off upright for the raised letters, whose heading is part of their
+        identity, ``start_heading_deg=None``), which neither the agent nor the planner is told;
+      - the observation adds ``contact``: Box((6,), float32), where the last converged touch met
+        the surface, its point (m) and outward normal (zeros before one);
+      - the default budget is 30 touches.
+    """
+
+    _contact_in_observation = True
+
+    def __init__(
+        self,
+        objects: Union[str, Sequence["taction.Object"]] = "chess",
+        model: Union[None, str, os.PathLike, "taction.Model"] = None,
+        budget: int = 30,
+        start_pose: str = "random",
+        start_heading_deg: Optional[float] = None,
+        touch: str = "guarded",
+        **settings: Any,
+    ):
+        """``settings``: the other keyword arguments of ``ActiveTouchEnv``, with its defaults."""
+        if start_heading_deg is None:
+            start_heading_deg = LETTERS_HEADING_DEG if objects == "letters" else 180.0
+        super().__init__(
+            objects=objects,
+            model=model,
+            budget=budget,
+            start_pose=start_pose,
+            start_heading_deg=start_heading_deg,
+            touch=touch,
+            **settings,
+        )

@@ -1,4 +1,4 @@
-"""taction/ActiveTouch-v0: Gymnasium's own checks, vector envs, seeded determinism, rewards."""
+"""taction/ActiveTouch-v0 and -v1: Gymnasium's own checks, vector envs, seeded determinism, rewards."""
 
 import warnings
 
@@ -212,3 +212,43 @@ def test_the_default_recogniser_is_the_demos_calibrated_on_the_arm(chess):
     demos = taction.train_for_arm(training.converged(), seed=3, calibration=calibration)
     assert model.calibration == demos.calibration
     assert model.calibration != taction.train_for_arm(training.converged(), seed=3).calibration
+
+
+V1 = "taction/ActiveTouch-v1"
+STATUSES = {"converged", "no_contact", "saturated", "max_iterations", "collision", "unreachable", "aborted"}
+
+
+def test_v1_passes_check_env_and_says_how_every_touch_ended(small_model):
+    assert V1 in gymnasium.registry
+    env = gymnasium.make(V1, objects="chess", model=small_model)
+    assert env.unwrapped.budget == 30
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=True)
+    obs, _ = env.reset(seed=7)
+    assert "contact" in obs and not obs["contact"].any()
+    converged = 0
+    for step in range(12):
+        obs, reward, terminated, truncated, info = env.step(step % env.unwrapped.k)
+        assert env.observation_space.contains(obs)
+        assert info["reading"] in STATUSES, info
+        assert info["converged"] == (info["reading"] == "converged")
+        assert info["attempts"] == step + 1, "one reading attempt every touch"
+        converged += info["converged"]
+        if info["converged"]:
+            # Where the touch met the surface, and its outward normal.
+            assert abs(np.linalg.norm(obs["contact"][3:]) - 1.0) < 1e-5
+            assert obs["image"].max() > 0
+    # Planner iterations (v0) converge on about one in ten; guarded touches on most.
+    assert converged >= 9, converged
+    env.close()
+
+
+def test_v1_starts_every_episode_at_a_pose_its_seed_draws(small_model):
+    env = gymnasium.make(V1, objects="chess", model=small_model, budget=3)
+    traces = [trace(env, seed, [0, 1, 2]) for seed in (5, 5, 6)]
+    assert same(traces[0], traces[1])
+    assert not same(traces[0], traces[2])
+    env.close()
+    with pytest.raises(taction.TactionError, match="touch: 'poke' is none of guarded, iteration"):
+        taction.TouchEpisode(small_model, taction.objects("chess")[0], touch="poke")

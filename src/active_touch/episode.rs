@@ -1,7 +1,9 @@
 //! One object's active exploration, touch by touch, with the choice of each touch left to the
 //! caller (a policy learning where to touch, a Gymnasium environment): the arm and the object in
 //! their scene, the planner (Sec. III-A) that proposes where the next touch may go and carries the
-//! pad there, and the belief over identity after every converged reading (Eq. 15-16).
+//! pad there (a guarded touch by default, one reading attempt every action; or one planner
+//! iteration, [`TouchAction`]), and the belief over identity after every converged reading
+//! (Eq. 15-16).
 //!
 //! The scene and the planner are built as the `active` experiment builds them
 //! ([`CollectPlan::planner_for`]: the object's own random and sensor-noise streams of the seed, the
@@ -9,9 +11,9 @@
 //! an episode's touches are
 //! those the experiment's planner would make given the same choices. The model is shared
 //! (`Arc<Recognizer>`), not borrowed, so that an episode can live as long as its caller wants (a
-//! Python object); the recogniser's state is the images observed so far, replayed through a fresh
-//! [`ActiveRecognition`] when a belief or a score is asked for (describing a few images costs far
-//! less than one touch).
+//! Python object); the episode keeps one [`ActiveRecognition`] borrowing it (a self-referential
+//! cell), which describes each reading once, when it arrives: a belief or a score costs the same
+//! at the thirtieth touch as at the first.
 
 use std::sync::Arc;
 
@@ -21,12 +23,42 @@ use serde::{Deserialize, Serialize};
 use super::{ActiveRecognition, Touch, TouchError};
 use crate::control::ControlError;
 use crate::dataset::{Reading, Strategy};
-use crate::explore::{CollectMode, CollectPlan, DEFAULT_CANDIDATES, Planner, PlannerConfig, SensorReader};
+use crate::explore::{
+    CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, Planner, PlannerConfig, SensorReader,
+};
+use crate::locate::Contact;
 use crate::pose::PadPose;
 use crate::recognize::{Belief, Recognizer, check_same_sensor};
 use crate::sim::{Arm, ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
+
+/// What one touch action of a [`TouchEpisode`] does with the candidate it is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TouchAction {
+    /// A guarded touch through the candidate ([`Planner::guarded_touch`]): the pad moved along a
+    /// ray until the covering meets a surface, then settled; one reading attempt every action.
+    #[default]
+    Guarded,
+    /// One planner iteration toward the candidate ([`Planner::touch_toward`], Sec. III-A), what
+    /// `taction/ActiveTouch-v0` steps: most iterations of a blind exploration meet nothing.
+    Iteration,
+}
+
+impl TouchAction {
+    /// The names the Python package and the environment take.
+    pub const NAMES: [&'static str; 2] = ["guarded", "iteration"];
+
+    /// Parses one of [`NAMES`](Self::NAMES).
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "guarded" => Some(Self::Guarded),
+            "iteration" => Some(Self::Iteration),
+            _ => None,
+        }
+    }
+}
 
 /// How a [`TouchEpisode`] explores.
 ///
@@ -57,6 +89,10 @@ pub struct EpisodeConfig {
     pub start_pose: StartPose,
     /// K: candidate targets offered before every touch, at least 1.
     pub candidates: usize,
+    /// What a touch toward a candidate does: a guarded touch (the default) or one planner
+    /// iteration.
+    #[serde(default)]
+    pub touch: TouchAction,
     /// Readings within this distance of a candidate predict what a touch there shows, metres
     /// ([`InformationGain::neighbourhood_m`](super::InformationGain)).
     pub neighbourhood_m: f64,
@@ -65,7 +101,7 @@ pub struct EpisodeConfig {
 impl EpisodeConfig {
     /// The `active` experiment's settings for `sensor`: the default planner (L = 0.5), the object
     /// fixed where it was built, [`DEFAULT_CANDIDATES`] candidates, the neighbourhood one grid cell
-    /// of the planner.
+    /// of the planner; each touch a guarded one.
     pub fn new(sensor: SensorConfig) -> Self {
         let planner = Valid::<PlannerConfig>::default();
         Self {
@@ -75,6 +111,7 @@ impl EpisodeConfig {
             perturbation: PerturbationBounds::NONE,
             start_pose: StartPose::Canonical,
             candidates: DEFAULT_CANDIDATES,
+            touch: TouchAction::Guarded,
         }
     }
 }
@@ -94,6 +131,7 @@ impl Check for EpisodeConfig {
             planner: _,
             perturbation: _,
             start_pose: _,
+            touch: _,
             candidates,
             neighbourhood_m,
         } = *self;
@@ -143,20 +181,23 @@ impl Check for EpisodeConfig {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub struct TouchEpisode {
-    model: Arc<Recognizer>,
+    /// The recogniser after the converged readings so far, borrowing the model it shares.
+    recognition: Recognition,
     /// The object's index in the model's objects (the truth a guess is judged by).
     object_index: usize,
     object: String,
-    neighbourhood_m: f64,
     candidates_per_touch: usize,
+    touch_action: TouchAction,
     scene: Scene,
     arm: Arm,
     planner: Planner<SensorReader>,
     /// The planner's proposals the next touch may go toward, and their points.
     proposals: Vec<(Strategy, DVec3)>,
     targets: Vec<DVec3>,
-    /// The images of the converged readings, in order: the recogniser's state.
-    observed: Vec<TactileImage>,
+    /// The image of the last converged reading.
+    last_image: Option<TactileImage>,
+    /// Converged readings so far.
+    touches: usize,
     belief: Belief,
     attempts: usize,
     last_attempt: Option<Reading>,
@@ -187,19 +228,23 @@ impl TouchEpisode {
             .arm()
             .cloned()
             .ok_or_else(|| ControlError::from(SimError::NoArm))?;
-        let belief = ActiveRecognition::of(&model, config.neighbourhood_m)?.belief();
+        let recognition = Recognition::try_new(model, |model| {
+            ActiveRecognition::of(model, config.neighbourhood_m)
+        })?;
+        let belief = recognition.borrow_dependent().belief();
         let mut episode = Self {
-            model,
+            recognition,
             object_index,
             object: object.name.clone(),
-            neighbourhood_m: config.neighbourhood_m,
             candidates_per_touch: config.candidates,
+            touch_action: config.touch,
             scene,
             arm,
             planner,
             proposals: Vec::new(),
             targets: Vec::new(),
-            observed: Vec::new(),
+            last_image: None,
+            touches: 0,
             belief,
             attempts: 0,
             last_attempt: None,
@@ -221,7 +266,7 @@ impl TouchEpisode {
     /// the quantity the planner's active strategy maximises ([`crate::explore::expected_gains`]).
     pub fn gains(&self) -> Result<Vec<f64>, TouchError> {
         use crate::explore::TouchScorer;
-        let scores = self.recognition()?.scorer().score(&self.targets);
+        let scores = self.recognition.borrow_dependent().scorer().score(&self.targets);
         Ok(crate::explore::expected_gains(&scores, &self.touch_chances()))
     }
 
@@ -237,18 +282,18 @@ impl TouchEpisode {
         Ok(crate::explore::best_candidate(&self.gains()?))
     }
 
-    /// One planner iteration toward candidate `index` ([`Planner::touch_toward`]), then new
-    /// candidates. `Some`: the iteration ended in a converged reading, which the belief now
-    /// includes; `None`: it did not (no contact on the way, a collision, a reading that did not
-    /// converge). An index beyond [`candidates`](Self::candidates) is an error, and touches nothing.
+    /// One touch toward candidate `index` as the configuration's [`TouchAction`] says (a guarded
+    /// touch, [`Planner::guarded_touch`], or one planner iteration, [`Planner::touch_toward`]),
+    /// then new candidates. `Some`: it ended in a converged reading, which the belief now
+    /// includes; `None`: it did not ([`last_attempt`](Self::last_attempt) says how a guarded touch
+    /// ended; an iteration may also have met nothing at all). An index beyond
+    /// [`candidates`](Self::candidates) is an error, and touches nothing.
     pub fn touch(&mut self, index: usize) -> Result<Option<Touch>, TouchError> {
         let candidate = *self.proposals.get(index).ok_or(TouchError::NoSuchCandidate {
             index,
             candidates: self.proposals.len(),
         })?;
-        let report = self
-            .planner
-            .touch_toward(&mut self.scene, &self.object, candidate)?;
+        let report = self.touch_toward(candidate)?;
         self.attempts += report.readings.len();
         self.last_attempt = report.readings.last().cloned();
         let touch = match report.readings.into_iter().find(Reading::is_converged) {
@@ -266,7 +311,7 @@ impl TouchEpisode {
 
     /// Converged touches so far: the readings the belief includes.
     pub fn touches(&self) -> usize {
-        self.observed.len()
+        self.touches
     }
 
     /// The belief over the model's objects after the touches so far (uniform before any).
@@ -276,7 +321,7 @@ impl TouchEpisode {
 
     /// The model the belief is of.
     pub fn model(&self) -> &Arc<Recognizer> {
-        &self.model
+        self.recognition.borrow_owner()
     }
 
     /// The explored object's name.
@@ -291,7 +336,14 @@ impl TouchEpisode {
 
     /// The image of the last converged touch; `None` before any.
     pub fn last_image(&self) -> Option<&TactileImage> {
-        self.observed.last()
+        self.last_image.as_ref()
+    }
+
+    /// Where the last converged touch met the surface: the pressed taxels' surface point and the
+    /// outward normal ([`Contact::of_image`], without the model's contact noise); `None` before
+    /// any.
+    pub fn last_contact(&self) -> Option<Contact> {
+        Contact::of_image(self.last_image.as_ref()?, self.model().sensor())
     }
 
     /// The last reading attempt, whatever its status (its cause says what ended it); `None` before
@@ -310,22 +362,27 @@ impl TouchEpisode {
         &self.scene
     }
 
-    /// A converged reading added to the belief.
-    fn observe(&mut self, reading: Reading) -> Result<Touch, TouchError> {
-        let mut recognition = self.recognition()?;
-        let belief = recognition.observe(&reading.image)?;
-        self.observed.push(reading.image.clone());
-        self.belief = belief.clone();
-        Ok(Touch { reading, belief })
+    /// What the configured [`TouchAction`] does toward `candidate`.
+    fn touch_toward(&mut self, candidate: (Strategy, DVec3)) -> Result<ExplorationReport, ControlError> {
+        match self.touch_action {
+            TouchAction::Guarded => self
+                .planner
+                .guarded_touch(&mut self.scene, &self.object, candidate),
+            TouchAction::Iteration => self
+                .planner
+                .touch_toward(&mut self.scene, &self.object, candidate),
+        }
     }
 
-    /// The recogniser after the images observed so far, replayed in order.
-    fn recognition(&self) -> Result<ActiveRecognition<'_>, TouchError> {
-        let mut recognition = ActiveRecognition::of(&self.model, self.neighbourhood_m)?;
-        for image in &self.observed {
-            recognition.observe(image)?;
-        }
-        Ok(recognition)
+    /// A converged reading added to the belief: described once, here.
+    fn observe(&mut self, reading: Reading) -> Result<Touch, TouchError> {
+        let belief = self
+            .recognition
+            .with_dependent_mut(|_, recognition| recognition.observe(&reading.image))?;
+        self.last_image = Some(reading.image.clone());
+        self.touches += 1;
+        self.belief = belief.clone();
+        Ok(Touch { reading, belief })
     }
 
     fn draw_candidates(&mut self) {
@@ -333,6 +390,15 @@ impl TouchEpisode {
         self.targets = self.proposals.iter().map(|p| p.1).collect();
     }
 }
+
+self_cell::self_cell!(
+    /// The shared model and the recogniser of one episode's readings, which borrows it.
+    struct Recognition {
+        owner: Arc<Recognizer>,
+        #[covariant]
+        dependent: ActiveRecognition,
+    }
+);
 
 /// The collection plan whose planner the episode drives: the `active` experiment's (the default
 /// controllers, the configured sensor, planner, perturbation and start), seeded with `seed`.

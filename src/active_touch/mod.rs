@@ -45,7 +45,7 @@
 mod episode;
 mod stop;
 
-pub use episode::{EpisodeConfig, TouchEpisode};
+pub use episode::{EpisodeConfig, TouchAction, TouchEpisode};
 pub use stop::{REPORTED_STOPS, StopRecord, reported_stops, stops};
 
 use std::collections::BTreeMap;

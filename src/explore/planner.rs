@@ -38,6 +38,10 @@
 //! the pad off the surface along its normal (a checked motion), so the tree holds only collision-free
 //! configurations.
 
+mod guarded;
+
+pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay};
+
 use glam::DVec3;
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
@@ -267,6 +271,25 @@ struct Expansion<'a> {
     target: DVec3,
     object: &'a str,
     checkpoint: &'a SceneState,
+    /// Expansion steps at most.
+    max_steps: usize,
+    /// Whether the object reaching the pad's rigid back ([`Collision::back_on_object`]) hands
+    /// over to the controllers, as a rigid contact does in their Approach (a guarded touch, whose
+    /// motion is an Approach along the pad's normal), rather than stopping the expansion as a
+    /// collision (the planner's collision-free motions, Sec. III-A).
+    back_contact_settles: bool,
+}
+
+/// How an expansion ended.
+enum ExpansionEnd {
+    /// The sensor felt a surface and the controllers' reading was recorded.
+    Read,
+    /// A step's motion collided.
+    Collided(Collision),
+    /// A step had no inverse-kinematics solution.
+    Unreachable,
+    /// The target was reached, or the steps ran out, and nothing was felt.
+    Nothing,
 }
 
 /// What a run records as it goes: every reading attempt, and whom to tell of each converged one.
@@ -541,9 +564,23 @@ where
             target,
             object,
             checkpoint: &checkpoint,
+            max_steps: self.config.max_steps_per_iteration,
+            back_contact_settles: false,
         };
         match self.expand(scene, arm, &expansion, record) {
-            Ok(()) => Ok(()),
+            Ok(ExpansionEnd::Collided(c)) => {
+                *record
+                    .report
+                    .expansion_stops
+                    .entry(AttemptCause::from(&c).kind())
+                    .or_insert(0) += 1;
+                Ok(())
+            }
+            Ok(ExpansionEnd::Unreachable) => {
+                record.report.unreachable_steps += 1;
+                Ok(())
+            }
+            Ok(ExpansionEnd::Read | ExpansionEnd::Nothing) => Ok(()),
             Err(e) if e.is_physics_fault() => {
                 scene.restore(&checkpoint)?;
                 *record
@@ -599,45 +636,47 @@ where
     /// One iteration's expansion toward `expansion.target` in small steps, until a step is stopped
     /// (a collision, no IK solution) or the sensor feels something, when surface contact control
     /// takes over and its reading is recorded (a physics fault there: an `aborted` reading, the
-    /// world restored to the checkpoint). A physics fault elsewhere is the caller's to count.
+    /// world restored to the checkpoint). How it ended is the caller's to count; so is a physics
+    /// fault elsewhere.
     fn expand(
         &mut self,
         scene: &mut Scene,
         arm: &Arm,
         expansion: &Expansion<'_>,
         record: &mut Record<'_>,
-    ) -> Result<(), ControlError> {
+    ) -> Result<ExpansionEnd, ControlError> {
         let threshold = self.setup.control.effective_contact_threshold();
         let mut vertex = expansion.vertex;
         let facing = self.tree.vertices()[vertex].pad_normal;
-        for _ in 0..self.config.max_steps_per_iteration {
+        for _ in 0..expansion.max_steps {
             let pad = arm.pad_pose(scene.data());
             let Some(step) = self.step_toward(&pad, expansion, facing) else {
                 break;
             };
             let Some(q) = self.solve_step(scene, arm, &step, pad.normal) else {
-                record.report.unreachable_steps += 1;
-                break;
+                return Ok(ExpansionEnd::Unreachable);
             };
             let (outcome, sensed) = self.expand_to(scene, arm, &q, threshold)?;
-            if let MoveOutcome::Collided(c) = outcome {
-                *record
-                    .report
-                    .expansion_stops
-                    .entry(AttemptCause::from(&c).kind())
-                    .or_insert(0) += 1;
-                break;
-            }
-            if !sensed {
+            let felt = match outcome {
+                MoveOutcome::Collided(c)
+                    if expansion.back_contact_settles && c == Collision::back_on_object() =>
+                {
+                    true
+                }
+                MoveOutcome::Collided(c) => return Ok(ExpansionEnd::Collided(c)),
+                MoveOutcome::Reached | MoveOutcome::Stopped => sensed,
+            };
+            if !felt {
                 let pad = arm.pad_pose(scene.data());
                 vertex = self
                     .tree
                     .add(vertex, arm.q(scene.data()), pad.center_m, pad.normal);
                 continue;
             }
-            return self.read_surface(scene, arm, expansion, (vertex, pad), record);
+            self.read_surface(scene, arm, expansion, (vertex, pad), record)?;
+            return Ok(ExpansionEnd::Read);
         }
-        Ok(())
+        Ok(ExpansionEnd::Nothing)
     }
 
     /// The next step from the pad at `pad` toward the expansion's target: at most `step_m` along

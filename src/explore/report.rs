@@ -56,20 +56,39 @@ pub(crate) fn aborted_reading(
     object_pose: Pose,
     strategy: Strategy,
 ) -> Result<Reading, TactileError> {
+    unsettled_reading(
+        sensor,
+        start,
+        (object, object_pose),
+        strategy,
+        (ContactStatus::Aborted, Some(AttemptCause::PhysicsFault)),
+    )
+}
+
+/// The reading of an attempt that never reached the controllers (a guarded touch that met
+/// nothing, or was stopped on the way): no image (all zeros, tagged with the pad's pose `at`),
+/// `status` and its cause, no controller iterations.
+pub(crate) fn unsettled_reading(
+    sensor: &SensorConfig,
+    at: PadPose,
+    (object, object_pose): (&str, Pose),
+    strategy: Strategy,
+    (status, cause): (ContactStatus, Option<AttemptCause>),
+) -> Result<Reading, TactileError> {
     let image = TactileImage::zeros(sensor.rows, sensor.cols)
         .map_err(|source| TactileError::Image {
             sensor: "covering".into(),
             source,
         })?
-        .with_pose(start);
+        .with_pose(at);
     Ok(Reading {
         image,
         object: object.to_string(),
         object_pose,
-        status: ContactStatus::Aborted,
+        status,
         iterations: 0,
         strategy,
-        cause: Some(AttemptCause::PhysicsFault),
+        cause,
     })
 }
 
