@@ -196,8 +196,7 @@ pub struct TouchEpisode {
     targets: Vec<DVec3>,
     /// The image of the last converged reading.
     last_image: Option<TactileImage>,
-    /// Converged readings so far.
-    touches: usize,
+    /// The belief after the converged readings so far (its `readings` counts them).
     belief: Belief,
     attempts: usize,
     last_attempt: Option<Reading>,
@@ -244,7 +243,6 @@ impl TouchEpisode {
             proposals: Vec::new(),
             targets: Vec::new(),
             last_image: None,
-            touches: 0,
             belief,
             attempts: 0,
             last_attempt: None,
@@ -311,7 +309,7 @@ impl TouchEpisode {
 
     /// Converged touches so far: the readings the belief includes.
     pub fn touches(&self) -> usize {
-        self.touches
+        self.belief.readings
     }
 
     /// The belief over the model's objects after the touches so far (uniform before any).
@@ -380,7 +378,6 @@ impl TouchEpisode {
             .recognition
             .with_dependent_mut(|_, recognition| recognition.observe(&reading.image))?;
         self.last_image = Some(reading.image.clone());
-        self.touches += 1;
         self.belief = belief.clone();
         Ok(Touch { reading, belief })
     }
