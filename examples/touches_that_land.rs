@@ -3,7 +3,9 @@
 //! iteration toward the same kind of candidate (`Planner::touch_toward`, `ActiveTouch-v0`). Each
 //! object starts at a random pose drawn from the seed (the letters within 10 degrees of upright),
 //! each touch goes toward a candidate of the planner's local/global rule (L = 0.5) picked at
-//! random, as a random policy picks; the statuses of the attempts are counted by cause.
+//! random, as a random policy picks; how each touch's last attempt ended is counted by status and
+//! cause (a guarded touch makes a second attempt only after a first that met the object and
+//! failed, `RetryFrom`).
 //!
 //! `cargo run --release --example touches_that_land -- <shapes|letters|flat> [touches] [seed]`
 //! (`flat`: a 12 x 8 x 1 cm plate and a ring 12 cm across, 1 cm thick, 2.5 cm wide)
@@ -43,14 +45,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         seed,
         start_pose: StartPose::random(heading),
     };
-    println!("object,touch,touches,converged,converged_per_touch,attempts_by_status");
+    println!("object,touch,touches,converged,converged_per_touch,attempts,last_attempt_by_status");
     let mut totals: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
     for (index, object) in objects.iter().enumerate() {
         for guarded in [true, false] {
             let (mut scene, mut explorer) = plan.planner_for(object, index, planner)?;
             let mut pick = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ index as u64);
             let mut statuses: BTreeMap<String, usize> = BTreeMap::new();
-            let mut converged = 0;
+            let (mut converged, mut attempts) = (0, 0);
             for _ in 0..touches {
                 let candidates = explorer.propose_candidates(12);
                 let candidate = candidates[pick.random_range(0..candidates.len())];
@@ -60,6 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     explorer.touch_toward(&mut scene, &object.name, candidate)?
                 };
                 converged += report.converged();
+                attempts += report.readings.len();
                 *statuses.entry(outcome(report.readings.last())).or_insert(0) += 1;
             }
             let kind = if guarded { "guarded" } else { "iteration" };
@@ -67,7 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             *total = (total.0 + converged, total.1 + touches);
             let by_status: Vec<String> = statuses.iter().map(|(s, n)| format!("{s}={n}")).collect();
             println!(
-                "{},{kind},{touches},{converged},{:.3},{}",
+                "{},{kind},{touches},{converged},{:.3},{attempts},{}",
                 object.name,
                 converged as f64 / touches as f64,
                 by_status.join(" ")

@@ -340,11 +340,11 @@ fn active_exploration_touches_about_as_often_as_blind_exploration() {
     );
 }
 
-/// Every guarded touch is one reading attempt with a status, most of them converged on these two
+/// Every guarded touch is one or two reading attempts with a status, most converged on these two
 /// simple objects, where planner iterations toward the same kind of candidates mostly meet
 /// nothing; the episode's touches of one seed are the same touches again.
 #[test]
-fn every_guarded_touch_is_one_attempt_and_most_land() {
+fn every_guarded_touch_is_an_attempt_or_two_and_most_land() {
     const TOUCHES: usize = 12;
     let model = model();
     let guarded = |object: &ObjectSpec, touch: TouchAction| {
@@ -360,7 +360,9 @@ fn every_guarded_touch_is_one_attempt_and_most_land() {
             let attempts = episode.attempts();
             let touched = episode.touch(step % 4).unwrap();
             if touch == TouchAction::Guarded {
-                assert_eq!(episode.attempts(), attempts + 1, "one attempt a touch");
+                // A second only when the first met the object and failed (`RetryFrom`).
+                let made = episode.attempts() - attempts;
+                assert!(made == 1 || made == 2, "{made} attempts in a touch");
             }
             let status = episode.last_attempt().map(|r| r.status);
             assert_eq!(touched.is_some(), status == Some(ContactStatus::Converged));

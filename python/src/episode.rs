@@ -26,7 +26,8 @@ use crate::object::Object;
 /// 180 for any heading, 10 for the raised letters, whose heading is part of their identity) and
 /// perturbed after every reading within `perturb_deg` / `perturb_frac`. A touch is `touch`:
 /// `"guarded"` (the pad moved along a ray through the candidate until it meets a surface, then
-/// settled: one reading attempt every touch) or `"iteration"` (one planner iteration toward it).
+/// settled: a reading attempt every touch, two when the first met the object and failed) or
+/// `"iteration"` (one planner iteration toward it).
 ///
 /// Its touches release the GIL; one episode is used by one thread at a time (a lock).
 #[pyclass(module = "taction")]

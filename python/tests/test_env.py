@@ -227,13 +227,15 @@ def test_v1_passes_check_env_and_says_how_every_touch_ended(small_model):
         check_env(env.unwrapped, skip_render_check=True)
     obs, _ = env.reset(seed=7)
     assert "contact" in obs and not obs["contact"].any()
-    converged = 0
+    converged, attempts = 0, 0
     for step in range(12):
         obs, reward, terminated, truncated, info = env.step(step % env.unwrapped.k)
         assert env.observation_space.contains(obs)
         assert info["reading"] in STATUSES, info
         assert info["converged"] == (info["reading"] == "converged")
-        assert info["attempts"] == step + 1, "one reading attempt every touch"
+        # One reading attempt every touch, and a second when the first met the object and failed.
+        assert info["attempts"] - attempts in (1, 2), info
+        attempts = info["attempts"]
         converged += info["converged"]
         if info["converged"]:
             # Where the touch met the surface, and its outward normal.

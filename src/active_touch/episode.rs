@@ -1,8 +1,8 @@
 //! One object's active exploration, touch by touch, with the choice of each touch left to the
 //! caller (a policy learning where to touch, a Gymnasium environment): the arm and the object in
 //! their scene, the planner (Sec. III-A) that proposes where the next touch may go and carries the
-//! pad there (a guarded touch by default, one reading attempt every action; or one planner
-//! iteration, [`TouchAction`]), and the belief over identity after every converged reading
+//! pad there (a guarded touch by default, a reading attempt every action, two when the first met
+//! the object and failed; or one planner iteration, [`TouchAction`]), and the belief over identity after every converged reading
 //! (Eq. 15-16).
 //!
 //! The scene and the planner are built as the `active` experiment builds them
@@ -38,7 +38,8 @@ use crate::valid::{Check, FieldChecks, RangeError, Valid};
 #[serde(rename_all = "snake_case")]
 pub enum TouchAction {
     /// A guarded touch through the candidate ([`Planner::guarded_touch`]): the pad moved along a
-    /// ray until the covering meets a surface, then settled; one reading attempt every action.
+    /// ray until the covering meets a surface, then settled; a reading attempt every action (and
+    /// a second when the first met the object and failed, `explore::RetryFrom`).
     #[default]
     Guarded,
     /// One planner iteration toward the candidate ([`Planner::touch_toward`], Sec. III-A), what

@@ -23,6 +23,9 @@
 //! clear, as a compliant wrist would; Press then closes the gap. The IK holds the pad's roll
 //! through both (`InverseKinematics::solve_with_up`).
 
+use glam::DQuat;
+
+use crate::bodies::{ARM_BODIES, OBJECT_BODY, PAD_BODY};
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, backed_off};
 use crate::pose::PadPose;
 use crate::sim::arm::Execution;
@@ -39,6 +42,9 @@ pub struct ArmPad<'s, R> {
     motion: MoveOptions,
     /// The configuration at which a Press command was last refused outright by a rigid contact.
     refused_at: Option<Vec<f64>>,
+    /// Whether an Orient turn that would bring an arm link onto the table is shortened to what
+    /// the arm can reach ([`limited_by_the_table`](Self::limited_by_the_table)).
+    table_limits_turns: bool,
 }
 
 impl<'s, R> ArmPad<'s, R>
@@ -62,7 +68,19 @@ where
             reader,
             motion,
             refused_at: None,
+            table_limits_turns: false,
         })
+    }
+
+    /// The carrier with Orient turns limited by the table: a turn that would bring an arm link
+    /// (not the pad, whose rigid back backs off instead) onto the table is tried at half and a
+    /// quarter of its angle, and when none of them is free the pad stays, as Orient issuing no
+    /// command (the turn is out of the arm's reach: [`PadMotion::TurnOutOfReach`]). Near the
+    /// table's edge of an object the wrist cannot follow the surface normal to the horizontal,
+    /// and the reading is taken pressed at the steepest turn the arm allows.
+    pub fn limited_by_the_table(mut self) -> Self {
+        self.table_limits_turns = true;
+        self
     }
 
     pub fn scene(&mut self) -> &mut Scene {
@@ -93,6 +111,48 @@ impl<R> ArmPad<'_, R> {
     }
 }
 
+impl<R> ArmPad<'_, R>
+where
+    R: ReadTactile,
+{
+    /// Whether a collision is an arm link (the pad's body excepted) on the table.
+    fn is_arm_on_table(&self, c: &Collision) -> bool {
+        let on_table = |link: &str, other: &str| {
+            link != PAD_BODY
+                && ARM_BODIES.contains(&link)
+                && !ARM_BODIES.contains(&other)
+                && other != OBJECT_BODY
+        };
+        on_table(&c.body_a, &c.body_b) || on_table(&c.body_b, &c.body_a)
+    }
+
+    /// The turn from `current` to `target` at half, then a quarter of its angle (about the same
+    /// pivot: the pose interpolated), the first the arm makes without a collision; else the pad
+    /// put back at `start` and the turn reported out of reach.
+    fn shortened_turn(
+        &mut self,
+        current: &PadPose,
+        target: &PadPose,
+        start: &[f64],
+    ) -> Result<PadMotion, ControlError> {
+        let turn = DQuat::from_rotation_arc(current.normal, target.normal);
+        for fraction in [0.5, 0.25] {
+            let partial = DQuat::IDENTITY.slerp(turn, fraction);
+            let shorter = PadPose {
+                center_m: current.center_m.lerp(target.center_m, fraction),
+                normal: (partial * current.normal).normalize(),
+                up: (partial * current.up).normalize(),
+            };
+            self.arm.place(self.scene, start);
+            if let (PadMotion::Moved, None) = self.try_move(&shorter, start)? {
+                return Ok(PadMotion::Moved);
+            }
+        }
+        self.arm.place(self.scene, start);
+        Ok(PadMotion::TurnOutOfReach)
+    }
+}
+
 impl<R> PadCarrier for ArmPad<'_, R>
 where
     R: ReadTactile,
@@ -114,6 +174,13 @@ where
         let start = self.arm.q(self.scene.data());
         let current = self.pad_pose();
         let (motion, contact) = self.try_move(target, &start)?;
+        if let PadMotion::Collided(c) = &motion
+            && self.table_limits_turns
+            && self.is_arm_on_table(c)
+            && current.normal.angle_between(target.normal) > 1e-6
+        {
+            return self.shortened_turn(&current, target, &start);
+        }
         let Some(contact) = contact else {
             return Ok(motion);
         };

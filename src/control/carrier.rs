@@ -20,6 +20,9 @@ pub enum PadMotion {
     Collided(Collision),
     /// The pose cannot be reached (inverse kinematics failed within the joint limits).
     Unreachable,
+    /// An Orient turn the arm cannot make without touching the table; the pad stayed where it
+    /// was (a carrier limited by the table, `ArmPad::limited_by_the_table`).
+    TurnOutOfReach,
 }
 
 /// Errors that end a controller run abnormally (not a controller outcome such as `NoContact`).

@@ -144,6 +144,7 @@ impl<C: PadCarrier + ?Sized> Settling<'_, C> {
         self.trace.push(Command::Orient, target);
         match self.carrier.move_pad(&target)? {
             PadMotion::Moved | PadMotion::RigidContact => {}
+            PadMotion::TurnOutOfReach => return Ok(Step::On(false)),
             motion => return Ok(Step::Ended(Box::new(self.blocked(&motion, iteration)?))),
         }
         *image = self.carrier.read()?;
@@ -156,7 +157,9 @@ impl<C: PadCarrier + ?Sized> Settling<'_, C> {
         let (status, collision) = match motion {
             PadMotion::Collided(c) => (ContactStatus::Collision, Some(c.clone())),
             PadMotion::RigidContact => (ContactStatus::Saturated, None),
-            PadMotion::Unreachable | PadMotion::Moved => (ContactStatus::Unreachable, None),
+            PadMotion::Unreachable | PadMotion::Moved | PadMotion::TurnOutOfReach => {
+                (ContactStatus::Unreachable, None)
+            }
         };
         let image = self.carrier.read()?;
         self.finish(status, image, iteration, collision)

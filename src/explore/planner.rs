@@ -40,7 +40,7 @@
 
 mod guarded;
 
-pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay};
+pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay, RETRY_AHEAD_M, RETRY_BACK_M, RetryFrom};
 
 use glam::DVec3;
 use rand::RngExt;
@@ -273,11 +273,13 @@ struct Expansion<'a> {
     checkpoint: &'a SceneState,
     /// Expansion steps at most.
     max_steps: usize,
-    /// Whether the object reaching the pad's rigid back ([`Collision::back_on_object`]) hands
-    /// over to the controllers, as a rigid contact does in their Approach (a guarded touch, whose
-    /// motion is an Approach along the pad's normal), rather than stopping the expansion as a
-    /// collision (the planner's collision-free motions, Sec. III-A).
-    back_contact_settles: bool,
+    /// A guarded touch's motion (`planner/guarded.rs`), an Approach along the pad's normal: the
+    /// object reaching the pad's rigid back ([`Collision::back_on_object`]) hands over to the
+    /// controllers, as a rigid contact does in their Approach, rather than stopping the expansion
+    /// as a collision (the planner's collision-free motions, Sec. III-A); and the controllers'
+    /// turns are limited by the table ([`ArmPad::limited_by_the_table`]). The planner's own
+    /// iterations keep the paper's behaviour, so its experiments do not move.
+    guarded: bool,
 }
 
 /// How an expansion ended.
@@ -565,7 +567,7 @@ where
             object,
             checkpoint: &checkpoint,
             max_steps: self.config.max_steps_per_iteration,
-            back_contact_settles: false,
+            guarded: false,
         };
         match self.expand(scene, arm, &expansion, record) {
             Ok(ExpansionEnd::Collided(c)) => {
@@ -658,11 +660,7 @@ where
             };
             let (outcome, sensed) = self.expand_to(scene, arm, &q, threshold)?;
             let felt = match outcome {
-                MoveOutcome::Collided(c)
-                    if expansion.back_contact_settles && c == Collision::back_on_object() =>
-                {
-                    true
-                }
+                MoveOutcome::Collided(c) if expansion.guarded && c == Collision::back_on_object() => true,
                 MoveOutcome::Collided(c) => return Ok(ExpansionEnd::Collided(c)),
                 MoveOutcome::Reached | MoveOutcome::Stopped => sensed,
             };
@@ -731,13 +729,7 @@ where
         record: &mut Record<'_>,
     ) -> Result<(), ControlError> {
         let (vertex, pad) = at;
-        let mut reading = self.settle_here(
-            scene,
-            arm,
-            expansion.object,
-            expansion.label,
-            expansion.checkpoint,
-        )?;
+        let mut reading = self.settle_here(scene, arm, expansion)?;
         relabel_table_contact(&mut reading, &self.setup.sensor);
         let converged = reading.is_converged();
         let pose = reading.image.pose().copied().unwrap_or(pad);
@@ -870,10 +862,15 @@ where
         &mut self,
         scene: &mut Scene,
         arm: &Arm,
-        object: &str,
-        strategy: Strategy,
-        checkpoint: &SceneState,
+        expansion: &Expansion<'_>,
     ) -> Result<Reading, ControlError> {
+        let Expansion {
+            object,
+            label: strategy,
+            checkpoint,
+            guarded,
+            ..
+        } = *expansion;
         let object_pose = scene.object_pose().unwrap_or_default();
         let start = arm.pad_pose(scene.data());
         let Self {
@@ -885,6 +882,9 @@ where
             ..
         } = self;
         let mut carrier = ArmPad::new(scene, ik, *sensor, |s: &mut Scene| reader(s), *motion)?;
+        if guarded {
+            carrier = carrier.limited_by_the_table();
+        }
         match settle(&mut carrier, control) {
             Ok(outcome) => Ok(attempt_reading(outcome, object, object_pose, strategy)),
             Err(e) if e.is_physics_fault() => {

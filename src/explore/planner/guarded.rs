@@ -19,17 +19,27 @@
 //! pad's rigid back between the covering's samples before any taxel rises hands over to the
 //! controllers too, as a rigid contact does in their own Approach; a planner expansion counts it
 //! a collision (on the 12 shapes that was 59 of 240 touches, and converged touches rose from 0.66
-//! to 0.78 when it handed over). Every guarded
-//! touch yields one reading attempt: `converged` (or how the controllers ended), `no_contact`
-//! (the ray reached the table's height untouched), `collision` with who touched whom (the arm or
-//! the pad's back on the object or the table), `unreachable` (no inverse-kinematics solution on
-//! the ray), or `aborted` (a physics fault; the world put back).
+//! to 0.78 when it handed over). The controllers' turns are limited by the table
+//! ([`ArmPad::limited_by_the_table`](crate::control::ArmPad::limited_by_the_table)): on an
+//! object's side near the table the wrist (a capsule 2.8 cm across behind a 1.2 cm pad) cannot
+//! follow the surface normal to the horizontal, and the reading is taken at the steepest turn it
+//! allows rather than lost as `arm_on_table` (68 of 960 touches on the 12 shapes were).
+//!
+//! A first attempt that met the object and failed gets one more ([`RetryFrom`]): after the
+//! controllers had pressed (a contact lost off an edge, iterations run out, a collision while
+//! settling) again along the normal Orient had turned to, which is how the paper's controllers
+//! converge best (Sec. V-B1); after a motion stopped before any pressing (an arm link met the
+//! object beside the pad) straight down from above that spot. A touch therefore yields one
+//! reading attempt, or two when the first failed so, each with its status: `converged` (or how
+//! the controllers ended), `no_contact` (the ray reached its end untouched), `collision` with
+//! who touched whom (the arm or the pad's back on the object or the table), `unreachable` (no
+//! inverse-kinematics solution on the ray), or `aborted` (a physics fault; the world put back).
 
 use glam::DVec3;
 
 use super::{Expansion, ExpansionEnd, Planner, Record};
 use crate::control::{ControlError, ReadTactile};
-use crate::dataset::{AttemptCause, ContactStatus, Strategy};
+use crate::dataset::{AttemptCause, ContactStatus, Reading, Strategy};
 use crate::explore::report::{ExplorationReport, unsettled_reading};
 use crate::sim::mjcf::TABLE_TOP_Z_M;
 use crate::sim::{Arm, PadTarget, Scene, SimError};
@@ -42,6 +52,41 @@ use crate::sim::{Arm, PadTarget, Scene, SimError};
 /// 0.74 at 0, 0.75 / 0.84 at 0.1, 0.78 / 0.87 at 0.25, **0.80 / 0.82 at 0.3**, 0.81 / 0.73 at
 /// 0.35, 0.81 / 0.42 at 0.5, 0.69 at 0.7 (shapes).
 pub const AXIS_HEIGHT_FRACTION: f64 = 0.3;
+
+/// How far before the surface a second attempt along the normal starts, metres: clear of the
+/// surface by more than the covering and the Approach's reach is the ray's.
+pub const RETRY_BACK_M: f64 = 0.03;
+
+/// How far beyond the surface a second attempt along the normal goes before it gives up, metres.
+pub const RETRY_AHEAD_M: f64 = 0.02;
+
+/// Where a guarded touch's second attempt comes from, decided by how the first failed. A first
+/// attempt that met nothing on its ray, could not be reached, faulted or pressed the covering on
+/// the table gets none: nothing says the object is anywhere near.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RetryFrom {
+    /// The controllers had pressed (a contact lost off an edge, the iterations run out, the arm or
+    /// the pad's back on something while settling): again along the normal they had turned to
+    /// ([`ApproachRay::along_normal`]).
+    AlongNormal,
+    /// The motion stopped before the controllers pressed (an arm link or the pad's back met the
+    /// object or the table): straight down from above ([`ApproachRay::from_above`]).
+    Above,
+}
+
+impl RetryFrom {
+    /// The retry a failed first attempt earns, if any.
+    pub fn failure(failed: &Reading) -> Option<Self> {
+        let pressed = failed.iterations > 0;
+        match (failed.status, &failed.cause) {
+            (ContactStatus::Converged | ContactStatus::Unreachable | ContactStatus::Aborted, _)
+            | (ContactStatus::NoContact, None)
+            | (_, Some(AttemptCause::CoveringOnTable | AttemptCause::PhysicsFault)) => None,
+            _ if pressed => Some(Self::AlongNormal),
+            _ => Some(Self::Above),
+        }
+    }
+}
 
 /// A target within this horizontal distance of the workspace's axis is approached straight down,
 /// metres (the direction toward the axis is not defined there).
@@ -102,6 +147,31 @@ impl ApproachRay {
         })
     }
 
+    /// The ray of a second attempt after one the controllers could not settle: toward
+    /// `surface_m` (where the covering was, on the surface) along `normal` (the pad's normal,
+    /// which Orient had turned toward the surface's), from [`RETRY_BACK_M`] before it to
+    /// [`RETRY_AHEAD_M`] beyond. Approached along the surface's normal, the controllers converge
+    /// (Sec. V-B1: "the sensor must approach from an angle reasonably close to the object's
+    /// surface normal in order to converge well").
+    pub fn along_normal(surface_m: DVec3, normal: DVec3) -> Self {
+        Self {
+            start_m: surface_m - normal * RETRY_BACK_M,
+            direction: normal,
+            end_m: surface_m + normal * RETRY_AHEAD_M,
+        }
+    }
+
+    /// Straight down through `point` from the workspace's top `top_z_m` to `end_height_m` above
+    /// the table: the second attempt after a motion stopped before the covering felt anything
+    /// (an arm link met the object beside the pad: the object is there, below the wrist).
+    pub fn from_above(point: DVec3, top_z_m: f64, end_height_m: f64) -> Self {
+        Self {
+            start_m: DVec3::new(point.x, point.y, top_z_m.max(point.z)),
+            direction: DVec3::NEG_Z,
+            end_m: DVec3::new(point.x, point.y, TABLE_TOP_Z_M + end_height_m),
+        }
+    }
+
     /// The ray's length from start to end, metres.
     pub fn length_m(&self) -> f64 {
         (self.end_m - self.start_m).length()
@@ -129,13 +199,25 @@ impl<R> Planner<R>
 where
     R: ReadTactile,
 {
+    /// The second attempt of a guarded touch whose first attempt `failed` after the arm met
+    /// something ([`RetryFrom::failure`]): the ray it takes, `None` when there is none.
+    fn retry_ray(&self, failed: &Reading) -> Option<ApproachRay> {
+        let pose = failed.image.pose()?;
+        let t = self.setup.sensor.thickness_m;
+        Some(match RetryFrom::failure(failed)? {
+            RetryFrom::Above => ApproachRay::from_above(pose.center_m, self.config.workspace_max_m.z, t),
+            RetryFrom::AlongNormal => ApproachRay::along_normal(pose.center_m + pose.normal * t, pose.normal),
+        })
+    }
+
     /// One guarded touch through `candidate`'s target (a proposal of
     /// [`propose_candidates`](Self::propose_candidates), or any point above the table; its kind
     /// tags the reading): the pad placed where the [`ApproachRay`] enters the workspace, moved
     /// along it until the sensor feels a surface, and settled there by the controllers
-    /// (Algorithm 1). The report holds exactly one reading attempt, whatever happened (the module
-    /// docs list the statuses); a converged one enters the grid and the touch odds, as a planner
-    /// iteration's does, and the object is perturbed after every settled attempt.
+    /// (Algorithm 1). The report holds one reading attempt whatever happened, and a second when
+    /// the first met the object and failed ([`RetryFrom`]; the module docs list the statuses); a
+    /// converged one enters the grid and the touch odds, as a planner iteration's does, and the
+    /// object is perturbed after every settled attempt.
     pub fn guarded_touch(
         &mut self,
         scene: &mut Scene,
@@ -150,16 +232,21 @@ where
             },
             on_converged: &mut || {},
         };
-        if let Some(end) = self.approach_along_ray(scene, &arm, object, candidate, &mut record)? {
-            let at = arm.pad_pose(scene.data());
-            let object_pose = scene.object_pose().unwrap_or_default();
-            record.push(unsettled_reading(
-                &self.setup.sensor,
-                at,
-                (object, object_pose),
-                candidate.0,
-                end,
-            )?);
+        let (min, max) = (self.config.workspace_min_m, self.config.workspace_max_m);
+        let ray = ApproachRay::through(candidate.1, min, max, self.setup.sensor.thickness_m);
+        // The first attempt's ray (none: the target admits no descending ray), then the retry's.
+        let mut next = Some(ray);
+        while let Some(ray) = next.take() {
+            if let Some(end) = self.approach_along_ray(scene, &arm, object, candidate.0, ray, &mut record)? {
+                let at = arm.pad_pose(scene.data());
+                let object_pose = scene.object_pose().unwrap_or_default();
+                let reading =
+                    unsettled_reading(&self.setup.sensor, at, (object, object_pose), candidate.0, end);
+                record.push(reading?);
+            }
+            if let [first] = record.report.readings.as_slice() {
+                next = self.retry_ray(first).map(Some);
+            }
         }
         self.odds
             .record(candidate.0, candidate.1, record.report.converged() > 0);
@@ -174,12 +261,12 @@ where
         scene: &mut Scene,
         arm: &Arm,
         object: &str,
-        (label, target): (Strategy, DVec3),
+        label: Strategy,
+        ray: Option<ApproachRay>,
         record: &mut Record<'_>,
     ) -> Result<Option<(ContactStatus, Option<AttemptCause>)>, ControlError> {
         let unreachable = Some((ContactStatus::Unreachable, None));
-        let (min, max) = (self.config.workspace_min_m, self.config.workspace_max_m);
-        let Some(ray) = ApproachRay::through(target, min, max, self.setup.sensor.thickness_m) else {
+        let Some(ray) = ray else {
             return Ok(unreachable);
         };
         let start = PadTarget {
@@ -209,7 +296,7 @@ where
             object,
             checkpoint: &checkpoint,
             max_steps: (ray.length_m() / self.config.step_m).ceil() as usize + 1,
-            back_contact_settles: true,
+            guarded: true,
         };
         Ok(match self.expand(scene, arm, &expansion, record) {
             Ok(ExpansionEnd::Read) => None,
@@ -263,6 +350,81 @@ mod tests {
         let down = ApproachRay::through(DVec3::new(0.0, 0.0, 0.1), MIN, MAX, 0.002).unwrap();
         assert_eq!(down.direction, DVec3::NEG_Z);
         assert!((down.start_m.z - 0.2).abs() < 1e-12);
+    }
+
+    /// A failed first attempt as the dataset records it: `status`, `cause`, `iterations`.
+    fn failed(status: ContactStatus, cause: Option<AttemptCause>, iterations: u32) -> Reading {
+        Reading {
+            image: crate::tactile::TactileImage::zeros(6, 6).unwrap(),
+            object: "box".into(),
+            object_pose: crate::pose::Pose::default(),
+            status,
+            iterations,
+            strategy: Strategy::Global,
+            cause,
+        }
+    }
+
+    #[test]
+    fn a_second_attempt_follows_only_a_failure_that_met_the_object() {
+        let touched = |a: &str, b: &str| {
+            Some(AttemptCause::Touched {
+                body_a: a.into(),
+                body_b: b.into(),
+            })
+        };
+        let cases = [
+            (failed(ContactStatus::Converged, None, 3), None),
+            (failed(ContactStatus::NoContact, None, 0), None),
+            (failed(ContactStatus::Unreachable, None, 0), None),
+            (
+                failed(ContactStatus::Aborted, Some(AttemptCause::PhysicsFault), 2),
+                None,
+            ),
+            (
+                failed(ContactStatus::Collision, Some(AttemptCause::CoveringOnTable), 4),
+                None,
+            ),
+            (
+                failed(ContactStatus::NoContact, Some(AttemptCause::LostContact), 1),
+                Some(RetryFrom::AlongNormal),
+            ),
+            (
+                failed(ContactStatus::MaxIterations, None, 40),
+                Some(RetryFrom::AlongNormal),
+            ),
+            (
+                failed(ContactStatus::Collision, touched("link4", "world"), 6),
+                Some(RetryFrom::AlongNormal),
+            ),
+            (
+                failed(ContactStatus::Collision, touched("link4", "object"), 0),
+                Some(RetryFrom::Above),
+            ),
+        ];
+        for (reading, expected) in cases {
+            assert_eq!(RetryFrom::failure(&reading), expected, "{reading:?}");
+        }
+    }
+
+    #[test]
+    fn a_retry_approaches_the_surface_along_its_normal_or_comes_down_from_above() {
+        let normal = DVec3::new(1.0, 0.0, -1.0).normalize();
+        let surface = DVec3::new(0.02, 0.01, 0.05);
+        let ray = ApproachRay::along_normal(surface, normal);
+        assert_eq!(ray.direction, normal);
+        assert!((ray.length_m() - (RETRY_BACK_M + RETRY_AHEAD_M)).abs() < 1e-12);
+        assert!(((surface - ray.start_m).dot(normal) - RETRY_BACK_M).abs() < 1e-12);
+        assert!(
+            (surface - ray.start_m).cross(normal).length() < 1e-12,
+            "on the normal"
+        );
+
+        let down = ApproachRay::from_above(DVec3::new(0.03, -0.01, 0.02), MAX.z, 0.002);
+        assert_eq!(down.direction, DVec3::NEG_Z);
+        assert_eq!(down.start_m, DVec3::new(0.03, -0.01, MAX.z));
+        assert!((down.end_m.z - (TABLE_TOP_Z_M + 0.002)).abs() < 1e-12);
+        assert_eq!((down.end_m.x, down.end_m.y), (0.03, -0.01));
     }
 
     #[test]
