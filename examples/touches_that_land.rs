@@ -5,7 +5,7 @@
 //! each touch goes toward a candidate of the planner's local/global rule (L = 0.5) picked at
 //! random, as a random policy picks; how each touch's last attempt ended is counted by status and
 //! cause (a guarded touch makes a second attempt only after a first that met the object and
-//! failed, `RetryFrom`).
+//! failed, `earns_a_retry`).
 //!
 //! `cargo run --release --example touches_that_land -- <shapes|letters|flat> [touches] [seed]`
 //! (`flat`: a 12 x 8 x 1 cm plate and a ring 12 cm across, 1 cm thick, 2.5 cm wide)

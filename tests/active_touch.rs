@@ -360,7 +360,7 @@ fn every_guarded_touch_is_an_attempt_or_two_and_most_land() {
             let attempts = episode.attempts();
             let touched = episode.touch(step % 4).unwrap();
             if touch == TouchAction::Guarded {
-                // A second only when the first met the object and failed (`RetryFrom`).
+                // A second only when the first met the object and failed (`earns_a_retry`).
                 let made = episode.attempts() - attempts;
                 assert!(made == 1 || made == 2, "{made} attempts in a touch");
             }

@@ -40,7 +40,7 @@
 
 mod guarded;
 
-pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay, RETRY_AHEAD_M, RETRY_BACK_M, RetryFrom};
+pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay, earns_a_retry};
 
 use glam::DVec3;
 use rand::RngExt;
