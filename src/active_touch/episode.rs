@@ -29,7 +29,7 @@ use crate::explore::{
 use crate::locate::Contact;
 use crate::pose::PadPose;
 use crate::recognize::{Belief, Recognizer, check_same_sensor};
-use crate::sim::{Arm, ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
+use crate::sim::{Arm, ObjectSpec, PerturbationBounds, Scene, SimError, StartPose, give_back_freed_memory};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::{Check, FieldChecks, RangeError, Valid};
 
@@ -208,12 +208,17 @@ impl TouchEpisode {
     /// within `config.perturbation`), the planner at its start and the first candidates drawn, the belief
     /// uniform. `object` must be one of the model's objects (its index there selects its random
     /// streams, as in the `active` experiment), and `config.sensor` the model's sensor.
+    ///
+    /// The memory earlier episodes freed goes back to the system first
+    /// ([`give_back_freed_memory`]): a run that makes episode after episode (an environment's
+    /// resets) otherwise keeps every freed byte of them.
     pub fn new(
         model: Arc<Recognizer>,
         object: &ObjectSpec,
         config: &Valid<EpisodeConfig>,
         seed: u64,
     ) -> Result<Self, TouchError> {
+        give_back_freed_memory();
         check_same_sensor(model.sensor(), &config.sensor)?;
         let object_index = model
             .objects()

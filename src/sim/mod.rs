@@ -14,7 +14,9 @@ pub(crate) mod twin;
 
 // The world: built from objects and the arm, stepped, saved and restored.
 pub use object::{DRAWN_MESH_TRIANGLES, LARGE_MESH_TRIANGLES, ObjectMount, ObjectSpec, ObjectSurfaces};
-pub use scene::{Scene, SceneBuilder, SceneObject, SceneState, keep_mujoco_log_off_disk};
+pub use scene::{
+    Scene, SceneBuilder, SceneObject, SceneState, give_back_freed_memory, keep_mujoco_log_off_disk,
+};
 
 // The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.
 pub use arm::{

@@ -258,6 +258,24 @@ fn keep_heap_top() {
     }
 }
 
+/// Gives the heap's freed memory back to the system, where no MuJoCo XML is being parsed.
+///
+/// Heap trimming is off for the process (`keep_heap_top`, for the compiler's sake), so nothing
+/// freed is ever returned on its own, and a long run that builds and drops scenes (an environment
+/// resetting episode after episode, its Python objects' allocations interleaved with the
+/// library's) grows its resident memory with freed, fragmented heap: 269 -> 299 MiB over 30,000
+/// steps of one `taction/ActiveTouch-v1` environment, 106-111 MiB throughout with a trim at every
+/// reset (docs/measurements.md, "Touches that land"). A trim may leave `errno` set, as a refused
+/// `sbrk` does; that is harmless outside a parse (MuJoCo's parser zeroes `errno` before each
+/// attribute it reads, and `errno` is the calling thread's own), so it runs between episodes.
+pub fn give_back_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `malloc_trim` only walks glibc's own heap under its locks; any argument is valid.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 /// Stops MuJoCo from appending its messages to `MUJOCO_LOG.TXT` in the working directory; it
 /// still prints them on stderr. A run reports the faults those warnings announce itself
 /// ([`Scene::fault`]; `physics_fault` among a dataset's causes), so the file only left a stray
