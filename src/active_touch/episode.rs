@@ -2,8 +2,8 @@
 //! caller (a policy learning where to touch, a Gymnasium environment): the arm and the object in
 //! their scene, the planner (Sec. III-A) that proposes where the next touch may go and carries the
 //! pad there (a guarded touch by default, a reading attempt every action, two when the first met
-//! the object and failed; or one planner iteration, [`TouchAction`]), and the belief over identity after every converged reading
-//! (Eq. 15-16).
+//! the object and failed; or one planner iteration, [`TouchAction`]), and the belief over
+//! identity after every converged reading (Eq. 15-16).
 //!
 //! The scene and the planner are built as the `active` experiment builds them
 //! ([`CollectPlan::planner_for`]: the object's own random and sensor-noise streams of the seed, the

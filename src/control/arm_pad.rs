@@ -25,8 +25,9 @@
 
 use glam::DQuat;
 
-use crate::bodies::{ARM_BODIES, OBJECT_BODY, PAD_BODY};
+use crate::bodies::PAD_BODY;
 use crate::control::carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, backed_off};
+use crate::dataset::{AttemptCause, CauseKind};
 use crate::pose::PadPose;
 use crate::sim::arm::Execution;
 use crate::sim::{Arm, Collision, IkError, InverseKinematics, MoveOptions, MoveOutcome, PadTarget, Scene};
@@ -115,20 +116,18 @@ impl<R> ArmPad<'_, R>
 where
     R: ReadTactile,
 {
-    /// Whether a collision is an arm link (the pad's body excepted) on the table.
+    /// Whether a collision is an arm link (the pad's body excepted) on the table, as a reading's
+    /// cause names it (`arm_on_table`).
     fn is_arm_on_table(&self, c: &Collision) -> bool {
-        let on_table = |link: &str, other: &str| {
-            link != PAD_BODY
-                && ARM_BODIES.contains(&link)
-                && !ARM_BODIES.contains(&other)
-                && other != OBJECT_BODY
-        };
-        on_table(&c.body_a, &c.body_b) || on_table(&c.body_b, &c.body_a)
+        let cause = AttemptCause::from(c);
+        let pad = matches!(&cause, AttemptCause::Touched { body_a, .. } if body_a == PAD_BODY);
+        cause.kind() == CauseKind::ArmOnTable && !pad
     }
 
-    /// The turn from `current` to `target` at half, then a quarter of its angle (about the same
-    /// pivot: the pose interpolated), the first the arm makes without a collision; else the pad
-    /// put back at `start` and the turn reported out of reach.
+    /// The turn from `current` to `target` at half, then a quarter of its angle (the normal and up
+    /// turned by that part of the rotation, the centre that part of the way along the chord), the
+    /// first the arm makes without a collision; else the pad put back at `start` and the turn
+    /// reported out of reach.
     fn shortened_turn(
         &mut self,
         current: &PadPose,

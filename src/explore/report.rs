@@ -2,26 +2,11 @@
 
 use std::collections::BTreeMap;
 
-use crate::bodies::ARM_BODIES;
 use crate::control::ContactOutcome;
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::pose::PadPose;
 use crate::pose::Pose;
-use crate::sim::Collision;
 use crate::tactile::{SensorConfig, TactileError, TactileImage};
-
-/// The collision that stopped a motion, as a reading's cause: the arm's body first.
-impl From<&Collision> for AttemptCause {
-    fn from(collision: &Collision) -> Self {
-        let (a, b) = (&collision.body_a, &collision.body_b);
-        let (body_a, body_b) = if ARM_BODIES.contains(&b.as_str()) && !ARM_BODIES.contains(&a.as_str()) {
-            (b.clone(), a.clone())
-        } else {
-            (a.clone(), b.clone())
-        };
-        Self::Touched { body_a, body_b }
-    }
-}
 
 /// The reading of one settling attempt on `object` (at `object_pose`): the controllers' image and
 /// status, and what ended the attempt (the collision, or a contact lost after pressing). The one
@@ -143,52 +128,5 @@ impl ExplorationReport {
             *counts.entry(r.status).or_insert(0) += 1;
         }
         counts
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn causes_put_the_arm_first_round_trip_and_classify() {
-        let touched = |a: &str, b: &str| {
-            AttemptCause::from(&Collision {
-                body_a: a.into(),
-                body_b: b.into(),
-            })
-        };
-        let pad = touched("object", "sensor");
-        assert_eq!(pad.touched_bodies().as_deref(), Some("sensor/object"));
-        assert_eq!(pad.name(), "pad_on_object");
-        assert_eq!(touched("link3", "object").kind(), CauseKind::ArmOnObject);
-        assert_eq!(touched("world", "link4").kind(), CauseKind::ArmOnTable);
-        assert_eq!(touched("base", "link3").kind(), CauseKind::ArmOnArm);
-        for cause in [
-            pad,
-            touched("world", "link4"),
-            AttemptCause::CoveringOnTable,
-            AttemptCause::LostContact,
-            AttemptCause::PhysicsFault,
-        ] {
-            let bodies = cause.touched_bodies().unwrap_or_default();
-            assert_eq!(AttemptCause::from_columns(cause.name(), &bodies), Ok(Some(cause)));
-        }
-        assert_eq!(AttemptCause::from_columns("", ""), Ok(None));
-        for (cause, bodies, wrong) in [
-            ("pad_on_object", "", "needs the two bodies"),
-            ("pad_on_object", "sensor", "needs the two bodies"),
-            (
-                "pad_on_object",
-                "link4/world",
-                "are arm_on_table, not pad_on_object",
-            ),
-            ("lost_contact", "sensor/object", "names no bodies"),
-            ("", "sensor/object", "without a cause"),
-            ("sensor/object", "", "unknown cause 'sensor/object'"),
-        ] {
-            let e = AttemptCause::from_columns(cause, bodies).unwrap_err();
-            assert!(e.contains(wrong), "{cause} {bodies}: {e}");
-        }
     }
 }

@@ -324,14 +324,14 @@ mod tests {
         assert!((down.start_m.z - 0.2).abs() < 1e-12);
     }
 
-    /// A failed first attempt as the dataset records it: `status`, `cause`, `iterations`.
-    fn failed(status: ContactStatus, cause: Option<AttemptCause>, iterations: u32) -> Reading {
+    /// A first attempt as the dataset records it: how it ended, `status` and `cause`.
+    fn attempt(status: ContactStatus, cause: Option<AttemptCause>) -> Reading {
         Reading {
             image: crate::tactile::TactileImage::zeros(6, 6).unwrap(),
             object: "box".into(),
             object_pose: crate::pose::Pose::default(),
             status,
-            iterations,
+            iterations: 0,
             strategy: Strategy::Global,
             cause,
         }
@@ -346,19 +346,19 @@ mod tests {
             })
         };
         let none = [
-            failed(ContactStatus::Converged, None, 3),
-            failed(ContactStatus::NoContact, None, 0),
-            failed(ContactStatus::Unreachable, None, 0),
-            failed(ContactStatus::Aborted, Some(AttemptCause::PhysicsFault), 2),
-            failed(ContactStatus::Collision, Some(AttemptCause::CoveringOnTable), 4),
+            attempt(ContactStatus::Converged, None),
+            attempt(ContactStatus::NoContact, None),
+            attempt(ContactStatus::Unreachable, None),
+            attempt(ContactStatus::Aborted, Some(AttemptCause::PhysicsFault)),
+            attempt(ContactStatus::Collision, Some(AttemptCause::CoveringOnTable)),
         ];
         let one = [
-            failed(ContactStatus::NoContact, Some(AttemptCause::LostContact), 1),
-            failed(ContactStatus::MaxIterations, None, 40),
-            failed(ContactStatus::Saturated, None, 3),
-            failed(ContactStatus::Collision, touched("link4", "world"), 6),
-            failed(ContactStatus::Collision, touched("link4", "object"), 0),
-            failed(ContactStatus::Collision, touched("sensor", "object"), 2),
+            attempt(ContactStatus::NoContact, Some(AttemptCause::LostContact)),
+            attempt(ContactStatus::MaxIterations, None),
+            attempt(ContactStatus::Saturated, None),
+            attempt(ContactStatus::Collision, touched("link4", "world")),
+            attempt(ContactStatus::Collision, touched("link4", "object")),
+            attempt(ContactStatus::Collision, touched("sensor", "object")),
         ];
         for reading in none {
             assert!(!earns_a_retry(&reading), "{reading:?}");
