@@ -4,13 +4,15 @@
 //! object starts at a random pose drawn from the seed (the letters within 10 degrees of upright),
 //! each touch goes toward a candidate of the planner's local/global rule (L = 0.5) picked at
 //! random, as a random policy picks; how each touch's last attempt ended is counted by status and
-//! cause (a guarded touch makes a second attempt only after a first that met the object and
-//! failed, `earns_a_retry`).
+//! cause (a guarded touch makes another attempt only after one that met the object and failed,
+//! `earns_a_retry`, three at most), and the wall time a touch takes (the scene's set-up not
+//! counted).
 //!
 //! `cargo run --release --example touches_that_land -- <shapes|letters|flat> [touches] [seed]`
 //! (`flat`: a 12 x 8 x 1 cm plate and a ring 12 cm across, 1 cm thick, 2.5 cm wide)
 
 use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
@@ -46,13 +48,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         start_pose: StartPose::random(heading),
     };
     println!("object,touch,touches,converged,converged_per_touch,attempts,last_attempt_by_status");
-    let mut totals: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    let mut totals: BTreeMap<&str, (usize, usize, Duration)> = BTreeMap::new();
     for (index, object) in objects.iter().enumerate() {
         for guarded in [true, false] {
             let (mut scene, mut explorer) = plan.planner_for(object, index, planner)?;
             let mut pick = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ index as u64);
             let mut statuses: BTreeMap<String, usize> = BTreeMap::new();
             let (mut converged, mut attempts) = (0, 0);
+            let start = Instant::now();
             for _ in 0..touches {
                 let candidates = explorer.propose_candidates(12);
                 let candidate = candidates[pick.random_range(0..candidates.len())];
@@ -66,8 +69,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 *statuses.entry(outcome(report.readings.last())).or_insert(0) += 1;
             }
             let kind = if guarded { "guarded" } else { "iteration" };
-            let total = totals.entry(kind).or_insert((0, 0));
-            *total = (total.0 + converged, total.1 + touches);
+            let total = totals.entry(kind).or_insert((0, 0, Duration::ZERO));
+            *total = (total.0 + converged, total.1 + touches, total.2 + start.elapsed());
             let by_status: Vec<String> = statuses.iter().map(|(s, n)| format!("{s}={n}")).collect();
             println!(
                 "{},{kind},{touches},{converged},{:.3},{attempts},{}",
@@ -77,10 +80,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    for (kind, (converged, touches)) in totals {
+    for (kind, (converged, touches, spent)) in totals {
         eprintln!(
-            "{set}, seed {seed}: {kind}: {converged} of {touches} touches converged ({:.3})",
-            converged as f64 / touches as f64
+            "{set}, seed {seed}: {kind}: {converged} of {touches} touches converged ({:.3}), {:.2} ms a touch",
+            converged as f64 / touches as f64,
+            1e3 * spent.as_secs_f64() / touches as f64
         );
     }
     Ok(())

@@ -11,8 +11,8 @@ use taction::active_touch::{EpisodeConfig, Touch, TouchAction, TouchEpisode, Tou
 use taction::dataset::{ContactStatus, Strategy};
 use taction::describe::DescriptorKind;
 use taction::explore::{
-    ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, PlannerConfig,
-    TouchScorer,
+    ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, MAX_ATTEMPTS,
+    PlannerConfig, TouchScorer,
 };
 use taction::pose::Pose;
 use taction::recognize::{Recognizer, TrainConfig, TrainedModel};
@@ -340,11 +340,11 @@ fn active_exploration_touches_about_as_often_as_blind_exploration() {
     );
 }
 
-/// Every guarded touch is one or two reading attempts with a status, most converged on these two
+/// Every guarded touch is one to three reading attempts with a status, most converged on these two
 /// simple objects, where planner iterations toward the same kind of candidates mostly meet
 /// nothing; the episode's touches of one seed are the same touches again.
 #[test]
-fn every_guarded_touch_is_an_attempt_or_two_and_most_land() {
+fn every_guarded_touch_is_one_to_three_attempts_and_most_land() {
     const TOUCHES: usize = 12;
     let model = model();
     let guarded = |object: &ObjectSpec, touch: TouchAction| {
@@ -360,9 +360,9 @@ fn every_guarded_touch_is_an_attempt_or_two_and_most_land() {
             let attempts = episode.attempts();
             let touched = episode.touch(step % 4).unwrap();
             if touch == TouchAction::Guarded {
-                // A second only when the first met the object and failed (`earns_a_retry`).
+                // Another only after one that met the object and failed (`earns_a_retry`).
                 let made = episode.attempts() - attempts;
-                assert!(made == 1 || made == 2, "{made} attempts in a touch");
+                assert!((1..=MAX_ATTEMPTS).contains(&made), "{made} attempts in a touch");
             }
             let status = episode.last_attempt().map(|r| r.status);
             assert_eq!(touched.is_some(), status == Some(ContactStatus::Converged));

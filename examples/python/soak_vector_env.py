@@ -2,7 +2,10 @@
 (``sync`` or ``async``) stepped with random actions, resetting as episodes end, for ``--steps``
 environment steps; the process's resident memory (with the async workers') and the wall time of
 every block of ``--block`` steps. Prints the memory after warm-up and at the end, and the cost of
-the last block against the first.
+the last block against the first, measured and along the least-squares line through every block:
+the host's speed wanders by 10-30% over minutes (other tenants: the same soak's blocks took
+61.7-71.8 s one morning and 75.4-96.9 s at noon), which moves any one block but not a trend that a
+process slowing with age would draw through all of them.
 
     .venv/bin/python examples/python/soak_vector_env.py --mode sync --steps 100000
 """
@@ -70,9 +73,12 @@ def main(argv=None):
     envs.close()
     growth = memory[-1] / memory[0] - 1
     drift = blocks[-1] / blocks[0]
+    slope, intercept = np.polyfit(np.arange(len(blocks)), blocks, 1)
+    trend = (intercept + slope * (len(blocks) - 1)) / intercept
     print(f"{args.mode}: {steps} steps of 2 environments; resident after the first block "
           f"{memory[0] / 1024:.1f} MiB, at the end {memory[-1] / 1024:.1f} MiB ({100 * growth:+.1f}%); "
-          f"last block {blocks[-1]:.1f} s against the first {blocks[0]:.1f} s ({drift:.3f}x)")
+          f"last block {blocks[-1]:.1f} s against the first {blocks[0]:.1f} s ({drift:.3f}x), "
+          f"along the trend of all {len(blocks)} blocks {trend:.3f}x")
 
 
 if __name__ == "__main__":

@@ -233,8 +233,9 @@ def test_v1_passes_check_env_and_says_how_every_touch_ended(small_model):
         assert env.observation_space.contains(obs)
         assert info["reading"] in STATUSES, info
         assert info["converged"] == (info["reading"] == "converged")
-        # One reading attempt every touch, and a second when the first met the object and failed.
-        assert info["attempts"] - attempts in (1, 2), info
+        # One reading attempt every touch, and another (three at most) after one that met the
+        # object and failed.
+        assert info["attempts"] - attempts in (1, 2, 3), info
         attempts = info["attempts"]
         converged += info["converged"]
         if info["converged"]:

@@ -39,7 +39,8 @@ use crate::valid::{Check, FieldChecks, RangeError, Valid};
 pub enum TouchAction {
     /// A guarded touch through the candidate ([`Planner::guarded_touch`]): the pad moved along a
     /// ray until the covering meets a surface, then settled; a reading attempt every action (and
-    /// a second when the first met the object and failed, `explore::earns_a_retry`).
+    /// another from above, three at most, after one that met the object and failed,
+    /// `explore::earns_a_retry`).
     #[default]
     Guarded,
     /// One planner iteration toward the candidate ([`Planner::touch_toward`], Sec. III-A), what

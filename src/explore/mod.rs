@@ -26,8 +26,8 @@ pub use surface_sampling::{SurfacePoint, SurfaceSampler};
 
 // The planner (Sec. III-A): its tree, how the arm reaches, and its report.
 pub use planner::{
-    AXIS_HEIGHT_FRACTION, ApproachRay, ITERATIONS_PER_READING, PROPOSAL_DRAWS_PER_CANDIDATE, Planner,
-    PlannerConfig, WORKSPACE_MARGIN_M, earns_a_retry, precise_kinematic_motion, precise_motion,
+    AXIS_HEIGHT_FRACTION, ApproachRay, ITERATIONS_PER_READING, MAX_ATTEMPTS, PROPOSAL_DRAWS_PER_CANDIDATE,
+    Planner, PlannerConfig, WORKSPACE_MARGIN_M, earns_a_retry, precise_kinematic_motion, precise_motion,
 };
 pub use reach::{ArmReach, carried};
 pub use report::ExplorationReport;

@@ -40,7 +40,7 @@
 
 mod guarded;
 
-pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay, earns_a_retry};
+pub use guarded::{AXIS_HEIGHT_FRACTION, ApproachRay, MAX_ATTEMPTS, earns_a_retry};
 
 use glam::DVec3;
 use rand::RngExt;
