@@ -149,72 +149,263 @@ fn the_scan_sees_a_use_that_runs_back_up_the_flow() {
     assert!(!allowed()["recognize"].contains(&"sim"));
 }
 
-/// Pairs of files of one module that use each other and are known, to be untangled: the arm and
-/// the scene (the scene owns the arm, the arm moves in the scene). No new pair may join them.
-const KNOWN_MUTUAL_USES: [(&str, &str, &str); 1] = [("sim", "arm", "scene")];
-
-#[test]
-fn no_two_files_of_a_module_use_each_other() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut found = Vec::new();
-    for entry in std::fs::read_dir(&src).expect("src is readable") {
-        let dir = entry.expect("directory entry").path();
-        if !dir.is_dir() {
-            continue;
+/// The module paths `text`'s code names through `crate::`, `super::` (resolved from `module`, the
+/// file's own module path) and `self::`, each expanded through its `{...}` groups: `use
+/// super::{TriMesh, obj::parse as p}` in `mesh/load.rs` names `[mesh, TriMesh]` and `[mesh, obj,
+/// parse]`. Code only: comment lines, and the `#[cfg(test)]` module that ends a file (a test may
+/// reach anywhere in its own module), are skipped.
+fn named_paths(text: &str, module: &[String]) -> Vec<Vec<String>> {
+    let code: String = text
+        .lines()
+        .take_while(|l| l.trim() != "#[cfg(test)]")
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut out = Vec::new();
+    for keyword in ["crate::", "super::", "self::"] {
+        for (at, _) in code.match_indices(keyword) {
+            let before = code[..at].chars().next_back();
+            if before.is_some_and(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | ':' | '$')) {
+                continue; // inside a longer path (`super::super::`) or a macro's `$crate`
+            }
+            let mut rest = &code[at + keyword.len()..];
+            let base: &[String] = match keyword {
+                "crate::" => &[],
+                "self::" => module,
+                _ => {
+                    let mut up = 1;
+                    while let Some(more) = rest.strip_prefix("super::") {
+                        rest = more;
+                        up += 1;
+                    }
+                    &module[..module.len().saturating_sub(up)]
+                }
+            };
+            use_tree(rest, base, &mut out);
         }
-        let module = dir
-            .file_name()
-            .and_then(|n| n.to_str())
-            .expect("a folder name")
-            .to_string();
-        // Each file's uses of its siblings, by `super::x` or `crate::module::x`.
-        let mut uses: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-        let mut files = Vec::new();
-        rust_files(&dir, &mut files);
-        for file in files.iter().filter(|f| f.parent() == Some(dir.as_path())) {
-            let stem = file
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .expect("a file name")
-                .to_string();
-            let text = std::fs::read_to_string(file).expect("source is readable");
-            let mut siblings = BTreeSet::new();
-            for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
-                for prefix in ["super::".to_string(), format!("crate::{module}::")] {
-                    for (at, _) in line.match_indices(&prefix) {
-                        let name: String = line[at + prefix.len()..]
-                            .chars()
-                            .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '_')
-                            .collect();
-                        if !name.is_empty() && name != stem {
-                            siblings.insert(name);
+    }
+    out
+}
+
+/// Expands the use tree at the start of `rest` (`a::b`, `a::{b, c::{d}}`, `a as x`) under `prefix`
+/// into `out`; returns the bytes it read.
+fn use_tree(rest: &str, prefix: &[String], out: &mut Vec<Vec<String>>) -> usize {
+    let mut path = prefix.to_vec();
+    let mut at = 0;
+    loop {
+        at += rest[at..].len() - rest[at..].trim_start().len();
+        if rest[at..].starts_with('{') {
+            at += 1;
+            loop {
+                at += use_tree(&rest[at..], &path, out);
+                // On to the next item of the group, past an `as` alias; or out of it.
+                let mut depth = 0;
+                let mut next = None;
+                for (i, c) in rest[at..].char_indices() {
+                    match c {
+                        '{' => depth += 1,
+                        '}' if depth > 0 => depth -= 1,
+                        ',' | '}' if depth == 0 => {
+                            next = Some((i, c));
+                            break;
                         }
+                        _ => {}
                     }
                 }
+                match next {
+                    Some((i, ',')) => at += i + 1,
+                    Some((i, _)) => return at + i + 1,
+                    None => return rest.len(),
+                }
             }
-            uses.insert(stem, siblings);
         }
-        for (a, used) in &uses {
-            for b in used {
-                let mutual = uses.get(b).is_some_and(|back| back.contains(a));
-                if mutual && a < b && a != "mod" && b != "mod" {
-                    found.push((module.clone(), a.clone(), b.clone()));
+        let name: String = rest[at..]
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect();
+        if name.is_empty() {
+            break;
+        }
+        at += name.len();
+        path.push(name);
+        match rest[at..].strip_prefix("::") {
+            Some(_) => at += 2,
+            None => break,
+        }
+    }
+    if path.len() > prefix.len() {
+        out.push(path);
+    }
+    at
+}
+
+/// The files of the module at `folder` (module path `base`) as nodes, each a file directly in it
+/// (its stem) or a folder of files (its name), with the nodes each uses. The root (`mod.rs`,
+/// `lib.rs`) re-exports its files for users and is no node.
+fn file_graph(folder: &Path, base: &[String]) -> BTreeMap<String, BTreeSet<String>> {
+    let mut files = Vec::new();
+    rust_files(folder, &mut files);
+    let module_path = |file: &Path| -> Vec<String> {
+        let relative = file.strip_prefix(folder).expect("under the folder");
+        let mut path = base.to_vec();
+        path.extend(
+            relative
+                .with_extension("")
+                .iter()
+                .map(|c| c.to_string_lossy().into_owned()),
+        );
+        if path.last().is_some_and(|l| l == "mod" || l == "lib") {
+            path.pop();
+        }
+        path
+    };
+    let nodes: BTreeSet<String> = files
+        .iter()
+        .filter_map(|f| module_path(f).get(base.len()).cloned())
+        .collect();
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in &files {
+        let module = module_path(file);
+        let Some(node) = module.get(base.len()).cloned() else {
+            continue;
+        };
+        let text = std::fs::read_to_string(file).expect("source is readable");
+        let used = graph.entry(node.clone()).or_default();
+        for path in named_paths(&text, &module) {
+            if path.len() > base.len() && path[..base.len()] == *base {
+                let other = &path[base.len()];
+                if *other != node && nodes.contains(other) {
+                    used.insert(other.clone());
                 }
             }
         }
     }
-    let known: Vec<(String, String, String)> = KNOWN_MUTUAL_USES
-        .iter()
-        .map(|(m, a, b)| (m.to_string(), a.to_string(), b.to_string()))
-        .collect();
-    let new: Vec<_> = found.iter().filter(|f| !known.contains(f)).collect();
-    assert!(new.is_empty(), "files that use each other: {new:?}");
-    // `experiment` (the framework) and `paper` have none: the circles index <-> merge and
-    // context <-> recognition were taken apart.
+    graph
+}
+
+/// The circles of `graph`: its strongly connected components of more than one node (Tarjan).
+fn circles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct Search<'g> {
+        graph: &'g BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'g str, usize>,
+        low: BTreeMap<&'g str, usize>,
+        stack: Vec<&'g str>,
+        found: Vec<Vec<String>>,
+    }
+    impl<'g> Search<'g> {
+        fn visit(&mut self, node: &'g str) {
+            let index = self.index.len();
+            self.index.insert(node, index);
+            self.low.insert(node, index);
+            self.stack.push(node);
+            for next in self.graph.get(node).into_iter().flatten() {
+                let next = next.as_str();
+                if !self.index.contains_key(next) {
+                    self.visit(next);
+                    let low = self.low[node].min(self.low[next]);
+                    self.low.insert(node, low);
+                } else if self.stack.contains(&next) {
+                    let low = self.low[node].min(self.index[next]);
+                    self.low.insert(node, low);
+                }
+            }
+            if self.low[node] == self.index[node] {
+                let at = self.stack.iter().rposition(|n| *n == node).expect("on the stack");
+                let mut component: Vec<String> =
+                    self.stack.split_off(at).into_iter().map(String::from).collect();
+                if component.len() > 1 {
+                    component.sort();
+                    self.found.push(component);
+                }
+            }
+        }
+    }
+    let mut search = Search {
+        graph,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        found: Vec::new(),
+    };
+    for node in graph.keys() {
+        if !search.index.contains_key(node.as_str()) {
+            search.visit(node);
+        }
+    }
+    search.found.sort();
+    search.found
+}
+
+/// Every module of files (each folder of `src/`, and the Python package's crate `python/src`) with
+/// the circles among its files.
+fn module_circles() -> Vec<(String, Vec<Vec<String>>)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut modules = vec![("python/src".to_string(), root.join("python/src"), Vec::new())];
+    for entry in std::fs::read_dir(root.join("src")).expect("src is readable") {
+        let dir = entry.expect("directory entry").path();
+        if dir.is_dir() {
+            let name = dir
+                .file_name()
+                .and_then(|n| n.to_str())
+                .expect("a folder name")
+                .to_string();
+            modules.push((format!("src/{name}"), dir, vec![name]));
+        }
+    }
+    modules
+        .into_iter()
+        .map(|(name, dir, base)| (name, circles(&file_graph(&dir, &base))))
+        .filter(|(_, found)| !found.is_empty())
+        .collect()
+}
+
+#[test]
+fn no_module_has_a_circle_among_its_files() {
+    let found = module_circles();
     assert!(
-        found.iter().all(|(m, _, _)| m != "experiment" && m != "paper"),
-        "{found:?}"
+        found.is_empty(),
+        "files that use each other, directly or around a circle (split what ties the circle: \
+         a type both sides need into a file of its own, below them):\n{found:#?}"
     );
+}
+
+#[test]
+fn the_circle_scan_reads_groups_aliases_and_parents_and_sees_a_long_circle() {
+    let module = ["mesh".to_string(), "load".to_string()];
+    let text = "//! crate::mesh::stl in a comment\nuse super::{TriMesh, obj::{parse as p, Obj}, off};\n\
+                use crate::mesh::stl::Stl;\nfn f() { super::super::sim::x(); self::g(); }\n\
+                #[cfg(test)]\nmod tests { use super::ply; }\n";
+    let named: BTreeSet<String> = named_paths(text, &module).iter().map(|p| p.join("::")).collect();
+    let expected = [
+        "mesh::TriMesh",
+        "mesh::obj::parse",
+        "mesh::obj::Obj",
+        "mesh::off",
+        "mesh::stl::Stl",
+        "sim::x",
+        "mesh::load::g",
+    ];
+    assert_eq!(named, expected.iter().map(|s| s.to_string()).collect());
+    let graph = |edges: &[(&str, &str)]| {
+        let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+        for (a, b) in edges {
+            g.entry(a.to_string()).or_default().insert(b.to_string());
+            g.entry(b.to_string()).or_default();
+        }
+        g
+    };
+    // Three files around a circle, a fourth hanging off it, and a line that closes nothing.
+    let found = circles(&graph(&[
+        ("bag", "calibration"),
+        ("calibration", "evaluate"),
+        ("evaluate", "bag"),
+        ("evaluate", "confusion"),
+    ]));
+    assert_eq!(
+        found,
+        vec![vec!["bag".to_string(), "calibration".into(), "evaluate".into()]]
+    );
+    assert!(circles(&graph(&[("a", "b"), ("b", "c"), ("a", "c")])).is_empty());
 }
 
 /// The crate's top-level modules that have files of their own (a folder under `src/`), each with

@@ -1,5 +1,6 @@
 //! numpy arrays in and out, through numpy's own buffer functions (no compiled numpy API, so one
-//! abi3 wheel serves every numpy and Python from 3.9).
+//! abi3 wheel serves every numpy and Python from 3.9), and JSON values out as `json.loads` makes
+//! them.
 
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyTuple};
@@ -43,4 +44,12 @@ pub fn to_f64(value: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<usize>, Vec
         .map(|c| f64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
         .collect();
     Ok((shape, values))
+}
+
+/// A JSON value as the Python value `json.loads` makes of it.
+pub fn json_to_python(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    Ok(py
+        .import("json")?
+        .call_method1("loads", (value.to_string(),))?
+        .unbind())
 }

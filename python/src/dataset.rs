@@ -34,14 +34,6 @@ impl Dataset {
     }
 }
 
-/// A JSON value as the Python value `json.loads` makes of it.
-pub fn json_to_python(py: Python<'_>, value: &serde_json::Value) -> PyResult<Py<PyAny>> {
-    Ok(py
-        .import("json")?
-        .call_method1("loads", (value.to_string(),))?
-        .unbind())
-}
-
 #[pymethods]
 impl Dataset {
     /// Reads a dataset file (`taction collect`'s CSV, any format version).
@@ -120,7 +112,7 @@ impl Dataset {
     /// The header (sensor, object set, objects, generator, seed) as a dict.
     #[getter]
     fn header(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        json_to_python(py, &serde_json::to_value(self.inner.header()).map_err(refused)?)
+        array::json_to_python(py, &serde_json::to_value(self.inner.header()).map_err(refused)?)
     }
 
     #[getter]

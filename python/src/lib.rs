@@ -37,7 +37,7 @@ fn _taction(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<object::Object>()?;
     m.add_function(wrap_pyfunction!(object::objects, m)?)?;
-    m.add_function(wrap_pyfunction!(object::scene, m)?)?;
+    m.add_function(wrap_pyfunction!(sensor::scene, m)?)?;
     m.add_class::<sensor::Sensor>()?;
     m.add_class::<dataset::Dataset>()?;
     m.add_function(wrap_pyfunction!(dataset::collect, m)?)?;

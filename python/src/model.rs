@@ -119,7 +119,7 @@ impl Model {
             "floor": t.floor(),
             "confidence_map": map,
         });
-        crate::dataset::json_to_python(py, &calibration)
+        array::json_to_python(py, &calibration)
     }
 
     /// The same model recognising with the posterior `rule`: "calibrated" (the default) or
@@ -153,7 +153,7 @@ impl Model {
             .map_err(refused)?;
         let accuracy: Vec<Option<f64>> = (1..=readings).map(|n| evaluation.accuracy_at(n)).collect();
         let result = serde_json::json!({ "accuracy": accuracy, "trials": trials });
-        crate::dataset::json_to_python(py, &result)
+        array::json_to_python(py, &result)
     }
 
     fn __repr__(&self) -> String {

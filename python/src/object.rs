@@ -6,11 +6,9 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use taction::mesh::{BuildOptions, ObjectSet, sizes_its_own_objects};
-use taction::sim::{ObjectSpec, PAD_SITE, SceneBuilder};
-use taction::tactile::add_sensor;
+use taction::sim::ObjectSpec;
 
 use crate::error::{bad_argument, refused};
-use crate::sensor::Sensor;
 
 /// One object the sensor can touch: a name and a checked triangle mesh in metres.
 #[pyclass(module = "taction", frozen)]
@@ -179,21 +177,4 @@ pub fn objects(py: Python<'_>, set: PathBuf, size_m: Option<f64>) -> PyResult<Ve
         })
         .map_err(refused)?;
     Ok(built.into_iter().map(|o| Object { inner: Arc::new(o) }).collect())
-}
-
-/// The MJCF world the arm explores, for stock `mujoco`: the arm, the table, `object` (its mesh
-/// inline) and the `taction.covering` sensor named `tactile` on the pad (the paper's 6x6 sensor
-/// unless `sensor` is given). `import taction` registers the plugin, so
-/// `mujoco.MjModel.from_xml_string(taction.scene(obj))` compiles.
-#[pyfunction]
-#[pyo3(signature = (object, sensor=None))]
-pub fn scene(object: &Object, sensor: Option<PyRef<'_, Sensor>>) -> PyResult<String> {
-    let config = match sensor {
-        Some(s) => s.config,
-        None => Sensor::paper_config()?,
-    };
-    let builder = SceneBuilder::with_arm_and_table().object(object.spec());
-    add_sensor(builder, &config, "tactile", PAD_SITE)
-        .to_xml()
-        .map_err(refused)
 }

@@ -7,7 +7,8 @@ use glam::DVec3;
 use pyo3::prelude::*;
 use taction::control::FreePad;
 use taction::pose::PadPose;
-use taction::tactile::{SensorConfig, TactileImage, psf_sigma_for_thickness};
+use taction::sim::{PAD_SITE, SceneBuilder};
+use taction::tactile::{SensorConfig, TactileImage, add_sensor, psf_sigma_for_thickness};
 use taction::valid::Valid;
 
 use crate::args::Whole;
@@ -150,7 +151,7 @@ impl Sensor {
 
     /// The configuration as a dataset's header writes it.
     fn config(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        crate::dataset::json_to_python(py, &serde_json::to_value(*self.config).map_err(refused)?)
+        array::json_to_python(py, &serde_json::to_value(*self.config).map_err(refused)?)
     }
 
     fn __repr__(&self) -> String {
@@ -167,4 +168,21 @@ impl Sensor {
             c.noise_seed
         )
     }
+}
+
+/// The MJCF world the arm explores, for stock `mujoco`: the arm, the table, `object` (its mesh
+/// inline) and the `taction.covering` sensor named `tactile` on the pad (the paper's 6x6 sensor
+/// unless `sensor` is given). `import taction` registers the plugin, so
+/// `mujoco.MjModel.from_xml_string(taction.scene(obj))` compiles.
+#[pyfunction]
+#[pyo3(signature = (object, sensor=None))]
+pub fn scene(object: &Object, sensor: Option<PyRef<'_, Sensor>>) -> PyResult<String> {
+    let config = match sensor {
+        Some(s) => s.config,
+        None => Sensor::paper_config()?,
+    };
+    let builder = SceneBuilder::with_arm_and_table().object(object.spec());
+    add_sensor(builder, &config, "tactile", PAD_SITE)
+        .to_xml()
+        .map_err(refused)
 }

@@ -9,6 +9,7 @@
 //! - one object, loaded, checked and plausible ([`Object::from_file`]);
 //! - object sets: named, versioned manifests that datasets and models refer to ([`ObjectSet`]).
 
+mod builder;
 pub(crate) mod cgal;
 pub(crate) mod checksum;
 pub(crate) mod chess;

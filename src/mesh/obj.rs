@@ -6,8 +6,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::TriMesh;
+use super::builder::{MeshBuilder, content_lines_from};
 use super::error::{Location, MeshError};
-use super::load::{MeshBuilder, content_lines_from};
 
 /// Texts longer than this are parsed as two halves at once: a 1.3M-triangle scan is 72 MB of OBJ
 /// text, a fifth of the time from its file to its first reading on one core (issue 39).

@@ -7,8 +7,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::TriMesh;
+use super::builder::{MeshBuilder, content_lines};
 use super::error::{Location, MeshError};
-use super::load::{MeshBuilder, content_lines};
 
 pub(crate) fn parse(text: &str, path: &Path) -> Result<TriMesh, MeshError> {
     let mut builder = MeshBuilder::new(path);

@@ -12,8 +12,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::TriMesh;
+use super::builder::{MeshBuilder, content_lines};
 use super::error::{Location, MeshError};
-use super::load::{MeshBuilder, content_lines};
 
 const HEADER_BYTES: usize = 80;
 const FACET_BYTES: usize = 50;

@@ -47,10 +47,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
-use crate::recognize::evaluate::Trial;
 use crate::recognize::exp::{Lanes, exp};
 use crate::recognize::gmm::{log_sum_exp, log_sum_exp_of_parts};
 use crate::recognize::object_model::guess_of;
+use crate::recognize::trial::Trial;
 
 /// `w(n) = tau n^(beta - 1)`, the weight of the log-likelihood after `n` readings (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -20,11 +20,12 @@ use crate::dataset::Dataset;
 use crate::describe::{DescriptorKind, Feature};
 use crate::recognize::RecognizeError;
 use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
-use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with, make_trials};
+use crate::recognize::evaluate::{Evaluation, ReadingRange, evaluate_with};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, save_json};
 use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
 use crate::recognize::selection::{TrainConfig, TrainProgress};
+use crate::recognize::trial::{Trial, make_trials};
 use crate::valid::Valid;
 
 /// A descriptor name that names no descriptor, or a fusion that names one twice or none.

@@ -27,11 +27,12 @@ use crate::describe::{Descriptor, Feature};
 use crate::locate::{ContactNoise, GeometryModel, Touch};
 use crate::recognize::RecognizeError;
 use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
-use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate_with};
+use crate::recognize::evaluate::{Evaluation, ReadingRange, evaluate_with};
 use crate::recognize::fusion::{DescriptorChoice, FusedModel};
 use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_version, encode_json, save_json};
 use crate::recognize::object_model::guess_of;
 use crate::recognize::posterior::{EvidenceWeights, FusedPosterior, GeometricPosterior, TouchReading};
+use crate::recognize::trial::Trial;
 use crate::tactile::SensorConfig;
 
 /// The weights of the geometric evidence tried when fitting (`lambda`, the module docs); 0 is

@@ -40,6 +40,7 @@ pub(crate) mod posterior;
 pub(crate) mod recognizer;
 pub(crate) mod reliability;
 pub(crate) mod selection;
+pub(crate) mod trial;
 
 // The model: trained, saved and loaded, one descriptor or several fused.
 pub use bag::BagOfFeatures;
@@ -70,9 +71,9 @@ pub use posterior::{Belief, FusedPosterior, ModelPosterior, OnlinePosterior};
 // Evaluation over a test set (Sec. V-B2).
 pub use confusion::ConfusionMatrix;
 pub use evaluate::{
-    AccuracyPoint, Evaluation, ReadingRange, TouchRow, Trial, TrialOutcome, evaluate, evaluate_with,
-    make_trials,
+    AccuracyPoint, Evaluation, ReadingRange, TouchRow, TrialOutcome, evaluate, evaluate_with,
 };
+pub use trial::{Trial, make_trials};
 // Calibration: whether the top probability can be trusted (ECE, reliability table).
 pub use reliability::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
 

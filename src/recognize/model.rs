@@ -18,10 +18,11 @@ use crate::describe::{Descriptor, DescriptorParams};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::calibration::{EvidencePath, PosteriorRule, Tempering};
-use crate::recognize::evaluate::{Evaluation, ReadingRange, Trial, evaluate, make_trials};
+use crate::recognize::evaluate::{Evaluation, ReadingRange, evaluate};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::posterior::ModelPosterior;
 use crate::recognize::selection::{SelectionReport, TrainConfig, TrainProgress, train};
+use crate::recognize::trial::{Trial, make_trials};
 use crate::tactile::{SensorConfig, TactileImage};
 use crate::valid::Valid;
 

@@ -13,13 +13,13 @@ use crate::recognize::RecognizeError;
 use crate::recognize::bag::{BagOfFeatures, reduced_histogram};
 use crate::recognize::calibration::{EvidencePath, Tempering};
 use crate::recognize::codebook::{Codebook, CodebookConfig, CodebookKind, CodebookModel};
-use crate::recognize::evaluate::{Trial, make_trials};
 use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::TrainingFeatures;
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::neighbours::LeaveOneReadingOut;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels, PseudoCount};
 use crate::recognize::pca::{Pca, VarianceFraction};
+use crate::recognize::trial::{Trial, make_trials};
 use crate::rng::{stream, substream};
 use crate::valid::{Check, Valid};
 

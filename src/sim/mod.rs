@@ -6,6 +6,7 @@ pub(crate) mod collision_shell;
 pub(crate) mod contact_screen;
 pub(crate) mod ik;
 pub(crate) mod mjcf;
+mod motion;
 pub(crate) mod object;
 pub(crate) mod perturb;
 pub(crate) mod scene;
