@@ -295,7 +295,7 @@ fn explore_unknown(
     unknown: &mut Unknown,
     sensor: SensorConfig,
 ) -> Result<Explored, Box<dyn std::error::Error>> {
-    let planner_config = arm_planner_config(args, objects)?;
+    let planner_config = arm_planner_config(objects)?;
     let reader = sensor_reader(CoveringSensor::on_site(unknown.scene.model(), PAD_SITE)?);
     let mut planner = Planner::new(
         &unknown.scene,
@@ -349,18 +349,12 @@ fn explore_unknown(
 }
 
 /// The paper's planner settings, fitted to the objects: the local strategy with probability 0.5,
-/// the setting the recipe was measured at.
-fn arm_planner_config(
-    args: &DemoArgs,
-    objects: &[ObjectSpec],
-) -> Result<Valid<PlannerConfig>, Box<dyn std::error::Error>> {
+/// the setting the recipe was measured at, for either strategy (the active scorer picks among
+/// candidates half local, half global).
+fn arm_planner_config(objects: &[ObjectSpec]) -> Result<Valid<PlannerConfig>, Box<dyn std::error::Error>> {
     Ok(Valid::new(
         PlannerConfig {
-            local_probability: match args.strategy {
-                DemoStrategy::Blind => 0.5,
-                // Candidates half local, half global: the scorer picks among both kinds.
-                DemoStrategy::Active => 0.5,
-            },
+            local_probability: 0.5,
             ..PlannerConfig::default()
         }
         .fitted_to(objects),

@@ -106,10 +106,6 @@ impl FreePad {
         &mut self.scene
     }
 
-    pub fn into_scene(self) -> Scene {
-        self.scene
-    }
-
     /// The covering sensor the pad carries.
     pub fn covering(&self) -> &CoveringSensor {
         &self.sensor

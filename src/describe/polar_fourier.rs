@@ -265,8 +265,8 @@ mod tests {
 
     #[test]
     fn inserted_rows_combine_adjacent_rings() {
-        // Eq. 7-8 as corrected (DESIGN.md 5): mean and half-difference of rings i and i + 1, not
-        // of a ring with itself (which would give the ring again and a row of zeros).
+        // Eq. 7-8 as corrected (ARCHITECTURE.md, section 5): mean and half-difference of rings i
+        // and i + 1, not of a ring with itself (which would give the ring again and a row of zeros).
         let image = image_from(6, |x, y| 0.3 + 0.1 * x + 0.05 * y * y);
         let (d, a, rows) = PolarFourier::default().polar_rows(&image);
         let rows: Vec<&[f64]> = rows.chunks(a).collect();

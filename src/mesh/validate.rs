@@ -55,11 +55,6 @@ impl ValidationReport {
         *self == Self::default()
     }
 
-    /// Closed: no boundary and no non-manifold edge.
-    pub fn is_watertight(&self) -> bool {
-        self.boundary_edges == 0 && self.non_manifold_edges == 0
-    }
-
     /// The warnings as sentences, one per kind of defect found.
     pub fn warnings(&self) -> Vec<String> {
         let mut out = Vec::new();

@@ -8,7 +8,6 @@ use crate::describe::Feature;
 use crate::recognize::RecognizeError;
 use crate::recognize::calibration::{PosteriorRule, Tempering};
 use crate::recognize::codebook::{Codebook, CodebookModel};
-use crate::recognize::decision::Decision;
 use crate::recognize::features::FeatureMatrix;
 use crate::recognize::features::check_feature;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
@@ -121,13 +120,6 @@ impl BagOfFeatures {
             histogram.add(&membership);
         }
         Ok(())
-    }
-
-    /// The decision (Eq. 4, Eq. 16) for one set of raw features.
-    pub fn classify(&self, features: &[Feature]) -> Result<Decision, RecognizeError> {
-        let mut histogram = ClusterHistogram::new(self.codebook.clusters());
-        self.add_features(features, &mut histogram, "the unknown object's features")?;
-        Ok(self.models.decide(&histogram))
     }
 }
 
