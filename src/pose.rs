@@ -380,6 +380,18 @@ impl PadPose {
         self.normal.cross(self.up)
     }
 
+    /// A direction in the pad frame (`x` along [`right`](Self::right), `y` along `up`, `z` along
+    /// the normal) in world coordinates.
+    pub fn transform_vector(&self, v: DVec3) -> DVec3 {
+        self.right() * v.x + self.up * v.y + self.normal * v.z
+    }
+
+    /// A point in the pad frame (metres from the centre, axes as
+    /// [`transform_vector`](Self::transform_vector)'s) in world coordinates.
+    pub fn transform_point(&self, p: DVec3) -> DVec3 {
+        self.center_m + self.right() * p.x + self.up * p.y + self.normal * p.z
+    }
+
     /// The pad frame of a pad site at world pose `site`: centre at the site, normal its +z, up its
     /// +y (the module's convention).
     pub fn of_site(site: &Pose) -> Self {

@@ -472,46 +472,18 @@ fn deep_paths(text: &str, modules: &BTreeMap<String, BTreeSet<String>>) -> Vec<S
         .filter(|l| !l.trim_start().starts_with("//"))
         .collect::<Vec<_>>()
         .join("\n");
-    let ident = |s: &str| -> String {
-        s.chars()
-            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-            .collect()
-    };
     let mut found = Vec::new();
     for (at, _) in code.match_indices("taction::") {
-        let rest = &code[at + "taction::".len()..];
-        let module = ident(rest);
-        let Some(files) = modules.get(&module) else {
-            continue;
-        };
-        let Some(after) = rest[module.len()..].strip_prefix("::") else {
-            continue;
-        };
-        // The first segment after the module, or each first segment of a `{...}` group.
-        let mut firsts = Vec::new();
-        if let Some(group) = after.strip_prefix('{') {
-            let mut depth = 1;
-            let mut start = true;
-            for (i, c) in group.char_indices() {
-                match c {
-                    '{' => depth += 1,
-                    '}' if depth == 1 => break,
-                    '}' => depth -= 1,
-                    ',' if depth == 1 => start = true,
-                    c if start && !c.is_whitespace() => {
-                        start = false;
-                        firsts.push(&group[i..]);
-                    }
-                    _ => {}
-                }
-            }
-        } else {
-            firsts.push(after);
-        }
-        for first in firsts {
-            let name = ident(first);
-            if files.contains(&name) && first[name.len()..].starts_with("::") {
-                found.push(format!("taction::{module}::{name}::"));
+        let mut paths = Vec::new();
+        use_tree(&code[at + "taction::".len()..], &[], &mut paths);
+        // A path that goes on past a file of its module (`sim::arm::PAD_SITE`), once per use.
+        let mut deep = BTreeSet::new();
+        for path in &paths {
+            if let [module, file, _, ..] = path.as_slice()
+                && modules.get(module).is_some_and(|files| files.contains(file))
+                && deep.insert((module.clone(), file.clone()))
+            {
+                found.push(format!("taction::{module}::{file}::"));
             }
         }
     }

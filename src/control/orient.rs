@@ -237,9 +237,8 @@ pub fn orient_command(
     config: &ControlConfig,
 ) -> Option<OrientCommand> {
     let (normal_pad, centroid_pad) = surface_normal(image, sensor, config)?;
-    let to_world = |v: DVec3| pose.right() * v.x + pose.up * v.y + pose.normal * v.z;
     let sensor_n = pose.normal;
-    let surface_n = to_world(normal_pad).normalize();
+    let surface_n = pose.transform_vector(normal_pad).normalize();
     let misalignment_rad = sensor_n.angle_between(surface_n);
     if misalignment_rad <= config.orient_tolerance_rad {
         return None;
@@ -252,7 +251,7 @@ pub fn orient_command(
     }
     Some(OrientCommand {
         rotation,
-        pivot_m: pose.center_m + to_world(centroid_pad),
+        pivot_m: pose.center_m + pose.transform_vector(centroid_pad),
         misalignment_rad,
     })
 }

@@ -916,9 +916,7 @@ pub fn covering_meets_table(image: &TactileImage, sensor: &SensorConfig) -> bool
     let (half_w, half_h) = (0.5 * sensor.pad_width_m, 0.5 * sensor.pad_height_m);
     let lowest_z = [-1.0, 1.0]
         .into_iter()
-        .flat_map(|a| {
-            [-1.0, 1.0].map(|b| pose.center_m + pose.right() * (a * half_w) + pose.up * (b * half_h))
-        })
+        .flat_map(|a| [-1.0, 1.0].map(|b| pose.transform_point(DVec3::new(a * half_w, b * half_h, 0.0))))
         .flat_map(|corner| [corner, corner + pose.normal * sensor.thickness_m])
         .map(|p| p.z)
         .fold(f64::INFINITY, f64::min);

@@ -97,7 +97,7 @@ fn taxel_surface_point(
 ) -> DVec3 {
     let x_m = ((col as f64 + 0.5) / cols as f64 - 0.5) * sensor.pad_width_m;
     let y_m = (0.5 - (row as f64 + 0.5) / rows as f64) * sensor.pad_height_m;
-    pose.center_m + pose.right() * x_m + pose.up * y_m + pose.normal * (sensor.thickness_m * (1.0 - v))
+    pose.transform_point(DVec3::new(x_m, y_m, sensor.thickness_m * (1.0 - v)))
 }
 
 /// Two unit vectors perpendicular to the unit vector `n` and to each other.

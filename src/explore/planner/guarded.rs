@@ -93,8 +93,9 @@ fn where_felt_m(failed: &Reading, sensor: &SensorConfig, threshold: f64) -> Opti
     if felt.is_empty() {
         return Some(pose.center_m);
     }
+    // In the pad's plane: only the point's place across the pad matters to a ray from above.
     let mean = felt.iter().sum::<DVec3>() / felt.len() as f64;
-    Some(pose.center_m + pose.right() * mean.x + pose.up * mean.y)
+    Some(pose.transform_point(mean.with_z(0.0)))
 }
 
 /// A target within this horizontal distance of the workspace's axis is approached straight down,
