@@ -68,14 +68,9 @@ fn pawn() -> ObjectSpec {
 
 fn arm_scene(object: &ObjectSpec) -> Scene {
     let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-    add_sensor(
-        builder,
-        &Valid::new(sensor()).expect("a valid sensor"),
-        "covering",
-        PAD_SITE,
-    )
-    .build()
-    .expect("arm scene compiles")
+    add_sensor(builder, &Valid::new(sensor()).expect("a valid sensor"), PAD_SITE)
+        .build()
+        .expect("arm scene compiles")
 }
 
 /// A pad 0.3 t into the side of the pawn's base, level: a reading with contact.

@@ -11,8 +11,8 @@ use taction::dataset::ContactStatus;
 use taction::explore::precise_motion;
 use taction::mesh::{BuildOptions, ObjectSet};
 
-use taction::sim::{InverseKinematics, ObjectSpec, PAD_SITE, PadTarget, SceneBuilder, SimError};
-use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
+use taction::sim::{InverseKinematics, ObjectSpec, PAD_SITE, PadTarget, SimError};
+use taction::tactile::{CoveringSensor, SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -21,8 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // The world: the arm, the table, the pawn at the origin, the sensor on the arm's pad site.
     let sensor = Valid::new(SensorConfig::paper())?;
-    let builder = SceneBuilder::with_arm_and_table().object(ObjectSpec::from(pawn));
-    let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
+    let mut scene = arm_with_sensor(ObjectSpec::from(pawn), &sensor).build()?;
     let arm = scene.arm().cloned().ok_or(SimError::NoArm)?;
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
 

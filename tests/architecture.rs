@@ -538,3 +538,82 @@ fn the_scans_see_a_public_file_and_a_deep_path() {
     let root = "pub(crate) mod arm;\npub mod mjcf;\n/// Grouped.\npub mod pipeline {\n";
     assert_eq!(public_file_modules(root), ["mjcf"]);
 }
+
+/// The longest a function may be: beyond it, a function does several things that want names.
+const MAX_FUNCTION_LINES: usize = 80;
+
+/// Every function of `text` (rustfmt's layout: a `fn` item's body closes on a line holding its
+/// own indentation and `}`) with its first line (1-based) and its length in lines, signature,
+/// body and closing brace counted.
+fn function_lengths(text: &str) -> Vec<(String, usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut found = Vec::new();
+    for (start, line) in lines.iter().enumerate() {
+        let trimmed = line.trim_start();
+        let indent = &line[..line.len() - trimmed.len()];
+        let item = trimmed
+            .split_once("fn ")
+            .filter(|(before, _)| {
+                before.split_whitespace().all(|w| {
+                    ["pub", "const", "async", "unsafe", "extern", "\"C\""].contains(&w)
+                        || w.starts_with("pub(")
+                })
+            })
+            .map(|(_, after)| after);
+        let Some(name) = item.and_then(|rest| rest.split(['(', '<']).next()) else {
+            continue;
+        };
+        // A declaration without a body (a trait's) ends with `;` before any `{`.
+        let Some(open) = (start..lines.len()).find(|&i| lines[i].trim_end().ends_with(['{', ';'])) else {
+            continue;
+        };
+        if lines[open].trim_end().ends_with(';') {
+            continue;
+        }
+        let closing = format!("{indent}}}");
+        if lines[open].trim_end().ends_with("{}") {
+            continue;
+        }
+        if let Some(end) = (open + 1..lines.len()).find(|&i| lines[i].trim_end() == closing) {
+            found.push((name.to_string(), start + 1, end - start + 1));
+        }
+    }
+    found
+}
+
+#[test]
+fn no_function_in_the_library_or_the_bindings_is_over_80_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    rust_files(&root.join("python/src"), &mut files);
+    let mut long = Vec::new();
+    for file in &files {
+        let text = std::fs::read_to_string(file).unwrap();
+        for (name, line, length) in function_lengths(&text) {
+            if length > MAX_FUNCTION_LINES {
+                let shown = file.strip_prefix(root).unwrap_or(file).display();
+                long.push(format!("{shown}:{line} {name}: {length} lines"));
+            }
+        }
+    }
+    assert!(files.len() > 100, "the scan found {} files", files.len());
+    assert!(
+        long.is_empty(),
+        "functions over {MAX_FUNCTION_LINES} lines (split them into steps with names):\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn the_length_scan_counts_a_function_from_its_signature_to_its_closing_brace() {
+    let body: String = (0..79).map(|i| format!("        let _x{i} = {i};\n")).collect();
+    let text = format!(
+        "impl A {{\n    pub(crate) fn long(\n        a: u8,\n    ) -> u8 {{\n{body}    }}\n\n    fn short() {{}}\n}}\n\
+         trait T {{\n    fn declared(&self);\n}}\nfn free() -> u8 {{\n    1\n}}\n"
+    );
+    assert_eq!(
+        function_lengths(&text),
+        [("long".to_string(), 2, 83), ("free".to_string(), 91, 3)]
+    );
+}

@@ -56,7 +56,7 @@ fn touch_both(object: &ObjectSpec, sensor: SensorConfig, seed: u64) -> (Vec<Pair
     let control = Valid::new(ControlConfig::default()).expect("defaults are valid");
     let builder = SceneBuilder::with_arm_and_table().object(object.clone());
     let valid_sensor = Valid::new(sensor).expect("a valid sensor");
-    let mut scene: Scene = add_sensor(builder, &valid_sensor, "covering", PAD_SITE)
+    let mut scene: Scene = add_sensor(builder, &valid_sensor, PAD_SITE)
         .build()
         .expect("arm scene");
     let arm = scene.arm().cloned().expect("arm");

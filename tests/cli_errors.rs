@@ -516,7 +516,7 @@ fn every_command_with_a_seed_documents_it_alike_with_one_default() {
 }
 
 #[test]
-fn a_covering_thicker_than_half_the_pad_is_refused_with_the_reason() {
+fn a_covering_thicker_than_half_the_pad_is_refused_naming_the_limit() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = write(dir.path(), "t.obj", TETRA);
     let out = dir.path().join("r.csv").display().to_string();
@@ -524,7 +524,7 @@ fn a_covering_thicker_than_half_the_pad_is_refused_with_the_reason() {
     args.extend(["--thickness-m", "0.5"]);
     let line = fails_with(&taction(&args), 2);
     assert!(
-        line.contains("--thickness-m") && line.contains("half the 12 mm pad side, 6 mm"),
+        line.contains("--thickness-m: 0.5 is out of range: want <= half the pad side, 6 mm"),
         "{line}"
     );
 }

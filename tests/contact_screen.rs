@@ -32,7 +32,7 @@ fn sensor() -> SensorConfig {
 /// The scene of `object` with the arm, the table and the covering sensor, as the planner has it.
 fn scene_of(object: &ObjectSpec) -> Scene {
     let builder = SceneBuilder::with_arm_and_table().object(object.clone());
-    add_sensor(builder, &Valid::new(sensor()).unwrap(), "covering", PAD_SITE)
+    add_sensor(builder, &Valid::new(sensor()).unwrap(), PAD_SITE)
         .build()
         .unwrap()
 }
@@ -170,7 +170,7 @@ fn a_world_with_contacts_the_screen_does_not_model_is_not_screened() {
     let builder = SceneBuilder::with_arm_and_table()
         .object(object.clone())
         .add(Section::Contact, r#"<pair geom1="link4" geom2="table"/>"#);
-    let mut paired = add_sensor(builder, &Valid::new(sensor()).unwrap(), "covering", PAD_SITE)
+    let mut paired = add_sensor(builder, &Valid::new(sensor()).unwrap(), PAD_SITE)
         .build()
         .unwrap();
     assert_eq!(paired.screen_contacts(), Screened::Undecided);
@@ -180,7 +180,7 @@ fn a_world_with_contacts_the_screen_does_not_model_is_not_screened() {
         Section::Worldbody,
         r#"<geom name="floor" type="plane" size="2 2 0.1" pos="0 0 -0.5"/>"#,
     );
-    let mut floored = add_sensor(builder, &Valid::new(sensor()).unwrap(), "covering", PAD_SITE)
+    let mut floored = add_sensor(builder, &Valid::new(sensor()).unwrap(), PAD_SITE)
         .build()
         .unwrap();
     assert_eq!(floored.screen_contacts(), Screened::Undecided);

@@ -403,7 +403,6 @@ fn global_strategy_covers_the_workspace() {
     let mut scene = add_sensor(
         SceneBuilder::with_arm_and_table(),
         &Valid::new(sensor).unwrap(),
-        "covering",
         PAD_SITE,
     )
     .build()
@@ -722,7 +721,7 @@ fn faulted_planner(faults: &'static [usize]) -> taction::explore::ExplorationRep
     use taction::tactile::{CoveringSensor, add_sensor};
     let sensor = SensorConfig::square(6, 6, 0.012, 0.0012);
     let builder = SceneBuilder::with_arm_and_table().object(box_object());
-    let mut scene = add_sensor(builder, &Valid::new(sensor).unwrap(), "covering", PAD_SITE)
+    let mut scene = add_sensor(builder, &Valid::new(sensor).unwrap(), PAD_SITE)
         .build()
         .unwrap();
     let reader = faulting(

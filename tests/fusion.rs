@@ -8,8 +8,8 @@ use std::process::Command;
 
 use taction::describe::DescriptorKind;
 use taction::recognize::{
-    DescriptorChoice, FusedModel, LabelledFeatures, ReadingRange, Recognizer, TrainConfig, TrainedModel,
-    make_trials,
+    CodebookKind, DescriptorChoice, FusedModel, LabelledFeatures, ReadingRange, Recognizer, TrainChoices,
+    TrainConfig, TrainData, TrainedModel, make_trials, train_recognizer,
 };
 use taction::valid::Valid;
 
@@ -25,8 +25,23 @@ fn config() -> Valid<TrainConfig> {
 
 fn fused() -> FusedModel {
     let training = recognize_toy::dataset(30, 8);
-    let choice = DescriptorChoice::parse("mnti+mn").unwrap();
-    FusedModel::fit(&config(), &training, None, &choice, &mut |_| {}).unwrap()
+    let choices = TrainChoices {
+        codebook: CodebookKind::Gmm,
+        ks: Some(vec![4]),
+        restarts: 1,
+        seed: 5,
+        ..TrainChoices::of(DescriptorChoice::parse("mnti+mn").unwrap())
+    };
+    let data = TrainData {
+        training: &training,
+        validation: None,
+        calibration: &[],
+        contacts: None,
+    };
+    match train_recognizer(&Valid::new(choices).unwrap(), data, &mut ()).unwrap() {
+        Recognizer::Fused(model) => *model,
+        _ => panic!("two descriptors train a fused model"),
+    }
 }
 
 #[test]

@@ -11,7 +11,8 @@ use taction::locate::{GeometryModel, GeometryParams, ObjectSurface};
 use taction::mesh::TriMesh;
 use taction::pose::{PadPose, Pose};
 use taction::recognize::{
-    Appearance, Evidence, GeometricFusion, ReadingRange, Recognizer, TrainConfig, TrainedModel,
+    Appearance, CodebookKind, DescriptorChoice, Evidence, GeometricFusion, ReadingRange, Recognizer,
+    TrainChoices, TrainData, TrainedModel, train_recognizer,
 };
 use taction::valid::Valid;
 
@@ -76,29 +77,78 @@ fn dataset(per_object: usize, seed: u64, heading_rad: f64, shift_m: DVec3) -> Da
     Dataset::new(flat.header().clone(), readings).expect("the toy header")
 }
 
-fn model(calibration: &Dataset) -> Recognizer {
-    let config = Valid::new(TrainConfig {
-        ks: vec![4],
-        restarts: 1,
-        seed: 5,
-        ..TrainConfig::default()
-    })
-    .expect("a config");
-    let training = recognize_toy::dataset(30, 8);
-    let descriptor = taction::describe::DescriptorKind::Mnti.build();
-    let appearance =
-        TrainedModel::fit(&config, &training, None, descriptor.as_ref(), &mut |_| {}).expect("trains");
+/// The toy objects' surfaces, the contact half of the model.
+fn geometry() -> GeometryModel {
     let meshes = meshes();
-    let geometry = GeometryModel::build(
+    GeometryModel::build(
         recognize_toy::OBJECTS.iter().map(|o| o.to_string()).zip(&meshes),
         Valid::new(GeometryParams::default()).expect("defaults"),
     )
-    .expect("three boxes");
-    let fused =
-        GeometricFusion::new(Appearance::Single(Box::new(appearance)), geometry).expect("same objects");
-    Recognizer::Geometric(Box::new(fused))
-        .calibrate_on_all(&[calibration], 6)
-        .expect("calibrates")
+    .expect("three boxes")
+}
+
+fn choices() -> Valid<TrainChoices> {
+    Valid::new(TrainChoices {
+        codebook: CodebookKind::Gmm,
+        ks: Some(vec![4]),
+        restarts: 1,
+        seed: 5,
+        calibration_trial_readings: Some(6),
+        ..TrainChoices::of(DescriptorChoice::parse("mnti").expect("a descriptor"))
+    })
+    .expect("choices")
+}
+
+/// MNTI's appearance model of the toy readings fused with the toy objects' contacts, weighed and
+/// calibrated on `calibration` in trials of 6: what `train --objects` builds.
+fn model(calibration: &Dataset) -> Recognizer {
+    let training = recognize_toy::dataset(30, 8);
+    let geometry = geometry();
+    let data = TrainData {
+        training: &training,
+        validation: None,
+        calibration: &[calibration],
+        contacts: Some(&geometry),
+    };
+    train_recognizer(&choices(), data, &mut ()).expect("trains")
+}
+
+#[test]
+fn the_training_entry_builds_the_steps_in_order_and_refuses_contacts_it_cannot_weigh() {
+    let training = recognize_toy::dataset(30, 8);
+    let calibration = dataset(12, 41, 0.0, DVec3::ZERO);
+    let geometry = geometry();
+    let trained = model(&calibration);
+    // The same steps by hand: an appearance model, fused with the contacts, weighed on the
+    // calibration in trials of 6.
+    let config = choices().config(&training, false).expect("a config");
+    let descriptor = taction::describe::DescriptorKind::Mnti.build();
+    let appearance =
+        TrainedModel::fit(&config, &training, None, descriptor.as_ref(), &mut |_| {}).expect("trains");
+    let fused = GeometricFusion::new(Appearance::Single(Box::new(appearance)), geometry.clone())
+        .expect("same objects");
+    let by_hand = Recognizer::Geometric(Box::new(fused))
+        .calibrate_on_all(&[&calibration], 6)
+        .expect("calibrates");
+    assert_eq!(trained.to_json().expect("json"), by_hand.to_json().expect("json"));
+
+    let unweighed = TrainData {
+        training: &training,
+        validation: None,
+        calibration: &[],
+        contacts: Some(&geometry),
+    };
+    let e = train_recognizer(&choices(), unweighed, &mut ()).expect_err("nothing to weigh the contacts on");
+    assert!(
+        e.to_string().contains("objects") && e.to_string().contains("give calibration"),
+        "{e}"
+    );
+    let zero = TrainChoices {
+        calibration_trial_readings: Some(0),
+        ..choices().into_inner()
+    };
+    let e = Valid::new(zero).expect_err("trials of no reading");
+    assert!(e.to_string().contains("calibration_trial_readings"), "{e}");
 }
 
 fn accuracy_at(model: &Recognizer, test: &Dataset, n: usize) -> f64 {

@@ -581,7 +581,7 @@ fn train_calibrates_on_a_dataset_and_recognize_can_use_eq15() {
     for (extra, needle) in [
         (
             vec!["--calibration", arm.as_str(), "--calibration-trial-readings", "0"],
-            "--calibration-trial-readings 0",
+            "--calibration-trial-readings: want 1 or more",
         ),
         (vec!["--calibration-trial-readings", "5"], "--calibration <FILE>"),
     ] {

@@ -173,7 +173,7 @@ fn scene_export_writes_the_builders_scene_with_its_mesh_beside_it() {
         .unwrap();
     let builder = taction::sim::SceneBuilder::with_arm_and_table()
         .object(taction::sim::ObjectSpec::new("pawn", pawn.mesh));
-    let built = taction::tactile::add_sensor(builder, sensor.config(), "tactile", "pad")
+    let built = taction::tactile::add_sensor(builder, sensor.config(), "pad")
         .build()
         .unwrap();
     let model = built.model();
@@ -266,7 +266,7 @@ fn every_shipped_generated_and_exported_mjcf_is_well_formed_xml() {
     };
     for mount in [taction::sim::ObjectMount::Mocap, taction::sim::ObjectMount::Free] {
         let builder = taction::sim::SceneBuilder::with_arm_and_table().object(named(mount));
-        let xml = taction::tactile::add_sensor(builder, &config, "tactile", "pad")
+        let xml = taction::tactile::add_sensor(builder, &config, "pad")
             .to_xml()
             .unwrap();
         strictly_parsed(&xml, &format!("the arm's scene ({mount:?} object)"));

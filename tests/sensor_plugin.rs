@@ -430,7 +430,7 @@ fn the_pads_own_tree_is_not_sensed() {
         let builder = taction::sim::SceneBuilder::new()
             .table(false)
             .add(taction::sim::Section::Worldbody, tree(other));
-        let builder = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad");
+        let builder = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "pad");
         let scene = builder.build().unwrap();
         let sensor = taction::tactile::CoveringSensor::on_site(scene.model(), "pad").unwrap();
         let image = sensor.read(scene.data()).unwrap();
@@ -451,7 +451,7 @@ fn the_pads_own_tree_is_not_sensed() {
             taction::sim::Section::Worldbody,
             format!("<site name=\"pad\"/>{world}"),
         );
-        let scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "covering", "pad")
+        let scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "pad")
             .build()
             .unwrap();
         let image = taction::tactile::CoveringSensor::first(scene.model())
@@ -623,8 +623,7 @@ fn the_free_pad_reads_the_same_without_the_objects_collision_shell() {
         .table(false)
         .object(object)
         .add(Section::Worldbody, free_pad_body_xml(&config));
-    let mut with =
-        FreePad::from_scene(add_sensor(builder, &config, "covering", "pad").build().unwrap()).unwrap();
+    let mut with = FreePad::from_scene(add_sensor(builder, &config, "pad").build().unwrap()).unwrap();
     assert!(shell_geoms(&with) > 1, "the comparison scene has no shell");
     let mut r = taction::rng::rng(3);
     let mut touched = 0;

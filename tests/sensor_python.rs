@@ -379,7 +379,7 @@ fn python_reads_an_exported_scene_as_the_rust_scene_builder_does() {
         .unwrap();
     let top_z_m = pawn.mesh.bounds().unwrap().1.z;
     let builder = SceneBuilder::with_arm_and_table().object(ObjectSpec::new("pawn", pawn.mesh));
-    let mut scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), "tactile", PAD_SITE)
+    let mut scene = taction::tactile::add_sensor(builder, &Valid::new(config).unwrap(), PAD_SITE)
         .build()
         .unwrap();
     let arm = scene.arm().cloned().unwrap();

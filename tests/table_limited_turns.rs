@@ -47,14 +47,9 @@ fn a_turn_the_table_blocks_is_stopped_short_and_the_reading_settles() {
     let sensor = SensorConfig::paper();
     let object = ObjectSpec::new("box", TriMesh::cuboid(DVec3::splat(HALF_M)));
     let builder = SceneBuilder::with_arm_and_table().object(object);
-    let mut scene: Scene = add_sensor(
-        builder,
-        &Valid::new(sensor).expect("sensor"),
-        "covering",
-        PAD_SITE,
-    )
-    .build()
-    .expect("scene");
+    let mut scene: Scene = add_sensor(builder, &Valid::new(sensor).expect("sensor"), PAD_SITE)
+        .build()
+        .expect("scene");
     let arm = scene.arm().cloned().expect("arm");
     let (ik_options, _) = precise_kinematic_motion(0.125 * sensor.thickness_m);
     let mut ik = InverseKinematics::new(scene.model_arc(), arm.clone(), ik_options);

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use taction::active_touch::ArmTrainingRecipe;
 use taction::dataset::{ExportFormat, Reading};
-use taction::explore::{Collect, PlannerConfig};
+use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 
@@ -232,43 +232,25 @@ pub fn collect(
     let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
-    // An argument of the other mode would be ignored: the dataset would not be the one asked for.
-    let other_mode = match mode {
-        "sampler" => local_probability.is_some().then_some("local_probability"),
-        "planner" => [("from_above", from_above), ("reachable_by_arm", reachable_by_arm)]
-            .into_iter()
-            .find_map(|(name, on)| on.then_some(name)),
-        _ => None,
+    let mode = CollectModeName::parse(mode).ok_or_else(|| {
+        bad_argument(
+            "mode",
+            format!("'{mode}' is not one of {}", CollectModeName::NAMES.join(", ")),
+        )
+    })?;
+    let choices = ModeChoices {
+        from_above,
+        reachable_by_arm,
+        local_probability,
+        max_iterations: None,
     };
-    if let Some(name) = other_mode {
-        return Err(bad_argument(name, format!("not an argument of mode='{mode}'")));
-    }
-    let collect = match mode {
-        "sampler" => {
-            let c = Collect::sampler(sensor);
-            let c = if from_above { c.from_above() } else { c };
-            if reachable_by_arm { c.reachable_by_arm() } else { c }
-        }
-        "planner" => Collect::planner(
-            sensor,
-            PlannerConfig::for_collection(
-                &specs,
-                readings,
-                local_probability.unwrap_or(PlannerConfig::default().local_probability),
-                None,
-            ),
-        ),
-        other => {
-            return Err(bad_argument(
-                "mode",
-                format!("'{other}' is not 'sampler' or 'planner'"),
-            ));
-        }
-    }
-    .per_object(readings)
-    .seed(seed)
-    .threads(threads)
-    .perturbation(perturbation);
+    // An argument of the other mode would be ignored: the dataset would not be the one asked for.
+    let request = CollectRequest::of_mode(mode, choices).map_err(refused)?;
+    let collect = request
+        .collection(sensor, &specs, readings)
+        .seed(seed)
+        .threads(threads)
+        .perturbation(perturbation);
     let dataset = py
         .detach(|| collect.dataset(object_set, &specs))
         .map_err(refused)?;

@@ -43,16 +43,6 @@ impl TouchEpisode {
     }
 }
 
-/// The planner's workspace for `objects`: the default one fitted to them
-/// ([`PlannerConfig::fitted_to`]), where every candidate target lies.
-fn planner_for(objects: &[ObjectSpec], local_probability: f64) -> PlannerConfig {
-    PlannerConfig {
-        local_probability,
-        ..PlannerConfig::default()
-    }
-    .fitted_to(objects)
-}
-
 #[pymethods]
 impl TouchEpisode {
     #[new]
@@ -109,7 +99,7 @@ impl TouchEpisode {
             }
             None => vec![spec.clone()],
         };
-        let planner = planner_for(&fitted_to, local_probability);
+        let planner = PlannerConfig::exploring(&fitted_to, local_probability);
         let config = EpisodeConfig {
             planner: Valid::new(planner).map_err(refused)?,
             perturbation: PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?,
@@ -133,7 +123,7 @@ impl TouchEpisode {
     #[staticmethod]
     fn workspace_m<'py>(py: Python<'py>, objects: Vec<PyRef<'py, Object>>) -> PyResult<Bound<'py, PyAny>> {
         let specs: Vec<ObjectSpec> = objects.iter().map(|o| o.spec()).collect();
-        let planner = planner_for(&specs, 0.5);
+        let planner = PlannerConfig::exploring(&specs, 0.5);
         let values = [
             planner.workspace_min_m.to_array(),
             planner.workspace_max_m.to_array(),

@@ -11,8 +11,8 @@ use taction::describe::Feature;
 use taction::locate::GeometryModel;
 use taction::mesh::TriMesh;
 use taction::recognize::{
-    Appearance, Belief, CodebookKind, DescriptorChoice, FusedModel, GeometricFusion, PseudoCount,
-    RecognizeError, Recognizer, TrainConfig, TrainedModel, VarianceFraction,
+    Belief, CodebookKind, DescriptorChoice, PseudoCount, Recognizer, TrainChoices, TrainData,
+    VarianceFraction, train_recognizer,
 };
 use taction::sim::MaxHeading;
 use taction::tactile::TactileImage;
@@ -258,10 +258,14 @@ impl Posterior {
 
 /// Trains a recogniser on `dataset` as `taction train` does: `descriptor` one of `vectorize`,
 /// `sift`, `mr8`, `mn`, `pf`, `mnti` or several joined by `+` (fused), `codebook` `knn` (the
-/// default, the product's), `gmm` (the paper's) or `kmeans`; the codebook size chosen among `ks` (default: a grid sized to the data) on
-/// `validation` (default: the last 1/11 of each object's readings).
+/// default, the product's), `gmm` (the paper's) or `kmeans`; the codebook size chosen among `ks`
+/// (default: a grid sized to the data) on `validation` (default: the last 1/11 of each object's
+/// readings). `calibration`, the arm's explorations, calibrates the posterior (in trials of
+/// `calibration_trial_readings`, default each object's readings as one); `objects`, the objects the
+/// dataset was collected on, adds where each touch landed, weighed on `calibration` (else
+/// `validation`).
 #[pyfunction]
-#[pyo3(signature = (dataset, descriptor="mnti", codebook="knn", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0), text_signature = "(dataset, descriptor='mnti', codebook='knn', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0)")]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook="knn", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None), text_signature = "(dataset, descriptor='mnti', codebook='knn', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
 pub fn train(
     py: Python<'_>,
@@ -278,40 +282,42 @@ pub fn train(
     objects: Option<Vec<PyRef<'_, Object>>>,
     calibration: Option<Vec<PyRef<'_, Dataset>>>,
     start_heading_deg: f64,
+    calibration_trial_readings: Option<Whole<usize>>,
 ) -> PyResult<Model> {
-    let (Whole(restarts), Whole(seed), Whole(trial_readings)) = (restarts, seed, trial_readings);
-    let ks: Option<Vec<usize>> = ks.map(|ks| ks.into_iter().map(|Whole(k)| k).collect());
-    let choice = DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?;
-    let codebook = CodebookKind::parse(codebook).map_err(|e| bad_argument("codebook", e))?;
-    let config = TrainConfig {
-        codebook,
-        restarts,
-        seed,
-        variance_kept: match variance_kept {
-            Some(f) => VarianceFraction::new(f).map_err(refused)?,
-            None => codebook.default_variance_kept(),
-        },
+    let choices = TrainChoices {
+        descriptor: DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?,
+        codebook: CodebookKind::parse(codebook).map_err(|e| bad_argument("codebook", e))?,
+        ks: ks.map(|ks| ks.into_iter().map(|Whole(k)| k).collect()),
+        restarts: restarts.0,
+        seed: seed.0,
+        variance_kept: variance_kept
+            .map(VarianceFraction::new)
+            .transpose()
+            .map_err(refused)?,
         pseudo_count: PseudoCount::new(pseudo_count).map_err(refused)?,
-        trial_readings,
-        ..TrainConfig::default()
+        trial_readings: trial_readings.0,
+        calibration_trial_readings: calibration_trial_readings.map(|Whole(n)| n),
     };
-    let config = match ks {
-        Some(ks) => TrainConfig { ks, ..config },
-        None => config.with_grid_for_dataset(&dataset.inner, validation.is_some()),
-    };
-    let config = Valid::new(config).map_err(refused)?;
-    let geometry = objects
-        .map(|objects| ContactGeometry::of(&objects, calibration, validation.is_some(), start_heading_deg))
+    let choices = Valid::new(choices).map_err(refused)?;
+    let training = dataset.inner.clone();
+    let contacts = objects
+        .map(|objects| contact_geometry(&objects, &training.header().objects, start_heading_deg))
         .transpose()?;
     let validation = validation.map(|v| v.inner.clone());
-    let training = dataset.inner.clone();
+    let calibration: Vec<_> = calibration
+        .unwrap_or_default()
+        .iter()
+        .map(|d| d.inner.clone())
+        .collect();
     let model = py
         .detach(|| {
-            let appearance = fit(&config, &training, validation.as_deref(), &choice)?;
-            match geometry {
-                None => Ok(appearance),
-                Some(geometry) => geometry.fuse(appearance, validation.as_deref(), config.trial_readings),
-            }
+            let data = TrainData {
+                training: &training,
+                validation: validation.as_deref(),
+                calibration: &calibration.iter().map(AsRef::as_ref).collect::<Vec<_>>(),
+                contacts: contacts.as_ref(),
+            };
+            train_recognizer(&choices, data, &mut ())
         })
         .map_err(refused)?;
     Ok(Model {
@@ -319,104 +325,24 @@ pub fn train(
     })
 }
 
-/// What `train(objects=...)` fuses appearance with: the objects' meshes, the arm's explorations
-/// its weighing is fitted on, the headings the objects stand at (`taction train --objects`).
-struct ContactGeometry {
-    meshes: Vec<(String, TriMesh)>,
-    calibration: Vec<Arc<taction::dataset::Dataset>>,
-    max_heading: MaxHeading,
-}
-
-impl ContactGeometry {
-    /// Checks the arguments: the weighing needs explorations the appearance model was not trained
-    /// on (`calibration`, else the validation data).
-    fn of(
-        objects: &[PyRef<'_, Object>],
-        calibration: Option<Vec<PyRef<'_, Dataset>>>,
-        has_validation: bool,
-        start_heading_deg: f64,
-    ) -> PyResult<Self> {
-        let calibration: Vec<_> = calibration
-            .unwrap_or_default()
-            .iter()
-            .map(|d| d.inner.clone())
-            .collect();
-        if calibration.is_empty() && !has_validation {
-            return Err(bad_argument(
-                "objects",
-                "the fusion of appearance and contact geometry is weighed on explorations the appearance \
-                 model was not trained on: give calibration (the arm's explorations) or validation",
-            ));
-        }
-        let max_heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
-            bad_argument(
-                "start_heading_deg",
-                format!("{start_heading_deg} is outside [0, 180]"),
-            )
-        })?;
-        Ok(Self {
-            meshes: objects
-                .iter()
-                .map(|o| (o.inner.name.clone(), o.inner.mesh.clone()))
-                .collect(),
-            calibration,
-            max_heading,
-        })
-    }
-
-    /// `appearance` fused with the objects' contact geometry, weighed on the calibration
-    /// explorations (each object's readings one trial), else on `validation` in trials of
-    /// `trial_readings`.
-    fn fuse(
-        self,
-        appearance: Recognizer,
-        validation: Option<&taction::dataset::Dataset>,
-        trial_readings: usize,
-    ) -> Result<Recognizer, RecognizeError> {
-        let appearance = Appearance::try_from(appearance)?;
-        let meshes: Vec<(String, &TriMesh)> = self.meshes.iter().map(|(n, m)| (n.clone(), m)).collect();
-        let geometry =
-            GeometryModel::of_named(appearance.objects(), &meshes, self.max_heading).map_err(|e| {
-                RecognizeError::InvalidParameter {
-                    name: "objects",
-                    what: e.to_string(),
-                }
-            })?;
-        let fused = GeometricFusion::new(appearance, geometry)?;
-        let fused = match validation {
-            Some(v) if self.calibration.is_empty() => fused.calibrate_on_all(&[v], trial_readings)?,
-            _ => {
-                let data: Vec<&taction::dataset::Dataset> =
-                    self.calibration.iter().map(AsRef::as_ref).collect();
-                fused.calibrate_on_all(&data, usize::MAX)?
-            }
-        };
-        Ok(Recognizer::Geometric(Box::new(fused)))
-    }
-}
-
-fn fit(
-    config: &Valid<TrainConfig>,
-    training: &taction::dataset::Dataset,
-    validation: Option<&taction::dataset::Dataset>,
-    choice: &DescriptorChoice,
-) -> Result<Recognizer, taction::recognize::RecognizeError> {
-    Ok(match choice.kinds() {
-        [kind] => Recognizer::Single(Box::new(TrainedModel::fit(
-            config,
-            training,
-            validation,
-            kind.build().as_ref(),
-            &mut |_| {},
-        )?)),
-        _ => Recognizer::Fused(Box::new(FusedModel::fit(
-            config,
-            training,
-            validation,
-            choice,
-            &mut |_| {},
-        )?)),
-    })
+/// The surfaces of `names` (the training dataset's objects, in its order) picked from `objects`,
+/// standing within `start_heading_deg` of their canonical heading (`taction train --objects`).
+fn contact_geometry(
+    objects: &[PyRef<'_, Object>],
+    names: &[String],
+    start_heading_deg: f64,
+) -> PyResult<GeometryModel> {
+    let max_heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
+        bad_argument(
+            "start_heading_deg",
+            format!("{start_heading_deg} is outside [0, 180]"),
+        )
+    })?;
+    let meshes: Vec<(String, &TriMesh)> = objects
+        .iter()
+        .map(|o| (o.inner.name.clone(), &o.inner.mesh))
+        .collect();
+    GeometryModel::of_named(names, &meshes, max_heading).map_err(|e| bad_argument("objects", e))
 }
 
 /// The recogniser `taction demo` trains for the arm's own touches (`ArmTrainingRecipe`): sampler
@@ -434,8 +360,11 @@ pub fn train_for_arm(
     calibration: Option<&Dataset>,
 ) -> PyResult<Model> {
     let Whole(seed) = seed;
+    // The recipe's count is per object (it sizes the calibration explorations, which `fit` does
+    // not collect): the training data's readings shared among its objects.
+    let objects = training.inner.header().objects.len().max(1);
     let recipe = ArmTrainingRecipe {
-        readings_per_object: training.inner.len(),
+        readings_per_object: training.inner.len() / objects,
         seed,
     };
     let data = training.inner.clone();

@@ -7,8 +7,7 @@ use glam::DVec3;
 use pyo3::prelude::*;
 use taction::control::FreePad;
 use taction::pose::PadPose;
-use taction::sim::{PAD_SITE, SceneBuilder};
-use taction::tactile::{SensorConfig, TactileImage, add_sensor, psf_sigma_for_thickness};
+use taction::tactile::{SensorConfig, TactileImage, arm_with_sensor};
 use taction::valid::Valid;
 
 use crate::args::Whole;
@@ -104,17 +103,11 @@ impl Sensor {
     ) -> PyResult<Self> {
         let (Whole(rows), Whole(cols), Whole(rays_per_taxel), Whole(seed)) =
             (rows, cols, rays_per_taxel, seed);
-        let thickness_m = thickness_m.unwrap_or(0.1 * pad_m);
         let config = SensorConfig {
-            rows,
-            cols,
-            pad_width_m: pad_m,
-            pad_height_m: pad_m,
-            thickness_m,
-            psf_sigma_m: psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
             rays_per_taxel,
             noise_fraction: noise,
             noise_seed: seed,
+            ..SensorConfig::of_square_pad(rows, cols, pad_m, thickness_m, psf_sigma_m)
         };
         Ok(Self {
             config: Valid::new(config).map_err(refused)?,
@@ -181,8 +174,5 @@ pub fn scene(object: &Object, sensor: Option<PyRef<'_, Sensor>>) -> PyResult<Str
         Some(s) => s.config,
         None => Sensor::paper_config()?,
     };
-    let builder = SceneBuilder::with_arm_and_table().object(object.spec());
-    add_sensor(builder, &config, "tactile", PAD_SITE)
-        .to_xml()
-        .map_err(refused)
+    arm_with_sensor(object.spec(), &config).to_xml().map_err(refused)
 }

@@ -1,5 +1,7 @@
 """The sensor from Python reads what the CLI reads, bit for bit; bad input raises TactionError."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -41,6 +43,52 @@ def test_the_sensor_parameters_shape_the_image(sphere_path):
     lifted = list(TOUCH)
     lifted[2] += 0.01
     assert taction.Sensor().read(sphere, lifted).max() == 0.0
+
+
+# Sensors out of range, as Python keywords (each also given to the CLI as its flags, `--thickness-m`
+# for `thickness_m`), with the key the refusal names. The covering at most half the pad is the
+# sensor's own rule, which both edges meet through the library.
+REFUSED_SENSORS = [
+    ({"rows": 0}, "rows"),
+    ({"cols": 300}, "cols"),
+    ({"pad_m": -0.01}, "pad_width_m"),
+    ({"pad_m": 2.0}, "pad_width_m"),
+    ({"thickness_m": 0.0}, "thickness_m"),
+    ({"thickness_m": 0.007}, "thickness_m"),
+    ({"pad_m": 0.004, "thickness_m": 0.0025}, "thickness_m"),
+    ({"psf_sigma_m": -0.001}, "psf_sigma_m"),
+    ({"rays_per_taxel": 5}, "rays_per_taxel"),
+    ({"noise": 2.5}, "noise_fraction"),
+]
+# The CLI flag that sets each key of the sensor's configuration.
+FLAG_OF_KEY = {
+    "rows": "--rows",
+    "cols": "--cols",
+    "pad_width_m": "--pad-m",
+    "thickness_m": "--thickness-m",
+    "psf_sigma_m": "--psf-sigma-m",
+    "rays_per_taxel": "--rays-per-taxel",
+    "noise_fraction": "--noise",
+}
+
+
+@pytest.mark.parametrize(
+    "bad,key", REFUSED_SENSORS, ids=[",".join(f"{k}={v}" for k, v in bad.items()) for bad, _ in REFUSED_SENSORS]
+)
+def test_python_refuses_every_sensor_the_cli_refuses_for_the_same_reason(sphere_path, tmp_path, bad, key):
+    flags = []
+    for name, value in bad.items():
+        flags += ["--" + name.replace("_", "-"), str(value)]
+    cli = subprocess.run(
+        ["cargo", "run", "--quiet", "--package", "taction", "--", "sense", "--mesh", str(sphere_path),
+         "--pad-center", "0,0,0.0606", "--pad-normal", "0,0,-1", "--out", str(tmp_path / "r.csv"), *flags],
+        cwd=ROOT, capture_output=True, text=True,
+    )
+    assert cli.returncode == 2 and not (tmp_path / "r.csv").exists(), cli.stderr
+    with pytest.raises(taction.TactionError, match=f" {key}=") as python:
+        taction.Sensor(**bad)
+    reason = str(python.value).split("want ", 1)[1]
+    assert f"{FLAG_OF_KEY[key]}: " in cli.stderr and f"want {reason}" in cli.stderr, (str(python.value), cli.stderr)
 
 
 def test_noise_is_seeded(sphere_path):

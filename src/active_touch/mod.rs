@@ -64,7 +64,7 @@ use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, ModelPosterior};
 use crate::recognize::{
     CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer, Tempering,
-    TrainConfig, TrainedModel,
+    TrainChoices, TrainConfig, TrainData, TrainedModel, train_recognizer,
 };
 use crate::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
 use crate::tactile::{SensorConfig, TactileImage};
@@ -390,17 +390,26 @@ impl ArmTrainingRecipe {
         })
     }
 
-    /// Model selection for `training` (validation held out of it).
-    pub fn train_config(&self, training: &Dataset) -> Result<Valid<TrainConfig>, RecognizeError> {
-        let codebook = Self::CODEBOOK;
-        let config = TrainConfig {
-            codebook,
+    /// The training choices: [`Self::DESCRIPTORS`] over [`Self::CODEBOOK`], one restart, the
+    /// posterior calibrated on trials of 10 of the arm's touches.
+    pub fn choices(&self) -> Result<Valid<TrainChoices>, RecognizeError> {
+        let descriptor = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
+            name: "descriptors",
+            what: e.to_string(),
+        })?;
+        let choices = TrainChoices {
+            codebook: Self::CODEBOOK,
             restarts: 1,
             seed: self.seed,
-            variance_kept: codebook.default_variance_kept(),
-            ..TrainConfig::default()
+            calibration_trial_readings: Some(10),
+            ..TrainChoices::of(descriptor)
         };
-        Valid::new(config.with_grid_for_dataset(training, false))
+        Valid::new(choices)
+    }
+
+    /// Model selection for `training` (validation held out of it).
+    pub fn train_config(&self, training: &Dataset) -> Result<Valid<TrainConfig>, RecognizeError> {
+        self.choices()?.config(training, false)
     }
 
     /// Converged readings per object of the arm's own explorations the posterior is calibrated
@@ -441,15 +450,18 @@ impl ArmTrainingRecipe {
         training: &Dataset,
         calibration: Option<&Dataset>,
     ) -> Result<FusedModel, RecognizeError> {
-        let choice = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
-            name: "descriptors",
-            what: e.to_string(),
-        })?;
-        let config = self.train_config(training)?;
-        let model = FusedModel::fit(&config, training, None, &choice, &mut |_| {})?;
-        match calibration {
-            Some(arm) => model.calibrate_on(arm, config.trial_readings),
-            None => Ok(model),
+        let data = TrainData {
+            training,
+            validation: None,
+            calibration: calibration.as_slice(),
+            contacts: None,
+        };
+        match train_recognizer(&self.choices()?, data, &mut ())? {
+            Recognizer::Fused(model) => Ok(*model),
+            _ => Err(RecognizeError::InvalidParameter {
+                name: "descriptors",
+                what: "the recipe fuses two descriptors".into(),
+            }),
         }
     }
 }

@@ -7,10 +7,9 @@ use std::path::{Path, PathBuf};
 use clap::{Args, ValueEnum};
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
-use taction::explore::{Collect, ExplorationReport, PlannerConfig};
+use taction::explore::{CollectModeName, CollectRequest, ExplorationReport, ModeChoices};
 use taction::mesh::ObjectSet;
-use taction::sim::{ObjectSpec, PerturbationBounds, StartPose};
-use taction::tactile::SensorConfig;
+use taction::sim::{PerturbationBounds, StartPose};
 use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
@@ -95,6 +94,7 @@ pub struct CollectArgs {
 
 pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_flags(args)?;
+    let request = request(args)?;
     check_output_file(&args.out, "out")?;
     let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
     let sensor = args.sensor.config(args.seed.seed)?.into_inner();
@@ -116,11 +116,11 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
             ),
         )
     })?;
-    let collect = collection(args, sensor, &objects)
+    let collect = request
+        .collection(sensor, &objects, args.readings)
         .control(args.control.valid(sensor.noise_fraction)?)
         .perturbation(perturbation)
         .start_pose(start_pose)
-        .per_object(args.readings)
         .seed(args.seed.seed)
         .threads(args.threads.count().get());
     let plan = collect.plan().map_err(named_by_flag)?;
@@ -164,34 +164,6 @@ fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
             format!("want 1 to {MAX_READINGS} per object"),
         ));
     }
-    // A flag of the other mode would be ignored without a word: the run would not be the one asked for.
-    let given = |flags: &[(&'static str, bool)]| -> Vec<&'static str> {
-        flags
-            .iter()
-            .filter(|(_, on)| *on)
-            .map(|(name, _)| *name)
-            .collect()
-    };
-    let (others, mode) = match args.mode {
-        Mode::Sampler => (
-            given(&[
-                ("--local-prob", args.local_prob.is_some()),
-                ("--max-iterations", args.max_iterations.is_some()),
-            ]),
-            "sampler",
-        ),
-        Mode::Planner => (
-            given(&[("--from-above", args.from_above), ("--reachable", args.reachable)]),
-            "planner",
-        ),
-    };
-    if !others.is_empty() {
-        let flags = if others.len() == 1 { "a flag" } else { "flags" };
-        return Err(UsageError(format!(
-            "{}: not {flags} of --mode {mode} (the help says which mode each flag belongs to)",
-            others.join(", ")
-        )));
-    }
     if !(0.0..=180.0).contains(&args.perturb_deg) {
         return Err(flag_error(
             "perturb-deg",
@@ -209,33 +181,38 @@ fn check_flags(args: &CollectArgs) -> Result<(), UsageError> {
     Ok(())
 }
 
-/// The procedure the flags ask for on `objects` (the planner's workspace fitted to them); its
-/// parameters are checked by [`Collect::plan`].
-fn collection(args: &CollectArgs, sensor: SensorConfig, objects: &[ObjectSpec]) -> Collect<'static> {
-    match args.mode {
-        Mode::Sampler => {
-            let collect = Collect::sampler(sensor);
-            let collect = if args.from_above {
-                collect.from_above()
-            } else {
-                collect
-            };
-            if args.reachable {
-                collect.reachable_by_arm()
-            } else {
-                collect
-            }
-        }
-        Mode::Planner => Collect::planner(
-            sensor,
-            PlannerConfig::for_collection(
-                objects,
-                args.readings,
-                args.local_prob
-                    .unwrap_or(PlannerConfig::default().local_probability),
-                args.max_iterations,
-            ),
-        ),
+/// The mode the flags ask for with its own flags; a flag of the other mode is refused by its name
+/// (it would be ignored without a word: the run would not be the one asked for).
+fn request(args: &CollectArgs) -> Result<CollectRequest, UsageError> {
+    let mode = match args.mode {
+        Mode::Sampler => CollectModeName::Sampler,
+        Mode::Planner => CollectModeName::Planner,
+    };
+    let choices = ModeChoices {
+        from_above: args.from_above,
+        reachable_by_arm: args.reachable,
+        local_probability: args.local_prob,
+        max_iterations: args.max_iterations,
+    };
+    CollectRequest::of_mode(mode, choices).map_err(|e| {
+        let flags: Vec<&str> = e.choices.iter().map(|&choice| flag_of(choice)).collect();
+        let what = if flags.len() == 1 { "a flag" } else { "flags" };
+        UsageError(format!(
+            "{}: not {what} of --mode {} (the help says which mode each flag belongs to)",
+            flags.join(", "),
+            e.mode.name()
+        ))
+    })
+}
+
+/// The flag of a [`ModeChoices`] field.
+fn flag_of(choice: &str) -> &str {
+    match choice {
+        "from_above" => "--from-above",
+        "reachable_by_arm" => "--reachable",
+        "local_probability" => "--local-prob",
+        "max_iterations" => "--max-iterations",
+        other => other,
     }
 }
 

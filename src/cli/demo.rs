@@ -32,9 +32,9 @@ use taction::recognize::Belief;
 use taction::recognize::{FusedModel, Recognizer};
 use taction::rng;
 use taction::sim::PAD_SITE;
-use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder, StartPose};
+use taction::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
 use taction::tactile::write_contact_sheet;
-use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
+use taction::tactile::{CoveringSensor, SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error, parse_at_least_one};
@@ -260,13 +260,7 @@ fn place_unknown(
         None => r.random_range(0..objects.len()),
     };
     let spec = objects[index].clone();
-    let mut scene = add_sensor(
-        SceneBuilder::with_arm_and_table().object(spec.clone()),
-        &Valid::new(sensor)?,
-        "covering",
-        PAD_SITE,
-    )
-    .build()?;
+    let mut scene = arm_with_sensor(spec.clone(), &Valid::new(sensor)?).build()?;
     scene.place_at_start(start, &mut r)?;
     println!(
         "exploring an unknown object with the arm (it is '{}'; the planner is not told)",
@@ -352,13 +346,7 @@ fn explore_unknown(
 /// the setting the recipe was measured at, for either strategy (the active scorer picks among
 /// candidates half local, half global).
 fn arm_planner_config(objects: &[ObjectSpec]) -> Result<Valid<PlannerConfig>, Box<dyn std::error::Error>> {
-    Ok(Valid::new(
-        PlannerConfig {
-            local_probability: 0.5,
-            ..PlannerConfig::default()
-        }
-        .fitted_to(objects),
-    )?)
+    Ok(Valid::new(PlannerConfig::exploring(objects, 0.5))?)
 }
 
 /// The belief after every touch, printed as a table and kept as `touches.csv` and the series of

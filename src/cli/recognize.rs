@@ -68,28 +68,7 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
     if !(0.0..=10.0).contains(&args.contact_noise_scale) {
         return Err(flag_error("contact-noise-scale", args.contact_noise_scale, "want 0 to 10").into());
     }
-    let evidence = args.evidence.as_deref().and_then(Evidence::parse);
-    let model = match Recognizer::load(&args.model)?.with_posterior(args.posterior.rule) {
-        Recognizer::Geometric(g) => {
-            let noise = ContactNoise::ARM.scaled(args.contact_noise_scale);
-            let g = g
-                .with_contact_noise(noise)
-                .with_evidence(evidence.unwrap_or_default());
-            Recognizer::Geometric(Box::new(g))
-        }
-        _ if evidence.is_some_and(|e| e != Evidence::Appearance) => {
-            return Err(flag_error(
-                "evidence",
-                args.evidence.as_deref().unwrap_or_default(),
-                format!(
-                    "{} knows appearance alone; a model of contacts too is trained with `train --objects`",
-                    args.model.display()
-                ),
-            )
-            .into());
-        }
-        other => other,
-    };
+    let model = model_for(args)?;
     let test = read_dataset(&args.dataset)?;
     let spinner = ProgressBar::new_spinner().with_message("describing and recognising");
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
@@ -136,26 +115,63 @@ pub fn run(args: &RecognizeArgs) -> Result<(), Box<dyn std::error::Error>> {
         &plot_title(args),
     )?);
     print_summary(&model, &evaluation, trials, used);
-    // The stop is replayed from the first reading on, within the readings the trials had; a stop.csv
-    // of an earlier run into this folder would otherwise stand beside this run's files.
+    paths.extend(replay_stops(args, &evaluation, trials, used)?);
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    Ok(())
+}
+
+/// The model of `--model` with the posterior, contact noise and evidence the flags ask for.
+fn model_for(args: &RecognizeArgs) -> Result<Recognizer, Box<dyn std::error::Error>> {
+    let evidence = args.evidence.as_deref().and_then(Evidence::parse);
+    let model = Recognizer::load(&args.model)?.with_posterior(args.posterior.rule);
+    let Recognizer::Geometric(g) = model else {
+        if evidence.is_some_and(|e| e != Evidence::Appearance) {
+            return Err(flag_error(
+                "evidence",
+                args.evidence.as_deref().unwrap_or_default(),
+                format!(
+                    "{} knows appearance alone; a model of contacts too is trained with `train --objects`",
+                    args.model.display()
+                ),
+            )
+            .into());
+        }
+        return Ok(model);
+    };
+    let noise = ContactNoise::ARM.scaled(args.contact_noise_scale);
+    let g = g
+        .with_contact_noise(noise)
+        .with_evidence(evidence.unwrap_or_default());
+    Ok(Recognizer::Geometric(Box::new(g)))
+}
+
+/// Replays the confidence stops from the first reading on, within the readings the trials had
+/// (`used`), into `stop.csv`; when `--readings` starts later there is no replay, and a stop.csv of
+/// an earlier run into this folder would otherwise stand beside this run's files.
+fn replay_stops(
+    args: &RecognizeArgs,
+    evaluation: &Evaluation,
+    trials: usize,
+    used: usize,
+) -> Result<Option<PathBuf>, Box<dyn std::error::Error>> {
     let stops = args.out.join(STOP_FILE);
     if args.readings.first() == 1 {
-        paths.push(write_stops(
+        return Ok(Some(write_stops(
             &args.out,
-            &evaluation,
+            evaluation,
             trials,
             used.min(args.readings.last()),
-        )?);
-    } else if stops.exists() {
+        )?));
+    }
+    if stops.exists() {
         std::fs::remove_file(&stops).map_err(|e| format!("{}: {e}", stops.display()))?;
         eprintln!(
             "taction recognize: removed {} of an earlier run: the stop is replayed only when --readings starts at 1",
             stops.display()
         );
     }
-    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-    println!("wrote {}", names.join(", "));
-    Ok(())
+    Ok(None)
 }
 
 /// The confidence stops' replay a recognition writes.

@@ -18,10 +18,9 @@ use taction::dataset::ContactStatus;
 use taction::mesh::BUILTIN_SETS;
 use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
 use taction::pose::PadPose;
-use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, SceneBuilder};
 use taction::sim::{Section, comment, numbers};
-use taction::tactile::{SensorConfig, add_sensor};
+use taction::tactile::{SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ObjectSizeArg, SeedArg, check_output_folder};
@@ -201,11 +200,9 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     // Named as `taction objects export` names its files.
     let mesh_file = format!("{}.obj", built.name);
     let spec = ObjectSpec::from(built);
-    let builder = SceneBuilder::with_arm_and_table()
-        .object(spec.clone())
-        .object_mesh_file(mesh_file.clone());
+    let builder = arm_with_sensor(spec.clone(), &config).object_mesh_file(mesh_file.clone());
     let (builder, keyframe) = with_touch_keyframe(builder, &spec, &config, &args.object)?;
-    let xml = add_sensor(builder, &config, "tactile", PAD_SITE).to_xml()?;
+    let xml = builder.to_xml()?;
     let header = comment(&format!(
         "  Written by taction scene export for the object {}: the arm, the table, the object (mesh in {mesh_file},\n  \
          metres) and the taction.covering sensor on the pad site. Load the plugin library first:\n  \

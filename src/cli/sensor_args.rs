@@ -8,7 +8,7 @@ use glam::DVec3;
 use taction::mesh::Object;
 use taction::pose::PadPose;
 use taction::sim::ObjectSpec;
-use taction::tactile::{ConfigKey, SensorConfig, psf_sigma_for_thickness};
+use taction::tactile::{ConfigKey, SensorConfig};
 
 use crate::cli::common::ObjectSizeArg;
 use crate::cli::plausible::{Carrier, check_mesh};
@@ -65,40 +65,23 @@ pub fn flag_of(key: ConfigKey) -> &'static str {
 impl SensorArgs {
     /// The sensor configuration the flags describe, with noise seed `noise_seed`, validated.
     pub fn config(&self, noise_seed: u64) -> Result<Valid<SensorConfig>, SensorFlagError> {
-        let thickness_m = self.thickness_m.unwrap_or(0.1 * self.pad_m);
         let config = SensorConfig {
-            rows: self.rows,
-            cols: self.cols,
-            pad_width_m: self.pad_m,
-            pad_height_m: self.pad_m,
-            thickness_m,
-            psf_sigma_m: self
-                .psf_sigma_m
-                .unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
             rays_per_taxel: self.rays_per_taxel,
             noise_fraction: self.noise,
             noise_seed,
+            ..SensorConfig::of_square_pad(
+                self.rows,
+                self.cols,
+                self.pad_m,
+                self.thickness_m,
+                self.psf_sigma_m,
+            )
         };
-        let config = Valid::new(config).map_err(|e| SensorFlagError {
+        Valid::new(config).map_err(|e| SensorFlagError {
             flag: flag_of(e.key),
-            value: e.value.clone(),
-            allowed: e.key.allowed(),
-        })?;
-        // A covering thicker than half the pad is no thin skin on a fingertip: its point spread
-        // (sigma 0.48 t, Sec. V-B5) would blur the whole pad into one value.
-        let half_pad_m = 0.5 * self.pad_m;
-        if thickness_m > half_pad_m {
-            return Err(SensorFlagError {
-                flag: "thickness-m",
-                value: taction::units::significant(thickness_m),
-                allowed: format!(
-                    "at most half the {} pad side, {} (a thicker covering's point spread blurs the whole pad)",
-                    taction::units::length(self.pad_m),
-                    taction::units::length(half_pad_m)
-                ),
-            });
-        }
-        Ok(config)
+            value: e.value,
+            allowed: e.allowed,
+        })
     }
 }
 

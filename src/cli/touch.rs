@@ -23,8 +23,8 @@ use taction::control::{
 use taction::explore::precise_motion;
 use taction::pose::PadPose;
 use taction::sim::{ARM_JOINTS, PAD_SITE};
-use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget, SceneBuilder};
-use taction::tactile::{CoveringSensor, SensorConfig, add_sensor};
+use taction::sim::{IkError, InverseKinematics, ObjectSpec, PadTarget};
+use taction::tactile::{CoveringSensor, SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
 use crate::cli::common::{ControlArg, ControlFileError, SeedArg};
@@ -132,8 +132,7 @@ pub fn touch_arm(
     control: &Valid<ControlConfig>,
     start: &PadPose,
 ) -> Result<ArmTouch, TouchError> {
-    let builder = SceneBuilder::with_arm_and_table().object(object);
-    let mut scene = add_sensor(builder, sensor, "covering", PAD_SITE).build()?;
+    let mut scene = arm_with_sensor(object, sensor).build()?;
     let arm = scene.arm().cloned().ok_or(taction::sim::SimError::NoArm)?;
     let reader = sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?);
     let (ik_options, motion) = precise_motion();

@@ -10,12 +10,13 @@ use taction::describe::DescriptorKind;
 use taction::locate::GeometryModel;
 use taction::mesh::{ObjectSet, TriMesh};
 use taction::recognize::{
-    Appearance, CodebookKind, DescriptorChoice, FusedModel, GeometricFusion, PseudoCount, RecognizeError,
-    Recognizer, Tempering, TrainConfig, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
+    CodebookKind, DescriptorChoice, PseudoCount, RecognizeError, Recognizer, Tempering, TrainChoices,
+    TrainData, TrainObserver, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
+    train_recognizer,
 };
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, SeedArg, UsageError, check_output_file, flag_error, parse_codebook};
+use crate::cli::common::{ObjectSizeArg, SeedArg, UsageError, check_output_file, parse_codebook};
 use crate::cli::dataset::read_dataset;
 use crate::cli::plausible::{Carrier, build_objects};
 
@@ -100,6 +101,8 @@ fn named_by_flag(e: RecognizeError) -> Box<dyn std::error::Error> {
                 "trial_readings" => "trial-readings",
                 "variance_kept" => "variance-kept",
                 "pseudo_count" => "pseudo-count",
+                "calibration_trial_readings" => "calibration-trial-readings",
+                "objects" => "objects",
                 _ => return RecognizeError::InvalidParameter { name, what }.into(),
             };
             UsageError(format!("--{flag}: {what}")).into()
@@ -108,107 +111,51 @@ fn named_by_flag(e: RecognizeError) -> Box<dyn std::error::Error> {
     }
 }
 
-pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if args.calibration_trial_readings == Some(0) {
-        return Err(flag_error("calibration-trial-readings", 0, "want 1 or more").into());
-    }
-    check_output_file(&args.out, "out")?;
-    if !args.objects.is_empty() && args.calibration.is_empty() && args.validation.is_none() {
-        return Err(UsageError(
-            "--objects: the fusion of appearance and contact geometry is weighed on explorations the \
-             appearance model was not trained on: give --calibration (the arm's explorations) or --validation"
-                .into(),
-        )
-        .into());
-    }
-    let variance_kept = match args.variance_kept {
-        Some(fraction) => VarianceFraction::new(fraction).map_err(named_by_flag)?,
-        None => args.codebook.default_variance_kept(),
-    };
-    let pseudo_count = PseudoCount::new(args.pseudo_count).map_err(named_by_flag)?;
-    let flags = TrainConfig {
+/// The flags as the library's training choices, checked before any dataset is read (a bad value
+/// exits 2, named by its flag).
+fn choices(args: &TrainArgs) -> Result<Valid<TrainChoices>, Box<dyn std::error::Error>> {
+    let variance_kept = args
+        .variance_kept
+        .map(VarianceFraction::new)
+        .transpose()
+        .map_err(named_by_flag)?;
+    let choices = TrainChoices {
+        descriptor: args.descriptor.clone(),
         codebook: args.codebook,
+        ks: args.ks.clone(),
         restarts: args.restarts,
         seed: args.seed.seed,
         variance_kept,
-        pseudo_count,
+        pseudo_count: PseudoCount::new(args.pseudo_count).map_err(named_by_flag)?,
         trial_readings: args.trial_readings,
-        ks: args.ks.clone().unwrap_or_else(|| TrainConfig::default().ks),
-        ..TrainConfig::default()
+        calibration_trial_readings: args.calibration_trial_readings,
     };
-    // The flags' own values are checked before any dataset is read (a bad one exits 2, named by
-    // its flag); the grid a dataset chooses is checked again below.
-    Valid::new(flags.clone()).map_err(named_by_flag)?;
+    Valid::new(choices).map_err(named_by_flag)
+}
+
+pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let choices = choices(args)?;
+    check_output_file(&args.out, "out")?;
     let training = read_dataset(&args.dataset)?;
-    let config = flags;
-    let config = match &args.ks {
-        Some(ks) => TrainConfig {
-            ks: ks.clone(),
-            ..config
-        },
-        None => config.with_grid_for_dataset(&training, args.validation.is_some()),
-    };
     let validation = args.validation.as_deref().map(read_dataset).transpose()?;
     check_datasets(args, &training, validation.as_ref())?;
-    let config = Valid::new(config)?;
-    let mut models = Vec::new();
-    for &kind in args.descriptor.kinds() {
-        let model = fit_one(kind, &config, &training, validation.as_ref())?;
-        print_selection(&model);
-        models.push(model);
-    }
-    let model = if args.descriptor.is_fused() {
-        let fused = FusedModel::new(models)?.calibrated(&config, &training, validation.as_ref())?;
-        print_tempering("fused", "validation", fused.tempering);
-        Recognizer::Fused(Box::new(fused))
-    } else {
-        let model = models.into_iter().next().ok_or("no descriptor to train")?;
-        Recognizer::Single(Box::new(model))
+    let calibration = args
+        .calibration
+        .iter()
+        .map(|path| read_dataset(path))
+        .collect::<Result<Vec<_>, _>>()?;
+    let contacts = geometry_of(args, &training)?;
+    let data = TrainData {
+        training: &training,
+        validation: validation.as_ref(),
+        calibration: &calibration.iter().collect::<Vec<_>>(),
+        contacts: contacts.as_ref(),
     };
-    let model = match geometry_of(args, &training, model.objects())? {
-        None => model,
-        Some(geometry) => {
-            let fused = GeometricFusion::new(Appearance::try_from(model)?, geometry)?;
-            let model = Recognizer::Geometric(Box::new(fused));
-            // Weighed on the calibration explorations below when there are any; else on the
-            // validation data (one of the two is given: checked before training).
-            match (&validation, args.calibration.is_empty()) {
-                (Some(v), true) => {
-                    let model = model.calibrate_on_all(&[v], config.trial_readings)?;
-                    print_geometry(&model, "validation");
-                    model
-                }
-                _ => model,
-            }
-        }
-    };
-    let model = if args.calibration.is_empty() {
-        model
-    } else {
-        let data = args
-            .calibration
-            .iter()
-            .map(|path| read_dataset(path))
-            .collect::<Result<Vec<_>, _>>()?;
-        let (trial_readings, trials) = match args.calibration_trial_readings {
-            Some(n) => (n, format!("trials of {n} readings")),
-            None => (usize::MAX, "each object's readings one trial".to_string()),
-        };
-        let names: Vec<String> = args.calibration.iter().map(|p| p.display().to_string()).collect();
-        let model = model
-            .calibrate_on_all(&data.iter().collect::<Vec<_>>(), trial_readings)
-            .map_err(|e| format!("--calibration {}: {e}", names.join(", ")))?;
-        // A model of contacts too weighs them on the calibration, and says so itself.
-        if !matches!(model, Recognizer::Geometric(_)) {
-            print_tempering(
-                &args.descriptor.name(),
-                &format!("{} ({trials})", names.join(" + ")),
-                model.tempering(),
-            );
-        }
-        print_geometry(&model, &format!("{} ({trials})", names.join(" + ")));
-        model
-    };
+    let mut printer = Printer::new(args);
+    let model = train_recognizer(&choices, data, &mut printer).map_err(|e| match e {
+        RecognizeError::Calibration(e) => format!("--calibration {}: {e}", printer.calibration_names).into(),
+        e => named_by_flag(e),
+    })?;
     model.save(&args.out)?;
     let kind = match (&model, args.descriptor.is_fused()) {
         (Recognizer::Geometric(_), _) => "model of appearance and contact geometry",
@@ -221,6 +168,78 @@ pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
         args.out.display()
     );
     Ok(())
+}
+
+/// What training tried and chose, printed as it goes, with a progress bar over each descriptor's
+/// candidates.
+struct Printer {
+    bar: Option<ProgressBar>,
+    descriptor: String,
+    calibration_names: String,
+    calibration_trials: String,
+}
+
+impl Printer {
+    fn new(args: &TrainArgs) -> Self {
+        let names: Vec<String> = args.calibration.iter().map(|p| p.display().to_string()).collect();
+        Self {
+            bar: None,
+            descriptor: args.descriptor.name(),
+            calibration_names: names.join(", "),
+            calibration_trials: match args.calibration_trial_readings {
+                Some(n) => format!("{} (trials of {n} readings)", names.join(" + ")),
+                None => format!("{} (each object's readings one trial)", names.join(" + ")),
+            },
+        }
+    }
+
+    fn bar(&mut self, kind: DescriptorKind) -> &ProgressBar {
+        self.bar.get_or_insert_with(|| {
+            let bar = ProgressBar::new(0);
+            bar.set_style(
+                ProgressStyle::with_template("{bar:30} {pos}/{len} candidates  {msg}  [{elapsed}]")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            bar.set_message(format!("describing readings ({})", kind.name()));
+            bar
+        })
+    }
+}
+
+impl TrainObserver for Printer {
+    fn progress(&mut self, kind: DescriptorKind, event: TrainProgress) {
+        let bar = self.bar(kind);
+        match event {
+            TrainProgress::PcaFitted { total, .. } => bar.set_length(total as u64),
+            TrainProgress::Fitting { k, restart, .. } => {
+                bar.set_message(format!("fitting k={k} restart={restart}"))
+            }
+            TrainProgress::Scored(_) => bar.inc(1),
+        }
+    }
+
+    fn fitted(&mut self, model: &TrainedModel) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        print_selection(model);
+    }
+
+    fn fused(&mut self, tempering: Tempering) {
+        print_tempering("fused", "validation", tempering);
+    }
+
+    fn weighed_on_validation(&mut self, model: &Recognizer) {
+        print_geometry(model, "validation");
+    }
+
+    fn calibrated(&mut self, model: &Recognizer) {
+        // A model of contacts too weighs them on the calibration, and says so itself.
+        if !matches!(model, Recognizer::Geometric(_)) {
+            print_tempering(&self.descriptor, &self.calibration_trials, model.tempering());
+        }
+        print_geometry(model, &self.calibration_trials);
+    }
 }
 
 /// The training data has converged readings of every object, and the validation data is of the
@@ -260,38 +279,6 @@ fn check_datasets(
         .into());
     }
     Ok(())
-}
-
-/// Trains the model of one descriptor, with a progress bar.
-fn fit_one(
-    kind: DescriptorKind,
-    config: &Valid<TrainConfig>,
-    training: &Dataset,
-    validation: Option<&Dataset>,
-) -> Result<TrainedModel, Box<dyn std::error::Error>> {
-    let descriptor = kind.build();
-    let bar = ProgressBar::new(0);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} candidates  {msg}  [{elapsed}]")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("describing readings ({})", kind.name()));
-    let mut on_progress = |event: TrainProgress| match event {
-        TrainProgress::PcaFitted { total, .. } => bar.set_length(total as u64),
-        TrainProgress::Fitting { k, restart, .. } => {
-            bar.set_message(format!("fitting k={k} restart={restart}"))
-        }
-        TrainProgress::Scored(_) => bar.inc(1),
-    };
-    let model = TrainedModel::fit(
-        config,
-        training,
-        validation,
-        descriptor.as_ref(),
-        &mut on_progress,
-    )?;
-    bar.finish_and_clear();
-    Ok(model)
 }
 
 /// What model selection tried and chose.
@@ -350,12 +337,11 @@ fn print_tempering(name: &str, on: &str, t: Tempering) {
 }
 
 /// The geometric model of `--objects`, when given: the set the training data was collected on
-/// (its id is the dataset header's), the surface of each of the appearance model's objects
-/// (`names`, in its order) in its canonical frame.
+/// (its id is the dataset header's), the surface of each of the dataset's objects, in its order,
+/// in its canonical frame.
 fn geometry_of(
     args: &TrainArgs,
     training: &Dataset,
-    names: &[String],
 ) -> Result<Option<GeometryModel>, Box<dyn std::error::Error>> {
     if args.objects.is_empty() {
         return Ok(None);
@@ -374,7 +360,7 @@ fn geometry_of(
     }
     let objects = build_objects(&set, "train", Carrier::FreePad)?;
     let meshes: Vec<(String, &TriMesh)> = objects.iter().map(|o| (o.name.clone(), &o.mesh)).collect();
-    let geometry = GeometryModel::of_named(names, &meshes, set.start_heading())?;
+    let geometry = GeometryModel::of_named(&training.header().objects, &meshes, set.start_heading())?;
     Ok(Some(geometry))
 }
 

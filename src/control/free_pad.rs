@@ -178,9 +178,7 @@ mod tests {
             .table(false)
             .object(object)
             .add(Section::Worldbody, body);
-        let scene = add_sensor(builder, config, "covering", FREE_PAD_SITE)
-            .build()
-            .unwrap();
+        let scene = add_sensor(builder, config, FREE_PAD_SITE).build().unwrap();
         FreePad::from_scene(scene).unwrap()
     }
 

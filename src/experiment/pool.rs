@@ -452,38 +452,19 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
         None => None,
     };
 
-    let seeds = record.runs.len();
-    let mut calibration = Vec::new();
-    for spec in &manifest.spec.plots {
-        let titled = PlotSpec {
-            title: format!("{} ({seeds} seeds pooled)", spec.title),
-            ..spec.clone()
-        };
-        match (&spec.kind, &spec.table) {
-            (PlotKind::Accuracy, None) if *spec == accuracy_plot => {
-                let figure = summarised_accuracy_figure(
-                    &titled,
-                    &pooled_csv,
-                    &pooled_curves(&pooled),
-                    INTERVAL_BAND_LABEL,
-                )?;
-                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
-                figure.write_svg(&svg)?;
-                figure.write_png(&png)?;
-                files.extend([svg, png]);
-            }
-            (PlotKind::Reliability, Some(_)) => {
-                if let Some(table) = &reliability_csv {
-                    let (figure, paths) = render_plot(&titled, table, &target)?;
-                    calibration.extend(calibration_labels(&figure));
-                    files.extend(paths);
-                }
-            }
-            (PlotKind::Lines { .. }, None) => files.extend(render_plot(&titled, &union_csv, &target)?.1),
-            // Other plots read tables that are not pooled (per-object rows).
-            _ => {}
-        }
-    }
+    let tables = PooledTables {
+        union: &union_csv,
+        pooled: &pooled_csv,
+        pooled_rows: &pooled,
+        reliability: reliability_csv.as_deref(),
+    };
+    let plots = PooledPlots {
+        specs: &manifest.spec.plots,
+        accuracy: &accuracy_plot,
+        seeds: record.runs.len(),
+    };
+    let (plot_files, calibration) = write_pooled_plots(&plots, &tables, &target)?;
+    files.extend(plot_files);
 
     let record_path = target.root().join("pool.json");
     write_if_changed(&record_path, &to_json(&record, &record_path)?)?;
@@ -495,6 +476,63 @@ fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentE
         calibration,
         compared,
     })
+}
+
+/// The pooled tables a plot may read.
+struct PooledTables<'a> {
+    union: &'a Path,
+    pooled: &'a Path,
+    pooled_rows: &'a [PooledRow],
+    reliability: Option<&'a Path>,
+}
+
+/// The experiment's plots, its accuracy plot among them, over `seeds` pooled runs.
+struct PooledPlots<'a> {
+    specs: &'a [PlotSpec],
+    accuracy: &'a PlotSpec,
+    seeds: usize,
+}
+
+/// Draws every plot that reads a pooled table (the accuracy plot with the seeds' interval as a
+/// band); returns the files written and each reliability curve's label with its pooled ECE.
+fn write_pooled_plots(
+    plots: &PooledPlots<'_>,
+    tables: &PooledTables<'_>,
+    target: &ExperimentDir,
+) -> Result<(Vec<PathBuf>, Vec<String>), ExperimentError> {
+    let mut files = Vec::new();
+    let mut calibration = Vec::new();
+    for spec in plots.specs {
+        let titled = PlotSpec {
+            title: format!("{} ({} seeds pooled)", spec.title, plots.seeds),
+            ..spec.clone()
+        };
+        match (&spec.kind, &spec.table) {
+            (PlotKind::Accuracy, None) if spec == plots.accuracy => {
+                let figure = summarised_accuracy_figure(
+                    &titled,
+                    tables.pooled,
+                    &pooled_curves(tables.pooled_rows),
+                    INTERVAL_BAND_LABEL,
+                )?;
+                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
+                figure.write_svg(&svg)?;
+                figure.write_png(&png)?;
+                files.extend([svg, png]);
+            }
+            (PlotKind::Reliability, Some(_)) => {
+                if let Some(table) = tables.reliability {
+                    let (figure, paths) = render_plot(&titled, table, target)?;
+                    calibration.extend(calibration_labels(&figure));
+                    files.extend(paths);
+                }
+            }
+            (PlotKind::Lines { .. }, None) => files.extend(render_plot(&titled, tables.union, target)?.1),
+            // Other plots read tables that are not pooled (per-object rows).
+            _ => {}
+        }
+    }
+    Ok((files, calibration))
 }
 
 fn mismatch(

@@ -229,60 +229,9 @@ pub(super) fn against(
         let Some((_, reference_points)) = curves.iter().find(|(k, _)| *k == reference_key) else {
             continue;
         };
-        let pooled: Vec<(u32, f64)> = points
-            .iter()
-            .map(|(&n, sums)| (n, pooled_accuracy(sums, None)))
-            .collect();
-        let first = differences.len();
-        for (&(n, accuracy), sums) in pooled.iter().zip(points.values()) {
-            let Some(reference_sums) = reference_points.get(&n) else {
-                continue;
-            };
-            let reference_accuracy = pooled_accuracy(reference_sums, None);
-            let (difference_low, difference_high) = paired_interval(sums, reference_sums, draws);
-            let difference = accuracy - reference_accuracy;
-            differences.push(DifferenceRow {
-                experiment: experiment.to_string(),
-                descriptor: key.0.clone(),
-                factors: key.1.clone(),
-                reference: reference.to_string(),
-                n_readings: n,
-                seeds: sums.len(),
-                accuracy,
-                reference_accuracy,
-                difference: if difference.abs() <= TIE_TOLERANCE {
-                    0.0
-                } else {
-                    difference
-                },
-                difference_low,
-                difference_high,
-                seeds_level_or_ahead: sums
-                    .iter()
-                    .zip(reference_sums)
-                    .filter(|(s, r)| level_or_ahead(s.mean_accuracy(), r.mean_accuracy()))
-                    .count(),
-                readings_to_reach: pooled
-                    .iter()
-                    .find(|&&(_, a)| level_or_ahead(a, reference_accuracy))
-                    .map(|&(m, _)| m),
-            });
-        }
-        let rows = &differences[first..];
-        if let Some(last) = rows.last() {
-            comparisons.push(Comparison {
-                descriptor: key.0.clone(),
-                factors: key.1.clone(),
-                counts: rows.len(),
-                counts_level_or_ahead: rows
-                    .iter()
-                    .filter(|r| level_or_ahead(r.accuracy, r.reference_accuracy))
-                    .count(),
-                reference_readings: last.n_readings,
-                reference_accuracy: last.reference_accuracy,
-                readings_to_reach: last.readings_to_reach,
-            });
-        }
+        let rows = curve_differences((key, points), reference_points, reference, experiment, draws);
+        comparisons.extend(comparison(key, &rows));
+        differences.extend(rows);
     }
     if comparisons.is_empty() {
         return Err(format!(
@@ -291,6 +240,74 @@ pub(super) fn against(
         ));
     }
     Ok((differences, comparisons))
+}
+
+/// The rows of one curve (`key`, its points' per-seed sums) against its reference curve's points,
+/// at every reading count both have.
+fn curve_differences(
+    (key, points): (&CurveKey, &PointSums),
+    reference_points: &PointSums,
+    reference: &ReferenceLevels,
+    experiment: &str,
+    draws: &[Vec<usize>],
+) -> Vec<DifferenceRow> {
+    let mut differences = Vec::new();
+    let pooled: Vec<(u32, f64)> = points
+        .iter()
+        .map(|(&n, sums)| (n, pooled_accuracy(sums, None)))
+        .collect();
+    for (&(n, accuracy), sums) in pooled.iter().zip(points.values()) {
+        let Some(reference_sums) = reference_points.get(&n) else {
+            continue;
+        };
+        let reference_accuracy = pooled_accuracy(reference_sums, None);
+        let (difference_low, difference_high) = paired_interval(sums, reference_sums, draws);
+        let difference = accuracy - reference_accuracy;
+        differences.push(DifferenceRow {
+            experiment: experiment.to_string(),
+            descriptor: key.0.clone(),
+            factors: key.1.clone(),
+            reference: reference.to_string(),
+            n_readings: n,
+            seeds: sums.len(),
+            accuracy,
+            reference_accuracy,
+            difference: if difference.abs() <= TIE_TOLERANCE {
+                0.0
+            } else {
+                difference
+            },
+            difference_low,
+            difference_high,
+            seeds_level_or_ahead: sums
+                .iter()
+                .zip(reference_sums)
+                .filter(|(s, r)| level_or_ahead(s.mean_accuracy(), r.mean_accuracy()))
+                .count(),
+            readings_to_reach: pooled
+                .iter()
+                .find(|&&(_, a)| level_or_ahead(a, reference_accuracy))
+                .map(|&(m, _)| m),
+        });
+    }
+    differences
+}
+
+/// The summary of one curve's rows against its reference: the last reading count's accuracies.
+fn comparison(key: &CurveKey, rows: &[DifferenceRow]) -> Option<Comparison> {
+    let last = rows.last()?;
+    Some(Comparison {
+        descriptor: key.0.clone(),
+        factors: key.1.clone(),
+        counts: rows.len(),
+        counts_level_or_ahead: rows
+            .iter()
+            .filter(|r| level_or_ahead(r.accuracy, r.reference_accuracy))
+            .count(),
+        reference_readings: last.n_readings,
+        reference_accuracy: last.reference_accuracy,
+        readings_to_reach: last.readings_to_reach,
+    })
 }
 
 #[cfg(test)]

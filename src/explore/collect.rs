@@ -24,9 +24,9 @@ use crate::explore::setup::TouchSetup;
 use crate::pose::StartPose;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SceneBuilder, SimError};
+use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SimError};
 use crate::tactile::SensorConfig;
-use crate::tactile::sensor::{CoveringSensor, TactileError, add_sensor};
+use crate::tactile::sensor::{CoveringSensor, TactileError, arm_with_sensor};
 use crate::valid::{RangeError, Valid};
 
 /// Which procedure collects the readings.
@@ -171,9 +171,8 @@ impl CollectPlan {
         config: Valid<PlannerConfig>,
     ) -> Result<(Scene, Planner<SensorReader>), ControlError> {
         let setup = self.setup_for(index);
-        let builder = SceneBuilder::with_arm_and_table().object(object.clone());
         let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
-        let mut scene = add_sensor(builder, &sensor, "covering", PAD_SITE).build()?;
+        let mut scene = arm_with_sensor(object.clone(), &sensor).build()?;
         self.place_at_start(&mut scene, index)?;
         let reader: SensorReader = Box::new(sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?));
         let planner = Planner::new(

@@ -7,6 +7,7 @@ pub(crate) mod grid;
 pub(crate) mod planner;
 pub(crate) mod reach;
 pub(crate) mod report;
+pub(crate) mod request;
 pub(crate) mod sampler;
 pub(crate) mod setup;
 pub(crate) mod surface_sampling;
@@ -18,6 +19,7 @@ pub use collect::{
     collect_datasets,
 };
 pub use grid::ReadingGrid;
+pub use request::{CollectModeName, CollectRequest, ModeChoices, OtherModeChoices};
 pub use setup::TouchSetup;
 
 // The training sampler (Sec. V-A3) and the points it draws on the surface.

@@ -129,8 +129,17 @@ impl PlannerConfig {
         max_iterations: Option<usize>,
     ) -> Self {
         Self {
-            local_probability,
             max_iterations: max_iterations.unwrap_or_else(|| Self::iterations_for(readings)),
+            ..Self::exploring(objects, local_probability)
+        }
+    }
+
+    /// The defaults with local probability L = `local_probability` and the workspace
+    /// [`fitted_to`](Self::fitted_to) `objects`: the planner of every exploration of those objects
+    /// (the demo's, the environment's episodes, a collection's before its iteration budget).
+    pub fn exploring(objects: &[ObjectSpec], local_probability: f64) -> Self {
+        Self {
+            local_probability,
             ..Self::default()
         }
         .fitted_to(objects)

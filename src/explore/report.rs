@@ -62,7 +62,7 @@ pub(crate) fn unsettled_reading(
 ) -> Result<Reading, TactileError> {
     let image = TactileImage::zeros(sensor.rows, sensor.cols)
         .map_err(|source| TactileError::Image {
-            sensor: "covering".into(),
+            sensor: crate::tactile::SENSOR_NAME.into(),
             source,
         })?
         .with_pose(at);

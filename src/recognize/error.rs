@@ -54,6 +54,9 @@ pub enum RecognizeError {
     },
     #[error("{0}")]
     Dataset(#[from] crate::dataset::DatasetError),
+    /// Fitting the posterior on the calibration explorations failed; the edges name the files.
+    #[error("calibration: {0}")]
+    Calibration(Box<RecognizeError>),
 }
 
 impl From<crate::atomic::FileError> for RecognizeError {

@@ -24,9 +24,8 @@ use crate::recognize::evaluate::{Evaluation, ReadingRange, evaluate_with};
 use crate::recognize::labelled::LabelledFeatures;
 use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_same_sensor, save_json};
 use crate::recognize::posterior::{FusedPosterior, ModelPosterior};
-use crate::recognize::selection::{TrainConfig, TrainProgress};
+use crate::recognize::selection::TrainConfig;
 use crate::recognize::trial::{Trial, make_trials};
-use crate::valid::Valid;
 
 /// A descriptor name that names no descriptor, or a fusion that names one twice or none.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -157,26 +156,9 @@ impl FusedModel {
         })
     }
 
-    /// Trains one model per descriptor of `choice` on the same datasets ([`TrainedModel::fit`]),
-    /// each choosing its own codebook size.
-    pub fn fit(
-        config: &Valid<TrainConfig>,
-        training: &Dataset,
-        validation: Option<&Dataset>,
-        choice: &DescriptorChoice,
-        progress: &mut (dyn FnMut(TrainProgress) + Send),
-    ) -> Result<Self, RecognizeError> {
-        let models = choice
-            .kinds()
-            .iter()
-            .map(|kind| TrainedModel::fit(config, training, validation, kind.build().as_ref(), progress))
-            .collect::<Result<Vec<_>, _>>()?;
-        Self::new(models)?.calibrated(config, training, validation)
-    }
-
     /// The same models with the fused posterior's tempering fitted on the validation trials
     /// they were chosen on (`validation`, or the readings held out of `training` by `config`):
-    /// what [`fit`](Self::fit) does after fitting the parts.
+    /// what [`train_recognizer`](crate::recognize::train_recognizer) does after fitting the parts.
     pub fn calibrated(
         mut self,
         config: &TrainConfig,
@@ -189,12 +171,8 @@ impl FusedModel {
     }
 
     /// The same models with the fused posterior's tempering fitted again on the converged
-    /// readings of `data` in trials of `trial_readings` ([`TrainedModel::calibrate_on`]).
-    pub fn calibrate_on(self, data: &Dataset, trial_readings: usize) -> Result<Self, RecognizeError> {
-        self.calibrate_on_all(&[data], trial_readings)
-    }
-
-    /// [`calibrate_on`](Self::calibrate_on) the trials of every dataset of `data` together.
+    /// readings of every dataset of `data` together, in trials of `trial_readings`
+    /// ([`TrainedModel::calibrate_on_all`]).
     pub fn calibrate_on_all(
         mut self,
         data: &[&Dataset],

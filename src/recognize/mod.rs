@@ -39,6 +39,7 @@ pub(crate) mod pca;
 pub(crate) mod posterior;
 pub(crate) mod recognizer;
 pub(crate) mod reliability;
+pub(crate) mod request;
 pub(crate) mod selection;
 pub(crate) mod trial;
 
@@ -53,6 +54,8 @@ pub use model::{
 };
 pub use posterior::{GeometricPosterior, TouchReading};
 pub use recognizer::Recognizer;
+// The one training entry of the CLI and Python: a user's choices, the data, the recogniser.
+pub use request::{TrainChoices, TrainData, TrainObserver, train_recognizer};
 
 // Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
 pub use codebook::{CodebookConfig, CodebookKind};

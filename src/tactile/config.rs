@@ -51,7 +51,9 @@ pub const PSF_SIGMA_PER_THICKNESS: f64 = 0.480_079_409_263_117_5;
 pub const DEFAULT_PAD_M: f64 = 0.012;
 
 /// "10% covering thickness" (Figs. 7-8) read as 10% of the pad side: 1.2 mm on the 12 mm pad.
-pub const DEFAULT_THICKNESS_M: f64 = 0.1 * DEFAULT_PAD_M;
+pub const DEFAULT_THICKNESS_M: f64 = DEFAULT_THICKNESS_FRACTION * DEFAULT_PAD_M;
+/// The default covering thickness as a fraction of the pad side (the paper's 10%).
+pub const DEFAULT_THICKNESS_FRACTION: f64 = 0.1;
 
 /// The Gaussian point-spread sigma of a covering of thickness `thickness_m` (see
 /// `PSF_SIGMA_PER_THICKNESS`).
@@ -169,11 +171,25 @@ impl fmt::Display for ConfigKey {
 
 /// A configuration value outside its allowed range, or not a value of the key's kind at all.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("taction.covering: {key}={}: want {}", shortened(value), key.allowed())]
+#[error("taction.covering: {key}={}: want {allowed}", shortened(value))]
 pub struct ConfigError {
     pub key: ConfigKey,
     /// The value as given (text from MJCF or a flag, or the formatted number).
     pub value: String,
+    /// What the key allows: its range ([`ConfigKey::allowed`]), or for the thickness also what
+    /// the pad allows.
+    pub allowed: String,
+}
+
+impl ConfigError {
+    /// `value` outside `key`'s own range.
+    fn out_of_range(key: ConfigKey, value: String) -> Self {
+        Self {
+            key,
+            value,
+            allowed: key.allowed(),
+        }
+    }
 }
 
 /// At most 16 characters of `value`, so the whole message fits MuJoCo's error buffer.
@@ -208,7 +224,7 @@ impl Check for SensorConfig {
             noise_fraction,
             noise_seed: _,
         } = *self;
-        let bad = |key: ConfigKey, value: String| Err(ConfigError { key, value });
+        let bad = |key: ConfigKey, value: String| Err(ConfigError::out_of_range(key, value));
         for (key, n) in [(ConfigKey::Rows, rows), (ConfigKey::Cols, cols)] {
             if !(1..=MAX_TAXELS_PER_SIDE).contains(&n) {
                 return bad(key, n.to_string());
@@ -222,6 +238,16 @@ impl Check for SensorConfig {
             if !(v.is_finite() && v > 0.0 && v <= MAX_LENGTH_M) {
                 return bad(key, v.to_string());
             }
+        }
+        // A covering thicker than half the pad is no thin skin on a fingertip: its point spread
+        // (sigma 0.48 t, Sec. V-B5) would blur the whole pad into one value.
+        let half_pad_m = 0.5 * pad_width_m.min(pad_height_m);
+        if thickness_m > half_pad_m {
+            return Err(ConfigError {
+                key: ConfigKey::Thickness,
+                value: thickness_m.to_string(),
+                allowed: format!("<= half the pad side, {}", crate::units::length(half_pad_m)),
+            });
         }
         if !(psf_sigma_m.is_finite() && (0.0..=MAX_LENGTH_M).contains(&psf_sigma_m)) {
             return bad(ConfigKey::PsfSigma, psf_sigma_m.to_string());
@@ -251,6 +277,25 @@ impl SensorConfig {
         }
     }
 
+    /// The sensor as a user describes it (the CLI's sensor flags, Python's `Sensor`): `rows x
+    /// cols` taxels on a square pad of side `pad_m`, a covering `thickness_m` thick (default 10%
+    /// of the side, the paper's), its point spread `psf_sigma_m` (default the
+    /// half-space law for that thickness, [`psf_sigma_for_thickness`]), 4 rays per taxel and no
+    /// noise. Unchecked, as every config is until [`Valid::new`].
+    pub fn of_square_pad(
+        rows: usize,
+        cols: usize,
+        pad_m: f64,
+        thickness_m: Option<f64>,
+        psf_sigma_m: Option<f64>,
+    ) -> Self {
+        let thickness_m = thickness_m.unwrap_or(DEFAULT_THICKNESS_FRACTION * pad_m);
+        Self {
+            psf_sigma_m: psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
+            ..Self::square(rows, cols, pad_m, thickness_m)
+        }
+    }
+
     /// The `k` of the `k x k` rays per taxel (valid configs only; 1 otherwise).
     pub fn rays_per_side(&self) -> usize {
         rays_per_side(self.rays_per_taxel).unwrap_or(1)
@@ -264,10 +309,7 @@ impl SensorConfig {
     ) -> Result<Valid<Self>, ConfigError> {
         let mut config = Self::default();
         let text = |key| lookup(key).map(str::trim).filter(|s| !s.is_empty());
-        let bad = |key: ConfigKey, value: &str| ConfigError {
-            key,
-            value: value.to_string(),
-        };
+        let bad = |key: ConfigKey, value: &str| ConfigError::out_of_range(key, value.to_string());
         let integer = |key: ConfigKey, default: usize| -> Result<usize, ConfigError> {
             match text(key) {
                 None => Ok(default),
@@ -414,6 +456,23 @@ mod tests {
                 "too long for MuJoCo's error buffer: {message}"
             );
         }
+    }
+
+    #[test]
+    fn a_covering_thicker_than_half_the_shorter_pad_side_is_refused_in_mujocos_buffer() {
+        // Half of the 12 mm pad is allowed; a hair more is not, from MJCF as from a flag.
+        assert!(parse(&[("thickness_m", "0.006")]).is_ok());
+        let e = parse(&[("thickness_m", "0.0061")]).unwrap_err();
+        assert_eq!(e.key, ConfigKey::Thickness);
+        let message = e.to_string();
+        assert_eq!(
+            message,
+            "taction.covering: thickness_m=0.0061: want <= half the pad side, 6 mm"
+        );
+        assert!(message.len() <= 76, "{message}");
+        // The shorter side rules: a 12 x 4 mm pad takes at most 2 mm.
+        let e = parse(&[("pad_height_m", "0.004"), ("thickness_m", "0.003")]).unwrap_err();
+        assert!(e.to_string().ends_with("want <= half the pad side, 2 mm"), "{e}");
     }
 
     #[test]

@@ -12,8 +12,6 @@ use crate::valid::Valid;
 pub const FREE_PAD_BODY: &str = "free_pad";
 /// The pad site (the same name as the arm's, so controllers find either).
 pub const FREE_PAD_SITE: &str = crate::sim::arm::PAD_SITE;
-/// The sensor element's name.
-pub const FREE_PAD_SENSOR: &str = "covering";
 
 /// The MJCF body of the free-floating pad: a mocap body whose frame is the pad frame, with the
 /// pad site and a thin plate drawn behind the pad that takes part in no contact (`contype` and
@@ -38,5 +36,5 @@ pub fn free_floating_builder(object: ObjectSpec, config: &Valid<SensorConfig>) -
         .object(object)
         .without_collision_shell()
         .add(Section::Worldbody, free_pad_body_xml(config));
-    add_sensor(builder, config, FREE_PAD_SENSOR, FREE_PAD_SITE)
+    add_sensor(builder, config, FREE_PAD_SITE)
 }

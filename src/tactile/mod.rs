@@ -35,7 +35,9 @@ pub(crate) mod shared_bvh;
 // The sensor: its configuration, its image, and the handle that reads it from `sensordata`.
 pub use config::{ConfigError, ConfigKey, SensorConfig, psf_sigma_for_thickness};
 pub use image::{ImageError, TactileImage, write_contact_sheet};
-pub use sensor::{CoveringSensor, TactileError, add_sensor, extension_xml, sensor_xml};
+pub use sensor::{
+    CoveringSensor, SENSOR_NAME, TactileError, add_sensor, arm_with_sensor, extension_xml, sensor_xml,
+};
 
 // The pad on a mocap body, no arm (Sec. V-A3).
 pub use free_floating::{free_floating_builder, free_pad_body_xml};

@@ -6,8 +6,9 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 
 use crate::pose::PadPose;
-use crate::sim::SceneBuilder;
+use crate::sim::arm::PAD_SITE;
 use crate::sim::mjcf::{Section, escape_attr};
+use crate::sim::{ObjectSpec, SceneBuilder};
 use crate::tactile::config::{ConfigError, ConfigKey, SensorConfig};
 use crate::tactile::covering::CoveringStats;
 use crate::tactile::image::{ImageError, TactileImage};
@@ -170,16 +171,25 @@ pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str) -> Strin
     xml
 }
 
-/// Adds the plugin declaration and a covering sensor on site `site` to a scene, and registers the
-/// plugin so the scene compiles.
-pub fn add_sensor(
-    builder: SceneBuilder,
-    config: &Valid<SensorConfig>,
-    name: &str,
-    site: &str,
-) -> SceneBuilder {
+/// The name of the covering sensor's element in every scene the library builds, the arm's and the
+/// free pad's: users read it as `m.sensor("tactile")` (the README, `examples/python`).
+pub const SENSOR_NAME: &str = "tactile";
+
+/// Adds the plugin declaration and the covering sensor ([`SENSOR_NAME`]) on site `site` to a
+/// scene, and registers the plugin so the scene compiles.
+pub fn add_sensor(builder: SceneBuilder, config: &Valid<SensorConfig>, site: &str) -> SceneBuilder {
     ensure_registered();
     builder
         .add(Section::Extension, extension_xml())
-        .add(Section::Sensor, sensor_xml(config, name, site))
+        .add(Section::Sensor, sensor_xml(config, SENSOR_NAME, site))
+}
+
+/// The arm on its table with `object` and the covering sensor on the pad site: the world of every
+/// arm touch (collection, `touch`, `scene export`, the demo, Python's `scene`).
+pub fn arm_with_sensor(object: ObjectSpec, config: &Valid<SensorConfig>) -> SceneBuilder {
+    add_sensor(
+        SceneBuilder::with_arm_and_table().object(object),
+        config,
+        PAD_SITE,
+    )
 }

@@ -170,7 +170,7 @@ pub fn free_sensor_with(world_xml: &str, config: &SensorConfig) -> FreePad {
         .table(false)
         .add(Section::Worldbody, world_xml)
         .add(Section::Worldbody, free_pad_body_xml(config));
-    let builder = add_sensor(builder, &Valid::new(*config).unwrap(), "covering", "pad");
+    let builder = add_sensor(builder, &Valid::new(*config).unwrap(), "pad");
     FreePad::from_scene(builder.build().unwrap()).unwrap()
 }
 
