@@ -195,7 +195,11 @@ fn request(args: &CollectArgs) -> Result<CollectRequest, UsageError> {
         max_iterations: args.max_iterations,
     };
     CollectRequest::of_mode(mode, choices).map_err(|e| {
-        let flags: Vec<&str> = e.choices.iter().map(|&choice| flag_of(choice)).collect();
+        let flags: Vec<String> = e
+            .choices
+            .iter()
+            .map(|&choice| format!("--{}", flag_of(choice).unwrap_or(choice)))
+            .collect();
         let what = if flags.len() == 1 { "a flag" } else { "flags" };
         UsageError(format!(
             "{}: not {what} of --mode {} (the help says which mode each flag belongs to)",
@@ -205,23 +209,22 @@ fn request(args: &CollectArgs) -> Result<CollectRequest, UsageError> {
     })
 }
 
-/// The flag of a [`ModeChoices`] field.
-fn flag_of(choice: &str) -> &str {
-    match choice {
-        "from_above" => "--from-above",
-        "reachable_by_arm" => "--reachable",
-        "local_probability" => "--local-prob",
-        "max_iterations" => "--max-iterations",
-        other => other,
+/// The flag (without its dashes) that sets a field of [`ModeChoices`] and of the planner's
+/// configuration it becomes.
+fn flag_of(field: &str) -> Option<&'static str> {
+    match field {
+        "from_above" => Some("from-above"),
+        "reachable_by_arm" => Some("reachable"),
+        "local_probability" => Some("local-prob"),
+        "max_iterations" => Some("max-iterations"),
+        _ => None,
     }
 }
 
 /// A planner parameter out of range, named by the flag that set it.
 fn named_by_flag(e: RangeError) -> Box<dyn std::error::Error> {
-    let flag = match e.field {
-        "local_probability" => "local-prob",
-        "max_iterations" => "max-iterations",
-        _ => return e.into(),
+    let Some(flag) = flag_of(e.field) else {
+        return e.into();
     };
     let what = match e.allowed.starts_with(['[', '(']) {
         true => format!("is outside {}", e.allowed),
