@@ -7,8 +7,11 @@ mod common;
 use std::sync::Arc;
 
 use glam::DVec3;
-use taction::active_touch::{EpisodeConfig, Touch, TouchAction, TouchEpisode, TouchError};
-use taction::dataset::{ContactStatus, Strategy};
+use taction::active_touch::{
+    ArmData, ArmTrainingObserver, ArmTrainingRecipe, EpisodeConfig, Touch, TouchAction, TouchEpisode,
+    TouchError,
+};
+use taction::dataset::{ContactStatus, Dataset, Shortfall, Strategy};
 use taction::describe::DescriptorKind;
 use taction::explore::{
     ActiveGuidance, Collect, CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, MAX_ATTEMPTS,
@@ -435,4 +438,86 @@ fn a_guarded_touch_says_when_it_meets_nothing() {
         .unwrap();
     assert_eq!(low.readings[0].status, ContactStatus::Unreachable);
     assert_eq!(planner.tree().vertices().len(), before, "nothing moved");
+}
+
+/// What the recipe told its observer, in order.
+#[derive(Default)]
+struct Told {
+    events: Vec<String>,
+    converged: std::sync::atomic::AtomicUsize,
+}
+
+impl ArmTrainingObserver for Told {
+    fn collecting(&mut self, data: ArmData, objects: &[ObjectSpec], readings: usize) {
+        self.events
+            .push(format!("collecting {data:?} {} x {readings}", objects.len()));
+    }
+    fn converged(&self, _data: ArmData) {
+        self.converged.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+    fn collected(&mut self, data: ArmData, dataset: &Dataset, short: &[Shortfall]) {
+        let converged = self.converged.swap(0, std::sync::atomic::Ordering::Relaxed);
+        self.events.push(format!(
+            "collected {data:?} {converged} told, {} converged, {} short",
+            dataset.converged_only().len(),
+            short.len()
+        ));
+    }
+    fn fitting(&mut self, config: &TrainConfig, _features: usize) {
+        self.events.push(format!("fitting k {:?}", config.ks));
+    }
+}
+
+#[test]
+fn the_demos_recipe_is_its_two_collections_then_its_fit_told_step_by_step() {
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: 30,
+        seed: 5,
+    };
+    let mut told = Told::default();
+    let trained = recipe.train("test", &objects(), sensor(), 0, &mut told).unwrap();
+
+    let training = recipe
+        .collect_plan(sensor())
+        .unwrap()
+        .collect_dataset("test", &objects(), 1, &|| {})
+        .unwrap();
+    let calibration = recipe
+        .calibration_plan(sensor(), &objects())
+        .unwrap()
+        .collect_dataset("test", &objects(), 1, &|| {})
+        .unwrap();
+    assert_eq!(
+        trained.training, training,
+        "the training collection is the recipe's plan's"
+    );
+    assert_eq!(
+        trained.calibration, calibration,
+        "the calibration is the recipe's plan's"
+    );
+    assert_eq!(recipe.calibration_readings(), 10);
+    assert_eq!(
+        trained.model,
+        recipe.fit(&training, Some(&calibration)).unwrap(),
+        "the model is the recipe's fit of the two"
+    );
+    assert!(trained.calibrated_on_the_arm());
+
+    let ks = recipe.train_config(&training).unwrap().ks.clone();
+    let expected = [
+        "collecting Training 2 x 30".to_string(),
+        format!(
+            "collected Training {0} told, {0} converged, {1} short",
+            training.converged_only().len(),
+            training.shortfalls(30).len()
+        ),
+        "collecting Calibration 2 x 10".to_string(),
+        format!(
+            "collected Calibration {0} told, {0} converged, {1} short",
+            calibration.converged_only().len(),
+            calibration.shortfalls(10).len()
+        ),
+        format!("fitting k {ks:?}"),
+    ];
+    assert_eq!(told.events, expected);
 }

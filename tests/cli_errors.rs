@@ -1017,3 +1017,26 @@ fn a_flag_of_the_other_collection_mode_is_refused() {
         );
     }
 }
+
+#[test]
+fn train_with_objects_but_nothing_to_weigh_them_on_is_refused_before_any_dataset_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.csv").display().to_string();
+    let out = dir.path().join("m.json").display().to_string();
+    let line = fails_with(
+        &taction(&[
+            "train",
+            "--dataset",
+            &missing,
+            "--objects",
+            "chess",
+            "--out",
+            &out,
+        ]),
+        2,
+    );
+    assert!(
+        line.contains("--objects: ") && line.contains("give calibration") && !line.contains(&missing),
+        "{line}"
+    );
+}

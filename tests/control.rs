@@ -146,7 +146,7 @@ fn sphere_converges_and_box_edge_reading_shows_the_edge() {
     for r in 0..6 {
         for c in 0..6 {
             let v = image.get(r, c);
-            let (x, y) = taction::control::taxel_position_m(&sensor(), r, c);
+            let (x, y) = sensor().taxel_centre_m(r, c);
             wx += v * x;
             wy += v * y;
             w += v;

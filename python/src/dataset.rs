@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict};
 use taction::active_touch::ArmTrainingRecipe;
-use taction::dataset::{ExportFormat, Reading};
+use taction::dataset::{ColumnType, ExportFormat, Reading};
 use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
@@ -86,17 +86,37 @@ impl Dataset {
     }
 
     /// The dataset as a pandas DataFrame with the file's columns (`object`, `status`, ..., the pad
-    /// pose's nine, `t_{row}_{col}` per taxel): what `pandas.read_csv(path, comment="#")` gives
-    /// for its file.
+    /// pose's nine, `t_{row}_{col}` per taxel), each of the one type it has in every export
+    /// (`taction::dataset::column_types`): names strings (empty where none), `iterations` int64,
+    /// the poses float64 (the pad's NaN where a reading has none), the taxels float32. The values
+    /// are the file's, read back exactly.
     fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let text = self.inner.to_file_bytes("to_pandas").map_err(refused)?;
         let buffer = py
             .import("io")?
-            .call_method1("BytesIO", (pyo3::types::PyBytes::new(py, &text),))?;
-        let kwargs = pyo3::types::PyDict::new(py);
+            .call_method1("BytesIO", (PyBytes::new(py, &text),))?;
+        let sensor = &self.inner.header().sensor;
+        let (dtypes, missing) = (PyDict::new(py), PyDict::new(py));
+        for (name, column) in taction::dataset::column_types(sensor.rows, sensor.cols) {
+            dtypes.set_item(&name, column.numpy())?;
+            // Only a number may be missing (an empty field); an empty name stays "".
+            if column != ColumnType::Text {
+                missing.set_item(&name, vec![""])?;
+            }
+        }
+        let kwargs = PyDict::new(py);
         kwargs.set_item("comment", "#")?;
-        py.import("pandas")?
-            .call_method("read_csv", (buffer,), Some(&kwargs))
+        kwargs.set_item("dtype", dtypes)?;
+        kwargs.set_item("keep_default_na", false)?;
+        kwargs.set_item("na_values", missing)?;
+        let pandas = py.import("pandas")?;
+        // The file's numbers read back exactly: pandas 3 parses them so by default (and deprecates
+        // the choice), pandas 1 and 2 when asked.
+        let version: String = pandas.getattr("__version__")?.extract()?;
+        if version.split('.').next().and_then(|m| m.parse::<u32>().ok()) < Some(3) {
+            kwargs.set_item("float_precision", "round_trip")?;
+        }
+        pandas.call_method("read_csv", (buffer,), Some(&kwargs))
     }
 
     fn __len__(&self) -> usize {
@@ -299,7 +319,7 @@ pub fn collect_arm_calibration(
 }
 
 /// The objects to touch as the library's specifications, and the sensor (the paper's by default).
-fn touch_inputs(
+pub fn touch_inputs(
     objects: &Objects,
     sensor: Option<PyRef<'_, Sensor>>,
 ) -> PyResult<(SensorConfig, Vec<ObjectSpec>)> {
@@ -329,7 +349,13 @@ fn warn_of_shortfalls(
             "taction.{function}: fewer readings than asked: {}",
             taction::dataset::describe_shortfalls(&shortfalls)
         );
-        py.import("warnings")?.call_method1("warn", (message,))?;
+        warn(py, &message)?;
     }
+    Ok(())
+}
+
+/// `message` as a Python `UserWarning`.
+pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    py.import("warnings")?.call_method1("warn", (message,))?;
     Ok(())
 }

@@ -29,15 +29,138 @@ use crate::object::Object;
 /// settled: a reading attempt every touch, two when the first met the object and failed) or
 /// `"iteration"` (one planner iteration toward it).
 ///
-/// Its touches release the GIL; one episode is used by one thread at a time (a lock).
+/// Its touches release the GIL; one episode is used by one thread at a time (a lock). It pickles
+/// as its arguments and the touches made so far, which the unpickled episode makes again: the
+/// library is deterministic for a seed, so it is the same episode, bit for bit.
 #[pyclass(module = "taction")]
 pub struct TouchEpisode {
+    made: Made,
     inner: Mutex<taction::active_touch::TouchEpisode>,
+    /// The candidate index of every touch made so far, in order (locked after `inner`).
+    touched: Mutex<Vec<usize>>,
+}
+
+/// The arguments an episode was made with, as a pickle carries them.
+struct Made {
+    model: Py<Model>,
+    object: Py<Object>,
+    seed: u64,
+    candidates: usize,
+    local_probability: f64,
+    perturb_deg: f64,
+    perturb_frac: f64,
+    workspace: Option<Vec<Py<Object>>>,
+    start_pose: String,
+    start_heading_deg: f64,
+    touch: String,
+}
+
+/// [`Made`] as the constructor's positional arguments.
+type MadeArgs = (
+    Py<Model>,
+    Py<Object>,
+    u64,
+    usize,
+    f64,
+    f64,
+    f64,
+    Option<Vec<Py<Object>>>,
+    String,
+    f64,
+    String,
+);
+
+impl Made {
+    fn args(&self, py: Python<'_>) -> MadeArgs {
+        (
+            self.model.clone_ref(py),
+            self.object.clone_ref(py),
+            self.seed,
+            self.candidates,
+            self.local_probability,
+            self.perturb_deg,
+            self.perturb_frac,
+            self.workspace
+                .as_ref()
+                .map(|w| w.iter().map(|o| o.clone_ref(py)).collect()),
+            self.start_pose.clone(),
+            self.start_heading_deg,
+            self.touch.clone(),
+        )
+    }
+
+    /// The episode's configuration, its arguments checked.
+    fn config(&self) -> PyResult<Valid<EpisodeConfig>> {
+        let heading = MaxHeading::from_deg(self.start_heading_deg).ok_or_else(|| {
+            bad_argument(
+                "start_heading_deg",
+                format!("{} is outside [0, 180]", self.start_heading_deg),
+            )
+        })?;
+        let start_pose = StartPose::parse(&self.start_pose, heading).ok_or_else(|| {
+            bad_argument(
+                "start_pose",
+                format!("'{}' is none of {}", self.start_pose, StartPose::NAMES.join(", ")),
+            )
+        })?;
+        let touch = TouchAction::parse(&self.touch).ok_or_else(|| {
+            bad_argument(
+                "touch",
+                format!("'{}' is none of {}", self.touch, TouchAction::NAMES.join(", ")),
+            )
+        })?;
+        let planner = PlannerConfig::exploring(&self.fitted_to()?, self.local_probability);
+        let config = EpisodeConfig {
+            planner: Valid::new(planner).map_err(refused)?,
+            perturbation: PerturbationBounds::new(self.perturb_deg, self.perturb_frac).map_err(refused)?,
+            start_pose,
+            candidates: self.candidates,
+            touch,
+            ..EpisodeConfig::new(*self.model.get().inner.sensor())
+        };
+        Valid::new(config).map_err(refused)
+    }
+
+    /// The objects the planner's box is fitted to: `workspace`, which must include the episode's
+    /// object, or that object alone.
+    fn fitted_to(&self) -> PyResult<Vec<ObjectSpec>> {
+        let object = self.object.get();
+        let Some(objects) = &self.workspace else {
+            return Ok(vec![object.spec()]);
+        };
+        if !objects.iter().any(|o| o.get().inner.name == object.inner.name) {
+            let names: Vec<&str> = objects.iter().map(|o| o.get().inner.name.as_str()).collect();
+            return Err(bad_argument(
+                "workspace",
+                format!(
+                    "{names:?} does not include the episode's object '{}'",
+                    object.inner.name
+                ),
+            ));
+        }
+        Ok(objects.iter().map(|o| o.get().spec()).collect())
+    }
+
+    /// The episode, before any touch.
+    fn start(&self, py: Python<'_>) -> PyResult<taction::active_touch::TouchEpisode> {
+        let config = self.config()?;
+        let spec = self.object.get().spec();
+        let recognizer = Arc::clone(&self.model.get().inner);
+        let seed = self.seed;
+        py.detach(|| taction::active_touch::TouchEpisode::new(recognizer, &spec, &config, seed))
+            .map_err(refused)
+    }
 }
 
 impl TouchEpisode {
     fn episode(&self) -> PyResult<MutexGuard<'_, taction::active_touch::TouchEpisode>> {
         self.inner
+            .lock()
+            .map_err(|_| refused("the episode was poisoned by an earlier failure"))
+    }
+
+    fn touched(&self) -> PyResult<MutexGuard<'_, Vec<usize>>> {
+        self.touched
             .lock()
             .map_err(|_| refused("the episode was poisoned by an earlier failure"))
     }
@@ -50,72 +173,64 @@ impl TouchEpisode {
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each an episode parameter
     fn new(
         py: Python<'_>,
-        model: &Model,
-        object: &Object,
+        model: Py<Model>,
+        object: Py<Object>,
         seed: Whole<u64>,
         candidates: Whole<usize>,
         local_probability: f64,
         perturb_deg: f64,
         perturb_frac: f64,
-        workspace: Option<Vec<PyRef<'_, Object>>>,
+        workspace: Option<Vec<Py<Object>>>,
         start_pose: &str,
         start_heading_deg: f64,
         touch: &str,
     ) -> PyResult<Self> {
-        let (Whole(seed), Whole(candidates)) = (seed, candidates);
-        let heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
-            bad_argument(
-                "start_heading_deg",
-                format!("{start_heading_deg} is outside [0, 180]"),
-            )
-        })?;
-        let start_pose = StartPose::parse(start_pose, heading).ok_or_else(|| {
-            bad_argument(
-                "start_pose",
-                format!("'{start_pose}' is none of {}", StartPose::NAMES.join(", ")),
-            )
-        })?;
-        let touch = TouchAction::parse(touch).ok_or_else(|| {
-            bad_argument(
-                "touch",
-                format!("'{touch}' is none of {}", TouchAction::NAMES.join(", ")),
-            )
-        })?;
-        let spec = object.spec();
-        let fitted_to: Vec<ObjectSpec> = match workspace {
-            Some(objects) => {
-                // The planner's box is fitted to these objects; the episode's must be among them.
-                if !objects.iter().any(|o| o.inner.name == object.inner.name) {
-                    let names: Vec<&str> = objects.iter().map(|o| o.inner.name.as_str()).collect();
-                    return Err(bad_argument(
-                        "workspace",
-                        format!(
-                            "{names:?} does not include the episode's object '{}'",
-                            object.inner.name
-                        ),
-                    ));
-                }
-                objects.iter().map(|o| o.spec()).collect()
-            }
-            None => vec![spec.clone()],
+        let made = Made {
+            model,
+            object,
+            seed: seed.0,
+            candidates: candidates.0,
+            local_probability,
+            perturb_deg,
+            perturb_frac,
+            workspace,
+            start_pose: start_pose.to_string(),
+            start_heading_deg,
+            touch: touch.to_string(),
         };
-        let planner = PlannerConfig::exploring(&fitted_to, local_probability);
-        let config = EpisodeConfig {
-            planner: Valid::new(planner).map_err(refused)?,
-            perturbation: PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?,
-            start_pose,
-            candidates,
-            touch,
-            ..EpisodeConfig::new(*model.inner.sensor())
-        };
-        let config = Valid::new(config).map_err(refused)?;
-        let recognizer = Arc::clone(&model.inner);
-        let inner = py
-            .detach(|| taction::active_touch::TouchEpisode::new(recognizer, &spec, &config, seed))
-            .map_err(refused)?;
+        let inner = made.start(py)?;
         Ok(Self {
+            made,
             inner: Mutex::new(inner),
+            touched: Mutex::new(Vec::new()),
         })
+    }
+
+    /// Pickled as its arguments, and as its state the touches made so far (`__setstate__`).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, MadeArgs, Vec<usize>)> {
+        let _episode = self.episode()?;
+        let touched = self.touched()?.clone();
+        Ok((py.get_type::<Self>().into_any(), self.made.args(py), touched))
+    }
+
+    /// Makes the touches `touched` (candidate indices, in order) of a pickled episode again; only
+    /// on an episode not touched yet.
+    fn __setstate__(&self, py: Python<'_>, touched: Vec<Whole<usize>>) -> PyResult<()> {
+        let mut episode = self.episode()?;
+        let mut done = self.touched()?;
+        if !done.is_empty() {
+            return Err(bad_argument(
+                "state",
+                format!("the episode was touched {} times already", done.len()),
+            ));
+        }
+        let episode = &mut *episode;
+        for Whole(index) in touched {
+            py.detach(|| episode.touch(index))
+                .map_err(|e| bad_argument("state", format!("replaying touch {index}: {e}")))?;
+            done.push(index);
+        }
+        Ok(())
     }
 
     /// The box every candidate target of an episode among `objects` lies in, metres: `[[min x, y,
@@ -158,10 +273,11 @@ impl TouchEpisode {
         let Whole(index) = index;
         let mut episode = self.episode()?;
         let episode = &mut *episode;
-        Ok(py
-            .detach(move || episode.touch(index))
-            .map_err(refused)?
-            .is_some())
+        let touch = py.detach(move || episode.touch(index)).map_err(refused)?;
+        // Only touches that succeeded are made again when unpickled (a refused index touches
+        // nothing).
+        self.touched()?.push(index);
+        Ok(touch.is_some())
     }
 
     /// The last converged reading, `(rows, cols)` float32; zeros before one.

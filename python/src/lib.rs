@@ -46,6 +46,7 @@ fn _taction(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Posterior>()?;
     m.add_function(wrap_pyfunction!(model::train, m)?)?;
     m.add_function(wrap_pyfunction!(model::train_for_arm, m)?)?;
+    m.add_function(wrap_pyfunction!(model::arm_model, m)?)?;
     m.add_class::<episode::TouchEpisode>()?;
     Ok(())
 }

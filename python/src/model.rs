@@ -6,7 +6,8 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use taction::active_touch::ArmTrainingRecipe;
+use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
+use taction::dataset::{Shortfall, describe_shortfalls};
 use taction::describe::Feature;
 use taction::locate::GeometryModel;
 use taction::mesh::TriMesh;
@@ -18,11 +19,12 @@ use taction::sim::MaxHeading;
 use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
-use crate::args::Whole;
+use crate::args::{Objects, Whole};
 use crate::array;
-use crate::dataset::Dataset;
+use crate::dataset::{Dataset, touch_inputs, warn};
 use crate::error::{bad_argument, refused};
 use crate::object::Object;
+use crate::sensor::Sensor;
 
 /// A trained recogniser: one descriptor's model, or several fused (`"mnti+sift"`). Files are the
 /// ones `taction train` writes and `taction recognize` reads.
@@ -134,11 +136,7 @@ impl Model {
     /// A fresh posterior: uniform over the objects until it observes a reading.
     fn posterior(&self) -> PyResult<Posterior> {
         let _ = self.inner.posterior().map_err(refused)?;
-        Ok(Posterior {
-            model: self.inner.clone(),
-            observed: Vec::new(),
-            belief: None,
-        })
+        Ok(Posterior::of(self.inner.clone()))
     }
 
     /// Recognition accuracy on `dataset` in trials of `readings` consecutive converged readings per
@@ -171,12 +169,73 @@ impl Model {
 #[pyclass(module = "taction")]
 pub struct Posterior {
     model: Arc<Recognizer>,
-    /// Every observed reading (its image, with its pad pose when given) and its features under
-    /// each of the model's descriptors.
-    observed: Vec<(TactileImage, Vec<Vec<Feature>>)>,
+    /// Every observed reading, in order.
+    observed: Vec<Observed>,
     /// The belief after them; `None` before any (uniform).
     belief: Option<Belief>,
 }
+
+/// One reading a posterior observed.
+struct Observed {
+    /// The image, with its pad pose when given.
+    image: TactileImage,
+    /// The pad pose's numbers as given (a pickle carries them: the pose normalises its vectors).
+    pad_pose: Option<Vec<f64>>,
+    /// Its features under each of the model's descriptors.
+    features: Vec<Vec<Feature>>,
+}
+
+impl Posterior {
+    /// Uniform over `model`'s objects.
+    fn of(model: Arc<Recognizer>) -> Self {
+        Self {
+            model,
+            observed: Vec::new(),
+            belief: None,
+        }
+    }
+
+    /// Adds one reading: the image's `shape` and `values`, and the pad pose's numbers if given.
+    fn add(&mut self, shape: Vec<usize>, values: Vec<f64>, pad_pose: Option<Vec<f64>>) -> PyResult<()> {
+        let sensor = self.model.sensor();
+        if shape[..] != [sensor.rows, sensor.cols] {
+            return Err(bad_argument(
+                "image",
+                format!(
+                    "want the model's {}x{} taxels, got an array of shape {shape:?}",
+                    sensor.rows, sensor.cols
+                ),
+            ));
+        }
+        let mut image =
+            TactileImage::new(sensor.rows, sensor.cols, values).map_err(|e| bad_argument("image", e))?;
+        if let Some(pose) = &pad_pose {
+            image = image.with_pose(crate::sensor::pad_pose_of(pose)?);
+        }
+        // The posterior borrows the model, so it is rebuilt from the observed readings: adding a
+        // reading's features is cheap next to describing its image, which happens once.
+        let mut posterior = self.model.posterior().map_err(refused)?;
+        let features = posterior.describe(&image);
+        for earlier in &self.observed {
+            posterior
+                .observe_described(&earlier.image, earlier.features.clone())
+                .map_err(refused)?;
+        }
+        let belief = posterior
+            .observe_described(&image, features.clone())
+            .map_err(|e| bad_argument("image", e))?;
+        self.observed.push(Observed {
+            image,
+            pad_pose,
+            features,
+        });
+        self.belief = Some(belief);
+        Ok(())
+    }
+}
+
+/// A pickled posterior's readings: each image `(rows, cols)` and pad pose (or `None`), float64.
+type ObservedArrays<'py> = Vec<(Bound<'py, PyAny>, Option<Bound<'py, PyAny>>)>;
 
 #[pymethods]
 impl Posterior {
@@ -193,36 +252,51 @@ impl Posterior {
         pad_pose: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (shape, values) = array::to_f64(image, "image")?;
-        let sensor = self.model.sensor();
-        if shape[..] != [sensor.rows, sensor.cols] {
-            return Err(bad_argument(
-                "image",
-                format!(
-                    "want the model's {}x{} taxels, got an array of shape {shape:?}",
-                    sensor.rows, sensor.cols
-                ),
-            ));
-        }
-        let mut image =
-            TactileImage::new(sensor.rows, sensor.cols, values).map_err(|e| bad_argument("image", e))?;
-        if let Some(pose) = pad_pose {
-            image = image.with_pose(crate::sensor::pad_pose(pose)?);
-        }
-        // The posterior borrows the model, so it is rebuilt from the observed readings: adding a
-        // reading's features is cheap next to describing its image, which happens once.
-        let mut posterior = self.model.posterior().map_err(refused)?;
-        let features = posterior.describe(&image);
-        for (earlier, described) in &self.observed {
-            posterior
-                .observe_described(earlier, described.clone())
-                .map_err(refused)?;
-        }
-        let belief = posterior
-            .observe_described(&image, features.clone())
-            .map_err(|e| bad_argument("image", e))?;
-        self.observed.push((image, features));
-        self.belief = Some(belief);
+        let pad_pose = pad_pose
+            .map(|p| array::to_f64(p, "pad_pose").map(|(_, v)| v))
+            .transpose()?;
+        self.add(shape, values, pad_pose)?;
         self.probabilities(py)
+    }
+
+    /// Pickled as its model and the readings it observed (images and pad poses as given), which
+    /// the unpickled posterior observes again in order: the same probabilities, bit for bit.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Model, ObservedArrays<'py>))> {
+        let sensor = self.model.sensor();
+        let observed = self
+            .observed
+            .iter()
+            .map(|o| {
+                let image = array::from_f64(py, o.image.values(), &[sensor.rows, sensor.cols], "float64")?;
+                let pose = o
+                    .pad_pose
+                    .as_ref()
+                    .map(|p| array::from_f64(py, p, &[p.len()], "float64"))
+                    .transpose()?;
+                Ok((image, pose))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let model = Model {
+            inner: self.model.clone(),
+        };
+        Ok((py.get_type::<Self>().getattr("_from_state")?, (model, observed)))
+    }
+
+    /// The posterior [`__reduce__`](Self::__reduce__) pickled: `model`'s, after `observed`.
+    #[staticmethod]
+    fn _from_state(model: &Model, observed: ObservedArrays<'_>) -> PyResult<Self> {
+        let mut posterior = Self::of(model.inner.clone());
+        for (image, pad_pose) in observed {
+            let (shape, values) = array::to_f64(&image, "image")?;
+            let pad_pose = pad_pose
+                .map(|p| array::to_f64(&p, "pad_pose").map(|(_, v)| v))
+                .transpose()?;
+            posterior.add(shape, values, pad_pose)?;
+        }
+        Ok(posterior)
     }
 
     /// P(object | readings so far), in the order of `Model.objects`.
@@ -373,4 +447,65 @@ pub fn train_for_arm(
     Ok(Model {
         inner: Arc::new(Recognizer::Fused(Box::new(model))),
     })
+}
+
+/// The recogniser `taction demo` trains, all of it in one call (`ArmTrainingRecipe::train`): the
+/// sampler's `training_readings` converged readings per object from starts the arm can reach, the
+/// arm's own explorations to calibrate the posterior (`collect_arm_calibration`'s), MNTI and SIFT
+/// fused over the neighbour codebook. Collection runs on `threads` threads (0: one per core; the
+/// model does not depend on it). Same objects, sensor and seed, same model as the demo's, bit for
+/// bit. Fewer readings than asked, or a calibration that gathered none, is a Python warning.
+#[pyfunction]
+#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python"), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python')")]
+pub fn arm_model(
+    py: Python<'_>,
+    objects: Objects,
+    training_readings: Whole<usize>,
+    seed: Whole<u64>,
+    sensor: Option<PyRef<'_, Sensor>>,
+    threads: Whole<usize>,
+    object_set: &str,
+) -> PyResult<Model> {
+    let (Whole(training_readings), Whole(seed), Whole(threads)) = (training_readings, seed, threads);
+    let (sensor, specs) = touch_inputs(&objects, sensor)?;
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: training_readings,
+        seed,
+    };
+    let mut shortfalls = Shortfalls::default();
+    let trained = py
+        .detach(|| recipe.train(object_set, &specs, sensor, threads, &mut shortfalls))
+        .map_err(refused)?;
+    for message in shortfalls.0 {
+        warn(py, &format!("taction.arm_model: {message}"))?;
+    }
+    if !trained.calibrated_on_the_arm() {
+        warn(
+            py,
+            "taction.arm_model: the arm's calibration explorations gave no converged reading: the \
+             posterior is calibrated on held-out sampler readings and overconfident on the arm's touches",
+        )?;
+    }
+    Ok(Model {
+        inner: Arc::new(Recognizer::Fused(Box::new(trained.model))),
+    })
+}
+
+/// The recipe's collections that fell short, to warn of once the GIL is back.
+#[derive(Default)]
+struct Shortfalls(Vec<String>);
+
+impl ArmTrainingObserver for Shortfalls {
+    fn collected(&mut self, data: ArmData, _dataset: &taction::dataset::Dataset, short: &[Shortfall]) {
+        if !short.is_empty() {
+            let what = match data {
+                ArmData::Training => "training",
+                ArmData::Calibration => "calibration",
+            };
+            self.0.push(format!(
+                "{what}: fewer readings than asked: {}",
+                describe_shortfalls(short)
+            ));
+        }
+    }
 }

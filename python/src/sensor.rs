@@ -55,7 +55,11 @@ impl Sensor {
 /// The nine numbers of a pad pose, as a dataset's `pad_*` columns: the centre (metres), the normal
 /// (from the pad into the covering, toward the object) and the up direction (row 0's edge).
 pub fn pad_pose(value: &Bound<'_, PyAny>) -> PyResult<PadPose> {
-    let (_, v) = array::to_f64(value, "pad_pose")?;
+    pad_pose_of(&array::to_f64(value, "pad_pose")?.1)
+}
+
+/// [`pad_pose`] of the numbers given.
+pub fn pad_pose_of(v: &[f64]) -> PyResult<PadPose> {
     if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
         return Err(bad_argument(
             "pad_pose",
@@ -109,6 +113,22 @@ impl Sensor {
             noise_seed: seed,
             ..SensorConfig::of_square_pad(rows, cols, pad_m, thickness_m, psf_sigma_m)
         };
+        Ok(Self {
+            config: Valid::new(config).map_err(refused)?,
+            pads: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// Pickled as its configuration (the pads it built are made again on first use).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let json = serde_json::to_string(&*self.config).map_err(refused)?;
+        Ok((py.get_type::<Self>().getattr("_from_config")?, (json,)))
+    }
+
+    /// The sensor [`__reduce__`](Self::__reduce__) pickled, checked again.
+    #[staticmethod]
+    fn _from_config(json: &str) -> PyResult<Self> {
+        let config: SensorConfig = serde_json::from_str(json).map_err(|e| bad_argument("pickle", e))?;
         Ok(Self {
             config: Valid::new(config).map_err(refused)?,
             pads: Mutex::new(Vec::new()),

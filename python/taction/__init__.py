@@ -16,7 +16,8 @@ library ``target/release/libtaction_covering.so`` registered it first; either se
 
 # The MuJoCo library the extension links is the one the `mujoco` package ships (the extension's
 # rpath is `$ORIGIN/../mujoco`); importing `mujoco` first loads it once for both.
-import mujoco as _mujoco  # noqa: F401
+# (mujoco ships no type information: the import is untyped.)
+import mujoco as _mujoco  # type: ignore[import-untyped, unused-ignore]  # noqa: F401
 
 from taction._taction import (  # noqa: F401
     Dataset,
@@ -27,6 +28,7 @@ from taction._taction import (  # noqa: F401
     TactionError,
     TouchEpisode,
     __version__,
+    arm_model,
     collect,
     collect_arm_calibration,
     objects,
@@ -69,6 +71,7 @@ __all__ = [
     "Sensor",
     "TactionError",
     "TouchEpisode",
+    "arm_model",
     "collect",
     "collect_arm_calibration",
     "objects",

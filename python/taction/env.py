@@ -13,9 +13,9 @@ it is, which ends the episode. A right declaration pays ``right_reward``, a wron
 touches.
 
 The recogniser is ``model`` (a ``taction.Model`` or a model file), or by default the one
-``taction demo`` trains for the arm's touches (``taction.train_for_arm`` on ``training_readings``
+``taction demo`` trains for the arm's touches (``taction.arm_model``: ``training_readings``
 sampler readings per object from starts the arm can reach, its posterior calibrated on the arm's
-own explorations, ``taction.collect_arm_calibration``), trained once per process and set.
+own explorations), trained once per process and set.
 
 ``taction/ActiveTouch-v1`` (``GuardedTouchEnv``) makes every touch action a guarded touch: the arm
 moves the pad along a ray through the chosen candidate until its covering meets a surface, and the
@@ -33,6 +33,7 @@ from typing import Any, Optional, Sequence, Union
 import gymnasium
 import numpy as np
 from gymnasium import spaces
+from numpy.typing import NDArray
 
 import taction
 
@@ -46,40 +47,30 @@ LETTERS_HEADING_DEG = 10.0
 
 #: Models trained by default, per (set, readings, seed): one training per process serves every
 #: environment of a vector env.
-_DEFAULT_MODELS: dict = {}
+_DEFAULT_MODELS: dict[tuple[str, int, int], taction.Model] = {}
 
 
-def _objects_of(objects: Union[str, Sequence["taction.Object"]]) -> list:
+def _objects_of(objects: Union[str, os.PathLike[str], Sequence[taction.Object]]) -> list[taction.Object]:
     if isinstance(objects, (str, os.PathLike)):
         return taction.objects(objects)
     return list(objects)
 
 
-def _is_integer(value) -> bool:
+def _is_integer(value: Any) -> bool:
     """A Python or numpy integer; not a bool, which Python counts as one."""
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
-def default_model(objects, training_readings: int = 1000, seed: int = 1) -> "taction.Model":
-    """The recogniser ``taction demo`` trains for the arm (``taction.train_for_arm``) on ``objects``
-    (a set name or a list of objects), its posterior calibrated on the arm's own explorations
-    (``taction.collect_arm_calibration``) as the demo's is; trained once per process for a set
-    name."""
+def default_model(
+    objects: Union[str, Sequence[taction.Object]], training_readings: int = 1000, seed: int = 1
+) -> taction.Model:
+    """The recogniser ``taction demo`` trains for the arm (``taction.arm_model``: the library's
+    recipe, collection, calibration on the arm's own explorations and fit) on ``objects`` (a set
+    name or a list of objects); trained once per process for a set name."""
     key = (objects, training_readings, seed) if isinstance(objects, str) else None
     if key is not None and key in _DEFAULT_MODELS:
         return _DEFAULT_MODELS[key]
-    touched = _objects_of(objects)
-    training = taction.collect(
-        touched,
-        mode="sampler",
-        readings=training_readings,
-        seed=seed,
-        reachable_by_arm=True,
-    )
-    calibration = taction.collect_arm_calibration(
-        touched, training_readings=training_readings, seed=seed
-    )
-    model = taction.train_for_arm(training.converged(), seed=seed, calibration=calibration)
+    model = taction.arm_model(_objects_of(objects), training_readings=training_readings, seed=seed)
     if key is not None:
         _DEFAULT_MODELS[key] = model
     return model
@@ -125,7 +116,7 @@ class ActiveTouchEnv(gymnasium.Env):
         training_readings: int = 1000,
         training_seed: int = 1,
         touch: str = "iteration",
-    ):
+    ) -> None:
         if budget < 1:
             raise taction.TactionError(f"budget: {budget} is not 1 or more")
         if candidates < 1:
@@ -162,7 +153,7 @@ class ActiveTouchEnv(gymnasium.Env):
         self._episode_objects = [by_name[name] for name in self.objects]
         self.budget = budget
         self.k = candidates
-        self._settings = dict(
+        self._settings: dict[str, Any] = dict(
             candidates=candidates,
             local_probability=local_probability,
             perturb_deg=perturb_deg,
@@ -197,13 +188,19 @@ class ActiveTouchEnv(gymnasium.Env):
         self._touches = 0
         self._over = False
 
+    def _current(self, what: str) -> taction.TouchEpisode:
+        """The episode under way; before ``reset()``, a refusal naming ``what``."""
+        if self._episode is None:
+            raise taction.TactionError(f"{what}: call reset() first")
+        return self._episode
+
     # The episode's candidates, repeated in order when the planner offered fewer than K.
-    def _candidates(self) -> np.ndarray:
-        offered = self._episode.candidates
+    def _candidates(self) -> NDArray[np.float64]:
+        offered = self._current("candidates").candidates
         return offered[np.arange(self.k) % len(offered)]
 
-    def _observation(self) -> dict:
-        e = self._episode
+    def _observation(self) -> dict[str, Any]:
+        e = self._current("observation")
         observation = {
             "image": e.image.astype(np.float32),
             "pad_pose": e.pad_pose.astype(np.float32),
@@ -215,16 +212,16 @@ class ActiveTouchEnv(gymnasium.Env):
             observation["contact"] = e.contact.astype(np.float32)
         return observation
 
-    def gains(self) -> np.ndarray:
+    def gains(self) -> NDArray[np.float64]:
         """The expected information gain (nats) of a touch toward each of the K candidates: what a
         touch there would teach times the chance it touches at all, judged from the episode's
         earlier touches; what the information-gain policy maximises (``taction.active_touch``)."""
-        if self._episode is None:
-            raise taction.TactionError("gains: call reset() first")
-        offered = self._episode.gains()
+        offered = self._current("gains").gains()
         return offered[np.arange(self.k) % len(offered)]
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
         super().reset(seed=seed)
         options = options or {}
         unknown = sorted(set(options) - {"object"})
@@ -254,7 +251,7 @@ class ActiveTouchEnv(gymnasium.Env):
         self._over = False
         return self._observation(), {"attempts": 0, "readings": 0}
 
-    def step(self, action):
+    def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
         if self._episode is None:
             raise taction.TactionError("step: call reset() first")
         if self._over:
@@ -263,8 +260,9 @@ class ActiveTouchEnv(gymnasium.Env):
         if not (_is_integer(action) or scalar_array):
             raise taction.TactionError(f"action: {action!r} is not an integer of the action space")
         action = int(action)
-        if not 0 <= action < self.action_space.n:
-            raise taction.TactionError(f"action: {action} is outside 0..{self.action_space.n - 1}")
+        actions = self.k + len(self.objects)  # the action space's n
+        if not 0 <= action < actions:
+            raise taction.TactionError(f"action: {action} is outside 0..{actions - 1}")
         e = self._episode
         info: dict[str, Any] = {}
         terminated = truncated = False
@@ -318,7 +316,7 @@ class GuardedTouchEnv(ActiveTouchEnv):
         start_heading_deg: Optional[float] = None,
         touch: str = "guarded",
         **settings: Any,
-    ):
+    ) -> None:
         """``settings``: the other keyword arguments of ``ActiveTouchEnv``, with its defaults."""
         if start_heading_deg is None:
             start_heading_deg = LETTERS_HEADING_DEG if objects == "letters" else 180.0

@@ -43,9 +43,11 @@
 //! planner and the belief of one object's exploration, and touches toward the candidate it is told.
 
 mod episode;
+mod recipe;
 mod stop;
 
 pub use episode::{EpisodeConfig, TouchAction, TouchEpisode};
+pub use recipe::{ArmData, ArmTraining, ArmTrainingError, ArmTrainingObserver, ArmTrainingRecipe};
 pub use stop::{REPORTED_STOPS, StopRecord, reported_stops, stops};
 
 use std::collections::BTreeMap;
@@ -53,25 +55,17 @@ use std::collections::BTreeMap;
 use glam::DVec3;
 
 use crate::control::ControlError;
-use crate::dataset::{Dataset, Reading};
-use crate::describe::DescriptorKind;
+use crate::dataset::Reading;
+use crate::explore::Planner;
 use crate::explore::active::{ActiveGuidance, ConfidenceStop, TouchScorer};
-use crate::explore::collect::{CollectMode, CollectPlan};
-use crate::explore::{Planner, PlannerConfig, SamplerConfig};
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::decision::entropy_nats;
 use crate::recognize::object_model::{ClusterHistogram, ObjectModels};
 use crate::recognize::posterior::{Belief, ModelPosterior};
-use crate::recognize::{
-    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer, Tempering,
-    TrainChoices, TrainConfig, TrainData, TrainedModel, train_recognizer,
-};
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
-use crate::tactile::{SensorConfig, TactileImage};
-use crate::valid::{RangeError, Valid};
-
-/// The stream of the recipe's seed its calibration explorations draw from.
-const CALIBRATION_SEED_STREAM: u64 = 7;
+use crate::recognize::{FusedModel, RecognizeError, Recognizer, Tempering, TrainedModel};
+use crate::sim::Scene;
+use crate::tactile::TactileImage;
+use crate::valid::RangeError;
 
 /// `kappa`: how many readings' worth of weight the belief's own prediction has against the readings
 /// of a neighbourhood (see the module docs). One: a single nearby reading already counts as much as
@@ -335,134 +329,6 @@ impl<'a> ActiveRecognition<'a> {
 
     pub fn scorer(&self) -> &InformationGain<'a> {
         &self.gain
-    }
-}
-
-/// How the demo trains a recogniser on what the arm's pad feels (the README's "Training that
-/// matches the arm"; docs/measurements.md has the measurements behind each choice): sampler
-/// readings restricted to the starts the arm can take from any heading of the object, pressed by
-/// the same controllers as the arm's pad; MNTI and SIFT fused ([`Self::DESCRIPTORS`]: SIFT's
-/// gradient orientations with MNTI's moments gained on the arm's own touches as on sampler data)
-/// over the neighbour codebook, one restart (the neighbour codebook draws nothing at random), the
-/// `k` grid sized to the converged readings left after the hold-out
-/// ([`TrainConfig::with_grid_for_dataset`]). Library users get the model `taction demo` gets.
-///
-/// ```
-/// use taction::active_touch::ArmTrainingRecipe;
-///
-/// let recipe = ArmTrainingRecipe { readings_per_object: 3000, seed: 1 };
-/// assert_eq!(recipe.descriptors()?.name(), "mnti+sift");
-/// # Ok::<(), Box<dyn std::error::Error>>(())
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ArmTrainingRecipe {
-    /// Converged sampler readings per object.
-    pub readings_per_object: usize,
-    /// Seeds the training data and the model selection.
-    pub seed: u64,
-}
-
-impl ArmTrainingRecipe {
-    /// The fused descriptors.
-    pub const DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
-    /// The codebook every descriptor's model uses.
-    pub const CODEBOOK: CodebookKind = CodebookKind::Knn;
-
-    /// [`Self::DESCRIPTORS`], fused.
-    pub fn descriptors(&self) -> Result<DescriptorChoice, DescriptorChoiceError> {
-        DescriptorChoice::fused(Self::DESCRIPTORS.to_vec())
-    }
-
-    /// The training data's collection: the sampler from starts the arm can reach, the default
-    /// controllers, the object unperturbed.
-    pub fn collect_plan(&self, sensor: SensorConfig) -> Result<CollectPlan, RangeError> {
-        Ok(CollectPlan {
-            mode: CollectMode::Sampler(Valid::new(SamplerConfig {
-                reachable_by_arm: true,
-                ..SamplerConfig::default()
-            })?),
-            sensor,
-            control: Valid::default(),
-            perturbation: PerturbationBounds::NONE,
-            readings_per_object: self.readings_per_object,
-            seed: self.seed,
-            start_pose: StartPose::Canonical,
-        })
-    }
-
-    /// The training choices: [`Self::DESCRIPTORS`] over [`Self::CODEBOOK`], one restart, the
-    /// posterior calibrated on trials of 10 of the arm's touches.
-    pub fn choices(&self) -> Result<Valid<TrainChoices>, RecognizeError> {
-        let descriptor = self.descriptors().map_err(|e| RecognizeError::InvalidParameter {
-            name: "descriptors",
-            what: e.to_string(),
-        })?;
-        let choices = TrainChoices {
-            codebook: Self::CODEBOOK,
-            restarts: 1,
-            seed: self.seed,
-            calibration_trial_readings: Some(10),
-            ..TrainChoices::of(descriptor)
-        };
-        Valid::new(choices)
-    }
-
-    /// Model selection for `training` (validation held out of it).
-    pub fn train_config(&self, training: &Dataset) -> Result<Valid<TrainConfig>, RecognizeError> {
-        self.choices()?.config(training, false)
-    }
-
-    /// Converged readings per object of the arm's own explorations the posterior is calibrated
-    /// on: a thirtieth of the training readings, 10 to 100 (100 for the demo's 3000).
-    pub fn calibration_readings(&self) -> usize {
-        (self.readings_per_object / 30).clamp(10, 100)
-    }
-
-    /// The calibration data's collection: the arm exploring blind (L = 0.5, the object fixed) with
-    /// the default controllers, [`calibration_readings`](Self::calibration_readings) per object of
-    /// `objects`, on a seed of its own.
-    pub fn calibration_plan(
-        &self,
-        sensor: SensorConfig,
-        objects: &[ObjectSpec],
-    ) -> Result<CollectPlan, RangeError> {
-        let readings = self.calibration_readings();
-        Ok(CollectPlan {
-            mode: CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
-                objects, readings, 0.5, None,
-            ))?),
-            sensor,
-            control: Valid::default(),
-            perturbation: PerturbationBounds::NONE,
-            readings_per_object: readings,
-            seed: crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM),
-            start_pose: StartPose::Canonical,
-        })
-    }
-
-    /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan))
-    /// and, given the arm's explorations `calibration` ([`calibration_plan`](Self::calibration_plan)),
-    /// calibrates its posterior on them (`recognize::calibration`: the arm's successive touches
-    /// are correlated, which the sampler's held-out readings cannot show); without them the
-    /// posterior is calibrated on the held-out readings.
-    pub fn fit(
-        &self,
-        training: &Dataset,
-        calibration: Option<&Dataset>,
-    ) -> Result<FusedModel, RecognizeError> {
-        let data = TrainData {
-            training,
-            validation: None,
-            calibration: calibration.as_slice(),
-            contacts: None,
-        };
-        match train_recognizer(&self.choices()?, data, &mut ())? {
-            Recognizer::Fused(model) => Ok(*model),
-            _ => Err(RecognizeError::InvalidParameter {
-                name: "descriptors",
-                what: "the recipe fuses two descriptors".into(),
-            }),
-        }
     }
 }
 

@@ -18,9 +18,12 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use rand::RngExt;
-use taction::active_touch::{ActiveRecognition, ArmTrainingRecipe, TouchPlan, TouchRun, explore_recognizing};
+use taction::active_touch::{
+    ActiveRecognition, ArmData, ArmTrainingObserver, ArmTrainingRecipe, TouchPlan, TouchRun,
+    explore_recognizing,
+};
 use taction::control::sensor_reader;
-use taction::dataset::{Dataset, describe_shortfalls};
+use taction::dataset::{Dataset, Shortfall, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::experiment::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
@@ -29,7 +32,7 @@ use taction::explore::{Planner, PlannerConfig};
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
 use taction::recognize::Belief;
-use taction::recognize::{FusedModel, Recognizer};
+use taction::recognize::{FusedModel, Recognizer, TrainConfig};
 use taction::rng;
 use taction::sim::PAD_SITE;
 use taction::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
@@ -159,74 +162,87 @@ fn load_or_train(
     Ok(model)
 }
 
-/// Collects the recipe's training data, with a progress bar, and trains the fused model on it.
+/// Trains the library's [`ArmTrainingRecipe`], printing its steps: a progress bar per
+/// collection, its shortfalls and the posterior's calibration.
 fn train_model(
     recipe: &ArmTrainingRecipe,
     set: &ObjectSet,
     objects: &[ObjectSpec],
     sensor: SensorConfig,
 ) -> Result<FusedModel, Box<dyn std::error::Error>> {
-    let readings = recipe.readings_per_object;
-    println!(
-        "training: {readings} sampler readings of each of {} objects from starts the arm can reach ({})",
-        objects.len(),
-        objects
-            .iter()
-            .map(|o| o.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let progress = Progress::collection("training data", objects.len(), readings);
-    let dataset = recipe
-        .collect_plan(sensor)?
-        .collect_dataset(&set.id(), objects, 0, &|| progress.inc())?;
-    let converged = dataset.converged_only().len();
-    progress.finish(converged);
-    let short = dataset.shortfalls(readings);
-    if !short.is_empty() {
-        eprintln!("warning: training: {}", describe_shortfalls(&short));
-    }
-    let calibration = collect_calibration(recipe, set, objects, sensor)?;
-    let config = recipe.train_config(&dataset)?;
-    println!(
-        "training {}: {} training readings; trying k = {:?}",
-        recipe.descriptors()?.name(),
-        config.grid_training_features(converged, false),
-        config.ks
-    );
-    let model = recipe.fit(&dataset, Some(&calibration))?;
-    let t = model.tempering;
-    if calibration.converged_only().is_empty() {
+    let mut printer = RecipePrinter {
+        descriptors: recipe.descriptors()?.name(),
+        progress: None,
+    };
+    let trained = recipe.train(&set.id(), objects, sensor, 0, &mut printer)?;
+    let t = trained.model.tempering;
+    if trained.calibrated_on_the_arm() {
+        println!("posterior calibrated on the arm's explorations: {t}");
+    } else {
         eprintln!(
             "taction demo: warning: calibration: the arm's explorations gave no converged reading, so nothing calibrated \
              the posterior ({t}): it counts the arm's correlated touches as independent evidence"
         );
-    } else {
-        println!("posterior calibrated on the arm's explorations: {t}");
     }
-    Ok(model)
+    Ok(trained.model)
 }
 
-/// The arm's own blind explorations the recipe calibrates the posterior on, with a progress bar.
-fn collect_calibration(
-    recipe: &ArmTrainingRecipe,
-    set: &ObjectSet,
-    objects: &[ObjectSpec],
-    sensor: SensorConfig,
-) -> Result<Dataset, Box<dyn std::error::Error>> {
-    let readings = recipe.calibration_readings();
-    println!("calibration: the arm exploring each object blind for {readings} readings");
-    let progress = Progress::collection("calibration data", objects.len(), readings);
-    let dataset =
-        recipe
-            .calibration_plan(sensor, objects)?
-            .collect_dataset(&set.id(), objects, 0, &|| progress.inc())?;
-    progress.finish(dataset.converged_only().len());
-    let short = dataset.shortfalls(readings);
-    if !short.is_empty() {
-        eprintln!("warning: calibration: {}", describe_shortfalls(&short));
+/// Prints what the recipe does, as the demo always has.
+struct RecipePrinter {
+    /// The fused descriptors' name.
+    descriptors: String,
+    /// The bar of the collection under way.
+    progress: Option<Progress>,
+}
+
+impl ArmTrainingObserver for RecipePrinter {
+    fn collecting(&mut self, data: ArmData, objects: &[ObjectSpec], readings: usize) {
+        let names = objects
+            .iter()
+            .map(|o| o.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let bar = match data {
+            ArmData::Training => {
+                println!(
+                    "training: {readings} sampler readings of each of {} objects from starts the arm can reach ({names})",
+                    objects.len()
+                );
+                "training data"
+            }
+            ArmData::Calibration => {
+                println!("calibration: the arm exploring each object blind for {readings} readings");
+                "calibration data"
+            }
+        };
+        self.progress = Some(Progress::collection(bar, objects.len(), readings));
     }
-    Ok(dataset)
+
+    fn converged(&self, _data: ArmData) {
+        if let Some(progress) = &self.progress {
+            progress.inc();
+        }
+    }
+
+    fn collected(&mut self, data: ArmData, dataset: &Dataset, short: &[Shortfall]) {
+        if let Some(progress) = self.progress.take() {
+            progress.finish(dataset.converged_only().len());
+        }
+        if !short.is_empty() {
+            let what = match data {
+                ArmData::Training => "training",
+                ArmData::Calibration => "calibration",
+            };
+            eprintln!("warning: {what}: {}", describe_shortfalls(short));
+        }
+    }
+
+    fn fitting(&mut self, config: &TrainConfig, features: usize) {
+        println!(
+            "training {}: {features} training readings; trying k = {:?}",
+            self.descriptors, config.ks
+        );
+    }
 }
 
 /// The object to explore and its scene.

@@ -11,8 +11,8 @@ use taction::locate::GeometryModel;
 use taction::mesh::{ObjectSet, TriMesh};
 use taction::recognize::{
     CodebookKind, DescriptorChoice, PseudoCount, RecognizeError, Recognizer, Tempering, TrainChoices,
-    TrainData, TrainObserver, TrainProgress, TrainedModel, VarianceFraction, sensor_differences,
-    train_recognizer,
+    TrainData, TrainObserver, TrainProgress, TrainedModel, VarianceFraction, check_contacts_weighable,
+    sensor_differences, train_recognizer,
 };
 use taction::valid::Valid;
 
@@ -135,6 +135,12 @@ fn choices(args: &TrainArgs) -> Result<Valid<TrainChoices>, Box<dyn std::error::
 
 pub fn run(args: &TrainArgs) -> Result<(), Box<dyn std::error::Error>> {
     let choices = choices(args)?;
+    check_contacts_weighable(
+        !args.objects.is_empty(),
+        !args.calibration.is_empty(),
+        args.validation.is_some(),
+    )
+    .map_err(named_by_flag)?;
     check_output_file(&args.out, "out")?;
     let training = read_dataset(&args.dataset)?;
     let validation = args.validation.as_deref().map(read_dataset).transpose()?;

@@ -22,4 +22,3 @@ pub use carrier::{ControlError, PadCarrier, PadMotion, ReadTactile, sensor_reade
 pub use free_pad::FreePad;
 
 // Orient's geometry: where a taxel sits on the pad.
-pub use orient::taxel_position_m;

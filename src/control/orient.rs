@@ -55,13 +55,6 @@ pub fn fit_plane(points: &[DVec3]) -> PlaneFit {
     }
 }
 
-/// Position of taxel (`row`, `col`) centre on the pad: (right, up) in metres from the pad centre.
-pub fn taxel_position_m(sensor: &SensorConfig, row: usize, col: usize) -> (f64, f64) {
-    let x = ((col as f64 + 0.5) / sensor.cols as f64 - 0.5) * sensor.pad_width_m;
-    let y = (0.5 - (row as f64 + 0.5) / sensor.rows as f64) * sensor.pad_height_m;
-    (x, y)
-}
-
 /// The surface points of Algorithm 1, lines 1-7, in the pad frame (metres).
 pub fn contact_points(image: &TactileImage, sensor: &SensorConfig, threshold: f64) -> Vec<DVec3> {
     surface_points(image, sensor, |row, col| image.get(row, col) > threshold)
@@ -77,7 +70,7 @@ fn surface_points(
     for row in 0..image.rows() {
         for col in 0..image.cols() {
             if keep(row, col) {
-                let (x, y) = taxel_position_m(sensor, row, col);
+                let (x, y) = sensor.taxel_centre_m(row, col);
                 points.push(DVec3::new(x, y, sensor.thickness_m * (1.0 - image.get(row, col))));
             }
         }
@@ -198,7 +191,7 @@ fn refuted_by_a_drop(
 ) -> bool {
     (0..image.rows()).any(|row| {
         (0..image.cols()).any(|col| {
-            let (x, y) = taxel_position_m(sensor, row, col);
+            let (x, y) = sensor.taxel_centre_m(row, col);
             let depth = centroid.z - (normal.x * (x - centroid.x) + normal.y * (y - centroid.y)) / normal.z;
             let predicted = 1.0 - depth / sensor.thickness_m;
             predicted > threshold + 0.5 && image.get(row, col) <= threshold

@@ -19,6 +19,10 @@
 //! `t_{row}_{col}` row-major, so `df.filter(regex="^t_").to_numpy().reshape(-1, rows, cols)` gives
 //! the images. Snappy-compressed; the header JSON is the file's key-value metadata
 //! `taction_header` (`pyarrow.parquet.read_schema(path).metadata[b"taction_header"]`).
+//!
+//! Every column has one type wherever the dataset goes ([`column_types`]): the Parquet file's,
+//! the `.npz`'s arrays and the Python package's `Dataset.to_pandas()` all follow it (taxels
+//! float32, every pose column float64 even where the object never moved, `iterations` int64).
 
 use std::fmt;
 use std::io::{Cursor, Write};
@@ -253,6 +257,38 @@ impl Npy {
     }
 }
 
+/// The one type of a dataset column in every export and in pandas (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    /// A name (UTF-8; empty where a reading has none, e.g. `cause`).
+    Text,
+    /// `iterations`.
+    Int64,
+    /// The object's and the pad's pose (the pad's NaN, or null, where a reading has no pose).
+    Float64,
+    /// A taxel.
+    Float32,
+}
+
+impl ColumnType {
+    /// numpy's name of the type (`"str"` for text).
+    pub fn numpy(self) -> &'static str {
+        match self {
+            Self::Text => "str",
+            Self::Int64 => "int64",
+            Self::Float64 => "float64",
+            Self::Float32 => "float32",
+        }
+    }
+}
+
+/// Every column of a dataset of a `rows x cols` sensor, in the CSV's order ([`column_names`]),
+/// with its type.
+pub fn column_types(rows: usize, cols: usize) -> Vec<(String, ColumnType)> {
+    let columns = ParquetColumn::all(rows * cols).map(ParquetColumn::column_type);
+    column_names(rows, cols).into_iter().zip(columns).collect()
+}
+
 /// A column of the Parquet file: one of the CSV's columns before the taxels, or a taxel
 /// (row-major index).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -268,16 +304,34 @@ impl ParquetColumn {
         metas.chain((0..taxels).map(Self::Taxel))
     }
 
-    /// How the column is stored: names as UTF-8 strings, `iterations` int64, poses float64 (the
-    /// pad pose optional, for images without one), taxels float32.
-    fn storage(self) -> (PhysicalType, Repetition) {
+    /// The column's type: names text, `iterations` int64, poses float64, taxels float32.
+    fn column_type(self) -> ColumnType {
         match self {
-            Self::Taxel(_) => (PhysicalType::FLOAT, Repetition::REQUIRED),
-            Self::Meta(Meta::Iterations) => (PhysicalType::INT64, Repetition::REQUIRED),
-            Self::Meta(m) if Meta::pad().contains(&m) => (PhysicalType::DOUBLE, Repetition::OPTIONAL),
-            Self::Meta(m) if Meta::object_pose().contains(&m) => (PhysicalType::DOUBLE, Repetition::REQUIRED),
-            Self::Meta(_) => (PhysicalType::BYTE_ARRAY, Repetition::REQUIRED),
+            Self::Taxel(_) => ColumnType::Float32,
+            Self::Meta(Meta::Iterations) => ColumnType::Int64,
+            Self::Meta(m) if Meta::pad().contains(&m) || Meta::object_pose().contains(&m) => {
+                ColumnType::Float64
+            }
+            Self::Meta(_) => ColumnType::Text,
         }
+    }
+
+    /// How the column is stored: its [`ColumnType`], the pad pose optional (for images without
+    /// one).
+    fn storage(self) -> (PhysicalType, Repetition) {
+        let physical = match self.column_type() {
+            ColumnType::Text => PhysicalType::BYTE_ARRAY,
+            ColumnType::Int64 => PhysicalType::INT64,
+            ColumnType::Float64 => PhysicalType::DOUBLE,
+            ColumnType::Float32 => PhysicalType::FLOAT,
+        };
+        let optional = matches!(self, Self::Meta(m) if Meta::pad().contains(&m));
+        let repetition = if optional {
+            Repetition::OPTIONAL
+        } else {
+            Repetition::REQUIRED
+        };
+        (physical, repetition)
     }
 
     fn schema(self, name: &str) -> Result<TypePtr, ParquetError> {

@@ -30,7 +30,7 @@ pub use strategy::Strategy;
 // The file: its columns and numbers, and the counts `dataset show` prints.
 pub use format::{FORMAT_VERSION, column_names};
 // The file for the ML toolchain: numpy's npz, Parquet.
-pub use export::{ExportFormat, ExportFormatError};
+pub use export::{ColumnType, ExportFormat, ExportFormatError, column_types};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.

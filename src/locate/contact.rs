@@ -38,7 +38,7 @@ impl Contact {
                 if v <= 0.0 {
                     continue;
                 }
-                let point = taxel_surface_point(pose, sensor, rows, cols, (row, col), v);
+                let point = taxel_surface_point(pose, sensor, (row, col), v);
                 weighted += point * v;
                 total += v;
             }
@@ -87,16 +87,8 @@ const CONTACT_NOISE_STREAM: u64 = 0x6c6f_6361_7465; // "locate"
 
 /// The world point under taxel `(row, col)` of value `v`: the taxel's centre on the pad, moved
 /// along the normal to where the covering met the surface.
-fn taxel_surface_point(
-    pose: &PadPose,
-    sensor: &SensorConfig,
-    rows: usize,
-    cols: usize,
-    (row, col): (usize, usize),
-    v: f64,
-) -> DVec3 {
-    let x_m = ((col as f64 + 0.5) / cols as f64 - 0.5) * sensor.pad_width_m;
-    let y_m = (0.5 - (row as f64 + 0.5) / rows as f64) * sensor.pad_height_m;
+fn taxel_surface_point(pose: &PadPose, sensor: &SensorConfig, (row, col): (usize, usize), v: f64) -> DVec3 {
+    let (x_m, y_m) = sensor.taxel_centre_m(row, col);
     pose.transform_point(DVec3::new(x_m, y_m, sensor.thickness_m * (1.0 - v)))
 }
 

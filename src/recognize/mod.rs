@@ -55,7 +55,7 @@ pub use model::{
 pub use posterior::{GeometricPosterior, TouchReading};
 pub use recognizer::Recognizer;
 // The one training entry of the CLI and Python: a user's choices, the data, the recogniser.
-pub use request::{TrainChoices, TrainData, TrainObserver, train_recognizer};
+pub use request::{TrainChoices, TrainData, TrainObserver, check_contacts_weighable, train_recognizer};
 
 // Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
 pub use codebook::{CodebookConfig, CodebookKind};

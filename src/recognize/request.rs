@@ -135,19 +135,33 @@ pub struct TrainData<'a> {
 }
 
 impl TrainData<'_> {
-    /// The contacts' weight is fitted on explorations the appearance model was not trained on.
     fn check(&self) -> Result<(), RecognizeError> {
-        if self.contacts.is_some() && self.calibration.is_empty() && self.validation.is_none() {
-            return Err(RecognizeError::InvalidParameter {
-                name: "objects",
-                what: "the fusion of appearance and contact geometry is weighed on explorations the \
-                       appearance model was not trained on: give calibration (the arm's explorations) \
-                       or validation"
-                    .into(),
-            });
-        }
-        Ok(())
+        check_contacts_weighable(
+            self.contacts.is_some(),
+            !self.calibration.is_empty(),
+            self.validation.is_some(),
+        )
     }
+}
+
+/// The contacts' weight is fitted on explorations the appearance model was not trained on:
+/// training with `contacts` needs `calibration` explorations or a `validation` dataset. An edge
+/// asks before it reads any dataset; [`train_recognizer`] asks again of the data it is given.
+pub fn check_contacts_weighable(
+    contacts: bool,
+    calibration: bool,
+    validation: bool,
+) -> Result<(), RecognizeError> {
+    if contacts && !calibration && !validation {
+        return Err(RecognizeError::InvalidParameter {
+            name: "objects",
+            what: "the fusion of appearance and contact geometry is weighed on explorations the \
+                   appearance model was not trained on: give calibration (the arm's explorations) \
+                   or validation"
+                .into(),
+        });
+    }
+    Ok(())
 }
 
 /// What training says as it goes, for an edge that shows it (a progress bar, a report). Every

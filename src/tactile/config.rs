@@ -296,6 +296,15 @@ impl SensorConfig {
         }
     }
 
+    /// Where taxel (`row`, `col`)'s centre is on the pad: (right, up) in metres from the pad's
+    /// centre, row 0 at the top (the image's layout, Sec. V-A2). Orient's plane fit and the
+    /// contact a reading felt both place taxels by it.
+    pub fn taxel_centre_m(&self, row: usize, col: usize) -> (f64, f64) {
+        let x = ((col as f64 + 0.5) / self.cols as f64 - 0.5) * self.pad_width_m;
+        let y = (0.5 - (row as f64 + 0.5) / self.rows as f64) * self.pad_height_m;
+        (x, y)
+    }
+
     /// The `k` of the `k x k` rays per taxel (valid configs only; 1 otherwise).
     pub fn rays_per_side(&self) -> usize {
         rays_per_side(self.rays_per_taxel).unwrap_or(1)
