@@ -1028,6 +1028,8 @@ fn train_with_objects_but_nothing_to_weigh_them_on_is_refused_before_any_dataset
             "train",
             "--dataset",
             &missing,
+            "--descriptor",
+            "mnti",
             "--objects",
             "chess",
             "--out",
