@@ -617,3 +617,99 @@ fn the_length_scan_counts_a_function_from_its_signature_to_its_closing_brace() {
         [("long".to_string(), 2, 83), ("free".to_string(), 91, 3)]
     );
 }
+
+/// The requests the library owns (issue 72): each was once assembled again at an edge, by the
+/// command line (`src/cli`) and by the Python bindings (`python/src`); a spelling of one there is
+/// a twin growing back. Each entry: what an edge must not write, and the library's one place for it.
+const OWNED_BY_THE_LIBRARY: [(&str, &str); 8] = [
+    (
+        "CollectMode::",
+        "explore::CollectRequest::of_mode (one collect request keyed by mode)",
+    ),
+    (
+        "TrainConfig {",
+        "recognize::train_recognizer (one training entry, single or fused)",
+    ),
+    ("FusedModel::fit", "recognize::train_recognizer"),
+    (
+        "PlannerConfig {",
+        "PlannerConfig::exploring and CollectPlan::planner_for",
+    ),
+    (
+        ".collect_plan(",
+        "active_touch::ArmTrainingRecipe::train (the demo's and the environment's model)",
+    ),
+    (
+        "with_arm_and_table(",
+        "tactile::arm_with_sensor (one arm-with-sensor scene)",
+    ),
+    ("add_sensor(", "tactile::arm_with_sensor"),
+    (
+        "\"covering\"",
+        "tactile::SENSOR_NAME (the sensor users read as m.sensor(\"tactile\"))",
+    ),
+];
+
+/// The lines of `text` that are code: comments may name anything.
+fn code_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| !line.trim_start().starts_with("//"))
+}
+
+fn edge_twins(files: &[(String, String)]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (shown, text) in files {
+        for (number, line) in code_lines(text) {
+            for (spelling, owner) in OWNED_BY_THE_LIBRARY {
+                if line.contains(spelling) {
+                    found.push(format!("{shown}:{} writes `{spelling}`: use {owner}", number + 1));
+                }
+            }
+        }
+    }
+    found
+}
+
+#[test]
+fn the_edges_build_no_request_the_library_owns() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut paths = Vec::new();
+    rust_files(&root.join("src/cli"), &mut paths);
+    rust_files(&root.join("python/src"), &mut paths);
+    let files: Vec<(String, String)> = paths
+        .iter()
+        .map(|p| {
+            let shown = p.strip_prefix(root).unwrap_or(p).display().to_string();
+            (shown, std::fs::read_to_string(p).unwrap())
+        })
+        .collect();
+    assert!(files.len() > 20, "the scan found {} edge files", files.len());
+    let twins = edge_twins(&files);
+    assert!(
+        twins.is_empty(),
+        "the edges rebuild what the library owns:\n{}",
+        twins.join("\n")
+    );
+}
+
+#[test]
+fn the_twin_scan_sees_a_request_built_at_an_edge_but_not_one_named_in_a_comment() {
+    let files = [(
+        "src/cli/x.rs".to_string(),
+        "/// Builds no `TrainConfig { .. }` itself.\nfn f() {\n    let c = TrainConfig { k: 3 };\n    let s = \"covering\";\n}\n"
+            .to_string(),
+    )];
+    let twins = edge_twins(&files);
+    assert_eq!(twins.len(), 2, "{twins:?}");
+    assert!(
+        twins[0].starts_with("src/cli/x.rs:3 writes `TrainConfig {`"),
+        "{}",
+        twins[0]
+    );
+    assert!(
+        twins[1].starts_with("src/cli/x.rs:4 writes `\"covering\"`"),
+        "{}",
+        twins[1]
+    );
+}
