@@ -77,6 +77,132 @@ impl<'de, T: Deserialize<'de> + Check> Deserialize<'de> for Valid<T> {
     }
 }
 
+/// Declares a checked number: a newtype over a finite `f64` that only its checks can build.
+///
+/// Why one macro: a number with a range of its own (a probability, a pseudo-count, `--scale`)
+/// enters the program through a constructor, `TryFrom<f64>`, a flag's `FromStr` and serde. Four
+/// hand-written copies of those doors had drifted apart: two checked finiteness and two left it to
+/// their bounds, two parsed text and two could not. Each door here is the same check, so a value
+/// refused by one is refused by all, with the same message.
+///
+/// What it generates for `$name`:
+///
+/// - the struct, `Debug, Clone, Copy, PartialEq, PartialOrd`, serialized as its bare number and
+///   deserialized through `TryFrom<f64>` (a file cannot smuggle a value past the check);
+/// - `new(value) -> Result<$name, $error>`: `Ok` when `value` is finite and the predicate holds,
+///   else the out-of-range error of `value` (NaN and the infinities are always refused, whatever
+///   the predicate says, since a comparison with NaN is false and a negated one true);
+/// - `get(self) -> f64`, `From<$name> for f64`, `TryFrom<f64>` (`new`), `Display` (the number);
+/// - `FromStr`: the text trimmed and parsed, the untrimmed text in the not-a-number error, the
+///   number then through `new`.
+///
+/// The refusal is either an error enum the macro declares beside the number (`OutOfRange(f64)` and
+/// `NotANumber(String)`, each with its message), or an existing error type built by two functions,
+/// of the refused value and of the text that is no number:
+///
+/// ```ignore
+/// checked_f64! {
+///     /// A probability in (0, 1].
+///     pub struct Probability(p) where p > 0.0 && p <= 1.0;
+///     /// A value that is not a [`Probability`].
+///     pub enum ProbabilityError {
+///         OutOfRange = "{0} is not a probability in (0, 1]",
+///         NotANumber = "'{0}' is not a number",
+///     }
+/// }
+///
+/// checked_f64! {
+///     /// A count above zero.
+///     pub struct PseudoCount(alpha) where alpha > 0.0;
+///     refused as RecognizeError: out_of_range, not_a_number;
+/// }
+/// ```
+///
+/// Constants and a `Default` are written beside the invocation, in the same module (the field is
+/// private to it).
+macro_rules! checked_f64 {
+    (
+        $(#[$doc:meta])*
+        pub struct $name:ident($value:ident) where $accepts:expr;
+        $(#[$error_doc:meta])*
+        pub enum $error:ident {
+            OutOfRange = $out_of_range:tt,
+            NotANumber = $not_a_number:tt $(,)?
+        }
+    ) => {
+        $(#[$error_doc])*
+        #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+        pub enum $error {
+            #[error($out_of_range)]
+            OutOfRange(f64),
+            #[error($not_a_number)]
+            NotANumber(String),
+        }
+
+        $crate::valid::checked_f64! {
+            $(#[$doc])*
+            pub struct $name($value) where $accepts;
+            refused as $error: $error::OutOfRange, |text: &str| $error::NotANumber(text.to_string());
+        }
+    };
+    (
+        $(#[$doc:meta])*
+        pub struct $name:ident($value:ident) where $accepts:expr;
+        refused as $error:ty: $out_of_range:expr, $not_a_number:expr;
+    ) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, ::serde::Serialize, ::serde::Deserialize)]
+        #[serde(try_from = "f64", into = "f64")]
+        pub struct $name(f64);
+
+        impl $name {
+            #[doc = concat!(
+                "Checks `", stringify!($value), "`: it must be finite and `", stringify!($accepts), "`."
+            )]
+            pub fn new($value: f64) -> Result<Self, $error> {
+                if $value.is_finite() && $accepts {
+                    Ok(Self($value))
+                } else {
+                    Err(($out_of_range)($value))
+                }
+            }
+
+            /// The number, checked.
+            pub fn get(self) -> f64 {
+                self.0
+            }
+        }
+
+        impl TryFrom<f64> for $name {
+            type Error = $error;
+            fn try_from(value: f64) -> Result<Self, $error> {
+                Self::new(value)
+            }
+        }
+
+        impl From<$name> for f64 {
+            fn from(value: $name) -> f64 {
+                value.0
+            }
+        }
+
+        impl std::str::FromStr for $name {
+            type Err = $error;
+            fn from_str(text: &str) -> Result<Self, $error> {
+                let value: f64 = text.trim().parse().map_err(|_| ($not_a_number)(text))?;
+                Self::new(value)
+            }
+        }
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{}", self.0)
+            }
+        }
+    };
+}
+pub(crate) use checked_f64;
+
 /// A field outside its allowed range: the error type of most [`Check`] impls.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{config}: {field} = {value} is outside {allowed}")]

@@ -30,6 +30,7 @@ use glam::DVec3;
 
 use crate::dataset::Strategy;
 use crate::explore::cells::PointCells;
+use crate::valid::checked_f64;
 
 /// Scores candidate touch targets by what a touch there is expected to tell about the object's
 /// identity, given the readings it has been shown so far.
@@ -51,61 +52,13 @@ pub struct ActiveGuidance<'a> {
 /// stays a small share of an iteration.
 pub const DEFAULT_CANDIDATES: usize = 12;
 
-/// A probability in (0, 1]: the confidence at which exploration stops.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, serde::Serialize, serde::Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct Probability(f64);
-
-impl Probability {
-    pub fn new(p: f64) -> Result<Self, ProbabilityError> {
-        if p > 0.0 && p <= 1.0 {
-            Ok(Self(p))
-        } else {
-            Err(ProbabilityError::OutOfRange(p))
-        }
-    }
-
-    pub fn get(self) -> f64 {
-        self.0
-    }
-}
-
-/// A value that is not a [`Probability`].
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ProbabilityError {
-    #[error("{0} is not a probability in (0, 1]")]
-    OutOfRange(f64),
-    #[error("'{0}' is not a number")]
-    NotANumber(String),
-}
-
-impl TryFrom<f64> for Probability {
-    type Error = ProbabilityError;
-    fn try_from(p: f64) -> Result<Self, ProbabilityError> {
-        Self::new(p)
-    }
-}
-
-impl From<Probability> for f64 {
-    fn from(p: Probability) -> f64 {
-        p.0
-    }
-}
-
-impl std::str::FromStr for Probability {
-    type Err = ProbabilityError;
-    fn from_str(s: &str) -> Result<Self, ProbabilityError> {
-        let p: f64 = s
-            .trim()
-            .parse()
-            .map_err(|_| ProbabilityError::NotANumber(s.to_string()))?;
-        Self::new(p)
-    }
-}
-
-impl std::fmt::Display for Probability {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}", self.0)
+checked_f64! {
+    /// A probability in (0, 1]: the confidence at which exploration stops.
+    pub struct Probability(p) where p > 0.0 && p <= 1.0;
+    /// A value that is not a [`Probability`].
+    pub enum ProbabilityError {
+        OutOfRange = "{0} is not a probability in (0, 1]",
+        NotANumber = "'{0}' is not a number",
     }
 }
 

@@ -1,16 +1,20 @@
 //! How much of the paper's data a run collects (`--scale`).
 
-use std::fmt;
-use std::str::FromStr;
-
 use serde::{Deserialize, Serialize};
 
-/// The fraction of the paper's data sizes a run collects: 1.0 is Sec. V-B's protocol (1000
-/// training and 100 validation sampler readings per object, then 100 test readings per object,
-/// the test repeated 3 times), 0.1 a quick look. Positive and at most 10.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct Scale(f64);
+use crate::valid::checked_f64;
+
+checked_f64! {
+    /// The fraction of the paper's data sizes a run collects: 1.0 is Sec. V-B's protocol (1000
+    /// training and 100 validation sampler readings per object, then 100 test readings per object,
+    /// the test repeated 3 times), 0.1 a quick look. Positive and at most 10.
+    pub struct Scale(fraction) where fraction > 0.0 && fraction <= 10.0;
+    /// A `--scale` that is not a fraction of the paper's data sizes.
+    pub enum ScaleError {
+        OutOfRange = "--scale {0}: must be a number in (0, 10] (1.0 is the paper's data sizes)",
+        NotANumber = "--scale '{0}': not a number",
+    }
+}
 
 /// Readings per object at scale 1.0 (Sec. V-B).
 pub const PAPER_TRAINING_READINGS: usize = 1000;
@@ -32,14 +36,7 @@ pub struct DataCounts {
 impl Scale {
     pub const PAPER: Scale = Scale(1.0);
 
-    pub fn new(fraction: f64) -> Result<Self, ScaleError> {
-        if fraction.is_finite() && fraction > 0.0 && fraction <= 10.0 {
-            Ok(Self(fraction))
-        } else {
-            Err(ScaleError::OutOfRange(fraction))
-        }
-    }
-
+    /// The fraction of the paper's data sizes (the same as [`Scale::get`]).
     pub fn fraction(self) -> f64 {
         self.0
     }
@@ -55,45 +52,6 @@ impl Scale {
             test_per_object: scaled(PAPER_TEST_READINGS, 5),
             trials: PAPER_TRIALS,
         }
-    }
-}
-
-/// A `--scale` that is not a fraction of the paper's data sizes.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ScaleError {
-    #[error("--scale {0}: must be a number in (0, 10] (1.0 is the paper's data sizes)")]
-    OutOfRange(f64),
-    #[error("--scale '{0}': not a number")]
-    NotANumber(String),
-}
-
-impl TryFrom<f64> for Scale {
-    type Error = ScaleError;
-    fn try_from(fraction: f64) -> Result<Self, ScaleError> {
-        Self::new(fraction)
-    }
-}
-
-impl From<Scale> for f64 {
-    fn from(scale: Scale) -> f64 {
-        scale.0
-    }
-}
-
-impl FromStr for Scale {
-    type Err = ScaleError;
-    fn from_str(s: &str) -> Result<Self, ScaleError> {
-        let fraction: f64 = s
-            .trim()
-            .parse()
-            .map_err(|_| ScaleError::NotANumber(s.to_string()))?;
-        Self::new(fraction)
-    }
-}
-
-impl fmt::Display for Scale {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.0)
     }
 }
 

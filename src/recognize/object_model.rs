@@ -4,51 +4,33 @@
 use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
+use crate::valid::checked_f64;
 
-/// The count added to every cluster bin of every object before normalising. Eq. 4 takes
-/// `log p(c_i | O_j)`, which must be finite; with `alpha = 1` (the default, Laplace's rule) the
-/// smoothed histogram is the posterior mean of the bin probabilities under a uniform Dirichlet
-/// prior, and a cluster an object never produced in training costs it `ln(1 / (n_j + k))` per
-/// feature instead of ruling it out.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct PseudoCount(f64);
+checked_f64! {
+    /// The count added to every cluster bin of every object before normalising. Eq. 4 takes
+    /// `log p(c_i | O_j)`, which must be finite; with `alpha = 1` (the default, Laplace's rule) the
+    /// smoothed histogram is the posterior mean of the bin probabilities under a uniform Dirichlet
+    /// prior, and a cluster an object never produced in training costs it `ln(1 / (n_j + k))` per
+    /// feature instead of ruling it out.
+    pub struct PseudoCount(alpha) where alpha > 0.0;
+    refused as RecognizeError:
+        |alpha| RecognizeError::InvalidParameter {
+            name: "pseudo_count",
+            what: format!("{alpha} is not a positive finite count"),
+        },
+        |text| RecognizeError::InvalidParameter {
+            name: "pseudo_count",
+            what: format!("'{text}' is not a number"),
+        };
+}
 
 impl PseudoCount {
     pub const LAPLACE: Self = Self(1.0);
-
-    pub fn new(alpha: f64) -> Result<Self, RecognizeError> {
-        if alpha > 0.0 && alpha.is_finite() {
-            Ok(Self(alpha))
-        } else {
-            Err(RecognizeError::InvalidParameter {
-                name: "pseudo_count",
-                what: format!("{alpha} is not a positive finite count"),
-            })
-        }
-    }
-
-    pub fn get(self) -> f64 {
-        self.0
-    }
 }
 
 impl Default for PseudoCount {
     fn default() -> Self {
         Self::LAPLACE
-    }
-}
-
-impl TryFrom<f64> for PseudoCount {
-    type Error = RecognizeError;
-    fn try_from(v: f64) -> Result<Self, RecognizeError> {
-        Self::new(v)
-    }
-}
-
-impl From<PseudoCount> for f64 {
-    fn from(v: PseudoCount) -> f64 {
-        v.0
     }
 }
 

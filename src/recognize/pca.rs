@@ -6,50 +6,32 @@ use serde::{Deserialize, Serialize};
 
 use crate::recognize::RecognizeError;
 use crate::recognize::features::FeatureMatrix;
+use crate::valid::checked_f64;
 
-/// The fraction of the training variance the kept components must explain, in (0, 1].
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
-#[serde(try_from = "f64", into = "f64")]
-pub struct VarianceFraction(f64);
+checked_f64! {
+    /// The fraction of the training variance the kept components must explain, in (0, 1].
+    pub struct VarianceFraction(fraction) where fraction > 0.0 && fraction <= 1.0;
+    refused as RecognizeError:
+        |fraction| RecognizeError::InvalidParameter {
+            name: "variance_kept",
+            what: format!("{fraction} is not a fraction in (0, 1]"),
+        },
+        |text| RecognizeError::InvalidParameter {
+            name: "variance_kept",
+            what: format!("'{text}' is not a number"),
+        };
+}
 
 impl VarianceFraction {
     /// The paper's choice: keep 90% of the variance.
     pub const PAPER: Self = Self(0.9);
     /// The neighbour codebook's default (`CodebookKind::default_variance_kept`): 99%.
     pub const NEIGHBOURS: Self = Self(0.99);
-
-    pub fn new(fraction: f64) -> Result<Self, RecognizeError> {
-        if fraction > 0.0 && fraction <= 1.0 {
-            Ok(Self(fraction))
-        } else {
-            Err(RecognizeError::InvalidParameter {
-                name: "variance_kept",
-                what: format!("{fraction} is not a fraction in (0, 1]"),
-            })
-        }
-    }
-
-    pub fn get(self) -> f64 {
-        self.0
-    }
 }
 
 impl Default for VarianceFraction {
     fn default() -> Self {
         Self::PAPER
-    }
-}
-
-impl TryFrom<f64> for VarianceFraction {
-    type Error = RecognizeError;
-    fn try_from(v: f64) -> Result<Self, RecognizeError> {
-        Self::new(v)
-    }
-}
-
-impl From<VarianceFraction> for f64 {
-    fn from(v: VarianceFraction) -> f64 {
-        v.0
     }
 }
 
