@@ -4,121 +4,134 @@
 //!
 //! Both start with `experiment`, `descriptor` and the experiment's factor columns ([`Factor`]: one
 //! column per thing the experiment varies, none when it varies only the descriptor), then `trial`.
-//! The factor columns differ between experiments, so the rows are written and read by name rather
-//! than derived.
+//! The factor columns differ between experiments, so the rows are declared with `tidy_row!`
+//! (`tidy.rs`), which writes and reads them by name.
 
-use std::fmt;
-
-use serde::de::{self, Deserializer, MapAccess, Visitor};
-use serde::ser::{SerializeStruct, Serializer};
-use serde::{Deserialize, Serialize};
-
-use super::factor::{Factor, FactorError, Factors};
+#[cfg(doc)]
+use super::factor::Factor;
+use super::factor::Factors;
+use super::tidy::tidy_row;
 use super::unit::DetailRow;
 use crate::recognize::{AccuracyPoint, Evaluation, ReliabilityTable};
 
-/// One point of one recognition curve.
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment` | the experiment's name, e.g. `noise` |
-/// | `descriptor` | the descriptor's command-line name, e.g. `polar-fourier` |
-/// | one column per factor | what the experiment varies besides the descriptor, one level per cell (see [`Factor`]): `noise_fraction` = `0.1`; `data` = `validation` and `resolution` = `6x6`; none in `descriptors`, `letters`, `real-frames`, `sim-to-real` |
-/// | `trial` | the repetition (0-based); the plot averages over trials |
-/// | `n_readings` | number of readings of the unknown object used so far (1-based) |
-/// | `accuracy` | fraction of test objects whose most probable identity after `n_readings` readings is correct, in [0, 1] (the "empirical probability of correctly identifying any unknown object", Sec. V-B2) |
-/// | `reliability` | mean posterior probability given to the correct object, in [0, 1] (Sec. V-B1) |
-/// | `seed` | the run's seed, as given with `--seed` |
-/// | `stream_seed` | the seed the trial's randomness was drawn from (derived from `seed`), its 64 bits read as a signed integer so that every CSV reader takes it as an int64 (`as u64` gives it back) |
-#[derive(Debug, Clone, PartialEq)]
-pub struct AccuracyRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub trial: u32,
-    pub n_readings: u32,
-    pub accuracy: f64,
-    pub reliability: f64,
-    pub seed: u64,
-    pub stream_seed: i64,
+tidy_row! {
+    /// One point of one recognition curve.
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment` | the experiment's name, e.g. `noise` |
+    /// | `descriptor` | the descriptor's command-line name, e.g. `polar-fourier` |
+    /// | one column per factor | what the experiment varies besides the descriptor, one level per cell (see [`Factor`]): `noise_fraction` = `0.1`; `data` = `validation` and `resolution` = `6x6`; none in `descriptors`, `letters`, `real-frames`, `sim-to-real` |
+    /// | `trial` | the repetition (0-based); the plot averages over trials |
+    /// | `n_readings` | number of readings of the unknown object used so far (1-based) |
+    /// | `accuracy` | fraction of test objects whose most probable identity after `n_readings` readings is correct, in [0, 1] (the "empirical probability of correctly identifying any unknown object", Sec. V-B2) |
+    /// | `reliability` | mean posterior probability given to the correct object, in [0, 1] (Sec. V-B1) |
+    /// | `seed` | the run's seed, as given with `--seed` |
+    /// | `stream_seed` | the seed the trial's randomness was drawn from (derived from `seed`), its 64 bits read as a signed integer so that every CSV reader takes it as an int64 (`as u64` gives it back) |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct AccuracyRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub trial: u32,
+        pub n_readings: u32,
+        pub accuracy: f64,
+        pub reliability: f64,
+        pub seed: u64,
+        pub stream_seed: i64,
+    }
+    impl Deserialize;
 }
 
-/// One test object of one point of one recognition curve: the rows whose mean `correct` is the
-/// accuracy row's `accuracy` and whose mean `p_true` its `reliability`.
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns, `trial`, `n_readings` | as in [`AccuracyRow`] |
-/// | `object` | the test object's name (for recorded frames, its label) |
-/// | `correct` | 1 when the object's most probable identity after `n_readings` readings (or its last, when it has fewer; none for an object never read) is the object, else 0 |
-/// | `p_true` | the posterior probability given to the object itself (1 / objects for one never read) |
-#[derive(Debug, Clone, PartialEq)]
-pub struct PerObjectRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub trial: u32,
-    pub object: String,
-    pub n_readings: u32,
-    pub correct: bool,
-    pub p_true: f64,
+tidy_row! {
+    /// One test object of one point of one recognition curve: the rows whose mean `correct` is the
+    /// accuracy row's `accuracy` and whose mean `p_true` its `reliability`.
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns, `trial`, `n_readings` | as in [`AccuracyRow`] |
+    /// | `object` | the test object's name (for recorded frames, its label) |
+    /// | `correct` | 1 when the object's most probable identity after `n_readings` readings (or its last, when it has fewer; none for an object never read) is the object, else 0 |
+    /// | `p_true` | the posterior probability given to the object itself (1 / objects for one never read) |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct PerObjectRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub trial: u32,
+        pub object: String,
+        pub n_readings: u32,
+        pub correct: bool,
+        pub p_true: f64,
+    }
+    impl Deserialize;
 }
 
 impl DetailRow for PerObjectRow {
     const TABLE: Option<&'static str> = Some("per_object");
 }
 
-/// One point of one recognition curve counted in the arm's touch attempts rather than in its
-/// converged readings: what a touch that met nothing, ended in a collision or did not settle costs
-/// the recogniser (it reads converged readings only, Algorithm 1).
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns, `trial` | as in [`AccuracyRow`] |
-/// | `n_attempts` | touch attempts the arm made on each object so far, converged or not (1-based) |
-/// | `accuracy` | fraction of test objects whose most probable identity after the converged readings of their first `n_attempts` attempts is right; an object with none is not identified |
-/// | `reliability` | mean posterior probability on the right object (1 / objects for an object with no converged reading yet) |
-#[derive(Debug, Clone, PartialEq)]
-pub struct AttemptRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub trial: u32,
-    pub n_attempts: u32,
-    pub accuracy: f64,
-    pub reliability: f64,
+tidy_row! {
+    /// One point of one recognition curve counted in the arm's touch attempts rather than in its
+    /// converged readings: what a touch that met nothing, ended in a collision or did not settle costs
+    /// the recogniser (it reads converged readings only, Algorithm 1).
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns, `trial` | as in [`AccuracyRow`] |
+    /// | `n_attempts` | touch attempts the arm made on each object so far, converged or not (1-based) |
+    /// | `accuracy` | fraction of test objects whose most probable identity after the converged readings of their first `n_attempts` attempts is right; an object with none is not identified |
+    /// | `reliability` | mean posterior probability on the right object (1 / objects for an object with no converged reading yet) |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct AttemptRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub trial: u32,
+        pub n_attempts: u32,
+        pub accuracy: f64,
+        pub reliability: f64,
+    }
+    impl Deserialize;
 }
 
 impl DetailRow for AttemptRow {
     const TABLE: Option<&'static str> = Some("attempts");
 }
 
-/// One confidence bin of one curve's reliability table, pooled over all the curve's trials
-/// (`recognize::ReliabilityTable`: every belief after every number of readings of every trial is a
-/// prediction; its confidence is its top probability). A curve's rows are its table's 10 bins, all
-/// from one unit (each recognition experiment evaluates a curve's trials in one unit).
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] (no `trial`: pooled over trials) |
-/// | `bin` | 0-9: confidences in [`confidence_low`, `confidence_high`), the last bin with 1.0 |
-/// | `confidence_low`, `confidence_high` | the bin's bounds, b/10 and (b+1)/10 |
-/// | `count` | the predictions in the bin |
-/// | `mean_confidence` | their mean top probability; empty when `count` is 0 |
-/// | `accuracy` | the fraction of them whose guess is the true object; empty when `count` is 0 |
-/// | `ece` | the curve's expected calibration error, `sum_b (count_b / N) abs(accuracy_b - mean_confidence_b)`, the same on each of its rows; empty for a curve without predictions |
-#[derive(Debug, Clone, PartialEq)]
-pub struct ReliabilityRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub bin: u32,
-    pub confidence_low: f64,
-    pub confidence_high: f64,
-    pub count: u64,
-    pub mean_confidence: Option<f64>,
-    pub accuracy: Option<f64>,
-    pub ece: Option<f64>,
+tidy_row! {
+    /// One confidence bin of one curve's reliability table, pooled over all the curve's trials
+    /// (`recognize::ReliabilityTable`: every belief after every number of readings of every trial is a
+    /// prediction; its confidence is its top probability). A curve's rows are its table's 10 bins, all
+    /// from one unit (each recognition experiment evaluates a curve's trials in one unit).
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] (no `trial`: pooled over trials) |
+    /// | `bin` | 0-9: confidences in [`confidence_low`, `confidence_high`), the last bin with 1.0 |
+    /// | `confidence_low`, `confidence_high` | the bin's bounds, b/10 and (b+1)/10 |
+    /// | `count` | the predictions in the bin |
+    /// | `mean_confidence` | their mean top probability; empty when `count` is 0 |
+    /// | `accuracy` | the fraction of them whose guess is the true object; empty when `count` is 0 |
+    /// | `ece` | the curve's expected calibration error, `sum_b (count_b / N) abs(accuracy_b - mean_confidence_b)`, the same on each of its rows; empty for a curve without predictions |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ReliabilityRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub bin: u32,
+        pub confidence_low: f64,
+        pub confidence_high: f64,
+        pub count: u64,
+        pub mean_confidence: Option<f64>,
+        pub accuracy: Option<f64>,
+        pub ece: Option<f64>,
+    }
+    impl Deserialize;
 }
 
 impl ReliabilityRow {
@@ -155,44 +168,6 @@ impl ReliabilityRow {
 
 impl DetailRow for ReliabilityRow {
     const TABLE: Option<&'static str> = Some("reliability");
-}
-
-impl Serialize for ReliabilityRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("ReliabilityRow", 9 + self.factors.len())?;
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(&mut row)?;
-        row.serialize_field("bin", &self.bin)?;
-        row.serialize_field("confidence_low", &self.confidence_low)?;
-        row.serialize_field("confidence_high", &self.confidence_high)?;
-        row.serialize_field("count", &self.count)?;
-        row.serialize_field("mean_confidence", &self.mean_confidence)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("ece", &self.ece)?;
-        row.end()
-    }
-}
-
-impl<'de> Deserialize<'de> for ReliabilityRow {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let record = TidyRecord::deserialize(deserializer)?;
-        let row = || -> Result<Self, String> {
-            Ok(Self {
-                experiment: record.text("experiment")?,
-                descriptor: record.text("descriptor")?,
-                factors: record.factors_before("bin")?,
-                bin: record.number("bin")?,
-                confidence_low: record.number("confidence_low")?,
-                confidence_high: record.number("confidence_high")?,
-                count: record.number("count")?,
-                mean_confidence: record.optional_number("mean_confidence")?,
-                accuracy: record.optional_number("accuracy")?,
-                ece: record.optional_number("ece")?,
-            })
-        };
-        row().map_err(de::Error::custom)
-    }
 }
 
 /// Everything an [`AccuracyRow`] holds but the point itself: one curve of one trial.
@@ -330,247 +305,12 @@ impl AccuracyCurve {
     }
 }
 
-impl AccuracyRow {
-    /// The columns, in order, into a row that may add its own after them (`active` does).
-    pub(crate) fn serialize_columns<S: SerializeStruct>(&self, row: &mut S) -> Result<(), S::Error> {
-        serialize_trial_head(row, &self.experiment, &self.descriptor, &self.factors, self.trial)?;
-        row.serialize_field("n_readings", &self.n_readings)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("reliability", &self.reliability)?;
-        row.serialize_field("seed", &self.seed)?;
-        row.serialize_field("stream_seed", &self.stream_seed)
-    }
-
-    /// The number of columns.
-    pub(crate) fn width(&self) -> usize {
-        8 + self.factors.len()
-    }
-
-    /// The row in `record`; columns after the accuracy ones (`active`'s) are left there.
-    pub(crate) fn from_record(record: &TidyRecord) -> Result<Self, String> {
-        let (experiment, descriptor, factors, trial) = record.trial_head()?;
-        Ok(Self {
-            experiment,
-            descriptor,
-            factors,
-            trial,
-            n_readings: record.number("n_readings")?,
-            accuracy: record.number("accuracy")?,
-            reliability: record.number("reliability")?,
-            seed: record.number("seed")?,
-            stream_seed: record.number("stream_seed")?,
-        })
-    }
-}
-
-/// The columns every row of a curve's trial starts with: `experiment`, `descriptor`, the factor
-/// columns and `trial`.
-fn serialize_trial_head<S: SerializeStruct>(
-    row: &mut S,
-    experiment: &str,
-    descriptor: &str,
-    factors: &Factors,
-    trial: u32,
-) -> Result<(), S::Error> {
-    row.serialize_field("experiment", experiment)?;
-    row.serialize_field("descriptor", descriptor)?;
-    factors.serialize_columns(row)?;
-    row.serialize_field("trial", &trial)
-}
-
-impl Serialize for AccuracyRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("AccuracyRow", self.width())?;
-        self.serialize_columns(&mut row)?;
-        row.end()
-    }
-}
-
-impl<'de> Deserialize<'de> for AccuracyRow {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        Self::from_record(&TidyRecord::deserialize(deserializer)?).map_err(de::Error::custom)
-    }
-}
-
-impl Serialize for PerObjectRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("PerObjectRow", 7 + self.factors.len())?;
-        serialize_trial_head(
-            &mut row,
-            &self.experiment,
-            &self.descriptor,
-            &self.factors,
-            self.trial,
-        )?;
-        row.serialize_field("object", &self.object)?;
-        row.serialize_field("n_readings", &self.n_readings)?;
-        row.serialize_field("correct", &u8::from(self.correct))?;
-        row.serialize_field("p_true", &self.p_true)?;
-        row.end()
-    }
-}
-
-impl<'de> Deserialize<'de> for PerObjectRow {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let record = TidyRecord::deserialize(deserializer)?;
-        let row = || -> Result<Self, String> {
-            let (experiment, descriptor, factors, trial) = record.trial_head()?;
-            Ok(Self {
-                experiment,
-                descriptor,
-                factors,
-                trial,
-                object: record.text("object")?,
-                n_readings: record.number("n_readings")?,
-                correct: match record.number::<u8>("correct")? {
-                    0 => false,
-                    1 => true,
-                    other => return Err(format!("column 'correct': {other} is not 0 or 1")),
-                },
-                p_true: record.number("p_true")?,
-            })
-        };
-        row().map_err(de::Error::custom)
-    }
-}
-
-impl Serialize for AttemptRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("AttemptRow", 6 + self.factors.len())?;
-        serialize_trial_head(
-            &mut row,
-            &self.experiment,
-            &self.descriptor,
-            &self.factors,
-            self.trial,
-        )?;
-        row.serialize_field("n_attempts", &self.n_attempts)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("reliability", &self.reliability)?;
-        row.end()
-    }
-}
-
-impl<'de> Deserialize<'de> for AttemptRow {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let record = TidyRecord::deserialize(deserializer)?;
-        let row = || -> Result<Self, String> {
-            let (experiment, descriptor, factors, trial) = record.trial_head()?;
-            Ok(Self {
-                experiment,
-                descriptor,
-                factors,
-                trial,
-                n_attempts: record.number("n_attempts")?,
-                accuracy: record.number("accuracy")?,
-                reliability: record.number("reliability")?,
-            })
-        };
-        row().map_err(de::Error::custom)
-    }
-}
-
-/// One CSV record as (column, cell) pairs in header order: what the recognition rows are read
-/// from, since their factor columns are known only from the header.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub(crate) struct TidyRecord {
-    cells: Vec<(String, String)>,
-}
-
-impl TidyRecord {
-    fn cell(&self, column: &str) -> Result<&str, String> {
-        self.cells
-            .iter()
-            .find(|(c, _)| c == column)
-            .map(|(_, v)| v.as_str())
-            .ok_or_else(|| format!("no column '{column}'"))
-    }
-
-    pub(crate) fn text(&self, column: &str) -> Result<String, String> {
-        self.cell(column).map(str::to_string)
-    }
-
-    pub(crate) fn number<T: std::str::FromStr>(&self, column: &str) -> Result<T, String> {
-        let text = self.cell(column)?;
-        text.parse().map_err(|_| {
-            format!(
-                "column '{column}': '{text}' is not a {}",
-                std::any::type_name::<T>()
-            )
-        })
-    }
-
-    /// The cell of `column` as a number, `None` when it is empty.
-    pub(crate) fn optional_number<T: std::str::FromStr>(&self, column: &str) -> Result<Option<T>, String> {
-        match self.cell(column)? {
-            "" => Ok(None),
-            _ => self.number(column).map(Some),
-        }
-    }
-
-    /// The columns every row of a curve's trial starts with ([`serialize_trial_head`]).
-    fn trial_head(&self) -> Result<(String, String, Factors, u32), String> {
-        Ok((
-            self.text("experiment")?,
-            self.text("descriptor")?,
-            self.factors_before("trial")?,
-            self.number("trial")?,
-        ))
-    }
-
-    /// The columns between `descriptor` and `end` (`trial`, or `bin` in a reliability table), each
-    /// a [`Factor`] with a valid level.
-    fn factors_before(&self, end: &str) -> Result<Factors, String> {
-        let position = |column: &str| {
-            self.cells
-                .iter()
-                .position(|(c, _)| c == column)
-                .ok_or_else(|| format!("no column '{column}'"))
-        };
-        let (first, end) = (position("descriptor")? + 1, position(end)?);
-        let factors = Factors::new(
-            self.cells
-                .get(first..end)
-                .unwrap_or_default()
-                .iter()
-                .map(|(column, level)| {
-                    Factor::from_column(column)
-                        .map(|f| (f, level.clone()))
-                        .ok_or_else(|| FactorError::Unknown {
-                            column: column.clone(),
-                        })
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| e.to_string())?,
-        );
-        factors.check().map_err(|e| e.to_string())?;
-        Ok(factors)
-    }
-}
-
-impl<'de> Deserialize<'de> for TidyRecord {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct Cells;
-        impl<'de> Visitor<'de> for Cells {
-            type Value = TidyRecord;
-            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str("a CSV record with a header")
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<TidyRecord, A::Error> {
-                let mut cells = Vec::new();
-                while let Some((column, cell)) = map.next_entry::<String, String>()? {
-                    cells.push((column, cell));
-                }
-                Ok(TidyRecord { cells })
-            }
-        }
-        deserializer.deserialize_map(Cells)
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use serde::{Deserialize, Serialize};
+
     use super::*;
+    use crate::experiment::factor::Factor;
     use crate::recognize::evaluate::TrialOutcome;
 
     fn curve() -> AccuracyCurve {

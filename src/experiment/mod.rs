@@ -35,6 +35,7 @@ pub(crate) mod resample;
 pub(crate) mod runner;
 pub(crate) mod shard;
 pub(crate) mod spec;
+pub(crate) mod tidy;
 pub(crate) mod unit;
 
 // An experiment: named units producing rows, run on a shard, resumed, merged.

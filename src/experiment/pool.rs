@@ -31,11 +31,10 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::ser::{SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use super::accuracy::{AccuracyRow, ReliabilityRow, TidyRecord};
+use super::accuracy::{AccuracyRow, ReliabilityRow};
 use super::assemble::concatenate;
 use super::error::ExperimentError;
 use super::factor::Factors;
@@ -52,6 +51,7 @@ use super::resample::{
     resamples,
 };
 use super::spec::{Manifest, to_json};
+use super::tidy::{Cells, tidy_row};
 use super::unit::DetailRow;
 use crate::atomic::{remove_if_present, remove_stale_temporaries, write_if_changed};
 use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
@@ -81,103 +81,58 @@ pub struct PoolReport {
     pub skipped: Vec<(ExperimentName, String)>,
 }
 
-/// One point of one curve over every seed.
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns, `n_readings` | as in [`AccuracyRow`] |
-/// | `seeds` | runs pooled at this point |
-/// | `trials` | trials pooled (every seed's) |
-/// | `accuracy` | the mean of every trial's accuracy, all seeds together |
-/// | `accuracy_low`, `accuracy_high` | the [`INTERVAL_LEVEL`] percentile interval of that mean over [`RESAMPLES`] resamples of whole seeds (with replacement, each resample as many seeds as were given) |
-/// | `reliability` | the mean of every trial's reliability |
-/// | the experiment's own columns | each the mean of that column over every trial (`active`: the share of objects stopped, and stopped right, by each threshold) |
-#[derive(Debug, Clone, PartialEq)]
-pub struct PooledRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub n_readings: u32,
-    pub seeds: usize,
-    pub trials: usize,
-    pub accuracy: f64,
-    pub accuracy_low: f64,
-    pub accuracy_high: f64,
-    pub reliability: f64,
-    pub extras: Vec<(String, f64)>,
-}
-
-impl Serialize for PooledRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let width = 9 + self.factors.len() + self.extras.len();
-        let mut row = serializer.serialize_struct("PooledRow", width)?;
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(&mut row)?;
-        row.serialize_field("n_readings", &self.n_readings)?;
-        row.serialize_field("seeds", &self.seeds)?;
-        row.serialize_field("trials", &self.trials)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("accuracy_low", &self.accuracy_low)?;
-        row.serialize_field("accuracy_high", &self.accuracy_high)?;
-        row.serialize_field("reliability", &self.reliability)?;
-        for (column, value) in &self.extras {
-            // Columns named at run time: serde's struct fields want static names, so each is
-            // leaked once per distinct name (a handful per process).
-            row.serialize_field(static_name(column), value)?;
-        }
-        row.end()
+tidy_row! {
+    /// One point of one curve over every seed.
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns, `n_readings` | as in [`AccuracyRow`] |
+    /// | `seeds` | runs pooled at this point |
+    /// | `trials` | trials pooled (every seed's) |
+    /// | `accuracy` | the mean of every trial's accuracy, all seeds together |
+    /// | `accuracy_low`, `accuracy_high` | the [`INTERVAL_LEVEL`] percentile interval of that mean over [`RESAMPLES`] resamples of whole seeds (with replacement, each resample as many seeds as were given) |
+    /// | `reliability` | the mean of every trial's reliability |
+    /// | the experiment's own columns | each the mean of that column over every trial (`active`: the share of objects stopped, and stopped right, by each threshold) |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct PooledRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub n_readings: u32,
+        pub seeds: usize,
+        pub trials: usize,
+        pub accuracy: f64,
+        pub accuracy_low: f64,
+        pub accuracy_high: f64,
+        pub reliability: f64,
+        #[columns_named_at_run_time]
+        pub extras: Vec<(String, f64)>,
     }
 }
 
-/// One point of one curve of one seed: its trials' mean.
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] |
-/// | `seed` | the run's seed |
-/// | `n_readings` | as in [`AccuracyRow`] |
-/// | `trials` | the run's trials at this point |
-/// | `accuracy`, `reliability` | the mean over those trials |
-#[derive(Debug, Clone, PartialEq)]
-pub struct BySeedRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub seed: u64,
-    pub n_readings: u32,
-    pub trials: usize,
-    pub accuracy: f64,
-    pub reliability: f64,
-}
-
-impl Serialize for BySeedRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("BySeedRow", 7 + self.factors.len())?;
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(&mut row)?;
-        row.serialize_field("seed", &self.seed)?;
-        row.serialize_field("n_readings", &self.n_readings)?;
-        row.serialize_field("trials", &self.trials)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("reliability", &self.reliability)?;
-        row.end()
+tidy_row! {
+    /// One point of one curve of one seed: its trials' mean.
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] |
+    /// | `seed` | the run's seed |
+    /// | `n_readings` | as in [`AccuracyRow`] |
+    /// | `trials` | the run's trials at this point |
+    /// | `accuracy`, `reliability` | the mean over those trials |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct BySeedRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub seed: u64,
+        pub n_readings: u32,
+        pub trials: usize,
+        pub accuracy: f64,
+        pub reliability: f64,
     }
-}
-
-/// A column name as the `&'static str` serde's struct fields take.
-fn static_name(column: &str) -> &'static str {
-    use std::collections::BTreeSet;
-    use std::sync::Mutex;
-    static NAMES: Mutex<BTreeSet<&'static str>> = Mutex::new(BTreeSet::new());
-    let mut names = NAMES.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    if let Some(&name) = names.get(column) {
-        return name;
-    }
-    let name: &'static str = Box::leak(column.to_string().into_boxed_str());
-    names.insert(name);
-    name
 }
 
 /// `pool.json`: what was pooled and how.
@@ -690,11 +645,11 @@ fn read_run<'a>(
     let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
     let mut rows = Vec::new();
     let mut seen = std::collections::HashSet::new();
-    for (i, record) in reader.deserialize::<TidyRecord>().enumerate() {
+    for (i, record) in reader.deserialize::<Cells>().enumerate() {
         let line = i + 2;
         let at_line = |what: String| csv_error(&path, format!("line {line}: {what}"));
         let record = record.map_err(|e| csv_error(&path, e))?;
-        let row = AccuracyRow::from_record(&record).map_err(at_line)?;
+        let row = AccuracyRow::from_cells(&record).map_err(at_line)?;
         if row.n_readings == 0 {
             return Err(at_line("n_readings must be at least 1".to_string()));
         }

@@ -21,11 +21,9 @@
 use std::fmt;
 use std::str::FromStr;
 
-use serde::Serialize;
-use serde::ser::{SerializeStruct, Serializer};
-
 use super::factor::{Factor, Factors};
 use super::resample::{CurveKey, PointSums, TIE_TOLERANCE, level_or_ahead, paired_interval, pooled_accuracy};
+use super::tidy::tidy_row;
 
 /// The levels of the reference curves, as `--against` names them: some of the experiment's factors
 /// and optionally the descriptor (`descriptor=mnti`). Each curve's reference is the curve of its
@@ -138,52 +136,35 @@ impl FromStr for ReferenceLevels {
     }
 }
 
-/// One curve against its reference at one number of readings, over every seed.
-///
-/// | column | meaning |
-/// |---|---|
-/// | `experiment`, `descriptor`, factor columns, `n_readings` | the compared curve, as in the pooled table |
-/// | `reference` | the reference as `--against` named it |
-/// | `seeds` | runs pooled |
-/// | `accuracy`, `reference_accuracy` | each curve's pooled accuracy (the mean over every trial of every seed) |
-/// | `difference` | `accuracy - reference_accuracy`, 0 within [`TIE_TOLERANCE`] (a tie whose sums were added in another order) |
-/// | `difference_low`, `difference_high` | the 90% percentile interval of the difference over resamples of whole seeds, the same seeds for both curves |
-/// | `seeds_level_or_ahead` | the seeds whose own accuracy is level with (within [`TIE_TOLERANCE`]) or ahead of their reference's |
-/// | `readings_to_reach` | the first number of readings at which the pooled curve reaches `reference_accuracy` (level within [`TIE_TOLERANCE`]); empty when it does not within the readings run |
-#[derive(Debug, Clone, PartialEq)]
-pub struct DifferenceRow {
-    pub experiment: String,
-    pub descriptor: String,
-    pub factors: Factors,
-    pub reference: String,
-    pub n_readings: u32,
-    pub seeds: usize,
-    pub accuracy: f64,
-    pub reference_accuracy: f64,
-    pub difference: f64,
-    pub difference_low: f64,
-    pub difference_high: f64,
-    pub seeds_level_or_ahead: usize,
-    pub readings_to_reach: Option<u32>,
-}
-
-impl Serialize for DifferenceRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("DifferenceRow", 12 + self.factors.len())?;
-        row.serialize_field("experiment", &self.experiment)?;
-        row.serialize_field("descriptor", &self.descriptor)?;
-        self.factors.serialize_columns(&mut row)?;
-        row.serialize_field("reference", &self.reference)?;
-        row.serialize_field("n_readings", &self.n_readings)?;
-        row.serialize_field("seeds", &self.seeds)?;
-        row.serialize_field("accuracy", &self.accuracy)?;
-        row.serialize_field("reference_accuracy", &self.reference_accuracy)?;
-        row.serialize_field("difference", &self.difference)?;
-        row.serialize_field("difference_low", &self.difference_low)?;
-        row.serialize_field("difference_high", &self.difference_high)?;
-        row.serialize_field("seeds_level_or_ahead", &self.seeds_level_or_ahead)?;
-        row.serialize_field("readings_to_reach", &self.readings_to_reach)?;
-        row.end()
+tidy_row! {
+    /// One curve against its reference at one number of readings, over every seed.
+    ///
+    /// | column | meaning |
+    /// |---|---|
+    /// | `experiment`, `descriptor`, factor columns, `n_readings` | the compared curve, as in the pooled table |
+    /// | `reference` | the reference as `--against` named it |
+    /// | `seeds` | runs pooled |
+    /// | `accuracy`, `reference_accuracy` | each curve's pooled accuracy (the mean over every trial of every seed) |
+    /// | `difference` | `accuracy - reference_accuracy`, 0 within [`TIE_TOLERANCE`] (a tie whose sums were added in another order) |
+    /// | `difference_low`, `difference_high` | the 90% percentile interval of the difference over resamples of whole seeds, the same seeds for both curves |
+    /// | `seeds_level_or_ahead` | the seeds whose own accuracy is level with (within [`TIE_TOLERANCE`]) or ahead of their reference's |
+    /// | `readings_to_reach` | the first number of readings at which the pooled curve reaches `reference_accuracy` (level within [`TIE_TOLERANCE`]); empty when it does not within the readings run |
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct DifferenceRow {
+        pub experiment: String,
+        pub descriptor: String,
+        #[factors]
+        pub factors: Factors,
+        pub reference: String,
+        pub n_readings: u32,
+        pub seeds: usize,
+        pub accuracy: f64,
+        pub reference_accuracy: f64,
+        pub difference: f64,
+        pub difference_low: f64,
+        pub difference_high: f64,
+        pub seeds_level_or_ahead: usize,
+        pub readings_to_reach: Option<u32>,
     }
 }
 

@@ -22,9 +22,8 @@
 
 use std::sync::Arc;
 
-use serde::de::{self, Deserializer};
 use serde::ser::{SerializeStruct, Serializer};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 
 use super::context::Family;
 use super::context::PaperContext;
@@ -39,7 +38,7 @@ use crate::active_touch::{
     ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, reported_stops, stops,
 };
 use crate::describe::{Descriptor, DescriptorKind};
-use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow, TidyRecord};
+use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow};
 use crate::experiment::factor::{Factor, Factors};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
@@ -47,6 +46,7 @@ use crate::experiment::plot::{Axis, PlotSpec};
 use crate::experiment::progress::Progress;
 use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
+use crate::experiment::tidy::{ReadCell, TidyRecord, deserialize_record, serialize_record};
 use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES};
 use crate::explore::collect::CollectMode;
@@ -99,36 +99,45 @@ fn stop_columns(i: usize) -> (&'static str, &'static str) {
     }
 }
 
-impl Serialize for ActiveRow {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut row = serializer.serialize_struct("ActiveRow", self.accuracy.width() + 6)?;
-        self.accuracy.serialize_columns(&mut row)?;
+/// An `AccuracyRow`'s columns, then each stop's two: written by hand rather than by `tidy_row!`,
+/// since the stop columns are named by `stop_columns` rather than by fields.
+impl TidyRecord for ActiveRow {
+    fn width(&self) -> usize {
+        self.accuracy.width() + 2 * self.stops.len()
+    }
+
+    fn serialize_columns<S: SerializeStruct>(&self, row: &mut S) -> Result<(), S::Error> {
+        self.accuracy.serialize_columns(row)?;
         for (i, stop) in self.stops.iter().enumerate() {
             let (confident, correct) = stop_columns(i);
             row.serialize_field(confident, &stop.confident)?;
             row.serialize_field(correct, &stop.correct_at_stop)?;
         }
-        row.end()
+        Ok(())
+    }
+}
+
+impl Serialize for ActiveRow {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serialize_record("ActiveRow", self, serializer)
     }
 }
 
 impl<'de> Deserialize<'de> for ActiveRow {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let record = TidyRecord::deserialize(deserializer)?;
-        let row = || -> Result<Self, String> {
+        deserialize_record(deserializer, |cells| {
             let stop = |i: usize| -> Result<StopShare, String> {
                 let (confident, correct) = stop_columns(i);
                 Ok(StopShare {
-                    confident: record.number(confident)?,
-                    correct_at_stop: record.number(correct)?,
+                    confident: f64::read_cell(cells, confident)?,
+                    correct_at_stop: f64::read_cell(cells, correct)?,
                 })
             };
             Ok(Self {
-                accuracy: AccuracyRow::from_record(&record)?,
+                accuracy: AccuracyRow::from_cells(cells)?,
                 stops: [stop(0)?, stop(1)?, stop(2)?],
             })
-        };
-        row().map_err(de::Error::custom)
+        })
     }
 }
 
