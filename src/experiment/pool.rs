@@ -29,32 +29,25 @@
 //! Experiments without recognition curves (`convergence`) are reported as skipped; picture folders
 //! (`exploration`, Fig. 1's run) hold no manifest and are not experiments here.
 
+mod read;
+mod write;
+
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-use super::accuracy::{AccuracyRow, ReliabilityRow};
+use self::read::{Curves, experiments, pool_reliability, read_runs, shared_manifest};
+pub use self::write::{BySeedRow, PooledRow};
+use super::accuracy::ReliabilityRow;
 use super::assemble::concatenate;
 use super::error::ExperimentError;
-use super::factor::Factors;
-use super::files::{create_dir_all, read_json};
-use super::layout::{ExperimentDir, experiments_in};
+use super::layout::ExperimentDir;
 use super::name::{ExperimentName, SafeName};
-use super::plot::{
-    Ordered, PlotKind, PlotSpec, SummarisedCurve, calibration_labels, csv_error, render_plot,
-    summarised_accuracy_figure,
-};
+use super::plot::{PlotKind, PlotSpec};
 use super::reference::{Compared, Comparison, ReferenceLevels, against};
-use super::resample::{
-    CurveKey, INTERVAL_LEVEL, PointSums, RESAMPLE_SEED, RESAMPLES, SeedSums, interval, pooled_accuracy,
-    resamples,
-};
-use super::spec::{Manifest, to_json};
-use super::tidy::{Cells, tidy_row};
-use super::unit::DetailRow;
-use crate::atomic::{remove_if_present, remove_stale_temporaries, write_if_changed};
-use crate::recognize::{CONFIDENCE_BINS, ReliabilityBin, ReliabilityTable};
+use super::resample::{INTERVAL_LEVEL, RESAMPLE_SEED, RESAMPLES, resamples};
+use super::spec::Manifest;
 
 /// What the bands of a pooled accuracy plot are.
 pub const INTERVAL_BAND_LABEL: &str = "band: 90% interval, seeds resampled";
@@ -79,60 +72,6 @@ pub struct PoolReport {
     pub pooled: Vec<PooledExperiment>,
     /// Experiments found in every run but not pooled, with the reason.
     pub skipped: Vec<(ExperimentName, String)>,
-}
-
-tidy_row! {
-    /// One point of one curve over every seed.
-    ///
-    /// | column | meaning |
-    /// |---|---|
-    /// | `experiment`, `descriptor`, factor columns, `n_readings` | as in [`AccuracyRow`] |
-    /// | `seeds` | runs pooled at this point |
-    /// | `trials` | trials pooled (every seed's) |
-    /// | `accuracy` | the mean of every trial's accuracy, all seeds together |
-    /// | `accuracy_low`, `accuracy_high` | the [`INTERVAL_LEVEL`] percentile interval of that mean over [`RESAMPLES`] resamples of whole seeds (with replacement, each resample as many seeds as were given) |
-    /// | `reliability` | the mean of every trial's reliability |
-    /// | the experiment's own columns | each the mean of that column over every trial (`active`: the share of objects stopped, and stopped right, by each threshold) |
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct PooledRow {
-        pub experiment: String,
-        pub descriptor: String,
-        #[factors]
-        pub factors: Factors,
-        pub n_readings: u32,
-        pub seeds: usize,
-        pub trials: usize,
-        pub accuracy: f64,
-        pub accuracy_low: f64,
-        pub accuracy_high: f64,
-        pub reliability: f64,
-        #[columns_named_at_run_time]
-        pub extras: Vec<(String, f64)>,
-    }
-}
-
-tidy_row! {
-    /// One point of one curve of one seed: its trials' mean.
-    ///
-    /// | column | meaning |
-    /// |---|---|
-    /// | `experiment`, `descriptor`, factor columns | as in [`AccuracyRow`] |
-    /// | `seed` | the run's seed |
-    /// | `n_readings` | as in [`AccuracyRow`] |
-    /// | `trials` | the run's trials at this point |
-    /// | `accuracy`, `reliability` | the mean over those trials |
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct BySeedRow {
-        pub experiment: String,
-        pub descriptor: String,
-        #[factors]
-        pub factors: Factors,
-        pub seed: u64,
-        pub n_readings: u32,
-        pub trials: usize,
-        pub accuracy: f64,
-        pub reliability: f64,
-    }
 }
 
 /// `pool.json`: what was pooled and how.
@@ -169,24 +108,8 @@ pub fn pool(
     if inputs.len() < 2 {
         return Err(ExperimentError::PoolNeedsSeeds { given: inputs.len() });
     }
-    let mut found: Vec<Vec<ExperimentDir>> = Vec::new();
-    for input in inputs {
-        let dirs = experiment_dirs(input)?;
-        if dirs.is_empty() {
-            return Err(ExperimentError::NoExperiments { dir: input.clone() });
-        }
-        found.push(dirs);
-    }
+    let found = experiments(inputs)?;
     let names: Vec<&ExperimentName> = found[0].iter().map(ExperimentDir::name).collect();
-    for (input, dirs) in inputs.iter().zip(&found).skip(1) {
-        let here: Vec<&ExperimentName> = dirs.iter().map(ExperimentDir::name).collect();
-        if let Some(missing) = names.iter().find(|n| !here.contains(n)) {
-            return Err(not_in_both(missing, &inputs[0], input));
-        }
-        if let Some(extra) = here.iter().find(|n| !names.contains(n)) {
-            return Err(not_in_both(extra, input, &inputs[0]));
-        }
-    }
     let mut report = PoolReport {
         pooled: Vec::new(),
         skipped: Vec::new(),
@@ -216,49 +139,9 @@ pub fn pool(
         });
     }
     for experiment in prepared {
-        report.pooled.push(write(experiment, out)?);
+        report.pooled.push(write::write(experiment, out)?);
     }
     Ok(report)
-}
-
-/// The experiments of `input`: the one it is (a folder holding `manifest.json`, such as
-/// `results/active`), or those of the output root it is. An experiment's folder must carry its
-/// experiment's name, as a run writes it: its tables are named after the experiment.
-fn experiment_dirs(input: &Path) -> Result<Vec<ExperimentDir>, ExperimentError> {
-    let manifest = input.join("manifest.json");
-    if !manifest.is_file() {
-        return experiments_in(input);
-    }
-    let name = Manifest::read(&manifest)?.spec.name;
-    let folder = input.canonicalize().map_err(ExperimentError::io(input))?;
-    let parent = folder.parent().unwrap_or(&folder);
-    if folder.file_name().and_then(|n| n.to_str()) != Some(name.as_str()) {
-        return Err(ExperimentError::Json {
-            path: manifest,
-            what: format!(
-                "names experiment '{name}', but its folder is not named so; give the folder its \
-                 experiment's name or pool its output root"
-            ),
-        });
-    }
-    Ok(vec![ExperimentDir::new(parent, &name)])
-}
-
-fn not_in_both(name: &ExperimentName, has: &Path, lacks: &Path) -> ExperimentError {
-    ExperimentError::SeedRunMismatch {
-        experiment: name.to_string(),
-        first: has.to_path_buf(),
-        second: lacks.to_path_buf(),
-        what: "the first holds it, the second does not".to_string(),
-    }
-}
-
-/// One run of the experiment: its directory, seed, and assembled accuracy rows with the
-/// experiment's own columns.
-struct SeedRun<'a> {
-    dir: &'a ExperimentDir,
-    seed: u64,
-    rows: Vec<(AccuracyRow, Vec<f64>)>,
 }
 
 /// One experiment read, checked and pooled, with nothing written yet: every run's files are read
@@ -285,15 +168,8 @@ fn prepare(
     out: &Path,
     reference: Option<&ReferenceLevels>,
 ) -> Result<Result<Prepared, String>, ExperimentError> {
-    let first = runs[0];
-    let name = first.name();
-    let manifest_json: Value = read_json(&first.manifest())?;
-    for other in &runs[1..] {
-        if let Some(what) = first_difference(&manifest_json, &read_json::<Value>(&other.manifest())?, "") {
-            return Err(mismatch(name, first, other, format!("manifest.json {what}")));
-        }
-    }
-    let manifest = Manifest::read(&first.manifest())?;
+    let name = runs[0].name();
+    let manifest = shared_manifest(runs)?;
     let Some(accuracy_plot) = manifest
         .spec
         .plots
@@ -311,20 +187,12 @@ fn prepare(
             dir: target.root().to_path_buf(),
         });
     }
-    let (config, seeds) = shared_config(runs)?;
-    let columns = shared_columns(runs)?;
-    let extras: Vec<String> = match columns.iter().position(|c| c == "stream_seed") {
-        Some(last) => columns[last + 1..].to_vec(),
-        None => Vec::new(),
-    };
-    let runs: Vec<SeedRun> = runs
-        .iter()
-        .zip(&seeds)
-        .map(|(&dir, &seed)| read_run(dir, seed, &extras))
-        .collect::<Result<_, _>>()?;
+    let read = read_runs(runs)?;
+    let runs = read.runs;
+    let seeds: Vec<u64> = runs.iter().map(|r| r.seed).collect();
     let sources: Vec<PathBuf> = runs.iter().map(|r| r.dir.csv()).collect();
     let union = concatenate(&sources)?;
-    let curves = Curves::of(&runs, &extras)?;
+    let curves = Curves::of(&runs, &read.extras)?;
     let draws = resamples(runs.len());
     let compared = reference.map(|r| against(&curves.curves.items, r, name.as_str(), &draws));
     let reliability = pool_reliability(&runs, &manifest)?;
@@ -343,12 +211,12 @@ fn prepare(
         against: reference
             .filter(|_| matches!(compared, Some(Ok(_))))
             .map(ReferenceLevels::to_string),
-        config,
+        config: read.config,
     };
     Ok(Ok(Prepared {
         name: name.clone(),
-        pooled: curves.pooled(name, &extras, &draws),
-        by_seed: curves.by_seed(name, &seeds),
+        pooled: PooledRow::of_curves(&curves, name, &read.extras, &draws),
+        by_seed: BySeedRow::of_curves(&curves, name, &seeds),
         target,
         manifest,
         accuracy_plot,
@@ -359,574 +227,10 @@ fn prepare(
     }))
 }
 
-/// Writes a prepared experiment's tables, plots and `pool.json`.
-fn write(prepared: Prepared, out: &Path) -> Result<PooledExperiment, ExperimentError> {
-    let Prepared {
-        name,
-        target,
-        manifest,
-        accuracy_plot,
-        record,
-        union,
-        pooled,
-        by_seed,
-        reliability,
-        compared,
-    } = prepared;
-    for folder in [out, target.root()] {
-        create_dir_all(folder)?;
-        remove_stale_temporaries(folder)?;
-    }
-    let union_csv = target.csv();
-    write_if_changed(&union_csv, &union)?;
-    let pooled_csv = target.root().join(format!("{name}_pooled.csv"));
-    write_if_changed(&pooled_csv, &csv_bytes(&pooled, &pooled_csv)?)?;
-    let by_seed_csv = target.root().join(format!("{name}_by_seed.csv"));
-    write_if_changed(&by_seed_csv, &csv_bytes(&by_seed, &by_seed_csv)?)?;
-    let mut files = vec![union_csv.clone(), pooled_csv.clone(), by_seed_csv];
-    let differences_csv = target.root().join(format!("{name}_differences.csv"));
-    let compared = match compared {
-        Some(Ok((differences, comparisons))) => {
-            write_if_changed(&differences_csv, &csv_bytes(&differences, &differences_csv)?)?;
-            files.push(differences_csv);
-            Some(Ok(comparisons))
-        }
-        // An earlier pool's differences would stand beside this pool's tables as if they were its.
-        not_compared => {
-            remove_if_present(&differences_csv)?;
-            not_compared.map(|c| c.map(|(_, comparisons)| comparisons))
-        }
-    };
-    let reliability_csv = match &reliability {
-        Some((table, rows)) => {
-            let path = target.detail_csv(table);
-            write_if_changed(&path, &csv_bytes(rows, &path)?)?;
-            files.push(path.clone());
-            Some(path)
-        }
-        None => None,
-    };
-
-    let tables = PooledTables {
-        union: &union_csv,
-        pooled: &pooled_csv,
-        pooled_rows: &pooled,
-        reliability: reliability_csv.as_deref(),
-    };
-    let plots = PooledPlots {
-        specs: &manifest.spec.plots,
-        accuracy: &accuracy_plot,
-        seeds: record.runs.len(),
-    };
-    let (plot_files, calibration) = write_pooled_plots(&plots, &tables, &target)?;
-    files.extend(plot_files);
-
-    let record_path = target.root().join("pool.json");
-    write_if_changed(&record_path, &to_json(&record, &record_path)?)?;
-    files.push(record_path);
-    Ok(PooledExperiment {
-        name,
-        seeds: record.runs.iter().map(|r| r.seed).collect(),
-        files,
-        calibration,
-        compared,
-    })
-}
-
-/// The pooled tables a plot may read.
-struct PooledTables<'a> {
-    union: &'a Path,
-    pooled: &'a Path,
-    pooled_rows: &'a [PooledRow],
-    reliability: Option<&'a Path>,
-}
-
-/// The experiment's plots, its accuracy plot among them, over `seeds` pooled runs.
-struct PooledPlots<'a> {
-    specs: &'a [PlotSpec],
-    accuracy: &'a PlotSpec,
-    seeds: usize,
-}
-
-/// Draws every plot that reads a pooled table (the accuracy plot with the seeds' interval as a
-/// band); returns the files written and each reliability curve's label with its pooled ECE.
-fn write_pooled_plots(
-    plots: &PooledPlots<'_>,
-    tables: &PooledTables<'_>,
-    target: &ExperimentDir,
-) -> Result<(Vec<PathBuf>, Vec<String>), ExperimentError> {
-    let mut files = Vec::new();
-    let mut calibration = Vec::new();
-    for spec in plots.specs {
-        let titled = PlotSpec {
-            title: format!("{} ({} seeds pooled)", spec.title, plots.seeds),
-            ..spec.clone()
-        };
-        match (&spec.kind, &spec.table) {
-            (PlotKind::Accuracy, None) if spec == plots.accuracy => {
-                let figure = summarised_accuracy_figure(
-                    &titled,
-                    tables.pooled,
-                    &pooled_curves(tables.pooled_rows),
-                    INTERVAL_BAND_LABEL,
-                )?;
-                let (svg, png) = (target.plot(&spec.stem, "svg"), target.plot(&spec.stem, "png"));
-                figure.write_svg(&svg)?;
-                figure.write_png(&png)?;
-                files.extend([svg, png]);
-            }
-            (PlotKind::Reliability, Some(_)) => {
-                if let Some(table) = tables.reliability {
-                    let (figure, paths) = render_plot(&titled, table, target)?;
-                    calibration.extend(calibration_labels(&figure));
-                    files.extend(paths);
-                }
-            }
-            (PlotKind::Lines { .. }, None) => files.extend(render_plot(&titled, tables.union, target)?.1),
-            // Other plots read tables that are not pooled (per-object rows).
-            _ => {}
-        }
-    }
-    Ok((files, calibration))
-}
-
-fn mismatch(
-    name: &ExperimentName,
-    first: &ExperimentDir,
-    second: &ExperimentDir,
-    what: impl Into<String>,
-) -> ExperimentError {
-    ExperimentError::SeedRunMismatch {
-        experiment: name.to_string(),
-        first: first.root().to_path_buf(),
-        second: second.root().to_path_buf(),
-        what: what.into(),
-    }
-}
-
-/// Whether a configuration field is a seed (the run's `seed`, a derived `training.seed`, a sensor's
-/// `noise_seed`): the one thing pooled runs may differ in.
-fn is_seed_field(key: &str) -> bool {
-    key == "seed" || key.ends_with("_seed")
-}
-
-/// `value` without its seed fields, at any depth.
-fn without_seeds(value: &Value) -> Value {
-    match value {
-        Value::Object(map) => Value::Object(
-            map.iter()
-                .filter(|(k, _)| !is_seed_field(k))
-                .map(|(k, v)| (k.clone(), without_seeds(v)))
-                .collect(),
-        ),
-        Value::Array(items) => Value::Array(items.iter().map(without_seeds).collect()),
-        other => other.clone(),
-    }
-}
-
-/// The first place where `a` and `b` differ, as a path of keys and indices with both values.
-fn first_difference(a: &Value, b: &Value, at: &str) -> Option<String> {
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
-            keys.into_iter().find_map(|k| {
-                let here = format!("{at}/{k}");
-                match (x.get(k), y.get(k)) {
-                    (Some(u), Some(v)) => first_difference(u, v, &here),
-                    (u, v) => Some(format!("{here}: {} vs {}", shown(u), shown(v))),
-                }
-            })
-        }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
-            .iter()
-            .zip(y)
-            .enumerate()
-            .find_map(|(i, (u, v))| first_difference(u, v, &format!("{at}/{i}"))),
-        _ if a == b => None,
-        _ => Some(format!(
-            "{}: {} vs {}",
-            if at.is_empty() { "/" } else { at },
-            shown(Some(a)),
-            shown(Some(b))
-        )),
-    }
-}
-
-fn shown(value: Option<&Value>) -> String {
-    let text = value.map_or_else(|| "absent".to_string(), Value::to_string);
-    match text.char_indices().nth(60) {
-        Some((cut, _)) => format!("{}...", &text[..cut]),
-        None => text,
-    }
-}
-
-/// The configuration the runs share (the first's without its seeds) and each run's seed; an error
-/// when they differ in more than their seeds or share a seed.
-fn shared_config(runs: &[&ExperimentDir]) -> Result<(Value, Vec<u64>), ExperimentError> {
-    let name = runs[0].name();
-    let mut configs = Vec::new();
-    let mut seeds: Vec<u64> = Vec::new();
-    for &run in runs {
-        let path = run.config();
-        let value: Value = read_json(&path)?;
-        let seed = value
-            .get("seed")
-            .and_then(Value::as_u64)
-            .ok_or_else(|| ExperimentError::Json {
-                path: path.clone(),
-                what: "no top-level 'seed' (a run's seed) to tell the pooled runs apart".to_string(),
-            })?;
-        if let Some(i) = seeds.iter().position(|&s| s == seed) {
-            return Err(ExperimentError::RepeatedSeed {
-                experiment: name.to_string(),
-                seed,
-                first: runs[i].root().to_path_buf(),
-                second: run.root().to_path_buf(),
-            });
-        }
-        seeds.push(seed);
-        configs.push(without_seeds(&value));
-    }
-    for (run, config) in runs.iter().zip(&configs).skip(1) {
-        if let Some(what) = first_difference(&configs[0], config, "") {
-            return Err(mismatch(name, runs[0], run, format!("config.json {what}")));
-        }
-    }
-    Ok((configs.swap_remove(0), seeds))
-}
-
-/// The header every run's `<experiment>.csv` shares.
-fn shared_columns(runs: &[&ExperimentDir]) -> Result<Vec<String>, ExperimentError> {
-    let mut columns: Option<Vec<String>> = None;
-    for &run in runs {
-        let path = run.csv();
-        if !path.is_file() {
-            return Err(ExperimentError::NotFinished {
-                experiment: run.name().to_string(),
-                dir: run.root().to_path_buf(),
-                csv: path,
-            });
-        }
-        let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
-        let header: Vec<String> = reader
-            .headers()
-            .map_err(|e| csv_error(&path, e))?
-            .iter()
-            .map(str::to_string)
-            .collect();
-        match &columns {
-            None => columns = Some(header),
-            Some(first) if *first != header => {
-                return Err(mismatch(
-                    run.name(),
-                    runs[0],
-                    run,
-                    format!(
-                        "the columns of {}.csv differ ('{}' vs '{}')",
-                        run.name(),
-                        first.join(","),
-                        header.join(",")
-                    ),
-                ));
-            }
-            Some(_) => {}
-        }
-    }
-    Ok(columns.unwrap_or_default())
-}
-
-/// The accuracy rows of one run with its `extras` columns; every row must carry the run's seed.
-fn read_run<'a>(
-    dir: &'a ExperimentDir,
-    seed: u64,
-    extras: &[String],
-) -> Result<SeedRun<'a>, ExperimentError> {
-    let path = dir.csv();
-    let mut reader = csv::Reader::from_path(&path).map_err(|e| csv_error(&path, e))?;
-    let mut rows = Vec::new();
-    let mut seen = std::collections::HashSet::new();
-    for (i, record) in reader.deserialize::<Cells>().enumerate() {
-        let line = i + 2;
-        let at_line = |what: String| csv_error(&path, format!("line {line}: {what}"));
-        let record = record.map_err(|e| csv_error(&path, e))?;
-        let row = AccuracyRow::from_cells(&record).map_err(at_line)?;
-        if row.n_readings == 0 {
-            return Err(at_line("n_readings must be at least 1".to_string()));
-        }
-        if !seen.insert((
-            row.descriptor.clone(),
-            row.factors.clone(),
-            row.trial,
-            row.n_readings,
-        )) {
-            return Err(at_line(format!(
-                "{} {} trial {} at {} readings is given twice",
-                row.descriptor, row.factors, row.trial, row.n_readings
-            )));
-        }
-        for (column, value) in [("accuracy", row.accuracy), ("reliability", row.reliability)] {
-            if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
-                return Err(at_line(format!("{column} {value} is not a fraction in [0, 1]")));
-            }
-        }
-        if row.seed != seed {
-            return Err(at_line(format!(
-                "a row of seed {} in a run whose config.json says seed {seed}",
-                row.seed
-            )));
-        }
-        let values = extras
-            .iter()
-            .map(|column| {
-                let value: f64 = record.number(column)?;
-                if value.is_finite() {
-                    Ok(value)
-                } else {
-                    Err(format!("column '{column}': {value} is not finite"))
-                }
-            })
-            .collect::<Result<Vec<f64>, String>>()
-            .map_err(at_line)?;
-        rows.push((row, values));
-    }
-    if rows.is_empty() {
-        return Err(csv_error(&path, "no rows"));
-    }
-    Ok(SeedRun { dir, seed, rows })
-}
-
-/// Every curve (descriptor and factor levels, in order of first appearance) with, per number of
-/// readings, each seed's sums in the order the runs were given.
-struct Curves {
-    curves: Ordered<CurveKey, PointSums>,
-}
-
-impl Curves {
-    /// Sums every run's rows; every seed must have every point some seed has.
-    fn of(runs: &[SeedRun], extras: &[String]) -> Result<Self, ExperimentError> {
-        let mut curves: Ordered<CurveKey, PointSums> = Ordered::new();
-        let blank = SeedSums {
-            extras: vec![0.0; extras.len()],
-            ..SeedSums::default()
-        };
-        for (s, run) in runs.iter().enumerate() {
-            for (row, values) in &run.rows {
-                let point = curves
-                    .entry((row.descriptor.clone(), row.factors.clone()))
-                    .entry(row.n_readings)
-                    .or_insert_with(|| vec![blank.clone(); runs.len()]);
-                let sums = &mut point[s];
-                sums.trials += 1;
-                sums.accuracy += row.accuracy;
-                sums.reliability += row.reliability;
-                for (total, value) in sums.extras.iter_mut().zip(values) {
-                    *total += value;
-                }
-            }
-        }
-        for ((descriptor, factors), points) in &curves.items {
-            for (n, sums) in points {
-                if let Some(s) = sums.iter().position(|sum| sum.trials == 0) {
-                    return Err(csv_error(
-                        &runs[s].dir.csv(),
-                        format!(
-                            "no rows for {descriptor} {factors} at {n} readings, which seed {} has",
-                            runs[sums.iter().position(|sum| sum.trials > 0).unwrap_or(0)].seed
-                        ),
-                    ));
-                }
-            }
-        }
-        Ok(Self { curves })
-    }
-
-    /// The pooled rows, curve by curve, each point's interval from one shared set of resamples.
-    fn pooled(&self, experiment: &ExperimentName, extras: &[String], draws: &[Vec<usize>]) -> Vec<PooledRow> {
-        let mut rows = Vec::new();
-        for ((descriptor, factors), points) in &self.curves.items {
-            for (&n, sums) in points {
-                let trials: usize = sums.iter().map(|s| s.trials).sum();
-                let mean = |part: fn(&SeedSums) -> f64| sums.iter().map(part).sum::<f64>() / trials as f64;
-                let (accuracy_low, accuracy_high) = interval(sums, draws);
-                rows.push(PooledRow {
-                    experiment: experiment.to_string(),
-                    descriptor: descriptor.clone(),
-                    factors: factors.clone(),
-                    n_readings: n,
-                    seeds: sums.len(),
-                    trials,
-                    accuracy: pooled_accuracy(sums, None),
-                    accuracy_low,
-                    accuracy_high,
-                    reliability: mean(|s| s.reliability),
-                    extras: extras
-                        .iter()
-                        .enumerate()
-                        .map(|(e, column)| {
-                            let total: f64 = sums.iter().map(|s| s.extras[e]).sum();
-                            (column.clone(), total / trials as f64)
-                        })
-                        .collect(),
-                });
-            }
-        }
-        rows
-    }
-
-    fn by_seed(&self, experiment: &ExperimentName, seeds: &[u64]) -> Vec<BySeedRow> {
-        let mut rows = Vec::new();
-        for ((descriptor, factors), points) in &self.curves.items {
-            for (s, &seed) in seeds.iter().enumerate() {
-                for (&n, sums) in points {
-                    let sum = &sums[s];
-                    rows.push(BySeedRow {
-                        experiment: experiment.to_string(),
-                        descriptor: descriptor.clone(),
-                        factors: factors.clone(),
-                        seed,
-                        n_readings: n,
-                        trials: sum.trials,
-                        accuracy: sum.mean_accuracy(),
-                        reliability: sum.reliability / sum.trials as f64,
-                    });
-                }
-            }
-        }
-        rows
-    }
-}
-
-/// The curves of the pooled rows, as the accuracy figure draws them.
-fn pooled_curves(rows: &[PooledRow]) -> Ordered<CurveKey, SummarisedCurve> {
-    let mut curves = Ordered::new();
-    for row in rows {
-        let curve: &mut SummarisedCurve = curves.entry((row.descriptor.clone(), row.factors.clone()));
-        let n = f64::from(row.n_readings);
-        curve.points.push((n, row.accuracy));
-        curve.band.push((n, row.accuracy_low, row.accuracy_high));
-    }
-    curves
-}
-
-/// The largest bin count read back: far above any experiment's predictions, far below where sums
-/// of counts could overflow.
-const MAX_BIN_COUNT: u64 = 1 << 40;
-
-/// A curve of a reliability table: experiment, descriptor, factor levels.
-type ReliabilityKey = (String, String, Factors);
-
-/// The reliability tables of the runs summed curve by curve, when the manifest has the table
-/// (every run must then have assembled it, with the same curves): the table's name and rows.
-fn pool_reliability(
-    runs: &[SeedRun],
-    manifest: &Manifest,
-) -> Result<Option<(SafeName, Vec<ReliabilityRow>)>, ExperimentError> {
-    let Some(table) = manifest
-        .details
-        .iter()
-        .find(|t| Some(t.as_str()) == ReliabilityRow::TABLE)
-    else {
-        return Ok(None);
-    };
-    let mut curves: Ordered<ReliabilityKey, ReliabilityTable> = Ordered::new();
-    for (r, run) in runs.iter().enumerate() {
-        let path = run.dir.detail_csv(table);
-        if !path.is_file() {
-            return Err(ExperimentError::NotFinished {
-                experiment: run.dir.name().to_string(),
-                dir: run.dir.root().to_path_buf(),
-                csv: path,
-            });
-        }
-        let tables = read_reliability(&path)?;
-        let keys: Vec<&ReliabilityKey> = tables.iter().map(|(k, _)| k).collect();
-        let known: Vec<&ReliabilityKey> = curves.items.iter().map(|(k, _)| k).collect();
-        if r > 0 && keys != known {
-            return Err(mismatch(
-                run.dir.name(),
-                runs[0].dir,
-                run.dir,
-                format!("their {} tables hold different curves", table.as_str()),
-            ));
-        }
-        for (key, table) in tables {
-            curves.entry(key).merge(&table);
-        }
-    }
-    let rows = curves
-        .items
-        .iter()
-        .flat_map(|((experiment, descriptor, factors), table)| {
-            ReliabilityRow::of_table(experiment, descriptor, factors, table)
-        })
-        .collect();
-    Ok(Some((table.clone(), rows)))
-}
-
-/// The curves of one run's reliability table, in order, each bin given once, with its count,
-/// mean confidence and accuracy read back into sums: the number right exactly (a ratio of integers
-/// far below 2^52), the summed confidence to rounding.
-fn read_reliability(path: &Path) -> Result<Vec<(ReliabilityKey, ReliabilityTable)>, ExperimentError> {
-    let mut reader = csv::Reader::from_path(path).map_err(|e| csv_error(path, e))?;
-    let mut curves: Ordered<ReliabilityKey, [Option<ReliabilityBin>; CONFIDENCE_BINS]> = Ordered::new();
-    for (i, row) in reader.deserialize::<ReliabilityRow>().enumerate() {
-        let row = row.map_err(|e| csv_error(path, e))?;
-        let at_line = |what: String| csv_error(path, format!("line {}: {what}", i + 2));
-        let b = usize::try_from(row.bin)
-            .ok()
-            .filter(|&b| b < CONFIDENCE_BINS)
-            .ok_or_else(|| at_line(format!("bin {} is not 0-9", row.bin)))?;
-        if row.count > MAX_BIN_COUNT {
-            return Err(at_line(format!("count {} is beyond {MAX_BIN_COUNT}", row.count)));
-        }
-        let fraction = |column: &str, value: Option<f64>| match value {
-            Some(v) if v.is_finite() && (0.0..=1.0).contains(&v) => Ok(v),
-            Some(v) => Err(at_line(format!("{column} {v} is not a fraction in [0, 1]"))),
-            None if row.count == 0 => Ok(0.0),
-            None => Err(at_line(format!(
-                "{column} is empty in a bin of {} predictions",
-                row.count
-            ))),
-        };
-        let count = row.count as usize;
-        let bin = ReliabilityBin {
-            count,
-            confidence_sum: fraction("mean_confidence", row.mean_confidence)? * count as f64,
-            correct: (fraction("accuracy", row.accuracy)? * count as f64).round() as usize,
-        };
-        let bins = curves.entry((row.experiment, row.descriptor, row.factors));
-        if bins[b].replace(bin).is_some() {
-            return Err(at_line(format!("bin {b} of this curve is given twice")));
-        }
-    }
-    curves
-        .items
-        .into_iter()
-        .map(|(key, bins)| {
-            let missing = bins.iter().position(Option::is_none);
-            match missing {
-                Some(b) => Err(csv_error(path, format!("{} {}: no bin {b}", key.1, key.2))),
-                None => Ok((
-                    key,
-                    ReliabilityTable::from_bins(bins.map(Option::unwrap_or_default)),
-                )),
-            }
-        })
-        .collect()
-}
-
-/// `rows` as CSV with a header; `path` names the destination in errors.
-fn csv_bytes<R: Serialize>(rows: &[R], path: &Path) -> Result<Vec<u8>, ExperimentError> {
-    let mut writer = csv::Writer::from_writer(Vec::new());
-    for row in rows {
-        writer.serialize(row).map_err(|e| csv_error(path, e))?;
-    }
-    writer.into_inner().map_err(|e| csv_error(path, e.error()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::recognize::ReliabilityTable;
 
     /// Writes a finished run of the toy experiment under `root`: its manifest (an accuracy plot
     /// and a reliability table), `config` with `seed`, and the accuracy rows `trials[t][n - 1]`
