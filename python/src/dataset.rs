@@ -297,12 +297,8 @@ pub fn collect_arm_calibration(
     threads: Whole<usize>,
     object_set: &str,
 ) -> PyResult<Dataset> {
-    let (Whole(training_readings), Whole(seed), Whole(threads)) = (training_readings, seed, threads);
-    let (sensor, specs) = touch_inputs(&objects, sensor)?;
-    let recipe = ArmTrainingRecipe {
-        readings_per_object: training_readings,
-        seed,
-    };
+    let (recipe, sensor, specs) = arm_recipe_inputs(&objects, training_readings, seed, sensor)?;
+    let Whole(threads) = threads;
     let plan = recipe.calibration_plan(sensor, &specs).map_err(refused)?;
     let dataset = py
         .detach(|| plan.collect_dataset(object_set, &specs, threads, &|| {}))
@@ -318,8 +314,24 @@ pub fn collect_arm_calibration(
     })
 }
 
+/// The demo's recipe at `training_readings` per object and `seed`, the sensor and the objects to
+/// touch: what `arm_model` and `collect_arm_calibration` both start from, so they collect alike.
+pub fn arm_recipe_inputs(
+    objects: &Objects,
+    Whole(training_readings): Whole<usize>,
+    Whole(seed): Whole<u64>,
+    sensor: Option<PyRef<'_, Sensor>>,
+) -> PyResult<(ArmTrainingRecipe, SensorConfig, Vec<ObjectSpec>)> {
+    let (sensor, specs) = touch_inputs(objects, sensor)?;
+    let recipe = ArmTrainingRecipe {
+        readings_per_object: training_readings,
+        seed,
+    };
+    Ok((recipe, sensor, specs))
+}
+
 /// The objects to touch as the library's specifications, and the sensor (the paper's by default).
-pub fn touch_inputs(
+fn touch_inputs(
     objects: &Objects,
     sensor: Option<PyRef<'_, Sensor>>,
 ) -> PyResult<(SensorConfig, Vec<ObjectSpec>)> {

@@ -21,7 +21,7 @@ use taction::valid::Valid;
 
 use crate::args::{Objects, Whole};
 use crate::array;
-use crate::dataset::{Dataset, touch_inputs, warn};
+use crate::dataset::{Dataset, arm_recipe_inputs, warn};
 use crate::error::{bad_argument, refused};
 use crate::object::Object;
 use crate::sensor::Sensor;
@@ -466,12 +466,8 @@ pub fn arm_model(
     threads: Whole<usize>,
     object_set: &str,
 ) -> PyResult<Model> {
-    let (Whole(training_readings), Whole(seed), Whole(threads)) = (training_readings, seed, threads);
-    let (sensor, specs) = touch_inputs(&objects, sensor)?;
-    let recipe = ArmTrainingRecipe {
-        readings_per_object: training_readings,
-        seed,
-    };
+    let (recipe, sensor, specs) = arm_recipe_inputs(&objects, training_readings, seed, sensor)?;
+    let Whole(threads) = threads;
     let mut shortfalls = Shortfalls::default();
     let trained = py
         .detach(|| recipe.train(object_set, &specs, sensor, threads, &mut shortfalls))

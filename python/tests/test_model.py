@@ -176,6 +176,23 @@ def test_the_arm_calibration_is_the_recipes_exploration_and_calibrates_the_arm_m
     assert mean_top_probability(on_arm) < mean_top_probability(on_validation)
 
 
+def test_the_arm_model_is_the_recipes_collections_and_fit_in_one_call(chess, tmp_path):
+    # The demo's recipe in one call, bit for bit the model its steps give one at a time: the
+    # sampler's reachable training readings, the arm's calibration explorations, the fit.
+    whole = taction.arm_model(chess, training_readings=60, seed=4)
+    training = taction.collect(chess, mode="sampler", readings=60, seed=4, reachable_by_arm=True)
+    calibration = taction.collect_arm_calibration(chess, training_readings=60, seed=4)
+    steps = taction.train_for_arm(training, seed=4, calibration=calibration)
+    whole.save(tmp_path / "whole.json")
+    steps.save(tmp_path / "steps.json")
+    assert (tmp_path / "whole.json").read_bytes() == (tmp_path / "steps.json").read_bytes()
+    assert whole.objects == ["pawn", "rook"]
+    assert whole.descriptor == "mnti+sift"
+    other = taction.arm_model(chess, training_readings=60, seed=5)
+    other.save(tmp_path / "other.json")
+    assert (tmp_path / "other.json").read_bytes() != (tmp_path / "whole.json").read_bytes()
+
+
 def test_the_arm_calibration_rejects_no_objects():
     with pytest.raises(taction.TactionError, match="objects: no object to touch"):
         taction.collect_arm_calibration([])

@@ -472,11 +472,6 @@ impl<'p> Collect<'p> {
         Self { start_pose, ..self }
     }
 
-    /// The sampler's parameters (a planner run ignores them).
-    pub fn sampler_config(self, config: SamplerConfig) -> Self {
-        self.map_sampler(|_| config)
-    }
-
     /// Sampler: approach only from above (the raised letters, Sec. V-D).
     pub fn from_above(self) -> Self {
         self.map_sampler(|c| SamplerConfig {
