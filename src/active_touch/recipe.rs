@@ -187,7 +187,7 @@ impl ArmTraining {
     /// reading the held-out sampler readings did, and the posterior counts the arm's correlated
     /// touches as independent evidence: overconfident.
     pub fn calibrated_on_the_arm(&self) -> bool {
-        !self.calibration.converged_only().is_empty()
+        self.calibration.converged().next().is_some()
     }
 }
 
@@ -226,7 +226,7 @@ impl ArmTrainingRecipe {
             observer,
         )?;
         let config = self.train_config(&training)?;
-        let converged = training.converged_only().len();
+        let converged = training.converged().count();
         observer.fitting(&config, config.grid_training_features(converged, false));
         let model = self.fit(&training, Some(&calibration))?;
         Ok(ArmTraining {

@@ -226,7 +226,7 @@ impl ArmTrainingObserver for RecipePrinter {
 
     fn collected(&mut self, data: ArmData, dataset: &Dataset, short: &[Shortfall]) {
         if let Some(progress) = self.progress.take() {
-            progress.finish(dataset.converged_only().len());
+            progress.finish(dataset.converged().count());
         }
         if !short.is_empty() {
             let what = match data {
