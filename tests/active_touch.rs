@@ -455,11 +455,10 @@ impl ArmTrainingObserver for Told {
     fn converged(&self, _data: ArmData) {
         self.converged.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
-    fn collected(&mut self, data: ArmData, dataset: &Dataset, short: &[Shortfall]) {
-        let converged = self.converged.swap(0, std::sync::atomic::Ordering::Relaxed);
+    fn collected(&mut self, data: ArmData, converged: usize, short: &[Shortfall]) {
+        let told = self.converged.swap(0, std::sync::atomic::Ordering::Relaxed);
         self.events.push(format!(
-            "collected {data:?} {converged} told, {} converged, {} short",
-            dataset.converged_only().len(),
+            "collected {data:?} {told} told, {converged} converged, {} short",
             short.len()
         ));
     }
@@ -471,8 +470,9 @@ impl ArmTrainingObserver for Told {
 #[test]
 fn the_demos_recipe_is_its_two_collections_then_its_fit_told_step_by_step() {
     let recipe = ArmTrainingRecipe {
-        readings_per_object: 30,
+        readings_per_object: 600,
         seed: 5,
+        start_heading: MaxHeading::ANY,
     };
     let mut told = Told::default();
     let trained = recipe.train("test", &objects(), sensor(), 0, &mut told).unwrap();
@@ -482,40 +482,66 @@ fn the_demos_recipe_is_its_two_collections_then_its_fit_told_step_by_step() {
         .unwrap()
         .collect_dataset("test", &objects(), 1, &|| {})
         .unwrap();
-    let calibration = recipe
-        .calibration_plan(sensor(), &objects())
-        .unwrap()
-        .collect_dataset("test", &objects(), 1, &|| {})
-        .unwrap();
+    let plans = recipe.calibration_plans(sensor(), &objects()).unwrap();
+    let calibration: Vec<Dataset> = plans
+        .iter()
+        .map(|plan| plan.collect_dataset("test", &objects(), 1, &|| {}).unwrap())
+        .collect();
     assert_eq!(
         trained.training, training,
         "the training collection is the recipe's plan's"
     );
     assert_eq!(
         trained.calibration, calibration,
-        "the calibration is the recipe's plan's"
+        "the calibration is the recipe's plans'"
     );
-    assert_eq!(recipe.calibration_readings(), 10);
+    // A thirtieth of the training readings, in fresh explorations of 10 on seeds of their own.
+    assert_eq!(recipe.calibration_readings(), 20);
+    assert_eq!(calibration.len(), 2, "two explorations of 10");
+    assert_ne!(calibration[0].header().seed, calibration[1].header().seed);
+    for exploration in &calibration {
+        for object in ["box", "ball"] {
+            assert_eq!(
+                exploration.converged().filter(|r| r.object == object).count(),
+                10,
+                "{object}"
+            );
+        }
+        assert!(
+            exploration
+                .converged()
+                .all(|r| r.object_pose.rotation.w.abs() < 1.0 - 1e-9),
+            "the calibration explorations stand the objects at random starts, not the canonical pose"
+        );
+    }
+    let named: Vec<_> = objects().into_iter().map(|o| (o.name, o.mesh)).collect();
+    let meshes: Vec<_> = named.iter().map(|(n, m)| (n.clone(), m)).collect();
+    let contacts = recipe.geometry(&training, &meshes).unwrap();
+    let explored: Vec<&Dataset> = calibration.iter().collect();
     assert_eq!(
         trained.model,
-        recipe.fit(&training, Some(&calibration)).unwrap(),
-        "the model is the recipe's fit of the two"
+        recipe.fit(&training, &explored, Some(&contacts)).unwrap(),
+        "the model is the recipe's fit of the two and the objects' surfaces"
+    );
+    assert!(
+        matches!(trained.model, Recognizer::Geometric(_)),
+        "the recipe's model weighs where each touch landed"
     );
     assert!(trained.calibrated_on_the_arm());
 
     let ks = recipe.train_config(&training).unwrap().ks.clone();
+    let calibration_converged: usize = calibration.iter().map(|d| d.converged_only().len()).sum();
+    let calibration_short: usize = calibration.iter().map(|d| d.shortfalls(10).len()).sum();
     let expected = [
-        "collecting Training 2 x 30".to_string(),
+        "collecting Training 2 x 600".to_string(),
         format!(
             "collected Training {0} told, {0} converged, {1} short",
             training.converged_only().len(),
-            training.shortfalls(30).len()
+            training.shortfalls(600).len()
         ),
-        "collecting Calibration 2 x 10".to_string(),
+        "collecting Calibration 2 x 20".to_string(),
         format!(
-            "collected Calibration {0} told, {0} converged, {1} short",
-            calibration.converged_only().len(),
-            calibration.shortfalls(10).len()
+            "collected Calibration {calibration_converged} told, {calibration_converged} converged, {calibration_short} short"
         ),
         format!("fitting k {ks:?}"),
     ];

@@ -1,6 +1,6 @@
 //! The README's run command (`cargo xtask demo` runs `taction demo`) end to end: exactly as the README
 //! writes it (no flags: the 12 `shapes`, 3000 training readings each from starts the arm can
-//! reach, 30 touches of an object drawn with seed 1), then `demo --object NAME` for every object of that set on the model the first run
+//! reach, up to 30 touches of an object drawn with seed 1, stopping when sure), then `demo --object NAME` for every object of that set on the model the first run
 //! cached, and on a tiny set (the two generated chess pieces) the exit status, every output file,
 //! the model cache on a second run, and that the second run writes the same per-touch CSV.
 
@@ -43,14 +43,47 @@ fn the_readme_demo_command_succeeds_and_every_object_can_be_explored() {
     assert!(ok, "`taction demo` failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
     let out = dir.path().join("results/demo");
     let rows = touch_rows(&out);
-    assert_eq!(rows.len(), 30, "30 touches by default");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).expect("run.json"))
+            .expect("JSON");
+    assert_eq!(record["model_evidence"], "appearance+contacts", "{record}");
+    assert_eq!(record["touches_asked"], 30, "{record}");
+    assert_eq!(record["stop_at_confidence"], 0.9, "{record}");
+    let stop = record["stop_at_confidence"].as_f64().expect("the stop");
+    // By default the run stops once one guess has held p >= 0.9 over two touches, else spends
+    // the 30 touches.
+    let p_guess = |row: &Vec<String>| -> f64 { row[3].parse().expect("p_guess is a number") };
+    let last = rows.len() - 1;
+    if record["ending"] == "stopped: confident" {
+        assert!(last >= 1 && rows.len() <= 30, "{rows:?}");
+        assert!(
+            rows[last][2] == rows[last - 1][2]
+                && p_guess(&rows[last]) >= stop
+                && p_guess(&rows[last - 1]) >= stop,
+            "the stop fires on a guess held at the default over two touches: {rows:?}"
+        );
+        assert!(
+            !rows[..last]
+                .windows(2)
+                .any(|w| w[0][2] == w[1][2] && p_guess(&w[0]) >= stop && p_guess(&w[1]) >= stop),
+            "and not before: {rows:?}"
+        );
+    } else {
+        assert_eq!(rows.len(), 30, "{record}\n{rows:?}");
+    }
+    assert!(
+        stdout.contains(&format!("after {} touches", rows.len())),
+        "the touches used are reported:\n{stdout}"
+    );
     // Evidence accumulates toward the truth: after the last touch the true object is more probable
     // than under the uniform prior over the 12 objects.
-    let p_true: f64 = rows[29][4].parse().expect("p_true is a number");
-    assert!(p_true > 1.0 / 12.0, "{:?}\n{stdout}", rows[29]);
+    let p_true: f64 = rows[last][4].parse().expect("p_true is a number");
+    assert!(p_true > 1.0 / 12.0, "{:?}\n{stdout}", rows[last]);
+    assert_eq!(record["p_true"].as_f64(), Some(p_true), "{record}");
 
     for object in taction::mesh::ObjectSet::shapes().object_names() {
-        let (ok, stdout, stderr) = taction_demo(dir.path(), &["--object", object, "--touches", "3"]);
+        let (ok, stdout, stderr) =
+            taction_demo(dir.path(), &["--object", object, "--touches", "3", "--no-stop"]);
         assert!(
             ok,
             "`taction demo --object {object}` failed\nstdout:\n{stdout}\nstderr:\n{stderr}"
@@ -193,7 +226,7 @@ fn active_demo(out: &Path, extra: &[&str]) -> (String, Vec<Vec<String>>) {
 fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
     let dir = tempfile::tempdir().expect("a temporary folder");
     let out = dir.path().join("demo");
-    let (stdout, full) = active_demo(&out, &[]);
+    let (stdout, full) = active_demo(&out, &["--no-stop"]);
     assert_eq!(full.len(), 8, "no stop: the whole budget\n{stdout}");
     let guess: Vec<&str> = full.iter().map(|r| r[2].as_str()).collect();
     let p_guess: Vec<f64> = full.iter().map(|r| r[3].parse().expect("p_guess")).collect();
@@ -259,4 +292,9 @@ fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
     }
     let (_, _, stderr) = taction_demo(dir.path(), &["--stop-at-confidence", "1.5"]);
     assert!(stderr.contains("--stop-at-confidence"), "{stderr}");
+    let (ok, _, stderr) = taction_demo(dir.path(), &["--no-stop", "--stop-at-confidence", "0.9"]);
+    assert!(
+        !ok && stderr.contains("--no-stop") && stderr.contains("--stop-at-confidence"),
+        "a stop and no stop at once is refused: {stderr}"
+    );
 }

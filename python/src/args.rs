@@ -74,3 +74,27 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Objects {
         Ok(Self(list.iter().map(|o| Arc::clone(&o.inner)).collect()))
     }
 }
+
+/// `start_pose` (`StartPose::NAMES`) within `start_heading_deg` of the canonical heading.
+pub fn start_pose(name: &str, start_heading_deg: f64) -> PyResult<taction::sim::StartPose> {
+    let heading = max_heading(start_heading_deg)?;
+    taction::sim::StartPose::parse(name, heading).ok_or_else(|| {
+        crate::error::bad_argument(
+            "start_pose",
+            format!(
+                "'{name}' is none of {}",
+                taction::sim::StartPose::NAMES.join(", ")
+            ),
+        )
+    })
+}
+
+/// `start_heading_deg`, how far from its canonical heading an object may stand: 0 to 180 degrees.
+pub fn max_heading(start_heading_deg: f64) -> PyResult<taction::sim::MaxHeading> {
+    taction::sim::MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
+        crate::error::bad_argument(
+            "start_heading_deg",
+            format!("{start_heading_deg} is outside [0, 180]"),
+        )
+    })
+}

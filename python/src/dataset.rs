@@ -12,7 +12,7 @@ use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 
-use crate::args::{Objects, Whole};
+use crate::args::{self, Objects, Whole, max_heading};
 use crate::array;
 use crate::error::{bad_argument, refused};
 use crate::object::spec_of;
@@ -229,10 +229,12 @@ impl Dataset {
 ///   probability `local_probability` (0.5 by default).
 ///
 /// An argument of the other mode is refused rather than ignored.
-/// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3). Same seed, same
-/// dataset, bit for bit.
+/// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3);
+/// `start_pose="random"` stands each object at a start drawn from the seed (a heading within
+/// `start_heading_deg`, a tilt and a shift) as `taction collect --start-pose` does, which the
+/// header and `object_pose` record. Same seed, same dataset, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python"), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python')")]
+#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python", start_pose="canonical", start_heading_deg=180.0), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python', start_pose='canonical', start_heading_deg=180.0)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
 pub fn collect(
     py: Python<'_>,
@@ -248,9 +250,12 @@ pub fn collect(
     from_above: bool,
     reachable_by_arm: bool,
     object_set: &str,
+    start_pose: &str,
+    start_heading_deg: f64,
 ) -> PyResult<Dataset> {
     let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
+    let start_pose = args::start_pose(start_pose, start_heading_deg)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
     let mode = CollectModeName::parse(mode).ok_or_else(|| {
         bad_argument(
@@ -270,7 +275,8 @@ pub fn collect(
         .collection(sensor, &specs, readings)
         .seed(seed)
         .threads(threads)
-        .perturbation(perturbation);
+        .perturbation(perturbation)
+        .start_pose(start_pose);
     let dataset = py
         .detach(|| collect.dataset(object_set, &specs))
         .map_err(refused)?;
@@ -281,13 +287,16 @@ pub fn collect(
 }
 
 /// The arm's own blind explorations that `train_for_arm` calibrates its posterior on, collected as
-/// `taction demo` collects them (`ArmTrainingRecipe::calibration_plan`): the planner at L = 0.5,
-/// the object fixed, a thirtieth of `training_readings` (10 to 100) converged readings per object,
-/// on a random stream of `seed` the training data does not use. Successive touches of one
-/// exploration are correlated, which readings held out of the sampler's training data cannot show:
-/// calibrated on those, the posterior is overconfident on the arm's touches.
+/// `taction demo` collects them (`ArmTrainingRecipe::calibration_plans`), a list of datasets: a
+/// thirtieth of `training_readings` (10 to 100) converged readings per object in fresh
+/// explorations of 10 each, the planner at L = 0.5, the object fixed at a random start within
+/// `start_heading_deg` of its canonical heading, each on a random stream of `seed` the training
+/// data does not use. Successive touches of one exploration are correlated, which readings held
+/// out of the sampler's training data cannot show: calibrated on those, the posterior is
+/// overconfident on the arm's touches.
 #[pyfunction]
-#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python"), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python')")]
+#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python", start_heading_deg=180.0), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python', start_heading_deg=180.0)")]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each a recipe parameter
 pub fn collect_arm_calibration(
     py: Python<'_>,
     objects: Objects,
@@ -296,36 +305,45 @@ pub fn collect_arm_calibration(
     sensor: Option<PyRef<'_, Sensor>>,
     threads: Whole<usize>,
     object_set: &str,
-) -> PyResult<Dataset> {
-    let (recipe, sensor, specs) = arm_recipe_inputs(&objects, training_readings, seed, sensor)?;
+    start_heading_deg: f64,
+) -> PyResult<Vec<Dataset>> {
+    let (recipe, sensor, specs) =
+        arm_recipe_inputs(&objects, (training_readings, seed, start_heading_deg), sensor)?;
     let Whole(threads) = threads;
-    let plan = recipe.calibration_plan(sensor, &specs).map_err(refused)?;
-    let dataset = py
-        .detach(|| plan.collect_dataset(object_set, &specs, threads, &|| {}))
+    let plans = recipe.calibration_plans(sensor, &specs).map_err(refused)?;
+    let datasets = py
+        .detach(|| {
+            plans
+                .iter()
+                .map(|plan| plan.collect_dataset(object_set, &specs, threads, &|| {}))
+                .collect::<Result<Vec<_>, _>>()
+        })
         .map_err(refused)?;
-    warn_of_shortfalls(
-        py,
-        "collect_arm_calibration",
-        &dataset,
-        recipe.calibration_readings(),
-    )?;
-    Ok(Dataset {
-        inner: Arc::new(dataset),
-    })
+    datasets
+        .into_iter()
+        .zip(&plans)
+        .map(|(dataset, plan)| {
+            warn_of_shortfalls(py, "collect_arm_calibration", &dataset, plan.readings_per_object)?;
+            Ok(Dataset {
+                inner: Arc::new(dataset),
+            })
+        })
+        .collect()
 }
 
-/// The demo's recipe at `training_readings` per object and `seed`, the sensor and the objects to
-/// touch: what `arm_model` and `collect_arm_calibration` both start from, so they collect alike.
+/// The demo's recipe at `training_readings` per object, `seed` and `start_heading_deg`, the
+/// sensor and the objects to touch: what `arm_model` and `collect_arm_calibration` both start
+/// from, so they collect alike.
 pub fn arm_recipe_inputs(
     objects: &Objects,
-    Whole(training_readings): Whole<usize>,
-    Whole(seed): Whole<u64>,
+    (Whole(training_readings), Whole(seed), start_heading_deg): (Whole<usize>, Whole<u64>, f64),
     sensor: Option<PyRef<'_, Sensor>>,
 ) -> PyResult<(ArmTrainingRecipe, SensorConfig, Vec<ObjectSpec>)> {
     let (sensor, specs) = touch_inputs(objects, sensor)?;
     let recipe = ArmTrainingRecipe {
         readings_per_object: training_readings,
         seed,
+        start_heading: max_heading(start_heading_deg)?,
     };
     Ok((recipe, sensor, specs))
 }

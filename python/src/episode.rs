@@ -8,10 +8,10 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use pyo3::prelude::*;
 use taction::active_touch::{EpisodeConfig, TouchAction};
 use taction::explore::PlannerConfig;
-use taction::sim::{MaxHeading, ObjectSpec, PerturbationBounds, StartPose};
+use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::valid::Valid;
 
-use crate::args::Whole;
+use crate::args::{Whole, start_pose};
 use crate::array;
 use crate::error::{bad_argument, refused};
 use crate::model::Model;
@@ -91,18 +91,7 @@ impl Made {
 
     /// The episode's configuration, its arguments checked.
     fn config(&self) -> PyResult<Valid<EpisodeConfig>> {
-        let heading = MaxHeading::from_deg(self.start_heading_deg).ok_or_else(|| {
-            bad_argument(
-                "start_heading_deg",
-                format!("{} is outside [0, 180]", self.start_heading_deg),
-            )
-        })?;
-        let start_pose = StartPose::parse(&self.start_pose, heading).ok_or_else(|| {
-            bad_argument(
-                "start_pose",
-                format!("'{}' is none of {}", self.start_pose, StartPose::NAMES.join(", ")),
-            )
-        })?;
+        let start_pose = start_pose(&self.start_pose, self.start_heading_deg)?;
         let touch = TouchAction::parse(&self.touch).ok_or_else(|| {
             bad_argument(
                 "touch",

@@ -15,11 +15,10 @@ use taction::recognize::{
     Belief, CodebookKind, DescriptorChoice, PseudoCount, Recognizer, TrainChoices, TrainData,
     VarianceFraction, train_recognizer,
 };
-use taction::sim::MaxHeading;
 use taction::tactile::TactileImage;
 use taction::valid::Valid;
 
-use crate::args::{Objects, Whole};
+use crate::args::{Objects, Whole, max_heading};
 use crate::array;
 use crate::dataset::{Dataset, arm_recipe_inputs, warn};
 use crate::error::{bad_argument, refused};
@@ -378,11 +377,7 @@ pub fn train(
         .map(|objects| contact_geometry(&objects, &training.header().objects, start_heading_deg))
         .transpose()?;
     let validation = validation.map(|v| v.inner.clone());
-    let calibration: Vec<_> = calibration
-        .unwrap_or_default()
-        .iter()
-        .map(|d| d.inner.clone())
-        .collect();
+    let calibration = shared(calibration);
     let model = py
         .detach(|| {
             let data = TrainData {
@@ -399,6 +394,15 @@ pub fn train(
     })
 }
 
+/// The library's datasets behind Python's (none for `None`), shared, to use without the GIL.
+fn shared(datasets: Option<Vec<PyRef<'_, Dataset>>>) -> Vec<Arc<taction::dataset::Dataset>> {
+    datasets
+        .unwrap_or_default()
+        .iter()
+        .map(|d| d.inner.clone())
+        .collect()
+}
+
 /// The surfaces of `names` (the training dataset's objects, in its order) picked from `objects`,
 /// standing within `start_heading_deg` of their canonical heading (`taction train --objects`).
 fn contact_geometry(
@@ -406,12 +410,7 @@ fn contact_geometry(
     names: &[String],
     start_heading_deg: f64,
 ) -> PyResult<GeometryModel> {
-    let max_heading = MaxHeading::from_deg(start_heading_deg).ok_or_else(|| {
-        bad_argument(
-            "start_heading_deg",
-            format!("{start_heading_deg} is outside [0, 180]"),
-        )
-    })?;
+    let max_heading = max_heading(start_heading_deg)?;
     let meshes: Vec<(String, &TriMesh)> = objects
         .iter()
         .map(|o| (o.inner.name.clone(), &o.inner.mesh))
@@ -424,28 +423,41 @@ fn contact_geometry(
 /// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`; `calibration`, the
 /// arm's own explorations (`collect_arm_calibration`, as the demo collects them), calibrates the
 /// posterior (without it, the readings held out of `training` do, and the arm's correlated touches
-/// make it overconfident).
+/// make it overconfident; a list of datasets, each an exploration). `objects`, the objects `training` was collected on, adds where each
+/// touch landed, standing within `start_heading_deg` of their canonical heading, weighed on
+/// `calibration` (which it then needs), as the demo's model does.
 #[pyfunction]
-#[pyo3(signature = (training, seed=Whole(1), calibration=None), text_signature = "(training, seed=1, calibration=None)")]
+#[pyo3(signature = (training, seed=Whole(1), calibration=None, objects=None, start_heading_deg=180.0), text_signature = "(training, seed=1, calibration=None, objects=None, start_heading_deg=180.0)")]
 pub fn train_for_arm(
     py: Python<'_>,
     training: &Dataset,
     seed: Whole<u64>,
-    calibration: Option<&Dataset>,
+    calibration: Option<Vec<PyRef<'_, Dataset>>>,
+    objects: Option<Vec<PyRef<'_, Object>>>,
+    start_heading_deg: f64,
 ) -> PyResult<Model> {
     let Whole(seed) = seed;
     // The recipe's count is per object (it sizes the calibration explorations, which `fit` does
     // not collect): the training data's readings shared among its objects.
-    let objects = training.inner.header().objects.len().max(1);
+    let per_object = training.inner.header().objects.len().max(1);
     let recipe = ArmTrainingRecipe {
-        readings_per_object: training.inner.len() / objects,
+        readings_per_object: training.inner.len() / per_object,
         seed,
+        start_heading: max_heading(start_heading_deg)?,
     };
     let data = training.inner.clone();
-    let arm = calibration.map(|c| c.inner.clone());
-    let model = py.detach(|| recipe.fit(&data, arm.as_deref())).map_err(refused)?;
+    let contacts = objects
+        .map(|objects| contact_geometry(&objects, &data.header().objects, start_heading_deg))
+        .transpose()?;
+    let arm = shared(calibration);
+    let model = py
+        .detach(|| {
+            let arm: Vec<&taction::dataset::Dataset> = arm.iter().map(AsRef::as_ref).collect();
+            recipe.fit(&data, &arm, contacts.as_ref())
+        })
+        .map_err(refused)?;
     Ok(Model {
-        inner: Arc::new(Recognizer::Fused(Box::new(model))),
+        inner: Arc::new(model),
     })
 }
 
@@ -454,9 +466,13 @@ pub fn train_for_arm(
 /// arm's own explorations to calibrate the posterior (`collect_arm_calibration`'s), MNTI and SIFT
 /// fused over the neighbour codebook. Collection runs on `threads` threads (0: one per core; the
 /// model does not depend on it). Same objects, sensor and seed, same model as the demo's, bit for
-/// bit. Fewer readings than asked, or a calibration that gathered none, is a Python warning.
+/// bit. The model also weighs where each touch landed (the objects standing within
+/// `start_heading_deg` of their canonical heading: 180 for objects, 10 for the raised letters,
+/// whose heading is part of their identity). Fewer readings than asked, or a calibration that
+/// gathered none (the model then weighs appearance alone), is a Python warning.
 #[pyfunction]
-#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python"), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python')")]
+#[pyo3(signature = (objects, training_readings=Whole(1000), seed=Whole(1), sensor=None, threads=Whole(0), object_set="python", start_heading_deg=180.0), text_signature = "(objects, training_readings=1000, seed=1, sensor=None, threads=0, object_set='python', start_heading_deg=180.0)")]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each a recipe parameter
 pub fn arm_model(
     py: Python<'_>,
     objects: Objects,
@@ -465,8 +481,10 @@ pub fn arm_model(
     sensor: Option<PyRef<'_, Sensor>>,
     threads: Whole<usize>,
     object_set: &str,
+    start_heading_deg: f64,
 ) -> PyResult<Model> {
-    let (recipe, sensor, specs) = arm_recipe_inputs(&objects, training_readings, seed, sensor)?;
+    let (recipe, sensor, specs) =
+        arm_recipe_inputs(&objects, (training_readings, seed, start_heading_deg), sensor)?;
     let Whole(threads) = threads;
     let mut shortfalls = Shortfalls::default();
     let trained = py
@@ -479,11 +497,12 @@ pub fn arm_model(
         warn(
             py,
             "taction.arm_model: the arm's calibration explorations gave no converged reading: the \
-             posterior is calibrated on held-out sampler readings and overconfident on the arm's touches",
+             posterior is calibrated on held-out sampler readings and overconfident on the arm's touches, \
+             and the model weighs appearance alone",
         )?;
     }
     Ok(Model {
-        inner: Arc::new(Recognizer::Fused(Box::new(trained.model))),
+        inner: Arc::new(trained.model),
     })
 }
 
@@ -492,7 +511,7 @@ pub fn arm_model(
 struct Shortfalls(Vec<String>);
 
 impl ArmTrainingObserver for Shortfalls {
-    fn collected(&mut self, data: ArmData, _dataset: &taction::dataset::Dataset, short: &[Shortfall]) {
+    fn collected(&mut self, data: ArmData, _converged: usize, short: &[Shortfall]) {
         if !short.is_empty() {
             let what = match data {
                 ArmData::Training => "training",

@@ -129,6 +129,8 @@ def collect(
     from_above: bool = False,
     reachable_by_arm: bool = False,
     object_set: str = "python",
+    start_pose: str = "canonical",
+    start_heading_deg: float = 180.0,
 ) -> Dataset: ...
 def collect_arm_calibration(
     objects: _Objects,
@@ -137,7 +139,8 @@ def collect_arm_calibration(
     sensor: Sensor | None = None,
     threads: int = 0,
     object_set: str = "python",
-) -> Dataset: ...
+    start_heading_deg: float = 180.0,
+) -> list[Dataset]: ...
 
 @final
 class Model:
@@ -196,7 +199,13 @@ def train(
     start_heading_deg: float = 180.0,
     calibration_trial_readings: int | None = None,
 ) -> Model: ...
-def train_for_arm(training: Dataset, seed: int = 1, calibration: Dataset | None = None) -> Model: ...
+def train_for_arm(
+    training: Dataset,
+    seed: int = 1,
+    calibration: Sequence[Dataset] | None = None,
+    objects: Sequence[Object] | None = None,
+    start_heading_deg: float = 180.0,
+) -> Model: ...
 def arm_model(
     objects: _Objects,
     training_readings: int = 1000,
@@ -204,6 +213,7 @@ def arm_model(
     sensor: Sensor | None = None,
     threads: int = 0,
     object_set: str = "python",
+    start_heading_deg: float = 180.0,
 ) -> Model: ...
 
 @final

@@ -62,15 +62,24 @@ def _is_integer(value: Any) -> bool:
 
 
 def default_model(
-    objects: Union[str, Sequence[taction.Object]], training_readings: int = 1000, seed: int = 1
+    objects: Union[str, Sequence[taction.Object]],
+    training_readings: int = 1000,
+    seed: int = 1,
+    start_heading_deg: float = 180.0,
 ) -> taction.Model:
     """The recogniser ``taction demo`` trains for the arm (``taction.arm_model``: the library's
-    recipe, collection, calibration on the arm's own explorations and fit) on ``objects`` (a set
-    name or a list of objects); trained once per process for a set name."""
-    key = (objects, training_readings, seed) if isinstance(objects, str) else None
+    recipe, collection, calibration on the arm's own explorations of objects standing within
+    ``start_heading_deg`` of upright, and fit, appearance with where each touch landed) on
+    ``objects`` (a set name or a list of objects); trained once per process for a set name."""
+    key = (objects, training_readings, seed, start_heading_deg) if isinstance(objects, str) else None
     if key is not None and key in _DEFAULT_MODELS:
         return _DEFAULT_MODELS[key]
-    model = taction.arm_model(_objects_of(objects), training_readings=training_readings, seed=seed)
+    model = taction.arm_model(
+        _objects_of(objects),
+        training_readings=training_readings,
+        seed=seed,
+        start_heading_deg=start_heading_deg,
+    )
     if key is not None:
         _DEFAULT_MODELS[key] = model
     return model
@@ -132,7 +141,7 @@ class ActiveTouchEnv(gymnasium.Env):
             model = taction.Model.load(model)
         elif model is None:
             model = default_model(objects if isinstance(objects, str) else self._objects,
-                                  training_readings, training_seed)
+                                  training_readings, training_seed, start_heading_deg)
         elif not isinstance(model, taction.Model):
             raise taction.TactionError(
                 f"model: {model!r} is neither a taction.Model, a model file nor None (the default recogniser)"

@@ -209,7 +209,8 @@ def test_the_default_recogniser_is_the_demos_calibrated_on_the_arm(chess):
     model = default_model(chess, training_readings=110, seed=3)
     training = taction.collect(chess, mode="sampler", readings=110, seed=3, reachable_by_arm=True)
     calibration = taction.collect_arm_calibration(chess, training_readings=110, seed=3)
-    demos = taction.train_for_arm(training.converged(), seed=3, calibration=calibration)
+    demos = taction.train_for_arm(training.converged(), seed=3, calibration=calibration, objects=chess)
+    assert model.contacts
     assert model.calibration == demos.calibration
     assert model.calibration != taction.train_for_arm(training.converged(), seed=3).calibration
 

@@ -141,22 +141,33 @@ def test_models_objects_and_datasets_pickle(small_model, small_dataset, chess):
 
 
 def test_the_arm_calibration_is_the_recipes_exploration_and_calibrates_the_arm_model(chess):
-    calibration = taction.collect_arm_calibration(chess, training_readings=600, seed=3)
-    # A thirtieth of the training readings per object, by the planner at L = 0.5, the object fixed,
-    # on a stream of the seed of its own: the planner collection of that stream's seed, bit for bit.
-    converged = calibration.status == "converged"
-    for name in ("pawn", "rook"):
-        assert (calibration.object[converged] == name).sum() == 20
-    stream_seed = calibration.header["seed"]
-    assert stream_seed != 3
-    planner = taction.collect(chess, mode="planner", readings=20, local_probability=0.5, seed=stream_seed)
-    assert np.array_equal(calibration.images, planner.images)
-    assert list(calibration.object) == list(planner.object)
+    explorations = taction.collect_arm_calibration(chess, training_readings=600, seed=3)
+    # A thirtieth of the training readings per object in fresh explorations of 10, each by the
+    # planner at L = 0.5, the object fixed at a random start, on a stream of the seed of its own:
+    # the planner collection of that stream's seed, bit for bit.
+    assert len(explorations) == 2
+    seeds = {exploration.header["seed"] for exploration in explorations}
+    assert len(seeds) == 2 and 3 not in seeds
+    for exploration in explorations:
+        converged = exploration.status == "converged"
+        for name in ("pawn", "rook"):
+            assert (exploration.object[converged] == name).sum() == 10
+        seed = exploration.header["seed"]
+        planner = taction.collect(
+            chess, mode="planner", readings=10, local_probability=0.5, seed=seed, start_pose="random"
+        )
+        assert np.array_equal(exploration.images, planner.images)
+        assert list(exploration.object) == list(planner.object)
+        canonical = taction.collect(chess, mode="planner", readings=10, local_probability=0.5, seed=seed)
+        assert not np.array_equal(canonical.images, planner.images), "the start is drawn, not the canonical pose"
     again = taction.collect_arm_calibration(chess, training_readings=600, seed=3)
-    assert np.array_equal(calibration.images, again.images)
+    assert all(np.array_equal(a.images, b.images) for a, b in zip(explorations, again))
+    calibration = explorations[0]
+    converged = calibration.status == "converged"
     # At least 10 readings per object, however little training.
     few = taction.collect_arm_calibration(chess, training_readings=60, seed=3)
-    assert ((few.object == "pawn") & (few.status == "converged")).sum() == 10
+    assert len(few) == 1
+    assert ((few[0].object == "pawn") & (few[0].status == "converged")).sum() == 10
 
     # Calibrated on the arm's touches, the posterior is less sure of them than one calibrated on
     # readings held out of the sampler's training data.
@@ -182,12 +193,15 @@ def test_the_arm_model_is_the_recipes_collections_and_fit_in_one_call(chess, tmp
     whole = taction.arm_model(chess, training_readings=60, seed=4)
     training = taction.collect(chess, mode="sampler", readings=60, seed=4, reachable_by_arm=True)
     calibration = taction.collect_arm_calibration(chess, training_readings=60, seed=4)
-    steps = taction.train_for_arm(training, seed=4, calibration=calibration)
+    steps = taction.train_for_arm(training, seed=4, calibration=calibration, objects=chess)
     whole.save(tmp_path / "whole.json")
     steps.save(tmp_path / "steps.json")
     assert (tmp_path / "whole.json").read_bytes() == (tmp_path / "steps.json").read_bytes()
     assert whole.objects == ["pawn", "rook"]
     assert whole.descriptor == "mnti+sift"
+    assert whole.contacts, "the demo's model weighs where each touch landed"
+    appearance = taction.train_for_arm(training, seed=4, calibration=calibration)
+    assert not appearance.contacts
     other = taction.arm_model(chess, training_readings=60, seed=5)
     other.save(tmp_path / "other.json")
     assert (tmp_path / "other.json").read_bytes() != (tmp_path / "whole.json").read_bytes()

@@ -25,6 +25,7 @@ use crate::control::ControlError;
 use crate::dataset::{Reading, Strategy};
 use crate::explore::{
     CollectMode, CollectPlan, DEFAULT_CANDIDATES, ExplorationReport, Planner, PlannerConfig, SensorReader,
+    recorded_perturbation,
 };
 use crate::locate::Contact;
 use crate::pose::PadPose;
@@ -235,7 +236,11 @@ impl TouchEpisode {
             .cloned()
             .ok_or_else(|| ControlError::from(SimError::NoArm))?;
         let recognition = Recognition::try_new(model, |model| {
-            ActiveRecognition::of(model, config.neighbourhood_m)
+            ActiveRecognition::of(
+                model,
+                config.neighbourhood_m,
+                recorded_perturbation(&config.perturbation),
+            )
         })?;
         let belief = recognition.borrow_dependent().belief();
         let mut episode = Self {

@@ -55,7 +55,7 @@ use std::collections::BTreeMap;
 use glam::DVec3;
 
 use crate::control::ControlError;
-use crate::dataset::Reading;
+use crate::dataset::{Perturbed, Reading};
 use crate::explore::Planner;
 use crate::explore::active::{ActiveGuidance, ConfidenceStop, TouchScorer};
 use crate::recognize::bag::BagOfFeatures;
@@ -275,8 +275,13 @@ impl<'a> ActiveRecognition<'a> {
         ))
     }
 
-    /// The recogniser of a model of either kind ([`new`](Self::new) or [`fused`](Self::fused)).
-    pub fn of(model: &'a Recognizer, neighbourhood_m: f64) -> Result<Self, RecognizeError> {
+    /// The recogniser of a model of any kind ([`new`](Self::new), [`fused`](Self::fused), or with
+    /// the contacts) of an object `motion` perturbs after every touch.
+    pub fn of(
+        model: &'a Recognizer,
+        neighbourhood_m: f64,
+        motion: Perturbed,
+    ) -> Result<Self, RecognizeError> {
         match model {
             Recognizer::Single(m) => Self::new(m, neighbourhood_m),
             Recognizer::Fused(f) => Self::fused(f, neighbourhood_m),
@@ -286,7 +291,7 @@ impl<'a> ActiveRecognition<'a> {
                 let bag = &g.appearance().parts()[0].bag;
                 Ok(Self::with(
                     bag,
-                    model.posterior()?,
+                    model.posterior_for(motion)?,
                     g.tempering(),
                     neighbourhood_m,
                 ))

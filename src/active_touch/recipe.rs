@@ -6,9 +6,12 @@ use crate::dataset::{Dataset, Shortfall};
 use crate::describe::DescriptorKind;
 use crate::explore::collect::{CollectError, CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
+use crate::locate::{GeometryError, GeometryModel};
+use crate::mesh::TriMesh;
+use crate::pose::MaxHeading;
 use crate::recognize::{
-    CodebookKind, DescriptorChoice, DescriptorChoiceError, FusedModel, RecognizeError, Recognizer,
-    TrainChoices, TrainConfig, TrainData, train_recognizer,
+    CodebookKind, DescriptorChoice, DescriptorChoiceError, RecognizeError, Recognizer, TrainChoices,
+    TrainConfig, TrainData, train_recognizer,
 };
 use crate::sim::{ObjectSpec, PerturbationBounds, StartPose};
 use crate::tactile::SensorConfig;
@@ -17,6 +20,11 @@ use crate::valid::{RangeError, Valid};
 /// The stream of the recipe's seed its calibration explorations draw from.
 const CALIBRATION_SEED_STREAM: u64 = 7;
 
+/// Converged readings per object of each calibration exploration, and the trials the posterior is
+/// calibrated in: a fresh exploration's first touches, what the demo and an environment's episode
+/// recognise.
+const CALIBRATION_EXPLORATION_READINGS: usize = 10;
+
 /// How the demo trains a recogniser on what the arm's pad feels (the README's "Training that
 /// matches the arm"; docs/measurements.md has the measurements behind each choice): sampler
 /// readings restricted to the starts the arm can take from any heading of the object, pressed by
@@ -24,21 +32,30 @@ const CALIBRATION_SEED_STREAM: u64 = 7;
 /// gradient orientations with MNTI's moments gained on the arm's own touches as on sampler data)
 /// over the neighbour codebook, one restart (the neighbour codebook draws nothing at random), the
 /// `k` grid sized to the converged readings left after the hold-out
-/// ([`TrainConfig::with_grid_for_dataset`]). Library users get the model `taction demo` gets.
+/// ([`TrainConfig::with_grid_for_dataset`]); and where each touch landed, the contacts against
+/// every object's surface at a pose the model is not told (`recognize::geometric`, the README's
+/// "Where each touch landed"), weighed against appearance on the arm's own explorations of objects
+/// standing at random poses. Library users get the model `taction demo` gets.
 ///
 /// ```
 /// use taction::active_touch::ArmTrainingRecipe;
+/// use taction::pose::MaxHeading;
 ///
-/// let recipe = ArmTrainingRecipe { readings_per_object: 3000, seed: 1 };
+/// let recipe = ArmTrainingRecipe { readings_per_object: 3000, seed: 1, start_heading: MaxHeading::ANY };
 /// assert_eq!(recipe.descriptors()?.name(), "mnti+sift");
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArmTrainingRecipe {
     /// Converged sampler readings per object.
     pub readings_per_object: usize,
     /// Seeds the training data and the model selection.
     pub seed: u64,
+    /// How far from its canonical heading an object may stand (the set's
+    /// `ObjectSet::start_heading`: any for the 3D objects, 10 degrees for the raised letters):
+    /// the calibration explorations start the objects there, and the contacts' pose hypotheses
+    /// span it.
+    pub start_heading: MaxHeading,
 }
 
 impl ArmTrainingRecipe {
@@ -80,7 +97,7 @@ impl ArmTrainingRecipe {
             codebook: Self::CODEBOOK,
             restarts: 1,
             seed: self.seed,
-            calibration_trial_readings: Some(10),
+            calibration_trial_readings: Some(CALIBRATION_EXPLORATION_READINGS),
             ..TrainChoices::of(descriptor)
         };
         Valid::new(choices)
@@ -92,56 +109,83 @@ impl ArmTrainingRecipe {
     }
 
     /// Converged readings per object of the arm's own explorations the posterior is calibrated
-    /// on: a thirtieth of the training readings, 10 to 100 (100 for the demo's 3000).
+    /// on, all explorations together: a thirtieth of the training readings in whole explorations
+    /// of 10, 10 to 100 (100 for the demo's 3000).
     pub fn calibration_readings(&self) -> usize {
-        (self.readings_per_object / 30).clamp(10, 100)
+        self.calibration_explorations() * CALIBRATION_EXPLORATION_READINGS
     }
 
-    /// The calibration data's collection: the arm exploring blind (L = 0.5, the object fixed) with
-    /// the default controllers, [`calibration_readings`](Self::calibration_readings) per object of
-    /// `objects`, on a seed of its own.
-    pub fn calibration_plan(
+    /// How many explorations of 10 readings per object the calibration takes: a thirtieth of
+    /// the training readings per object in tens, 1 to 10.
+    pub fn calibration_explorations(&self) -> usize {
+        (self.readings_per_object / (30 * CALIBRATION_EXPLORATION_READINGS)).clamp(1, 10)
+    }
+
+    /// The calibration data's collections: [`calibration_explorations`](Self::calibration_explorations)
+    /// fresh explorations, each the arm exploring blind (L = 0.5, the object fixed) with the
+    /// default controllers for 10 converged readings per object of `objects`, each object standing
+    /// at a random start within [`start_heading`](Self::start_heading), each exploration on a seed
+    /// of its own. Many short fresh explorations, not one long one: a long exploration's later
+    /// touches lie spread over the object by the planner's grown tree and say more than a fresh
+    /// one's first touches, which lie close together, so a posterior calibrated on its windows is
+    /// sure too soon of the demo's touches, and the contacts' weight fitted on one exploration
+    /// swings with its seed (docs/measurements.md, "The demo stops when sure"). The start is drawn
+    /// because the contacts' weight fitted at the canonical pose would trust them more than an
+    /// unknown pose allows.
+    pub fn calibration_plans(
         &self,
         sensor: SensorConfig,
         objects: &[ObjectSpec],
-    ) -> Result<CollectPlan, RangeError> {
-        let readings = self.calibration_readings();
-        Ok(CollectPlan {
-            mode: CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
-                objects, readings, 0.5, None,
-            ))?),
-            sensor,
-            control: Valid::default(),
-            perturbation: PerturbationBounds::NONE,
-            readings_per_object: readings,
-            seed: crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM),
-            start_pose: StartPose::Canonical,
-        })
+    ) -> Result<Vec<CollectPlan>, RangeError> {
+        let readings = CALIBRATION_EXPLORATION_READINGS;
+        let stream = crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM);
+        (0..self.calibration_explorations() as u64)
+            .map(|exploration| {
+                Ok(CollectPlan {
+                    mode: CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
+                        objects, readings, 0.5, None,
+                    ))?),
+                    sensor,
+                    control: Valid::default(),
+                    perturbation: PerturbationBounds::NONE,
+                    readings_per_object: readings,
+                    seed: crate::rng::substream(stream, exploration),
+                    start_pose: StartPose::random(self.start_heading),
+                })
+            })
+            .collect()
+    }
+
+    /// The contacts' model of `training`'s objects (in its order), their surfaces picked by name
+    /// from `meshes`, their poses unknown within [`start_heading`](Self::start_heading).
+    pub fn geometry(
+        &self,
+        training: &Dataset,
+        meshes: &[(String, &TriMesh)],
+    ) -> Result<GeometryModel, GeometryError> {
+        GeometryModel::of_named(&training.header().objects, meshes, self.start_heading)
     }
 
     /// Trains the fused model on `training` (collected by [`collect_plan`](Self::collect_plan))
-    /// and, given the arm's explorations `calibration` ([`calibration_plan`](Self::calibration_plan)),
+    /// and, given the arm's explorations `calibration` ([`calibration_plans`](Self::calibration_plans)),
     /// calibrates its posterior on them (`recognize::calibration`: the arm's successive touches
     /// are correlated, which the sampler's held-out readings cannot show); without them the
-    /// posterior is calibrated on the held-out readings.
+    /// posterior is calibrated on the held-out readings. With `contacts`
+    /// ([`geometry`](Self::geometry)) the model also weighs where each touch landed, the weight
+    /// fitted on `calibration`, which it then needs.
     pub fn fit(
         &self,
         training: &Dataset,
-        calibration: Option<&Dataset>,
-    ) -> Result<FusedModel, RecognizeError> {
+        calibration: &[&Dataset],
+        contacts: Option<&GeometryModel>,
+    ) -> Result<Recognizer, RecognizeError> {
         let data = TrainData {
             training,
             validation: None,
-            calibration: calibration.as_slice(),
-            contacts: None,
+            calibration,
+            contacts,
         };
-        match train_recognizer(&self.choices()?, data, &mut ())? {
-            Recognizer::Fused(model) => Ok(*model),
-            _ => Err(RecognizeError::InvalidParameter {
-                name: "descriptors",
-                what: "the recipe fuses two descriptors".into(),
-            }),
-        }
+        train_recognizer(&self.choices()?, data, &mut ())
     }
 }
 
@@ -151,7 +195,7 @@ pub enum ArmData {
     /// The sampler's readings the model is fitted on ([`ArmTrainingRecipe::collect_plan`]).
     Training,
     /// The arm's explorations its posterior is calibrated on
-    /// ([`ArmTrainingRecipe::calibration_plan`]).
+    /// ([`ArmTrainingRecipe::calibration_plans`]).
     Calibration,
 }
 
@@ -162,9 +206,10 @@ pub trait ArmTrainingObserver: Sync {
     fn collecting(&mut self, _data: ArmData, _objects: &[ObjectSpec], _readings: usize) {}
     /// One converged reading of `data` was gathered, on whichever worker thread gathered it.
     fn converged(&self, _data: ArmData) {}
-    /// `data` is collected; `short` lists the objects it gathered fewer readings of than asked
-    /// (the planner may run out of iterations on an object the arm reaches badly).
-    fn collected(&mut self, _data: ArmData, _dataset: &Dataset, _short: &[Shortfall]) {}
+    /// `data` is collected, `converged` readings in all; `short` lists the objects it gathered
+    /// fewer readings of than asked, once per exploration that fell short (the planner may run
+    /// out of iterations on an object the arm reaches badly).
+    fn collected(&mut self, _data: ArmData, _converged: usize, _short: &[Shortfall]) {}
     /// The fit starts: model selection `config` over `features` training features.
     fn fitting(&mut self, _config: &TrainConfig, _features: usize) {}
 }
@@ -174,12 +219,14 @@ impl ArmTrainingObserver for () {}
 /// What [`ArmTrainingRecipe::train`] made: the model and the two datasets behind it.
 #[derive(Debug, Clone)]
 pub struct ArmTraining {
-    /// The fused model, its posterior calibrated on `calibration` (on the readings held out of
-    /// `training` when `calibration` has no converged reading: check
+    /// The model: appearance fused with the contacts, its posterior and the contacts' weight
+    /// fitted on `calibration`; when `calibration` has no converged reading, appearance alone,
+    /// calibrated on the readings held out of `training` (check
     /// [`calibrated_on_the_arm`](Self::calibrated_on_the_arm)).
-    pub model: FusedModel,
+    pub model: Recognizer,
     pub training: Dataset,
-    pub calibration: Dataset,
+    /// One dataset per calibration exploration.
+    pub calibration: Vec<Dataset>,
 }
 
 impl ArmTraining {
@@ -187,7 +234,7 @@ impl ArmTraining {
     /// reading the held-out sampler readings did, and the posterior counts the arm's correlated
     /// touches as independent evidence: overconfident.
     pub fn calibrated_on_the_arm(&self) -> bool {
-        self.calibration.converged().next().is_some()
+        self.calibration.iter().any(|d| d.converged().next().is_some())
     }
 }
 
@@ -200,12 +247,15 @@ pub enum ArmTrainingError {
     Collect(#[from] CollectError),
     #[error(transparent)]
     Recognize(#[from] RecognizeError),
+    #[error(transparent)]
+    Geometry(#[from] GeometryError),
 }
 
 impl ArmTrainingRecipe {
     /// The whole recipe on `objects` (of the set with id `object_set`, which the datasets'
     /// headers record) touched by `sensor`: collects the training data and the arm's calibration
-    /// explorations on `threads` threads (0: all cores), then fits and calibrates the model.
+    /// explorations on `threads` threads (0: all cores), then fits the model with the objects'
+    /// surfaces and calibrates it.
     /// The demo, Python's `arm_model` and the Gymnasium environments' default model all come from
     /// here, so they are the same model for the same objects, sensor and recipe.
     pub fn train(
@@ -216,7 +266,14 @@ impl ArmTrainingRecipe {
         threads: usize,
         observer: &mut dyn ArmTrainingObserver,
     ) -> Result<ArmTraining, ArmTrainingError> {
-        let training = self.collect(ArmData::Training, object_set, objects, sensor, threads, observer)?;
+        let training = self
+            .collect(ArmData::Training, object_set, objects, sensor, threads, observer)?
+            .into_iter()
+            .next()
+            .ok_or(RecognizeError::InvalidParameter {
+                name: "training",
+                what: "no training data was collected".into(),
+            })?;
         let calibration = self.collect(
             ArmData::Calibration,
             object_set,
@@ -228,7 +285,19 @@ impl ArmTrainingRecipe {
         let config = self.train_config(&training)?;
         let converged = training.converged().count();
         observer.fitting(&config, config.grid_training_features(converged, false));
-        let model = self.fit(&training, Some(&calibration))?;
+        let explored: Vec<&Dataset> = calibration
+            .iter()
+            .filter(|d| d.converged().next().is_some())
+            .collect();
+        let model = if explored.is_empty() {
+            // Nothing to weigh the contacts on, nor to calibrate on: appearance alone, calibrated
+            // on the readings held out of the training data.
+            self.fit(&training, &[], None)?
+        } else {
+            let meshes: Vec<(String, &TriMesh)> = objects.iter().map(|o| (o.name.clone(), &o.mesh)).collect();
+            let contacts = self.geometry(&training, &meshes)?;
+            self.fit(&training, &explored, Some(&contacts))?
+        };
         Ok(ArmTraining {
             model,
             training,
@@ -236,7 +305,8 @@ impl ArmTrainingRecipe {
         })
     }
 
-    /// Collects `data` by its plan, telling `observer`.
+    /// Collects `data` by its plans (one for the training data, one per calibration
+    /// exploration), telling `observer`.
     fn collect(
         &self,
         data: ArmData,
@@ -245,18 +315,27 @@ impl ArmTrainingRecipe {
         sensor: SensorConfig,
         threads: usize,
         observer: &mut dyn ArmTrainingObserver,
-    ) -> Result<Dataset, ArmTrainingError> {
-        let (plan, readings) = match data {
-            ArmData::Training => (self.collect_plan(sensor)?, self.readings_per_object),
+    ) -> Result<Vec<Dataset>, ArmTrainingError> {
+        let (plans, readings) = match data {
+            ArmData::Training => (vec![self.collect_plan(sensor)?], self.readings_per_object),
             ArmData::Calibration => (
-                self.calibration_plan(sensor, objects)?,
+                self.calibration_plans(sensor, objects)?,
                 self.calibration_readings(),
             ),
         };
         observer.collecting(data, objects, readings);
         let watcher: &dyn ArmTrainingObserver = observer;
-        let dataset = plan.collect_dataset(object_set, objects, threads, &|| watcher.converged(data))?;
-        observer.collected(data, &dataset, &dataset.shortfalls(readings));
-        Ok(dataset)
+        let datasets = plans
+            .iter()
+            .map(|plan| plan.collect_dataset(object_set, objects, threads, &|| watcher.converged(data)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let converged = datasets.iter().map(|d| d.converged().count()).sum();
+        let short: Vec<Shortfall> = datasets
+            .iter()
+            .zip(&plans)
+            .flat_map(|(d, plan)| d.shortfalls(plan.readings_per_object))
+            .collect();
+        observer.collected(data, converged, &short);
+        Ok(datasets)
     }
 }

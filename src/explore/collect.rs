@@ -242,12 +242,17 @@ impl CollectPlan {
             self.seed,
         )
         .with_start_pose(self.start_pose)
-        .with_perturbation(Perturbed {
-            // Degrees as given: the bound was made from degrees, and the file should say 10, not 10.000000000000002.
-            max_rotation_deg: (self.perturbation.max_rotation_rad().to_degrees() * 1e9).round() / 1e9,
-            max_translation_fraction: self.perturbation.max_translation_fraction(),
-        });
+        .with_perturbation(recorded_perturbation(&self.perturbation));
         Dataset::new(header, reports.into_iter().flat_map(|r| r.readings).collect())
+    }
+}
+
+/// The perturbation `bounds` as a dataset records them, and a recogniser is told them.
+pub fn recorded_perturbation(bounds: &PerturbationBounds) -> Perturbed {
+    Perturbed {
+        // Degrees as given: the bound was made from degrees, and the file should say 10, not 10.000000000000002.
+        max_rotation_deg: (bounds.max_rotation_rad().to_degrees() * 1e9).round() / 1e9,
+        max_translation_fraction: bounds.max_translation_fraction(),
     }
 }
 

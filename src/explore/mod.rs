@@ -16,7 +16,7 @@ pub(crate) mod tree;
 // Collecting a dataset: the sampler or the exploring arm, over a set of objects.
 pub use collect::{
     BatchDataset, Collect, CollectError, CollectMode, CollectPlan, START_POSE_STREAM, SensorReader,
-    collect_datasets,
+    collect_datasets, recorded_perturbation,
 };
 pub use grid::ReadingGrid;
 pub use request::{CollectModeName, CollectRequest, ModeChoices, OtherModeChoices};

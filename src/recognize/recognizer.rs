@@ -133,15 +133,21 @@ impl Recognizer {
         }
     }
 
-    /// A posterior that takes tactile images ([`ModelPosterior`]), of either kind of model.
+    /// A posterior that takes tactile images ([`ModelPosterior`]), of any kind of model, the
+    /// object fixed.
     pub fn posterior(&self) -> Result<ModelPosterior<'_>, RecognizeError> {
+        self.posterior_for(Perturbed::FIXED)
+    }
+
+    /// A posterior that takes tactile images of an object that `motion` perturbs after every
+    /// touch (Sec. V-B4): a model that weighs the contacts follows each pose hypothesis through
+    /// the moves with the weight fitted on moving objects (`recognize::geometric`); appearance
+    /// does not depend on it.
+    pub fn posterior_for(&self, motion: Perturbed) -> Result<ModelPosterior<'_>, RecognizeError> {
         match self {
             Self::Single(m) => m.posterior(),
             Self::Fused(f) => f.image_posterior(),
-            Self::Geometric(g) => Ok(ModelPosterior::geometric(
-                g.posterior(Perturbed::FIXED),
-                g.descriptors()?,
-            )),
+            Self::Geometric(g) => Ok(ModelPosterior::geometric(g.posterior(motion), g.descriptors()?)),
         }
     }
 
