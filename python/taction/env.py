@@ -47,7 +47,7 @@ LETTERS_HEADING_DEG = 10.0
 
 #: Models trained by default, per (set, readings, seed): one training per process serves every
 #: environment of a vector env.
-_DEFAULT_MODELS: dict[tuple[str, int, int], taction.Model] = {}
+_DEFAULT_MODELS: dict[tuple[str, int, int, float], taction.Model] = {}
 
 
 def _objects_of(objects: Union[str, os.PathLike[str], Sequence[taction.Object]]) -> list[taction.Object]:

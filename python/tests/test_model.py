@@ -170,10 +170,11 @@ def test_the_arm_calibration_is_the_recipes_exploration_and_calibrates_the_arm_m
     assert ((few[0].object == "pawn") & (few[0].status == "converged")).sum() == 10
 
     # Calibrated on the arm's touches, the posterior is less sure of them than one calibrated on
-    # readings held out of the sampler's training data.
+    # readings held out of the sampler's training data (on both explorations' four trials: one
+    # exploration of 10 per object is two trials, too few to fit a tempering on).
     training = taction.collect(chess, mode="sampler", readings=110, seed=3, reachable_by_arm=True)
     on_validation = taction.train_for_arm(training.converged(), seed=3)
-    on_arm = taction.train_for_arm(training.converged(), seed=3, calibration=few)
+    on_arm = taction.train_for_arm(training.converged(), seed=3, calibration=explorations)
     assert on_arm.calibration != on_validation.calibration
 
     def mean_top_probability(model):
