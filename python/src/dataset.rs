@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use taction::active_touch::ArmTrainingRecipe;
-use taction::dataset::{ColumnType, ExportFormat, Reading};
+use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
+use taction::dataset::{ColumnType, ExportFormat, Reading, Shortfall, describe_shortfalls};
 use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
 use taction::sim::{ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
@@ -310,25 +310,46 @@ pub fn collect_arm_calibration(
     let (recipe, sensor, specs) =
         arm_recipe_inputs(&objects, (training_readings, seed, start_heading_deg), sensor)?;
     let Whole(threads) = threads;
-    let plans = recipe.calibration_plans(sensor, &specs).map_err(refused)?;
+    let mut shortfalls = Shortfalls::default();
     let datasets = py
-        .detach(|| {
-            plans
-                .iter()
-                .map(|plan| plan.collect_dataset(object_set, &specs, threads, &|| {}))
-                .collect::<Result<Vec<_>, _>>()
-        })
+        .detach(|| recipe.collect_calibration(object_set, &specs, sensor, threads, &mut shortfalls))
         .map_err(refused)?;
-    datasets
+    shortfalls.warn(py, "collect_arm_calibration")?;
+    Ok(datasets
         .into_iter()
-        .zip(&plans)
-        .map(|(dataset, plan)| {
-            warn_of_shortfalls(py, "collect_arm_calibration", &dataset, plan.readings_per_object)?;
-            Ok(Dataset {
-                inner: Arc::new(dataset),
-            })
+        .map(|dataset| Dataset {
+            inner: Arc::new(dataset),
         })
-        .collect()
+        .collect())
+}
+
+/// The recipe's collections that fell short, to warn of once the GIL is back.
+#[derive(Default)]
+pub struct Shortfalls(Vec<String>);
+
+impl ArmTrainingObserver for Shortfalls {
+    fn collected(&mut self, data: ArmData, _converged: usize, short: &[Shortfall]) {
+        if !short.is_empty() {
+            let what = match data {
+                ArmData::Training => "training",
+                ArmData::Calibration => "calibration",
+            };
+            self.0.push(format!(
+                "{what}: fewer readings than asked: {}",
+                describe_shortfalls(short)
+            ));
+        }
+    }
+}
+
+impl Shortfalls {
+    /// Warns of each collection that fell short, as `taction.{function}`.
+    pub fn warn(self, py: Python<'_>, function: &str) -> PyResult<()> {
+        for message in self.0 {
+            warn(py, &format!("taction.{function}: {message}"))?;
+        }
+        Ok(())
+    }
 }
 
 /// The demo's recipe at `training_readings` per object, `seed` and `start_heading_deg`, the
@@ -377,7 +398,7 @@ fn warn_of_shortfalls(
     if !shortfalls.is_empty() {
         let message = format!(
             "taction.{function}: fewer readings than asked: {}",
-            taction::dataset::describe_shortfalls(&shortfalls)
+            describe_shortfalls(&shortfalls)
         );
         warn(py, &message)?;
     }

@@ -6,8 +6,7 @@ use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
-use taction::dataset::{Shortfall, describe_shortfalls};
+use taction::active_touch::ArmTrainingRecipe;
 use taction::describe::Feature;
 use taction::locate::GeometryModel;
 use taction::mesh::TriMesh;
@@ -20,7 +19,7 @@ use taction::valid::Valid;
 
 use crate::args::{Objects, Whole, max_heading};
 use crate::array;
-use crate::dataset::{Dataset, arm_recipe_inputs, warn};
+use crate::dataset::{Dataset, Shortfalls, arm_recipe_inputs, warn};
 use crate::error::{bad_argument, refused};
 use crate::object::Object;
 use crate::sensor::Sensor;
@@ -90,7 +89,7 @@ impl Model {
     /// posterior's `observe` then reads a `pad_pose`.
     #[getter]
     fn contacts(&self) -> bool {
-        matches!(*self.inner, Recognizer::Geometric(_))
+        self.inner.weighs_contacts()
     }
 
     /// The sensor's `(rows, cols)`: the shape of the images it recognises.
@@ -423,9 +422,10 @@ fn contact_geometry(
 /// `training` is a dataset collected by `collect(..., reachable_by_arm=True)`; `calibration`, the
 /// arm's own explorations (`collect_arm_calibration`, as the demo collects them), calibrates the
 /// posterior (without it, the readings held out of `training` do, and the arm's correlated touches
-/// make it overconfident; a list of datasets, each an exploration). `objects`, the objects `training` was collected on, adds where each
-/// touch landed, standing within `start_heading_deg` of their canonical heading, weighed on
-/// `calibration` (which it then needs), as the demo's model does.
+/// make it overconfident; a list of datasets, each an exploration). `objects`, the objects
+/// `training` was collected on, adds where each touch landed, standing within `start_heading_deg`
+/// of their canonical heading, weighed on `calibration` (which it then needs), as the demo's model
+/// does.
 #[pyfunction]
 #[pyo3(signature = (training, seed=Whole(1), calibration=None, objects=None, start_heading_deg=180.0), text_signature = "(training, seed=1, calibration=None, objects=None, start_heading_deg=180.0)")]
 pub fn train_for_arm(
@@ -490,9 +490,7 @@ pub fn arm_model(
     let trained = py
         .detach(|| recipe.train(object_set, &specs, sensor, threads, &mut shortfalls))
         .map_err(refused)?;
-    for message in shortfalls.0 {
-        warn(py, &format!("taction.arm_model: {message}"))?;
-    }
+    shortfalls.warn(py, "arm_model")?;
     if !trained.calibrated_on_the_arm() {
         warn(
             py,
@@ -504,23 +502,4 @@ pub fn arm_model(
     Ok(Model {
         inner: Arc::new(trained.model),
     })
-}
-
-/// The recipe's collections that fell short, to warn of once the GIL is back.
-#[derive(Default)]
-struct Shortfalls(Vec<String>);
-
-impl ArmTrainingObserver for Shortfalls {
-    fn collected(&mut self, data: ArmData, _converged: usize, short: &[Shortfall]) {
-        if !short.is_empty() {
-            let what = match data {
-                ArmData::Training => "training",
-                ArmData::Calibration => "calibration",
-            };
-            self.0.push(format!(
-                "{what}: fewer readings than asked: {}",
-                describe_shortfalls(short)
-            ));
-        }
-    }
 }

@@ -138,22 +138,21 @@ impl ArmTrainingRecipe {
         objects: &[ObjectSpec],
     ) -> Result<Vec<CollectPlan>, RangeError> {
         let readings = CALIBRATION_EXPLORATION_READINGS;
+        let mode = CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
+            objects, readings, 0.5, None,
+        ))?);
         let stream = crate::rng::substream(self.seed, CALIBRATION_SEED_STREAM);
-        (0..self.calibration_explorations() as u64)
-            .map(|exploration| {
-                Ok(CollectPlan {
-                    mode: CollectMode::Planner(Valid::new(PlannerConfig::for_collection(
-                        objects, readings, 0.5, None,
-                    ))?),
-                    sensor,
-                    control: Valid::default(),
-                    perturbation: PerturbationBounds::NONE,
-                    readings_per_object: readings,
-                    seed: crate::rng::substream(stream, exploration),
-                    start_pose: StartPose::random(self.start_heading),
-                })
+        Ok((0..self.calibration_explorations() as u64)
+            .map(|exploration| CollectPlan {
+                mode,
+                sensor,
+                control: Valid::default(),
+                perturbation: PerturbationBounds::NONE,
+                readings_per_object: readings,
+                seed: crate::rng::substream(stream, exploration),
+                start_pose: StartPose::random(self.start_heading),
             })
-            .collect()
+            .collect())
     }
 
     /// The contacts' model of `training`'s objects (in its order), their surfaces picked by name
@@ -274,14 +273,7 @@ impl ArmTrainingRecipe {
                 name: "training",
                 what: "no training data was collected".into(),
             })?;
-        let calibration = self.collect(
-            ArmData::Calibration,
-            object_set,
-            objects,
-            sensor,
-            threads,
-            observer,
-        )?;
+        let calibration = self.collect_calibration(object_set, objects, sensor, threads, observer)?;
         let config = self.train_config(&training)?;
         let converged = training.converged().count();
         observer.fitting(&config, config.grid_training_features(converged, false));
@@ -303,6 +295,27 @@ impl ArmTrainingRecipe {
             training,
             calibration,
         })
+    }
+
+    /// The calibration explorations of [`train`](Self::train) alone
+    /// ([`calibration_plans`](Self::calibration_plans), collected), telling `observer`: for a
+    /// caller that fits the model itself (Python's `collect_arm_calibration`).
+    pub fn collect_calibration(
+        &self,
+        object_set: &str,
+        objects: &[ObjectSpec],
+        sensor: SensorConfig,
+        threads: usize,
+        observer: &mut dyn ArmTrainingObserver,
+    ) -> Result<Vec<Dataset>, ArmTrainingError> {
+        self.collect(
+            ArmData::Calibration,
+            object_set,
+            objects,
+            sensor,
+            threads,
+            observer,
+        )
     }
 
     /// Collects `data` by its plans (one for the training data, one per calibration

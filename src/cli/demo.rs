@@ -118,7 +118,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let objects = build_objects(&set, "demo", Carrier::Arm)?;
     // 1. The model: cached per (object set, readings, training seed, descriptors), else trained now.
     let model = load_or_train(args, &set, &objects, sensor)?.with_posterior(args.posterior.rule);
-    if !matches!(model, Recognizer::Geometric(_)) {
+    if !model.weighs_contacts() {
         eprintln!(
             "taction demo: warning: the model weighs appearance alone (its calibration explorations gave no \
              converged reading to weigh the contacts on): expect many more touches"
@@ -515,17 +515,15 @@ fn write_run_record(
     let names = model.objects();
     let pose = unknown.scene.object_pose().unwrap_or(unknown.spec.pose);
     let guess = belief.guess();
+    let stop = confidence_stop(args);
     let record = serde_json::json!({
         "objects": args.objects.display().to_string(),
         "object_size_m": args.object_size.m,
         "seed": args.seed.seed,
         "strategy": args.strategy.to_possible_value().map(|v| v.get_name().to_string()),
-        "stop_at_confidence": confidence_stop(args).map(|_| f64::from(args.stop_at_confidence)),
-        "stop_held_readings": confidence_stop(args).map(|_| args.stop_held_readings.get()),
-        "model_evidence": match model {
-            Recognizer::Geometric(_) => "appearance+contacts",
-            _ => "appearance",
-        },
+        "stop_at_confidence": stop.map(|s| f64::from(s.threshold())),
+        "stop_held_readings": stop.map(|s| s.held_readings().get()),
+        "model_evidence": if model.weighs_contacts() { "appearance+contacts" } else { "appearance" },
         "posterior": args.posterior.rule.name(),
         "training_readings": args.training_readings,
         "object": unknown.spec.name,

@@ -124,6 +124,12 @@ impl Recognizer {
         })
     }
 
+    /// Whether the model weighs where each touch landed as well as what it felt (a posterior's
+    /// readings then need their pad pose).
+    pub fn weighs_contacts(&self) -> bool {
+        matches!(self, Self::Geometric(_))
+    }
+
     /// The tempering its posterior applies.
     pub fn tempering(&self) -> Tempering {
         match self {
