@@ -22,7 +22,10 @@
 //!   expected-information-gain scores of 12 candidate targets (`active_touch`) for a model of
 //!   12 objects and 50 clusters after 30 readings; the summary reports it per iteration against a
 //!   plain kinematic planner iteration on the pawn (total time / iterations of `planner/kinematic`
-//!   runs), the baseline.
+//!   runs), the baseline;
+//! - `active/contact_gain_12_candidates`: what `--gain identity` adds to it, the contact's gain of
+//!   the same 12 candidates (`locate::predict`) over the shapes' 12 surfaces at 36 pose hypotheses
+//!   each, after three contacts; criterion reports it beside `active/score_12_candidates`.
 //!
 //! Scenes are compiled once per configuration, outside the timed loops (a collection run compiles one
 //! per object). After criterion's own report a summary prints readings/s and the ratios, measured
@@ -36,11 +39,13 @@ use glam::DVec3;
 use rand::RngExt;
 use taction::active_touch::InformationGain;
 use taction::control::{FreePad, sensor_reader};
+use taction::dataset::Perturbed;
 use taction::explore::TouchScorer;
 use taction::explore::{CollectMode, CollectPlan};
 use taction::explore::{ExplorationReport, Planner, PlannerConfig};
-use taction::mesh::{BuildOptions, ObjectSet};
-use taction::pose::PadPose;
+use taction::locate::{Contact, GainOf, GeometryModel, GeometryPosterior, Touch};
+use taction::mesh::{BuildOptions, ObjectSet, TriMesh};
+use taction::pose::{MaxHeading, PadPose};
 use taction::recognize::PseudoCount;
 use taction::recognize::pipeline::{ClusterHistogram, ObjectModels};
 use taction::sim::{Execution, PAD_SITE};
@@ -189,6 +194,39 @@ fn scorer_and_candidates(models: &ObjectModels) -> (InformationGain<'_>, Vec<DVe
     (gain, candidates)
 }
 
+/// The weight of a contact's log-likelihood in the demo's posterior after a few touches (its fused
+/// weight 0.15 times the tempering's `w(4)`, 1.35).
+const CONTACT_WEIGHT: f64 = 0.2;
+
+/// The shapes' surfaces, every object followed at the default 36 headings.
+fn shapes_geometry(objects: &[ObjectSpec]) -> GeometryModel {
+    let meshes: Vec<(String, &TriMesh)> = objects.iter().map(|o| (o.name.clone(), &o.mesh)).collect();
+    let names: Vec<String> = objects.iter().map(|o| o.name.clone()).collect();
+    GeometryModel::of_named(&names, &meshes, MaxHeading::ANY).expect("the shapes' surfaces")
+}
+
+/// The geometric posterior after three contacts on the first object's surface, and a belief
+/// leaning toward it: the contact gain's work in the middle of an exploration.
+fn geometry_after_contacts(geometry: &GeometryModel) -> (GeometryPosterior<'_>, Vec<f64>) {
+    let mut posterior = geometry.posterior(Perturbed::FIXED);
+    let surface = &geometry.surfaces()[0];
+    let step = surface.points().len() / 3;
+    for attempt in 0..3 {
+        let i = attempt * step;
+        posterior.observe(Touch {
+            contact: Some(Contact {
+                point_m: surface.points()[i],
+                normal: surface.normals()[i],
+            }),
+            attempt,
+        });
+    }
+    let objects = geometry.objects().len();
+    let mut probabilities = vec![0.5 / (objects - 1) as f64; objects];
+    probabilities[0] = 0.5;
+    (posterior, probabilities)
+}
+
 fn shapes() -> Vec<ObjectSpec> {
     ObjectSpec::all_of(&ObjectSet::shapes()).expect("the shapes (fetched by `cargo xtask setup`)")
 }
@@ -271,6 +309,19 @@ fn benches(c: &mut Criterion) {
         b.iter(|| black_box(gain.score(black_box(&candidates))))
     });
     let objects = shapes();
+    let geometry = shapes_geometry(&objects);
+    let (posterior, probabilities) = geometry_after_contacts(&geometry);
+    group.bench_function("active/contact_gain_12_candidates", |b| {
+        b.iter(|| {
+            black_box(posterior.contact_gains_nats(
+                &probabilities,
+                black_box(&candidates),
+                CONTACT_WEIGHT,
+                0.006,
+                GainOf::Identity,
+            ))
+        })
+    });
     group.throughput(Throughput::Elements((SHAPES_READINGS * objects.len()) as u64));
     group.bench_function("planner/shapes", |b| {
         b.iter(|| {

@@ -298,3 +298,28 @@ fn the_active_demo_stops_exactly_when_the_threshold_is_crossed() {
         "a stop and no stop at once is refused: {stderr}"
     );
 }
+
+/// `--gain` is recorded in `run.json` (`appearance` by default), and the contact's gain, on a model
+/// that weighs contacts, chooses other touches from the same seed (the first differs: the
+/// appearance gain scores every candidate alike before any reading, the contact's does not).
+#[test]
+fn the_gain_is_recorded_and_the_contacts_gain_chooses_other_touches() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let out = dir.path().join("demo");
+    let read_record = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).expect("run.json")).expect("JSON")
+    };
+    let (_, appearance) = active_demo(&out, &["--no-stop"]);
+    let record = read_record();
+    assert_eq!(record["gain"], "appearance");
+    assert_eq!(record["model_evidence"], "appearance+contacts");
+    let (_, identity) = active_demo(&out, &["--no-stop", "--gain", "identity"]);
+    assert_eq!(read_record()["gain"], "identity");
+    assert_eq!(identity.len(), appearance.len());
+    assert_ne!(
+        identity[0], appearance[0],
+        "the first touch is chosen differently"
+    );
+    let (_, again) = active_demo(&out, &["--no-stop", "--gain", "identity"]);
+    assert_eq!(again, identity, "the same seed, the same touches");
+}

@@ -141,6 +141,24 @@ fn sensor_config_that_does_not_match_the_data() {
     );
 }
 
+/// A covering worked out as a tenth of the pad (0.0012000000000000001 m) is the 0.0012 m one
+/// (the demo's cache refused such a model and trained again); a micrometre more is not.
+#[test]
+fn a_sensor_an_ulp_away_is_the_same_sensor() {
+    let m = model(CodebookKind::Kmeans);
+    let mut other = m.sensor;
+    other.thickness_m = m.sensor.thickness_m * (1.0 + f64::EPSILON);
+    other.pad_width_m = m.sensor.pad_width_m * (1.0 - f64::EPSILON);
+    assert_ne!(other.thickness_m, m.sensor.thickness_m);
+    m.check_sensor(&other).unwrap();
+    other.thickness_m = m.sensor.thickness_m + 1e-6;
+    let text = m.check_sensor(&other).unwrap_err().to_string();
+    assert!(
+        text.contains("thickness_m") && !text.contains("pad_width_m"),
+        "{text}"
+    );
+}
+
 #[test]
 fn inconsistent_or_foreign_content() {
     let (_dir, path, text) = saved();

@@ -275,7 +275,6 @@ impl TouchEpisode {
     /// so far) times the chance the iteration touches at all ([`touch_chances`](Self::touch_chances));
     /// the quantity the planner's active strategy maximises ([`crate::explore::expected_gains`]).
     pub fn gains(&self) -> Result<Vec<f64>, TouchError> {
-        use crate::explore::TouchScorer;
         let scores = self.recognition.borrow_dependent().scorer().score(&self.targets);
         Ok(crate::explore::expected_gains(&scores, &self.touch_chances()))
     }

@@ -32,6 +32,7 @@ use taction::experiment::{BAND_LABEL, Figure, Panel, ReferenceLine, Series};
 use taction::explore::DEFAULT_CANDIDATES;
 use taction::explore::{ConfidenceStop, Probability};
 use taction::explore::{Planner, PlannerConfig};
+use taction::locate::GainOf;
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
 use taction::recognize::Belief;
@@ -84,6 +85,13 @@ pub struct DemoArgs {
     /// else global).
     #[arg(long, value_enum, default_value_t = DemoStrategy::Active)]
     pub strategy: DemoStrategy,
+    /// What the active strategy's expected information gain weighs: `appearance` (the default),
+    /// what a touch there would show; `identity`, also where it would land on each pose hypothesis,
+    /// about the object's identity with its pose marginalised; `identity-and-pose`, that about
+    /// identity and pose together. Measured on the demo's seeds, the contact's gain chose touches
+    /// that recognised worse (docs/measurements.md, "Touches chosen for where they land").
+    #[arg(long, value_enum, default_value_t = DemoGain::Appearance)]
+    pub gain: DemoGain,
     /// Stop exploring once one guess has held probability P or more over the last
     /// --stop-held-readings touches, P in (0, 1]. The posterior is calibrated on fresh
     /// explorations like the demo's, so a stop at P is right at least a fraction P of the time;
@@ -101,6 +109,24 @@ pub struct DemoArgs {
     pub no_stop: bool,
     #[command(flatten)]
     pub posterior: PosteriorArg,
+}
+
+/// What the active strategy's gain is about (`locate::GainOf`, or appearance alone).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoGain {
+    Identity,
+    IdentityAndPose,
+    Appearance,
+}
+
+impl DemoGain {
+    fn contact_gain(self) -> Option<GainOf> {
+        match self {
+            Self::Identity => Some(GainOf::Identity),
+            Self::IdentityAndPose => Some(GainOf::IdentityAndPose),
+            Self::Appearance => None,
+        }
+    }
 }
 
 /// How the demo's arm chooses its touches.
@@ -339,7 +365,8 @@ fn explore_unknown(
         rng::stream(args.seed.seed, PLANNER_STREAM),
         reader,
     )?;
-    let mut recognition = ActiveRecognition::of(model, planner_config.grid_cell_m, Perturbed::FIXED)?;
+    let mut recognition = ActiveRecognition::of(model, planner_config.grid_cell_m, Perturbed::FIXED)?
+        .with_contact_gain(args.gain.contact_gain());
     let mut shown = TouchTable::new(model.objects(), &unknown.spec.name, unknown.index);
     let run = explore_recognizing(
         &mut planner,
@@ -502,6 +529,18 @@ fn write_outputs(
     Ok(())
 }
 
+/// What the active strategy's gain was about: the flag's choice, or `appearance` for a model that
+/// does not weigh contacts.
+fn gain_name(args: &DemoArgs, model: &Recognizer) -> String {
+    let gain = if model.weighs_contacts() {
+        args.gain
+    } else {
+        DemoGain::Appearance
+    };
+    gain.to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
+}
+
 /// `run.json`: what the run used and how it ended, so that the files beside it say which run made
 /// them (each run into the folder overwrites the last one's).
 fn write_run_record(
@@ -521,6 +560,7 @@ fn write_run_record(
         "object_size_m": args.object_size.m,
         "seed": args.seed.seed,
         "strategy": args.strategy.to_possible_value().map(|v| v.get_name().to_string()),
+        "gain": (args.strategy == DemoStrategy::Active).then(|| gain_name(args, model)),
         "stop_at_confidence": stop.map(|s| f64::from(s.threshold())),
         "stop_held_readings": stop.map(|s| s.held_readings().get()),
         "model_evidence": if model.weighs_contacts() { "appearance+contacts" } else { "appearance" },

@@ -13,9 +13,11 @@
 pub(crate) mod contact;
 pub(crate) mod model;
 pub(crate) mod pose_fit;
+pub(crate) mod predict;
 pub(crate) mod surface;
 pub(crate) mod track;
 
 pub use contact::{Contact, ContactNoise, Touch};
 pub use model::{GeometryError, GeometryModel, GeometryParams, GeometryPosterior};
+pub use predict::GainOf;
 pub use surface::{ObjectSurface, SURFACE_SPACING_M};

@@ -329,6 +329,15 @@ impl GeometryPosterior<'_> {
         &self.log_likelihoods
     }
 
+    pub(crate) fn model(&self) -> &GeometryModel {
+        self.model
+    }
+
+    /// Per object, its pose hypotheses now.
+    pub(crate) fn tracks(&self) -> &[Vec<Track>] {
+        &self.tracks
+    }
+
     /// Object `object`'s most likely pose now (mesh frame in the world), from its best
     /// hypothesis: where the recogniser believes it stands if it is that object.
     pub fn best_pose(&self, object: usize) -> Option<Pose> {

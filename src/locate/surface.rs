@@ -21,6 +21,11 @@ pub const SURFACE_SPACING_M: f64 = 0.0015;
 /// robust likelihood reads as a contact the pose does not explain.
 const CELL_M: f64 = 0.005;
 
+/// Spacing of the sparse points [`ObjectSurface::nearest_anywhere`] scans beyond the grid's reach,
+/// metres: a few thousand points on a 12 cm object, a millimetre or two of error in a prediction
+/// that looks centimetres away (`locate::predict`).
+const SPARSE_SPACING_M: f64 = 0.004;
+
 /// One object's surface points and normals (object frame), with what the likelihood needs of it.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(try_from = "SurfaceFile", into = "SurfaceFile")]
@@ -35,6 +40,8 @@ pub struct ObjectSurface {
     /// The larger horizontal side of the bounding box, metres.
     width_m: f64,
     grid: CellGrid,
+    /// Indices of points about [`SPARSE_SPACING_M`] apart.
+    sparse: Vec<u32>,
 }
 
 impl PartialEq for ObjectSurface {
@@ -108,8 +115,10 @@ impl ObjectSurface {
             .iter()
             .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
 
+        let sparse = thinned_indices(&points, SPARSE_SPACING_M);
         Some(Self {
             grid: CellGrid::new(&points, lo, hi),
+            sparse,
             points,
             normals,
             area_m2,
@@ -149,16 +158,41 @@ impl ObjectSurface {
     }
 }
 
-/// Keeps the first point of each cube of side `cell_m`.
-fn thin(points: Vec<DVec3>, normals: Vec<DVec3>, cell_m: f64) -> (Vec<DVec3>, Vec<DVec3>) {
+impl ObjectSurface {
+    /// The index of the surface point nearest `query` (object frame) however far it lies: the
+    /// exact one within the grid's reach ([`nearest`](Self::nearest)), else the nearest of the
+    /// sparse points, 4 mm apart (so within 4 mm of the exact one), the first of equals.
+    pub fn nearest_anywhere(&self, query: DVec3) -> usize {
+        if let Some(near) = self.nearest(query) {
+            return near.index;
+        }
+        let mut best = (f64::INFINITY, 0);
+        for &i in &self.sparse {
+            let d = self.points[i as usize].distance_squared(query);
+            if d < best.0 {
+                best = (d, i as usize);
+            }
+        }
+        best.1
+    }
+}
+
+/// The index of the first point of each cube of side `cell_m`, in order.
+fn thinned_indices(points: &[DVec3], cell_m: f64) -> Vec<u32> {
     let mut seen = std::collections::HashSet::new();
-    points
-        .into_iter()
-        .zip(normals)
-        .filter(|(p, _)| {
-            let key = (*p / cell_m).floor();
+    (0..points.len() as u32)
+        .filter(|&i| {
+            let key = (points[i as usize] / cell_m).floor();
             seen.insert((key.x as i64, key.y as i64, key.z as i64))
         })
+        .collect()
+}
+
+/// Keeps the first point of each cube of side `cell_m`.
+fn thin(points: Vec<DVec3>, normals: Vec<DVec3>, cell_m: f64) -> (Vec<DVec3>, Vec<DVec3>) {
+    thinned_indices(&points, cell_m)
+        .into_iter()
+        .map(|i| (points[i as usize], normals[i as usize]))
         .unzip()
 }
 

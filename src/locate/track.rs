@@ -68,6 +68,12 @@ impl Track {
         }
     }
 
+    /// The covariance of the pose about [`pose`](Self::pose) (a step's coordinates, `pose_fit`),
+    /// at the last contact; `None` where the information cannot be inverted.
+    pub fn covariance(&self) -> Option<Matrix6<f64>> {
+        self.information.try_inverse()
+    }
+
     /// The log-evidence of the contacts seen (`ln p(c_1..c_n | this hypothesis)`).
     pub fn evidence(&self) -> f64 {
         self.pose.score

@@ -363,20 +363,15 @@ pub fn check_same_sensor(model: &SensorConfig, data: &SensorConfig) -> Result<()
     }
 }
 
-/// The fields in which two sensors differ, `noise_seed` aside, each as `name A (a) vs B (b)` with
-/// the two sides' labels; `None` when they are the same sensor.
+/// The fields in which two sensors differ in what changes their readings, each as
+/// `name A (a) vs B (b)` with the two sides' labels; `None` when they read alike. Lengths and
+/// fractions are the same within a relative 1e-9: a covering of 0.0012 m and one worked out as a
+/// tenth of 0.012 m (0.0012000000000000001) are one sensor. `noise_seed` never counts: it draws the
+/// noise, which a model does not learn sample by sample.
 pub fn sensor_differences(
     (a, a_label): (&SensorConfig, &str),
     (b, b_label): (&SensorConfig, &str),
 ) -> Option<String> {
-    if *a
-        == (SensorConfig {
-            noise_seed: a.noise_seed,
-            ..*b
-        })
-    {
-        return None;
-    }
     let SensorConfig {
         rows,
         cols,
@@ -387,39 +382,28 @@ pub fn sensor_differences(
         rays_per_taxel,
         noise_fraction,
         noise_seed: _,
-    } = a;
-    let fields: [(&str, String, String); 8] = [
-        ("rows", rows.to_string(), b.rows.to_string()),
-        ("cols", cols.to_string(), b.cols.to_string()),
-        ("pad_width_m", pad_width_m.to_string(), b.pad_width_m.to_string()),
-        (
-            "pad_height_m",
-            pad_height_m.to_string(),
-            b.pad_height_m.to_string(),
-        ),
-        ("thickness_m", thickness_m.to_string(), b.thickness_m.to_string()),
-        ("psf_sigma_m", psf_sigma_m.to_string(), b.psf_sigma_m.to_string()),
-        (
-            "rays_per_taxel",
-            rays_per_taxel.to_string(),
-            b.rays_per_taxel.to_string(),
-        ),
-        (
-            "noise_fraction",
-            noise_fraction.to_string(),
-            b.noise_fraction.to_string(),
-        ),
-    ];
-    let differences: Vec<String> = fields
-        .into_iter()
-        .filter(|(_, x, y)| x != y)
-        .map(|(name, x, y)| format!("{name} {x} ({a_label}) vs {y} ({b_label})"))
-        .collect();
-    Some(if differences.is_empty() {
-        "a field differs".into()
-    } else {
-        differences.join(", ")
-    })
+    } = *a;
+    let count =
+        |name: &'static str, x: usize, y: usize| (x != y).then(|| (name, x.to_string(), y.to_string()));
+    let real = |name: &'static str, x: f64, y: f64| {
+        let same = x == y || (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+        (!same).then(|| (name, x.to_string(), y.to_string()))
+    };
+    let differences: Vec<String> = [
+        count("rows", rows, b.rows),
+        count("cols", cols, b.cols),
+        real("pad_width_m", pad_width_m, b.pad_width_m),
+        real("pad_height_m", pad_height_m, b.pad_height_m),
+        real("thickness_m", thickness_m, b.thickness_m),
+        real("psf_sigma_m", psf_sigma_m, b.psf_sigma_m),
+        count("rays_per_taxel", rays_per_taxel, b.rays_per_taxel),
+        real("noise_fraction", noise_fraction, b.noise_fraction),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|(name, x, y)| format!("{name} {x} ({a_label}) vs {y} ({b_label})"))
+    .collect();
+    (!differences.is_empty()).then(|| differences.join(", "))
 }
 
 /// The bytes of a model file and its name for error messages.

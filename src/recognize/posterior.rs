@@ -2,8 +2,10 @@
 //! the distribution of Eq. 16 it implies. [`OnlinePosterior`] takes described readings;
 //! [`ModelPosterior`] takes tactile images and describes them as the model's training did.
 
+use glam::DVec3;
+
 use crate::describe::{Descriptor, Feature};
-use crate::locate::{Contact, ContactNoise, GeometryPosterior, Touch};
+use crate::locate::{Contact, ContactNoise, GainOf, GeometryPosterior, Touch};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::calibration::Tempering;
@@ -283,6 +285,14 @@ impl<'a> ModelPosterior<'a> {
         self.belief().decision.probabilities
     }
 
+    /// The posterior of appearance fused with contact geometry, when the model is one.
+    pub fn as_geometric(&self) -> Option<&GeometricPosterior<'a>> {
+        match &self.beliefs {
+            Beliefs::Geometric(p) => Some(p),
+            _ => None,
+        }
+    }
+
     /// Readings observed so far.
     pub fn readings(&self) -> usize {
         match &self.beliefs {
@@ -340,6 +350,23 @@ impl GeometricPosterior<'_> {
 
     pub fn readings(&self) -> usize {
         self.readings
+    }
+
+    /// The expected gain of the contact of a touch toward each of `targets_m`, nats
+    /// (`locate::predict`): predicted by the pose hypotheses the contacts so far left, weighed by
+    /// the belief over identity before its confidence map (the gain follows Bayes' rule, which the
+    /// tempered belief does and the map does not) and by the weight the next contact will have,
+    /// `lambda w(n + 1)`; a touch meets a surface its target lies less than half the pad's width
+    /// outside. Zero for a posterior that does not weigh contacts.
+    pub fn contact_gains_nats(&self, targets_m: &[DVec3], of: GainOf) -> Vec<f64> {
+        let weight = self.weights.geometry * self.tempering.weight(self.readings + 1);
+        if weight.is_nan() || weight <= 0.0 {
+            return vec![0.0; targets_m.len()];
+        }
+        let belief = self.belief();
+        let reach_m = 0.5 * self.sensor.pad_width_m.min(self.sensor.pad_height_m);
+        self.geometry
+            .contact_gains_nats(belief.decision.evidence(), targets_m, weight, reach_m, of)
     }
 
     pub fn belief(&self) -> Belief {
