@@ -354,11 +354,6 @@ impl<'a> ActiveRecognition<'a> {
     pub fn scorer(&self) -> &dyn TouchScorer {
         self
     }
-
-    /// The appearance part of the score.
-    pub fn appearance_gain(&self) -> &InformationGain<'a> {
-        &self.gain
-    }
 }
 
 /// A touch's expected gain: what its appearance would tell (`InformationGain`) plus what its

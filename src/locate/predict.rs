@@ -32,9 +32,9 @@
 //!
 //! For two contacts at points `p` and normals `n`, `D` is the Bhattacharyya distance of two
 //! isotropic Gaussians, `|p_i - p_k|^2 / (4 (v_i + v_k)) + (d / 2) ln((v_i + v_k) / (2 sqrt(v_i
-//! v_k)))` in `d` dimensions, for the points (3) and the normals (2), summed. A predicted contact's variance `v` is the likelihood's (`sigma^2 / s`, the
-//! spreads of `GeometryParams` and `s` the weight the next contact's log-likelihood has in the
-//! posterior, the fused weight `lambda` times the tempering's `w(n + 1)`: a likelihood raised to
+//! v_k)))` in `d` dimensions, for the points (3) and the normals (2), summed. A predicted
+//! contact's variance `v` is the likelihood's (`sigma^2 / s`, the spreads of `GeometryParams` and
+//! `s` the weight the next contact's log-likelihood has in the posterior, the fused weight `lambda` times the tempering's `w(n + 1)`: a likelihood raised to
 //! `s` is a Gaussian of variance `sigma^2 / s`) plus the spread the hypothesis's own pose
 //! uncertainty gives the point (or the normal) there, per axis: early on, when every hypothesis
 //! is uncertain by several degrees and millimetres, its predictions are as vague and say less.
@@ -52,6 +52,7 @@ use nalgebra::{Matrix3, Matrix6, SMatrix};
 use crate::locate::model::GeometryPosterior;
 use crate::locate::pose_fit::Hypothesis;
 use crate::locate::surface::ObjectSurface;
+use crate::locate::track::Track;
 
 /// What the expected gain of a contact is about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -132,7 +133,7 @@ impl GeometryPosterior<'_> {
     /// summing to 1.
     fn weighted(&self, object_probabilities: &[f64]) -> Vec<Weighted<'_>> {
         let surfaces = self.model().surfaces();
-        let mut all: Vec<Weighted<'_>> = Vec::new();
+        let mut all: Vec<(usize, &Track, f64)> = Vec::new();
         for (object, (tracks, &p)) in self.tracks().iter().zip(object_probabilities).enumerate() {
             if p.is_nan() || p <= 0.0 || tracks.is_empty() {
                 continue;
@@ -142,30 +143,36 @@ impl GeometryPosterior<'_> {
                 .map(|t| t.evidence())
                 .fold(f64::NEG_INFINITY, f64::max);
             let total: f64 = tracks.iter().map(|t| (t.evidence() - best).exp()).sum();
-            all.extend(tracks.iter().map(|t| Weighted {
-                object,
-                surface: &surfaces[object],
-                pose: t.pose,
-                covariance: t.covariance().unwrap_or_else(Matrix6::zeros),
-                weight: p * (t.evidence() - best).exp() / total,
-            }));
+            all.extend(
+                tracks
+                    .iter()
+                    .map(|t| (object, t, p * (t.evidence() - best).exp() / total)),
+            );
         }
         // Heaviest first; equal weights keep the objects' and tracks' order (a stable sort).
-        all.sort_by(|a, b| b.weight.total_cmp(&a.weight));
+        all.sort_by(|a, b| b.2.total_cmp(&a.2));
         let mut kept = 0.0;
         let keep = all
             .iter()
             .take(MAX_HYPOTHESES)
             .take_while(|h| {
                 let more = kept < 1.0 - NEGLIGIBLE_WEIGHT;
-                kept += h.weight;
+                kept += h.2;
                 more
             })
             .count();
         all.truncate(keep);
-        let total: f64 = all.iter().map(|h| h.weight).sum();
-        all.iter_mut().for_each(|h| h.weight /= total);
-        all
+        let total: f64 = all.iter().map(|h| h.2).sum();
+        // Only the kept hypotheses' covariances: an inversion each, asked for every candidate.
+        all.into_iter()
+            .map(|(object, track, weight)| Weighted {
+                object,
+                surface: &surfaces[object],
+                pose: track.pose,
+                covariance: track.covariance().unwrap_or_else(Matrix6::zeros),
+                weight: weight / total,
+            })
+            .collect()
     }
 }
 

@@ -156,9 +156,7 @@ impl ObjectSurface {
             signed_distance_m: (query - self.points[index]).dot(self.normals[index]),
         })
     }
-}
 
-impl ObjectSurface {
     /// The index of the surface point nearest `query` (object frame) however far it lies: the
     /// exact one within the grid's reach ([`nearest`](Self::nearest)), else the nearest of the
     /// sparse points, 4 mm apart (so within 4 mm of the exact one), the first of equals.
