@@ -6,8 +6,8 @@
 mod recognize_toy;
 
 use glam::{DQuat, DVec3};
-use taction::dataset::{Dataset, Reading};
-use taction::locate::{GeometryModel, GeometryParams, ObjectSurface};
+use taction::dataset::{Dataset, Perturbed, Reading};
+use taction::locate::{GeometryModel, GeometryParams, ObjectSurface, Touch};
 use taction::mesh::TriMesh;
 use taction::pose::{PadPose, Pose};
 use taction::recognize::{
@@ -261,4 +261,61 @@ fn a_corrupt_geometric_model_file_is_named() {
     value["geometry"]["surfaces"][0]["points"] = serde_json::json!([]);
     let e = Recognizer::from_json(&serde_json::to_vec(&value).expect("json"), "m.json").expect_err("refused");
     assert!(e.to_string().contains("m.json"), "{e}");
+}
+
+/// An attempt that gave no reading (it met nothing, collided, did not settle) still let a
+/// perturbed object move (Sec. V-B4): online (`missed`), the next reading's touch is the attempt
+/// after it, as a recorded exploration numbers its readings (`Touch::of_dataset`), so its pose
+/// belief has widened by those moves; an object that stays put is unaffected.
+#[test]
+fn an_attempt_without_a_reading_counts_as_a_move_of_a_perturbed_object() {
+    // The contacts alone: the toy model is weighed on a fixed object only, so its fused belief
+    // gives a moving object's contacts no weight.
+    let model = weighing(&model(&dataset(12, 21, 0.4, DVec3::ZERO)), Evidence::Contacts);
+    let Recognizer::Geometric(g) = &model else {
+        panic!("a geometric model");
+    };
+    let test = dataset(2, 29, 0.7, DVec3::ZERO);
+    let images: Vec<_> = test
+        .readings()
+        .iter()
+        .filter(|r| r.object == recognize_toy::OBJECTS[1])
+        .map(|r| r.image.clone())
+        .collect();
+    let perturbed = Perturbed {
+        max_rotation_deg: 10.0,
+        max_translation_fraction: 0.1,
+    };
+    let online = |motion: Perturbed, missed: usize| {
+        let mut posterior = model.posterior_for(motion).expect("a posterior");
+        posterior.observe(&images[0]).expect("observes");
+        (0..missed).for_each(|_| posterior.missed());
+        posterior
+            .observe(&images[1])
+            .expect("observes")
+            .probabilities()
+            .to_vec()
+    };
+    // By hand: the second reading's touch is attempt 4 (readings at attempts 0 and 4).
+    let describer = model.posterior_for(perturbed).expect("a posterior");
+    let mut by_hand = g.posterior(perturbed);
+    let first = by_hand.touch_of(&images[0]);
+    assert_eq!(first.attempt, 0);
+    by_hand
+        .observe(&(describer.describe(&images[0]), first))
+        .expect("observes");
+    let second = Touch {
+        attempt: 4,
+        ..by_hand.touch_of(&images[1])
+    };
+    let expected = by_hand
+        .observe(&(describer.describe(&images[1]), second))
+        .expect("observes");
+    assert_eq!(online(perturbed, 3), expected.probabilities());
+    assert_ne!(
+        online(perturbed, 3),
+        online(perturbed, 0),
+        "three moves more widen the pose belief"
+    );
+    assert_eq!(online(Perturbed::FIXED, 3), online(Perturbed::FIXED, 0));
 }

@@ -26,7 +26,7 @@ fn factor_columns(experiment: &str) -> &'static [&'static str] {
         "training-size" => &["training_readings"],
         "active" => &["strategy", "local_probability", "object_motion"],
         "end-to-end" => &["training", "local_probability", "object_motion"],
-        "fusion" => &["evidence", "local_probability", "object_motion"],
+        "fusion" => &["evidence", "strategy", "local_probability", "object_motion"],
         _ => &[],
     }
 }
@@ -406,14 +406,34 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
         ])
     );
     let mut fusion_curves = BTreeSet::new();
-    for evidence in ["appearance", "contacts", "fused"] {
-        for l in ["0.5", "1"] {
-            for motion in ["fixed", "perturbed"] {
-                fusion_curves.insert(format!("{evidence} {l} {motion}"));
+    for motion in ["fixed", "perturbed"] {
+        for evidence in ["appearance", "contacts", "fused"] {
+            for l in ["0.5", "1"] {
+                fusion_curves.insert(format!("{evidence} blind {l} {motion}"));
             }
         }
+        fusion_curves.insert(format!("fused active 0.5 {motion}"));
     }
     assert_eq!(values("fusion"), fusion_curves);
+    // The active curves explore under the plans of the blind L = 0.5 test explorations (the same
+    // starts, streams and perturbations), trial by trial.
+    let fusion = rows(&out.join("fusion/fusion.csv"));
+    let plans = |strategy: &str| -> BTreeSet<(String, u32, i64)> {
+        fusion
+            .iter()
+            .filter(|r| {
+                r.factors.level(Factor::Strategy) == Some(strategy)
+                    && r.factors.level(Factor::Evidence) == Some("fused")
+                    && r.factors.level(Factor::LocalProbability) == Some("0.5")
+            })
+            .map(|r| {
+                let motion = r.factors.level(Factor::ObjectMotion).unwrap_or_default();
+                (motion.to_string(), r.trial, r.stream_seed)
+            })
+            .collect()
+    };
+    assert!(!plans("active").is_empty());
+    assert_eq!(plans("active"), plans("blind"));
     assert_attempts_end_at_the_last_reading(&out);
     let e2e = rows(&out.join("end-to-end/end-to-end.csv"));
     assert!(
@@ -505,8 +525,8 @@ fn assert_attempts_end_at_the_last_reading(out: &Path) {
     }
     assert_eq!(
         last.len(),
-        12 * 3,
-        "twelve curves, three repetitions each at any scale"
+        14 * 3,
+        "twelve blind curves and two active, three repetitions each at any scale"
     );
     for ((curve, trial), rows_of) in &last {
         let ns: Vec<u32> = rows_of.iter().map(|r| r.n_attempts).collect();

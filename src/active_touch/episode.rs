@@ -303,12 +303,19 @@ impl TouchEpisode {
             candidates: self.proposals.len(),
         })?;
         let report = self.touch_toward(candidate)?;
-        self.attempts += report.readings.len();
         self.last_attempt = report.readings.last().cloned();
-        let touch = match report.readings.into_iter().find(Reading::is_converged) {
-            Some(reading) => Some(self.observe(reading)?),
-            None => None,
-        };
+        // The first converged reading is the touch; every other attempt gave the belief nothing
+        // but time for a perturbed object to move.
+        let mut touch = None;
+        for reading in report.readings {
+            if touch.is_none() && reading.is_converged() {
+                touch = Some(self.observe(reading)?);
+            } else {
+                self.recognition
+                    .with_dependent_mut(|_, recognition| recognition.missed());
+            }
+            self.attempts += 1;
+        }
         self.draw_candidates();
         Ok(touch)
     }
@@ -390,7 +397,11 @@ impl TouchEpisode {
             .with_dependent_mut(|_, recognition| recognition.observe(&reading.image))?;
         self.last_image = Some(reading.image.clone());
         self.belief = belief.clone();
-        Ok(Touch { reading, belief })
+        Ok(Touch {
+            reading,
+            belief,
+            attempt: self.attempts,
+        })
     }
 
     fn draw_candidates(&mut self) {

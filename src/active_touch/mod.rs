@@ -345,6 +345,12 @@ impl<'a> ActiveRecognition<'a> {
         Ok(belief)
     }
 
+    /// Counts a touch attempt that gave no reading (the belief of a perturbed object widens by
+    /// one more move before the next reading, `ModelPosterior::missed`).
+    pub fn missed(&mut self) {
+        self.posterior.missed();
+    }
+
     pub fn belief(&self) -> Belief {
         self.posterior.belief()
     }
@@ -390,6 +396,8 @@ pub struct TouchPlan {
 pub struct Touch {
     pub reading: Reading,
     pub belief: Belief,
+    /// Its attempt among the exploration's touch attempts, converged or not (from 0).
+    pub attempt: usize,
 }
 
 /// What [`explore_recognizing`] did.
@@ -454,19 +462,23 @@ where
             candidates,
         });
         let report = planner.explore_guided(scene, object, 1, guidance, &mut || {})?;
+        let first_attempt = run.attempts;
         run.attempts += report.readings.len();
         run.iterations += report.iterations;
-        let mut converged = report
-            .readings
-            .into_iter()
-            .filter(|r| r.is_converged())
-            .peekable();
-        if converged.peek().is_none() {
+        if !report.readings.iter().any(Reading::is_converged) {
             break;
         }
-        for reading in converged {
+        for (attempt, reading) in (first_attempt..).zip(report.readings) {
+            if !reading.is_converged() {
+                recognition.missed();
+                continue;
+            }
             let belief = recognition.observe(&reading.image)?;
-            let touch = Touch { reading, belief };
+            let touch = Touch {
+                reading,
+                belief,
+                attempt,
+            };
             on_touch(&touch);
             trace.push((touch.belief.guess(), max_probability(&touch.belief)));
             let confident = plan.stop_at_confidence.is_some_and(|stop| stop.fires(&trace));

@@ -18,7 +18,7 @@ use serde::{Serialize, Serializer};
 /// | `noise_fraction` | width of the uniform additive noise, fraction of the sensing range, in training and test (Sec. V-B7) | `noise` |
 /// | `training_readings` | training readings per object at scale 1 (`--scale` scales them) | `training-size` |
 /// | `training` | `paper` (sampler readings from every direction) or `reachable` (ours: three times as many, from the starts the arm can reach) | `end-to-end` |
-/// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) | `active` |
+/// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) | `active`, `fusion` |
 /// | `evidence` | what the recogniser weighs: `appearance` (the tactile images' bag of features), `contacts` (where each touch landed, against each object's surface at a pose it is not told) or `fused` (both) | `fusion` |
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Factor {

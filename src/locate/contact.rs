@@ -151,6 +151,20 @@ pub struct Touch {
 }
 
 impl Touch {
+    /// The touch of a reading's `image`, its exploration's `attempt`-th attempt: its contact with
+    /// `noise` added (none when the image has no pad pose).
+    pub fn of_image(
+        image: &TactileImage,
+        sensor: &SensorConfig,
+        noise: &ContactNoise,
+        attempt: usize,
+    ) -> Self {
+        Self {
+            contact: Contact::of_image(image, sensor).map(|c| c.with_noise(noise)),
+            attempt,
+        }
+    }
+
     /// The converged readings of every object of `dataset` (in the header's object order, each
     /// object's readings in order, as recognition takes them) as touches: each one's contact
     /// with `noise` added, and its attempt among all of that object's recorded readings.
@@ -165,10 +179,7 @@ impl Touch {
             let attempt = attempts[j];
             attempts[j] += 1;
             if reading.is_converged() {
-                per_object[j].push(Touch {
-                    contact: Contact::of_image(&reading.image, sensor).map(|c| c.with_noise(noise)),
-                    attempt,
-                });
+                per_object[j].push(Touch::of_image(&reading.image, sensor, noise, attempt));
             }
         }
         per_object

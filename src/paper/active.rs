@@ -35,7 +35,7 @@ use super::recognition::{
 };
 use super::scale::DataCounts;
 use crate::active_touch::{
-    ActiveRecognition, REPORTED_STOPS, TouchPlan, explore_recognizing, reported_stops, stops,
+    ActiveRecognition, REPORTED_STOPS, TouchPlan, TouchRun, explore_recognizing, reported_stops, stops,
 };
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow};
@@ -49,7 +49,7 @@ use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::tidy::{ReadCell, TidyRecord, deserialize_record, serialize_record};
 use crate::experiment::unit::{BoxError, Unit};
 use crate::explore::active::{ConfidenceStop, DEFAULT_CANDIDATES};
-use crate::explore::collect::CollectMode;
+use crate::explore::collect::{CollectMode, CollectPlan};
 use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::recognize::{
     CodebookKind, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig, TrainedModel, Trial, evaluate,
@@ -63,7 +63,7 @@ pub const DESCRIPTION: &str = "Beyond the paper: active touch by expected inform
 const DESCRIPTOR: DescriptorKind = DescriptorKind::PolarFourier;
 
 /// L of the active strategy's proposals: half local, half global candidates.
-const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
+pub(super) const ACTIVE_LOCAL_PROBABILITY: f64 = 0.5;
 
 /// One point of one curve: the columns of an [`AccuracyRow`] (so the accuracy plot and the
 /// headline table read it) and the confidence stop's after them.
@@ -420,7 +420,7 @@ impl ActiveUnit<'_> {
 /// Object `index` explored actively under `plan` (a planner plan) with `model` in the loop: the
 /// features of its converged touches, in order.
 fn active_trial(
-    plan: &crate::explore::collect::CollectPlan,
+    plan: &CollectPlan,
     objects: &Objects,
     index: usize,
     model: &TrainedModel,
@@ -428,35 +428,49 @@ fn active_trial(
     touches: usize,
     neighbourhood_m: f64,
 ) -> Result<Trial, BoxError> {
-    let CollectMode::Planner(config) = plan.mode else {
-        return Err("internal: the active curve's plan is not a planner plan".into());
-    };
     let spec = &objects.specs[index];
     let object = model
         .bag
         .models()
         .object_index(&spec.name)
         .ok_or_else(|| format!("object '{}' is not in the trained model", spec.name))?;
-    let (mut scene, mut planner) = plan.planner_for(spec, index, config)?;
     let mut recognition = ActiveRecognition::new(model, neighbourhood_m)?;
-    let run = explore_recognizing(
-        &mut planner,
-        &mut scene,
-        &spec.name,
-        &mut recognition,
-        TouchPlan {
-            budget: touches,
-            active_candidates: Some(DEFAULT_CANDIDATES),
-            stop_at_confidence: None,
-        },
-        &mut |_| {},
-    )?;
+    let run = explore_actively(plan, objects, index, &mut recognition, touches)?;
     let readings = run
         .touches
         .iter()
         .map(|t| descriptor.describe(&t.reading.image))
         .collect();
     Ok(Trial { object, readings })
+}
+
+/// Object `index` of `objects` explored under `plan` (a planner plan: its start, sensor, random
+/// streams and perturbation) by the active strategy, `recognition` in the loop scoring
+/// [`DEFAULT_CANDIDATES`] candidates per iteration, until `touches` converged touches (no stop).
+pub(super) fn explore_actively(
+    plan: &CollectPlan,
+    objects: &Objects,
+    index: usize,
+    recognition: &mut ActiveRecognition<'_>,
+    touches: usize,
+) -> Result<TouchRun, BoxError> {
+    let CollectMode::Planner(config) = plan.mode else {
+        return Err("internal: the active curve's plan is not a planner plan".into());
+    };
+    let spec = &objects.specs[index];
+    let (mut scene, mut planner) = plan.planner_for(spec, index, config)?;
+    Ok(explore_recognizing(
+        &mut planner,
+        &mut scene,
+        &spec.name,
+        recognition,
+        TouchPlan {
+            budget: touches,
+            active_candidates: Some(DEFAULT_CANDIDATES),
+            stop_at_confidence: None,
+        },
+        &mut |_| {},
+    )?)
 }
 
 /// The rows of one curve: accuracy and reliability as every recognition figure defines them

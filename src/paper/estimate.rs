@@ -28,12 +28,13 @@ const REFERENCE_SCALES: [f64; 3] = [0.05, 0.2, 1.0];
 /// Wall seconds of each experiment at the [`REFERENCE_SCALES`] on the reference machine (seed 1,
 /// the built-in sets, each experiment's own codebook; `reproduce` one experiment after another
 /// into an empty folder, so datasets shared between experiments were collected by the first one
-/// that needed them; docs/benchmarks.md has the runs). The 1.0 column is the shipped
-/// `results/timings.csv` (2026-12-02, a slow day: the fifteen experiments before `fusion` took
-/// 1,134 s, 1,007 s on 2026-11-29), the 0.2 column a run of 2026-11-29, the 0.05 column a run of
+/// that needed them; docs/benchmarks.md has the runs). The 1.0 column is the run of 2026-12-02
+/// (a slow day: the fifteen experiments before `fusion` took 1,134 s, 1,007 s on 2026-11-29), the 0.2 column a run of 2026-11-29, the 0.05 column a run of
 /// the same day (`reproduce --scale 0.05`: 132 s in all, where a power law through 0.2 and 1.0 said
-/// 45 s); `fusion`'s 0.05 and 0.2 are runs of it alone on 2026-12-02, its sampler datasets
-/// collected by itself.
+/// 45 s); `fusion`'s are its runs with the active curves on 2026-12-03 (0.05 and 0.2 alone, its
+/// sampler datasets collected by itself: 36.2 s and 89.7 s; 1.0 in the shipped run, 406.2 s) at
+/// 2026-12-02's pace, x 0.72, the ratio of the fifteen other experiments' 1,134 s that day to their
+/// 1,576 s in the shipped run.
 /// A single experiment run on its own also collects the datasets an earlier one would have
 /// shared: at small scales it takes longer than its share here.
 const REFERENCE_SECONDS: [(&str, [f64; 3]); 16] = [
@@ -52,7 +53,7 @@ const REFERENCE_SECONDS: [(&str, [f64; 3]); 16] = [
     ("training-size", [21.0, 35.0, 187.4]),
     ("active", [16.4, 15.3, 69.4]),
     ("end-to-end", [1.5, 3.8, 27.6]),
-    ("fusion", [23.7, 51.1, 191.6]),
+    ("fusion", [26.1, 64.6, 292.5]),
 ];
 
 /// The estimated wall seconds of experiment `name` at `scale` with `threads` threads; `None` for

@@ -16,6 +16,13 @@
 //! explorations with one kind of evidence (`evidence`), so the three are compared on the same
 //! touches.
 //!
+//! The active curves (`strategy` = `active`) choose each touch with the fused model in the loop:
+//! the planner's candidates scored by expected information gain (`active_touch`, the `active`
+//! experiment's strategy and the demo's, its gain the appearance's), the belief updated after every
+//! touch with both kinds of evidence. They cannot come from a dataset collected beforehand, so they
+//! explore anew under the plans of the blind L = 0.5 test explorations (the same starts, sensor,
+//! random streams and perturbations: common random numbers), as many converged touches as those.
+//!
 //! Besides the accuracy table, `fusion_attempts.csv` counts the same curves in touch attempts
 //! ([`AttemptRow`]): a touch that met nothing, collided or did not settle costs a touch but gives
 //! no reading.
@@ -24,6 +31,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::active::{ACTIVE_LOCAL_PROBABILITY, explore_actively};
 use super::context::{Family, PaperContext};
 use super::data::{DataRequest, Objects};
 use super::figures::{END_TO_END_TRAINING_FRACTION, default_sensor};
@@ -31,6 +39,7 @@ use super::recognition::{
     CALIBRATION_STREAM, CalibratedOn, Setting, SettingData, TEST_STREAM, training_config,
 };
 use super::scale::DataCounts;
+use crate::active_touch::ActiveRecognition;
 use crate::dataset::{Dataset, Perturbed};
 use crate::describe::DescriptorKind;
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, AttemptRow, PerObjectRow, ReliabilityRow};
@@ -38,21 +47,24 @@ use crate::experiment::factor::{Factor, Factors};
 use crate::experiment::layout::ExperimentDir;
 use crate::experiment::name::SafeName;
 use crate::experiment::plot::{Axis, PlotSpec};
+use crate::experiment::progress::Progress;
 use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, DetailRow, Unit};
-use crate::explore::SamplerConfig;
+use crate::explore::active::DEFAULT_CANDIDATES;
+use crate::explore::collect::CollectPlan;
+use crate::explore::{PlannerConfig, SamplerConfig};
 use crate::locate::{ContactNoise, GeometryModel, GeometryParams};
 use crate::mesh::TriMesh;
 use crate::pose::StartPose;
 use crate::recognize::{
     Appearance, CodebookKind, DescriptorChoice, Evidence, FusedModel, GeometricFusion, PosteriorRule,
-    ReadingRange, ReliabilityTable, TouchReading, TrainConfig, Trial,
+    ReadingRange, Recognizer, ReliabilityTable, TouchReading, TrainConfig, Trial,
 };
 use crate::sim::PerturbationBounds;
 
 pub const EXPERIMENT_NAME: &str = "fusion";
-pub const DESCRIPTION: &str = "Beyond the paper: appearance, contact geometry and their fusion (MNTI+SIFT; 3D set at random start poses, blind L = 0.5 and 1, fixed and perturbed), against readings and touch attempts";
+pub const DESCRIPTION: &str = "Beyond the paper: appearance, contact geometry and their fusion (MNTI+SIFT; 3D set at random start poses, blind L = 0.5 and 1 and the fused model's active touch, fixed and perturbed), against readings and touch attempts";
 
 /// The appearance descriptors: the product's recipe (`taction train --descriptor mnti+sift`).
 const DESCRIPTORS: [DescriptorKind; 2] = [DescriptorKind::Mnti, DescriptorKind::Sift];
@@ -67,12 +79,21 @@ const LOCAL_PROBABILITIES: [f64; 2] = [0.5, 1.0];
 const MOVING_CALIBRATION_L: f64 = 0.5;
 
 /// The legend's name of a curve.
-const CURVE_LABEL: &str = "{evidence} L={local_probability} {object_motion}";
+const CURVE_LABEL: &str = "{evidence} {strategy} L={local_probability} {object_motion}";
 
-/// A curve's levels: the `evidence` weighed, L = `local_probability`, the object `motion`.
-fn levels(evidence: Evidence, local_probability: f64, motion: &str) -> Factors {
+/// The `strategy` level of the planner's random local or global moves.
+const BLIND: &str = "blind";
+
+/// The `strategy` level of the planner's candidates scored by expected information gain, the
+/// fused model in the loop (`active_touch`).
+const ACTIVE: &str = "active";
+
+/// A curve's levels: the `evidence` weighed, the `strategy` that chose the touches, L =
+/// `local_probability` (of the active strategy's proposals), the object `motion`.
+fn levels(evidence: Evidence, strategy: &str, local_probability: f64, motion: &str) -> Factors {
     Factors::new([
         (Factor::Evidence, evidence.name().to_string()),
+        (Factor::Strategy, strategy.to_string()),
         (Factor::LocalProbability, local_probability.to_string()),
         (Factor::ObjectMotion, motion.to_string()),
     ])
@@ -116,6 +137,31 @@ struct FusionCalibration {
     trial_readings: usize,
 }
 
+/// How the active curves explore, as `config.json` records them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+struct FusionActive {
+    /// L of the active strategy's proposals, and of the blind test explorations whose plans
+    /// (starts, sensor, random streams, perturbations) the active ones share.
+    local_probability: f64,
+    candidates: usize,
+    /// Readings nearer than this to a candidate discount its appearance gain (`active_touch`).
+    neighbourhood_m: f64,
+    /// What the gain scores: a touch's `appearance` (the product's default, `taction demo
+    /// --gain`); the belief it starts from is the fused one.
+    gain: &'static str,
+}
+
+impl FusionActive {
+    fn new() -> Self {
+        Self {
+            local_probability: ACTIVE_LOCAL_PROBABILITY,
+            candidates: DEFAULT_CANDIDATES,
+            neighbourhood_m: PlannerConfig::default().grid_cell_m,
+            gain: "appearance",
+        }
+    }
+}
+
 /// Everything the rows depend on, written as the run's `config.json`.
 #[derive(Serialize)]
 struct FusionConfig<'a> {
@@ -123,6 +169,7 @@ struct FusionConfig<'a> {
     descriptor: String,
     evidence: Vec<&'static str>,
     local_probabilities: [f64; 2],
+    active: FusionActive,
     start_pose: StartPose,
     geometry: GeometryParams,
     contact_noise: ContactNoise,
@@ -172,6 +219,7 @@ pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
         descriptor: choice.name(),
         evidence: EVIDENCE.iter().map(Evidence::name).collect(),
         local_probabilities: LOCAL_PROBABILITIES,
+        active: FusionActive::new(),
         start_pose,
         geometry: GeometryParams {
             max_heading: objects.set.start_heading(),
@@ -196,7 +244,7 @@ pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
         "Accuracy against touch attempts (converged or not)",
         Axis::new("n_attempts", "touch attempts per object"),
         vec![Axis::new("accuracy", "accuracy")],
-        &["evidence", "local_probability", "object_motion"],
+        &["evidence", "strategy", "local_probability", "object_motion"],
     )
     .with_legend(CURVE_LABEL);
     attempts.table = AttemptRow::TABLE.map(SafeName::new).transpose()?;
@@ -338,10 +386,11 @@ impl FusionUnit<'_> {
     }
 
     /// The model, then each (L, motion)'s test explorations, described once, recognised with each
-    /// evidence.
+    /// evidence; then the active curves, on the plans of the L = 0.5 explorations.
     fn rows(&self) -> Result<Rows, BoxError> {
         let model = self.model()?;
         let mut rows: Rows = Default::default();
+        let mut active_plans = Vec::new();
         for (l, motion, requests) in self.tests()? {
             let mut tests = Vec::new();
             for request in &requests {
@@ -357,15 +406,96 @@ impl FusionUnit<'_> {
             }
             for evidence in EVIDENCE {
                 let judge = model.clone().with_evidence(evidence);
-                let (accuracy, (per_object, reliability, attempts)) =
-                    self.curve_rows(&judge, &levels(evidence, l, motion), &tests)?;
-                rows.0.extend(accuracy);
-                rows.1.0.extend(per_object);
-                rows.1.1.extend(reliability);
-                rows.1.2.extend(attempts);
+                extend(
+                    &mut rows,
+                    self.curve_rows(&judge, &levels(evidence, BLIND, l, motion), &tests)?,
+                );
+            }
+            if l == ACTIVE_LOCAL_PROBABILITY {
+                let plans = requests.iter().zip(&tests).map(|(r, t)| (r.plan, t.motion));
+                active_plans.push((motion, plans.collect::<Vec<_>>()));
             }
         }
+        let fused = model.with_evidence(Evidence::Fused);
+        for (motion, tests) in self.active_tests(&fused, &active_plans)? {
+            let factors = levels(Evidence::Fused, ACTIVE, ACTIVE_LOCAL_PROBABILITY, motion);
+            extend(&mut rows, self.curve_rows(&fused, &factors, &tests)?);
+        }
         Ok(rows)
+    }
+
+    /// The active curves' explorations: for each motion's `plans` (those of its blind test
+    /// explorations, one per trial), every object explored actively with `model` in the loop,
+    /// as many converged touches as a blind test run. All of them share one pass over the pool
+    /// ([`crate::queue`]), the perturbed ones (the longer) first, as the `active` experiment's.
+    fn active_tests<'m>(
+        &self,
+        model: &GeometricFusion,
+        plans: &[(&'m str, Vec<(CollectPlan, Perturbed)>)],
+    ) -> Result<Vec<(&'m str, Vec<TestRun>)>, BoxError> {
+        let objects = &self.objects;
+        let recognizer = Recognizer::Geometric(Box::new(model.clone()));
+        let descriptors = model.descriptors()?;
+        let active = FusionActive::new();
+        let jobs: Vec<(usize, usize, usize)> = (0..plans.len())
+            .rev()
+            .flat_map(|s| {
+                (0..plans[s].1.len()).flat_map(move |t| (0..objects.specs.len()).map(move |o| (s, t, o)))
+            })
+            .collect();
+        // The curves are part of the run's one unit, saved when whole: the bar says how far.
+        let progress = Progress::new("active touch (fused)", jobs.len(), "objects explored");
+        let explored = crate::queue::run_in_order(jobs.len(), |i| -> Result<_, BoxError> {
+            let (s, t, o) = jobs[i];
+            let (plan, motion) = &plans[s].1[t];
+            let name = &objects.specs[o].name;
+            let object = model
+                .objects()
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| format!("object '{name}' is not in the fused model"))?;
+            let mut recognition = ActiveRecognition::of(&recognizer, active.neighbourhood_m, *motion)?;
+            let run = explore_actively(
+                plan,
+                objects,
+                o,
+                &mut recognition,
+                self.data.counts.test_per_object,
+            )?;
+            let readings = run
+                .touches
+                .iter()
+                .map(|t| model.touch_reading(&descriptors, &t.reading.image, t.attempt))
+                .collect();
+            let mut converged = vec![false; run.attempts];
+            for touch in &run.touches {
+                converged[touch.attempt] = true;
+            }
+            progress.inc();
+            Ok((Trial { object, readings }, converged))
+        })?;
+        progress.finish(explored.len());
+        let mut explored = jobs.iter().zip(explored);
+        let mut curves: Vec<(&str, Vec<TestRun>)> = Vec::new();
+        for (motion, motion_plans) in plans.iter().rev() {
+            let mut tests = Vec::new();
+            for (plan, perturbed) in motion_plans {
+                let (trials, attempts) = explored
+                    .by_ref()
+                    .take(objects.specs.len())
+                    .map(|(_, e)| e)
+                    .unzip();
+                tests.push(TestRun {
+                    stream_seed: plan.seed,
+                    motion: *perturbed,
+                    trials,
+                    attempts,
+                });
+            }
+            curves.push((motion, tests));
+        }
+        curves.reverse();
+        Ok(curves)
     }
 
     /// One curve: `model` recognising each test exploration (one repetition per dataset, each
@@ -414,6 +544,14 @@ impl FusionUnit<'_> {
     }
 }
 
+/// Appends one curve's rows to the unit's.
+fn extend(rows: &mut Rows, (accuracy, (per_object, reliability, attempts)): Rows) {
+    rows.0.extend(accuracy);
+    rows.1.0.extend(per_object);
+    rows.1.1.extend(reliability);
+    rows.1.2.extend(attempts);
+}
+
 /// One test exploration, described: each object's readings with their touches, and each object's
 /// attempts (whether each converged), in the same order.
 struct TestRun {
@@ -450,20 +588,29 @@ mod tests {
 
     #[test]
     fn every_curve_has_the_same_factor_columns_and_a_level_of_each() {
-        let mut names = std::collections::BTreeSet::new();
-        for evidence in EVIDENCE {
-            for l in LOCAL_PROBABILITIES {
-                for (motion, _) in object_states() {
-                    let factors = levels(evidence, l, motion);
-                    factors.check().unwrap_or_else(|e| panic!("{e}"));
-                    assert_eq!(
-                        factors.factors().collect::<Vec<_>>(),
-                        [Factor::Evidence, Factor::LocalProbability, Factor::ObjectMotion]
-                    );
-                    names.insert(factors.to_string());
+        let mut curves = Vec::new();
+        for (motion, _) in object_states() {
+            for evidence in EVIDENCE {
+                for l in LOCAL_PROBABILITIES {
+                    curves.push(levels(evidence, BLIND, l, motion));
                 }
             }
+            curves.push(levels(Evidence::Fused, ACTIVE, ACTIVE_LOCAL_PROBABILITY, motion));
         }
-        assert_eq!(names.len(), 12, "twelve distinct curves");
+        let mut names = std::collections::BTreeSet::new();
+        for factors in &curves {
+            factors.check().unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(
+                factors.factors().collect::<Vec<_>>(),
+                [
+                    Factor::Evidence,
+                    Factor::Strategy,
+                    Factor::LocalProbability,
+                    Factor::ObjectMotion
+                ]
+            );
+            names.insert(factors.to_string());
+        }
+        assert_eq!(names.len(), 14, "fourteen distinct curves");
     }
 }

@@ -19,7 +19,7 @@
 //! | `training-size` | beyond | training readings per object (100, 300, 1000, 3000, 10,000) |
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //! | `end-to-end` | beyond | the arm's blind touches recognised by the paper's training and ours (L, fixed/perturbed) |
-//! | `fusion` | beyond | appearance, contact geometry and their fusion at random start poses (L, fixed/perturbed), against readings and touch attempts (`fusion.rs`) |
+//! | `fusion` | beyond | appearance, contact geometry and their fusion at random start poses (blind L and the fused model's active touch, fixed/perturbed), against readings and touch attempts (`fusion.rs`) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` (`data.rs`, [`read_shortfalls`]).

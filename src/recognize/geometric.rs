@@ -33,7 +33,7 @@ use crate::recognize::model::{MODEL_FORMAT_VERSION, TrainedModel, check_version,
 use crate::recognize::object_model::guess_of;
 use crate::recognize::posterior::{EvidenceWeights, FusedPosterior, GeometricPosterior, TouchReading};
 use crate::recognize::trial::Trial;
-use crate::tactile::SensorConfig;
+use crate::tactile::{SensorConfig, TactileImage};
 
 /// The weights of the geometric evidence tried when fitting (`lambda`, the module docs); 0 is
 /// appearance alone, so the fit can never do worse on its calibration data than appearance.
@@ -430,6 +430,7 @@ impl GeometricFusion {
             contact_noise: self.contact_noise,
             sensor: *self.sensor(),
             readings: 0,
+            attempts: 0,
         }
     }
 
@@ -440,6 +441,22 @@ impl GeometricFusion {
             .iter()
             .map(|m| m.build_descriptor())
             .collect()
+    }
+
+    /// A reading of an exploration made with the model in the loop, as [`trials`](Self::trials)
+    /// takes a recorded one: `image` described by every appearance model (`descriptors`, from
+    /// [`descriptors`](Self::descriptors)), its touch the exploration's `attempt`-th.
+    pub(crate) fn touch_reading(
+        &self,
+        descriptors: &[Box<dyn Descriptor>],
+        image: &TactileImage,
+        attempt: usize,
+    ) -> TouchReading {
+        let features = descriptors.iter().map(|d| d.describe(image)).collect();
+        (
+            features,
+            Touch::of_image(image, self.sensor(), &self.contact_noise, attempt),
+        )
     }
 
     /// The model file's contents.

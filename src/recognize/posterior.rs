@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use crate::describe::{Descriptor, Feature};
-use crate::locate::{Contact, ContactNoise, GainOf, GeometryPosterior, Touch};
+use crate::locate::{ContactNoise, GainOf, GeometryPosterior, Touch};
 use crate::recognize::RecognizeError;
 use crate::recognize::bag::BagOfFeatures;
 use crate::recognize::calibration::Tempering;
@@ -263,7 +263,7 @@ impl<'a> ModelPosterior<'a> {
             Beliefs::Geometric(p) => {
                 let touch = Touch {
                     contact: None,
-                    attempt: p.readings(),
+                    attempt: p.attempts,
                 };
                 p.observe(&(features.to_vec(), touch))
             }
@@ -293,6 +293,14 @@ impl<'a> ModelPosterior<'a> {
         }
     }
 
+    /// Counts a touch attempt that gave no reading: only a model that weighs contacts keeps
+    /// count, since a perturbed object moved after it ([`GeometricPosterior::missed`]).
+    pub fn missed(&mut self) {
+        if let Beliefs::Geometric(p) = &mut self.beliefs {
+            p.missed();
+        }
+    }
+
     /// Readings observed so far.
     pub fn readings(&self) -> usize {
         match &self.beliefs {
@@ -319,6 +327,10 @@ pub struct GeometricPosterior<'a> {
     pub(crate) contact_noise: ContactNoise,
     pub(crate) sensor: SensorConfig,
     pub(crate) readings: usize,
+    /// Touch attempts so far, converged or not: an object perturbed after every attempt
+    /// (Sec. V-B4) moves between two readings as often as attempts were made between them, so the
+    /// pose beliefs widen by that many moves (`locate::Track`).
+    pub(crate) attempts: usize,
 }
 
 impl GeometricPosterior<'_> {
@@ -328,16 +340,20 @@ impl GeometricPosterior<'_> {
         self.appearance.observe(features)?;
         self.geometry.observe(*touch);
         self.readings += 1;
+        self.attempts = self.attempts.max(touch.attempt + 1);
         Ok(self.belief())
     }
 
-    /// The touch of `image`, the `readings`-th reading of its exploration: its contact, with the
-    /// model's noise (none when the image has no pad pose).
+    /// Counts a touch attempt that gave no reading (it met nothing, collided or did not settle):
+    /// the next reading's touch is one attempt later.
+    pub fn missed(&mut self) {
+        self.attempts += 1;
+    }
+
+    /// The touch of `image`, the next attempt of its exploration: its contact, with the model's
+    /// noise (none when the image has no pad pose).
     pub fn touch_of(&self, image: &TactileImage) -> Touch {
-        Touch {
-            contact: Contact::of_image(image, &self.sensor).map(|c| c.with_noise(&self.contact_noise)),
-            attempt: self.readings,
-        }
+        Touch::of_image(image, &self.sensor, &self.contact_noise, self.attempts)
     }
 
     /// `A + lambda G` for every object (or one part alone, `recognize::Evidence`).
