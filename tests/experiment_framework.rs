@@ -11,7 +11,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use taction::dataset::parse_real_csv;
-use taction::dataset::{Normalisation, RealImport, import_real_csv};
+use taction::dataset::{FramePlace, Normalisation, RealImport, import_real_csv};
 use taction::experiment::build_figure;
 use taction::experiment::{
     AccuracyCurve, AccuracyRow, Axis, DetailRow, DetailTables, Experiment, ExperimentError, ExperimentSpec,
@@ -1224,7 +1224,8 @@ fn the_example_file_imports_and_splits() {
         ["A", "E", "I", "O", "U"]
     );
     assert_eq!(
-        data.readings[0].line, 5,
+        data.readings[0].place,
+        FramePlace::Line(5),
         "three comment lines and the header come first"
     );
     let max = data.readings.iter().map(|r| r.image.max()).fold(0.0, f64::max);
@@ -1240,12 +1241,12 @@ fn the_example_file_imports_and_splits() {
         (split.train.len(), split.validation.len(), split.test.len()),
         (20, 10, 10)
     );
-    let lines: BTreeSet<u64> = split
+    let lines: BTreeSet<String> = split
         .train
         .iter()
         .chain(&split.validation)
         .chain(&split.test)
-        .map(|r| r.line)
+        .map(|r| r.place.to_string())
         .collect();
     assert_eq!(lines.len(), 40, "disjoint and complete");
     assert_eq!(
@@ -1312,10 +1313,7 @@ fn malformed_real_csvs_name_the_line() {
         ("label,r0c0,r1c1\n", "expected r0c1"),
         ("label,r0c0,x\n", "'x' is not r<row>c<col>"),
         ("label,r0c0,r0c1,r1c0\n", "do not fill a 2x2 grid"),
-        (
-            "label,r0c0,r0c1,r1c0,r1c1\n",
-            "a 2x2 sensor; accepted are 4 to 32",
-        ),
+        ("label,r0c0,r0c1\n", "a 1x2 sensor; accepted are 2 to 128"),
     ];
     for (bad, needle) in header_cases {
         let e = parse_real_csv(&format!("# c\n{bad}A,1,2,3\n"), "f.csv", &opts)
@@ -1362,7 +1360,10 @@ fn import_normalises_by_the_file_maximum_or_the_range() {
     let data = parse_real_csv(&text, "t", &RealImport::default()).unwrap();
     assert_eq!(&data.readings[0].image.values()[..2], &[0.0, 0.25]);
     assert_eq!(&data.readings[1].image.values()[..2], &[1.0, 0.5]);
-    assert_eq!((data.readings[1].label.as_str(), data.readings[1].line), ("B", 3));
+    assert_eq!(
+        (data.readings[1].label.as_str(), &data.readings[1].place),
+        ("B", &FramePlace::Line(3))
+    );
     assert_eq!("max".parse::<Normalisation>(), Ok(Normalisation::FileMax));
     assert_eq!("400".parse::<Normalisation>(), Ok(Normalisation::Range(400.0)));
     assert!(

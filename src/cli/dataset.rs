@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use taction::dataset::{Calibration, RealImport, import_real_csv};
+use taction::dataset::{Calibration, RealImport, import_real, import_real_csv};
 use taction::dataset::{Dataset, DatasetError, ExportFormat};
 use taction::paper::RealFramesOptions;
 use taction::paper::recorded_dataset;
@@ -56,10 +56,13 @@ pub struct ExportArgs {
 /// images (the same flags as `experiment real-frames`).
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Recorded frames. CSV: a header `label,r0c0,r0c1,...` naming every taxel of a rows x cols
-    /// grid (4x4 to 32x32), then one frame per line: its label, then one non-negative raw value
-    /// per taxel; `#` lines are comments. Values are divided by the file's largest value.
-    #[arg(value_name = "FRAMES.csv")]
+    /// Recorded frames of a rows x cols grid (2 to 128 taxels a side), as a CSV, a folder of class
+    /// folders of images or an .npz. CSV: a header `label,r0c0,r0c1,...` naming every taxel, then
+    /// one frame per line: its label, then one non-negative raw value per taxel; `#` lines are
+    /// comments. Folder: one folder per label, each image (PNG 8/16-bit or JPEG 8-bit grayscale)
+    /// one frame. npz: arrays `frames` (N, rows, cols) and `labels` (N strings or integers).
+    /// Values are divided by the largest one.
+    #[arg(value_name = "FRAMES")]
     pub frames: PathBuf,
     /// The dataset to write.
     #[arg(long, value_name = "DATASET.csv")]
@@ -123,7 +126,7 @@ fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
         .map(Calibration::read)
         .transpose()
         .map_err(|e| format!("--calibration: {e}"))?;
-    let real = import_real_csv(
+    let real = import_real(
         &args.frames,
         &RealImport {
             calibration,

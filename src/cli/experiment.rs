@@ -44,7 +44,7 @@ pub struct PaperArgs {
     pub letters: Vec<PathBuf>,
     /// Recorded real frames for the sim-to-real and real-frames experiments [default: the shipped
     /// synthetic example]. CSV: a header `label,r0c0,r0c1,...` naming every taxel of a rows x cols
-    /// grid (4x4 to 32x32), then one frame per line: its label, then one non-negative raw value
+    /// grid (2x2 to 128x128), then one frame per line: its label, then one non-negative raw value
     /// per taxel; `#` lines are comments. Frames of the wrong size or with non-finite values are
     /// rejected with their line number. Values are divided by the file's largest value.
     #[arg(long, value_name = "CSV")]

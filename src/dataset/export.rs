@@ -25,7 +25,6 @@
 //! float32, every pose column float64 even where the object never moved, `iterations` int64).
 
 use std::fmt;
-use std::io::{Cursor, Write};
 use std::path::Path;
 use std::str::FromStr;
 use std::sync::Arc;
@@ -37,11 +36,10 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 use parquet::file::writer::{SerializedColumnWriter, SerializedFileWriter};
 use parquet::schema::types::{Type as SchemaType, TypePtr};
-use zip::write::SimpleFileOptions;
-use zip::{CompressionMethod, ZipWriter};
 
 use crate::atomic::write_atomic;
 use crate::dataset::format::{Meta, column_names};
+use crate::dataset::npy::{Npy, npz_bytes};
 use crate::dataset::{Dataset, DatasetError, Reading};
 
 /// A format [`Dataset::export`] writes.
@@ -159,102 +157,7 @@ fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::Zip
         ("touched_bodies", text(Meta::TouchedBodies)),
         ("header", Npy::unicode(vec![], &[header_json.to_string()])),
     ];
-    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
-    for (name, array) in arrays {
-        let bytes = array.to_bytes();
-        let options = SimpleFileOptions::default()
-            .compression_method(CompressionMethod::Deflated)
-            .large_file(bytes.len() >= u32::MAX as usize);
-        zip.start_file(format!("{name}.npy"), options)?;
-        zip.write_all(&bytes)?;
-    }
-    Ok(zip.finish()?.into_inner())
-}
-
-/// One array of an `.npz`: its NPY dtype (`descr`), shape (C order), and little-endian data.
-#[derive(Debug, Clone, PartialEq)]
-struct Npy {
-    descr: String,
-    shape: Vec<usize>,
-    data: Vec<u8>,
-}
-
-impl Npy {
-    fn f4(shape: Vec<usize>, values: impl IntoIterator<Item = f32>) -> Self {
-        let data = values.into_iter().flat_map(f32::to_le_bytes).collect();
-        Self {
-            descr: "<f4".into(),
-            shape,
-            data,
-        }
-    }
-
-    fn f8(shape: Vec<usize>, values: impl IntoIterator<Item = f64>) -> Self {
-        let data = values.into_iter().flat_map(f64::to_le_bytes).collect();
-        Self {
-            descr: "<f8".into(),
-            shape,
-            data,
-        }
-    }
-
-    fn i8(shape: Vec<usize>, values: impl IntoIterator<Item = i64>) -> Self {
-        let data = values.into_iter().flat_map(i64::to_le_bytes).collect();
-        Self {
-            descr: "<i8".into(),
-            shape,
-            data,
-        }
-    }
-
-    /// Fixed-width unicode `<U{width}`, the longest text's length in characters (at least 1, as
-    /// numpy makes it): UTF-32LE, each text padded with NULs, so no pickle is needed to load it.
-    fn unicode(shape: Vec<usize>, texts: &[String]) -> Self {
-        let width = texts.iter().map(|t| t.chars().count()).max().unwrap_or(0).max(1);
-        let mut data = Vec::with_capacity(4 * width * texts.len());
-        for text in texts {
-            data.extend(text.chars().flat_map(|c| u32::from(c).to_le_bytes()));
-            data.resize(data.len() + 4 * (width - text.chars().count()), 0);
-        }
-        Self {
-            descr: format!("<U{width}"),
-            shape,
-            data,
-        }
-    }
-
-    /// The NPY 1.0 header: magic `\x93NUMPY`, version 1.0, the dict's length (u16 LE), then the
-    /// dict as numpy writes it, padded with spaces and a newline so the data starts at a multiple
-    /// of 64 bytes (numpy's own padding rule, so the bytes equal `numpy.save`'s).
-    fn header(&self) -> Vec<u8> {
-        let shape = match self.shape.as_slice() {
-            [n] => format!("({n},)"),
-            dims => format!(
-                "({})",
-                dims.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
-            ),
-        };
-        let mut dict = format!(
-            "{{'descr': '{}', 'fortran_order': False, 'shape': {shape}, }}",
-            self.descr
-        );
-        const PREFIX: usize = 10;
-        let padding = 64 - (PREFIX + dict.len() + 1) % 64;
-        dict.extend(std::iter::repeat_n(' ', padding));
-        dict.push('\n');
-        let mut header = b"\x93NUMPY\x01\x00".to_vec();
-        // A dict of one dtype and a shape of at most three numbers is far below u16::MAX.
-        header.extend((dict.len() as u16).to_le_bytes());
-        header.extend(dict.as_bytes());
-        header
-    }
-
-    /// The `.npy` file: [`header`](Self::header), then the data.
-    fn to_bytes(&self) -> Vec<u8> {
-        let mut bytes = self.header();
-        bytes.extend(&self.data);
-        bytes
-    }
+    npz_bytes(arrays)
 }
 
 /// The one type of a dataset column in every export and in pandas (module docs).

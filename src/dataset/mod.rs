@@ -12,10 +12,13 @@
 //! alike. The file format is in `format.rs`, its export as npz or Parquet in `export.rs`
 //! ([`Dataset::export`]); the counts `dataset show` prints in `summary.rs`; the
 //! recorded frames of a real sensor, and their import as a dataset (`dataset import`), in
-//! `recorded.rs` ([`import_real_csv`]).
+//! `recorded.rs` ([`import_real_csv`]) and, kept as image folders or `.npz`, `frame_files.rs`
+//! ([`import_real`]); numpy's array format, both ways, in `npy.rs`.
 
 mod export;
 mod format;
+mod frame_files;
+pub(crate) mod npy;
 mod reading;
 pub(crate) mod recorded;
 mod status;
@@ -34,9 +37,10 @@ pub use export::{ColumnType, ExportFormat, ExportFormatError, column_types};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.
+pub use frame_files::{import_real, import_real_images, import_real_npz};
 pub use recorded::{
-    Calibration, Normalisation, RealData, RealImport, RealReading, SYNTHETIC_MARK, import_real_csv,
-    parse_real_csv,
+    Calibration, FramePlace, Normalisation, RealData, RealDataError, RealImport, RealReading, SYNTHETIC_MARK,
+    import_real_csv, parse_real_csv,
 };
 
 use std::fmt;

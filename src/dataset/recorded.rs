@@ -25,8 +25,10 @@
 //!   shipped `data/real_letters_example.csv`): [`RealData::synthetic`], so that plots of them do not
 //!   speak of a real sensor.
 //!
-//! Sensors of [`MIN_TAXELS_PER_SIDE`] to [`MAX_TAXELS_PER_SIDE`] taxels per side are accepted (the
-//! paper's PPS sensor is 6x6; Sec. V-C compares 6x6 to 26x26).
+//! Sensors of [`MIN_TAXELS_PER_SIDE`] to [`MAX_TAXELS_PER_SIDE`] taxels per side are accepted,
+//! square or not (the paper's PPS sensor is 6x6; Sec. V-C compares 6x6 to 26x26; arrays on
+//! grippers are often 16x16 to 44x44, or 28x50). Frames kept as a folder of class folders of
+//! images or as an `.npz` are read by `frame_files.rs` into the same [`RealData`].
 //!
 //! When a per-taxel [`Calibration`] is given, every raw value `v` of taxel `(i, j)` first becomes
 //! `gain(i, j) * (v - offset(i, j))`, clamped at 0 (a taxel reading below its no-load offset
@@ -51,6 +53,7 @@
 //! and non-negative, `offset` finite, both in raw units of the recording.
 
 use std::collections::BTreeSet;
+use std::fmt;
 use std::ops::RangeInclusive;
 use std::path::Path;
 
@@ -91,10 +94,12 @@ impl std::str::FromStr for Normalisation {
     }
 }
 
-/// The smallest sensor side accepted, in taxels.
-pub const MIN_TAXELS_PER_SIDE: usize = 4;
-/// The largest sensor side accepted, in taxels.
-pub const MAX_TAXELS_PER_SIDE: usize = 32;
+/// The smallest sensor side accepted, in taxels: a 2x2 grid still has a centre of pressure and a
+/// spread, what every descriptor needs.
+pub const MIN_TAXELS_PER_SIDE: usize = 2;
+/// The largest sensor side accepted, in taxels: large resistive and capacitive arrays on grippers
+/// (32x32, 44x44, 28x50) fit with room to spare.
+pub const MAX_TAXELS_PER_SIDE: usize = 128;
 /// The accepted sensor sides, in taxels.
 pub const TAXELS_PER_SIDE: RangeInclusive<usize> = MIN_TAXELS_PER_SIDE..=MAX_TAXELS_PER_SIDE;
 
@@ -263,12 +268,33 @@ fn parse_taxel_name(name: &str) -> Option<(usize, usize)> {
     Some((r.parse().ok()?, c.parse().ok()?))
 }
 
+/// Where in its source a frame came from, as messages name it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FramePlace {
+    /// A line of a frames CSV (1-based).
+    Line(u64),
+    /// The index of a frame in an `.npz`'s frames array (0-based, as numpy indexes it).
+    Frame(usize),
+    /// An image file of a folder of class folders, as a path below that folder (`A/003.png`).
+    Image(String),
+}
+
+impl fmt::Display for FramePlace {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Line(line) => write!(f, "line {line}"),
+            Self::Frame(index) => write!(f, "frame {index}"),
+            Self::Image(path) => f.write_str(path),
+        }
+    }
+}
+
 /// One imported frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RealReading {
     pub label: String,
-    /// The line of the file it came from (1-based).
-    pub line: u64,
+    /// Where in the source it came from.
+    pub place: FramePlace,
     /// Values normalised to [0, 1]; no pad pose (a recording has none).
     pub image: TactileImage,
 }
@@ -345,14 +371,30 @@ impl RealData {
         Dataset::new(header, readings)
     }
 
+    /// Recorded frames of a `grid` from any source, checked ([`checked_frame`]) and in source
+    /// order, normalised ([`normalised`]).
+    pub(crate) fn recorded(
+        raw: Vec<RawFrame>,
+        grid: (usize, usize),
+        options: &RealImport,
+        origin: &str,
+    ) -> Result<Self, RealDataError> {
+        Ok(Self {
+            rows: grid.0,
+            cols: grid.1,
+            readings: normalised(raw, grid, options, origin)?,
+            synthetic: false,
+        })
+    }
+
     /// The distinct labels, sorted.
     pub fn labels(&self) -> BTreeSet<&str> {
         self.readings.iter().map(|r| r.label.as_str()).collect()
     }
 
-    /// The line of the first frame labelled `label`, for messages about the label.
-    pub fn first_line_of(&self, label: &str) -> Option<u64> {
-        self.readings.iter().find(|r| r.label == label).map(|r| r.line)
+    /// Where the first frame labelled `label` came from, for messages about the label.
+    pub fn first_place_of(&self, label: &str) -> Option<&FramePlace> {
+        self.readings.iter().find(|r| r.label == label).map(|r| &r.place)
     }
 }
 
@@ -363,6 +405,14 @@ pub enum RealDataError {
     Io { origin: String, source: std::io::Error },
     #[error("{origin}: line {line}: {what}")]
     Invalid { origin: String, line: u64, what: String },
+    #[error("{origin}: {at}: {what}")]
+    Frame {
+        origin: String,
+        at: FramePlace,
+        what: String,
+    },
+    #[error("{origin}: {what}")]
+    Source { origin: String, what: String },
     #[error("{origin}: line {line}: bad header: {what}")]
     Header { origin: String, line: u64, what: String },
     #[error("{origin}: no header line (label,r0c0,...)")]
@@ -376,12 +426,12 @@ pub enum RealDataError {
         rows: usize,
         cols: usize,
     },
-    #[error("{origin}: line {line}: empty label")]
-    EmptyLabel { origin: String, line: u64 },
-    #[error("{origin}: line {line}: unknown label '{label}' (allowed: {allowed})")]
+    #[error("{origin}: {at}: empty label")]
+    EmptyLabel { origin: String, at: FramePlace },
+    #[error("{origin}: {at}: unknown label '{label}' (allowed: {allowed})")]
     UnknownLabel {
         origin: String,
-        line: u64,
+        at: FramePlace,
         label: String,
         allowed: String,
     },
@@ -392,24 +442,24 @@ pub enum RealDataError {
         column: String,
         text: String,
     },
-    #[error("{origin}: line {line}: column {column}: {value} is not finite")]
+    #[error("{origin}: {at}: column {column}: {value} is not finite")]
     NotFinite {
         origin: String,
-        line: u64,
+        at: FramePlace,
         column: String,
         value: f64,
     },
-    #[error("{origin}: line {line}: column {column}: {value} is negative")]
+    #[error("{origin}: {at}: column {column}: {value} is negative")]
     Negative {
         origin: String,
-        line: u64,
+        at: FramePlace,
         column: String,
         value: f64,
     },
-    #[error("{origin}: line {line}: column {column}: {value} exceeds the range {range}")]
+    #[error("{origin}: {at}: column {column}: {value} exceeds the range {range}")]
     AboveRange {
         origin: String,
-        line: u64,
+        at: FramePlace,
         column: String,
         value: f64,
         range: f64,
@@ -455,22 +505,20 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
             origin: origin.to_string(),
         });
     };
-    let readings = normalised(raw, (rows, cols), options, origin)?;
     let synthetic = text
         .lines()
         .any(|line| line.trim_start().starts_with(SYNTHETIC_MARK));
     Ok(RealData {
-        rows,
-        cols,
-        readings,
         synthetic,
+        ..RealData::recorded(raw, (rows, cols), options, origin)?
     })
 }
 
-/// One frame as read: its label, its line and its calibrated values, not yet normalised.
-struct RawFrame {
+/// One frame as read: its label, where it came from and its calibrated values, not yet
+/// normalised.
+pub(crate) struct RawFrame {
     label: String,
-    line: u64,
+    place: FramePlace,
     values: Vec<f64>,
 }
 
@@ -482,19 +530,23 @@ fn calibrated_header(
     options: &RealImport,
 ) -> Result<(usize, usize, Vec<String>), RealDataError> {
     let parsed = parse_header(record, line, origin)?;
-    if let Some(calibration) = &options.calibration
-        && (calibration.rows, calibration.cols) != (parsed.0, parsed.1)
-    {
-        return Err(RealDataError::Header {
-            origin: origin.to_string(),
-            line,
-            what: format!(
-                "the frames are {}x{} taxels but the calibration {} is {}x{}",
-                parsed.0, parsed.1, calibration.origin, calibration.rows, calibration.cols
-            ),
-        });
-    }
+    check_calibration_grid((parsed.0, parsed.1), options).map_err(|what| RealDataError::Header {
+        origin: origin.to_string(),
+        line,
+        what,
+    })?;
     Ok(parsed)
+}
+
+/// The calibration, when there is one, is of the frames' `grid`.
+pub(crate) fn check_calibration_grid(grid: (usize, usize), options: &RealImport) -> Result<(), String> {
+    match &options.calibration {
+        Some(calibration) if (calibration.rows, calibration.cols) != grid => Err(format!(
+            "the frames are {}x{} taxels but the calibration {} is {}x{}",
+            grid.0, grid.1, calibration.origin, calibration.rows, calibration.cols
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// A frame line of a `rows x cols` grid with taxel columns `names`: a known, non-empty label and
@@ -518,11 +570,43 @@ fn parse_frame(
             cols: *cols,
         });
     }
-    let label = record[0].to_string();
+    let values = record[1..]
+        .iter()
+        .zip(names)
+        .map(|(text, column)| {
+            text.parse().map_err(|_| RealDataError::NotANumber {
+                origin: origin.to_string(),
+                line,
+                column: column.clone(),
+                text: text.to_string(),
+            })
+        })
+        .collect::<Result<Vec<f64>, _>>()?;
+    checked_frame(
+        record[0].to_string(),
+        FramePlace::Line(line),
+        values,
+        *cols,
+        options,
+        origin,
+    )
+}
+
+/// One frame of raw values (row-major, `cols` a row) as read from any source: a known, non-empty
+/// label, and every value finite, calibrated, not negative and within the range when one is
+/// given.
+pub(crate) fn checked_frame(
+    label: String,
+    place: FramePlace,
+    mut values: Vec<f64>,
+    cols: usize,
+    options: &RealImport,
+    origin: &str,
+) -> Result<RawFrame, RealDataError> {
     if label.is_empty() {
         return Err(RealDataError::EmptyLabel {
             origin: origin.to_string(),
-            line,
+            at: place,
         });
     }
     if let Some(allowed) = &options.allowed_labels
@@ -531,72 +615,73 @@ fn parse_frame(
         let allowed = allowed.iter().cloned().collect::<Vec<_>>().join(", ");
         return Err(RealDataError::UnknownLabel {
             origin: origin.to_string(),
-            line,
+            at: place,
             label,
             allowed,
         });
     }
-    let values = record[1..]
-        .iter()
-        .zip(names)
-        .enumerate()
-        .map(|(k, (text, column))| parse_value(k, text, column, line, options, origin))
-        .collect::<Result<Vec<f64>, _>>()?;
-    Ok(RawFrame { label, line, values })
+    for (k, value) in values.iter_mut().enumerate() {
+        *value = checked_value(k, *value, options).map_err(|problem| {
+            let (origin, at, column) = (origin.to_string(), place.clone(), taxel_name(k, cols));
+            match problem {
+                ValueProblem::NotFinite(value) => RealDataError::NotFinite {
+                    origin,
+                    at,
+                    column,
+                    value,
+                },
+                ValueProblem::Negative(value) => RealDataError::Negative {
+                    origin,
+                    at,
+                    column,
+                    value,
+                },
+                ValueProblem::AboveRange(value, range) => RealDataError::AboveRange {
+                    origin,
+                    at,
+                    column,
+                    value,
+                    range,
+                },
+            }
+        })?;
+    }
+    Ok(RawFrame { label, place, values })
 }
 
-/// Taxel `k`'s value `text` (column `column`): a finite number, calibrated, not negative, and
-/// within the range when one is given.
-fn parse_value(
-    k: usize,
-    text: &str,
-    column: &str,
-    line: u64,
-    options: &RealImport,
-    origin: &str,
-) -> Result<f64, RealDataError> {
-    let column = column.to_string();
-    let raw: f64 = text.parse().map_err(|_| RealDataError::NotANumber {
-        origin: origin.to_string(),
-        line,
-        column: column.clone(),
-        text: text.to_string(),
-    })?;
+/// The name of taxel `k` of a grid `cols` wide: `r<row>c<col>`, as the CSV header names it.
+fn taxel_name(k: usize, cols: usize) -> String {
+    format!("r{}c{}", k / cols.max(1), k % cols.max(1))
+}
+
+/// What is wrong with one raw value.
+enum ValueProblem {
+    NotFinite(f64),
+    Negative(f64),
+    AboveRange(f64, f64),
+}
+
+/// Taxel `k`'s `raw` value: finite, calibrated, not negative, and within the range when one is
+/// given.
+fn checked_value(k: usize, raw: f64, options: &RealImport) -> Result<f64, ValueProblem> {
     if !raw.is_finite() {
-        return Err(RealDataError::NotFinite {
-            origin: origin.to_string(),
-            line,
-            column,
-            value: raw,
-        });
+        return Err(ValueProblem::NotFinite(raw));
     }
     let value = match &options.calibration {
         Some(calibration) => calibration.apply(k, raw),
         None => raw,
     };
     if value < 0.0 {
-        return Err(RealDataError::Negative {
-            origin: origin.to_string(),
-            line,
-            column,
-            value,
-        });
+        return Err(ValueProblem::Negative(value));
     }
-    if let Normalisation::Range(range) = options.normalisation
-        && value > range
-    {
-        return Err(RealDataError::AboveRange {
-            origin: origin.to_string(),
-            line,
-            column,
-            value,
-            range,
-        });
+    match options.normalisation {
+        Normalisation::Range(range) if value > range => Err(ValueProblem::AboveRange(value, range)),
+        _ => Ok(value),
     }
-    Ok(value)
 }
 
-/// The frames divided by the range, or by the file's largest value: images in [0, 1].
+/// The frames of a `grid` divided by the range, or by the source's largest value: images in
+/// [0, 1].
 fn normalised(
     raw: Vec<RawFrame>,
     grid: (usize, usize),
@@ -622,15 +707,16 @@ fn normalised(
     }
     let (rows, cols) = grid;
     raw.into_iter()
-        .map(|RawFrame { label, line, values }| {
+        .map(|RawFrame { label, place, values }| {
             let values = values.into_iter().map(|v| v / scale).collect();
-            TactileImage::new(rows, cols, values)
-                .map(|image| RealReading { label, line, image })
-                .map_err(|e| RealDataError::Invalid {
+            match TactileImage::new(rows, cols, values) {
+                Ok(image) => Ok(RealReading { label, place, image }),
+                Err(e) => Err(RealDataError::Frame {
                     origin: origin.to_string(),
-                    line,
+                    at: place,
                     what: e.to_string(),
-                })
+                }),
+            }
         })
         .collect()
 }
@@ -680,12 +766,19 @@ fn parse_header(
             cells.len()
         )));
     }
-    if !(TAXELS_PER_SIDE.contains(&rows) && TAXELS_PER_SIDE.contains(&cols)) {
-        return Err(bad(format!(
-            "a {rows}x{cols} sensor; accepted are {MIN_TAXELS_PER_SIDE} to {MAX_TAXELS_PER_SIDE} taxels per side"
-        )));
-    }
+    check_grid(rows, cols).map_err(bad)?;
     Ok((rows, cols, names))
+}
+
+/// A recording's grid is `rows x cols` taxels, each side within [`TAXELS_PER_SIDE`].
+pub(crate) fn check_grid(rows: usize, cols: usize) -> Result<(), String> {
+    if TAXELS_PER_SIDE.contains(&rows) && TAXELS_PER_SIDE.contains(&cols) {
+        Ok(())
+    } else {
+        Err(format!(
+            "a {rows}x{cols} sensor; accepted are {MIN_TAXELS_PER_SIDE} to {MAX_TAXELS_PER_SIDE} taxels per side"
+        ))
+    }
 }
 
 /// The lines of a CSV text that carry data, as (1-based line number, trimmed comma-separated

@@ -196,9 +196,9 @@ impl PaperContext {
             }
             .ok_or_else(|| {
                 format!(
-                    "{}: line {}: label '{label}' names no letter (labels are single letters such as 'A' or names such as 'upper_A')",
+                    "{}: {}: label '{label}' names no letter (labels are single letters such as 'A' or names such as 'upper_A')",
                     self.real.origin,
-                    real.first_line_of(label).unwrap_or(0)
+                    real.first_place_of(label).map_or_else(String::new, ToString::to_string)
                 )
             })?;
             // A letter the set lacks is drawn like the set's other letters.

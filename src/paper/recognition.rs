@@ -809,8 +809,8 @@ fn real_trials(
     for reading in &real.readings {
         let j = objects.iter().position(|o| *o == reading.label).ok_or_else(|| {
             format!(
-                "line {}: label '{}' is not a trained object",
-                reading.line, reading.label
+                "{}: label '{}' is not a trained object",
+                reading.place, reading.label
             )
         })?;
         per_object[j].push(descriptor.describe(&preprocess.apply(&reading.image)));

@@ -1,0 +1,276 @@
+//! Recorded frames as users keep them (`dataset::frame_files`): folders of class folders of PNG and
+//! JPEG images and numpy's `.npz`, made here or by numpy and Pillow themselves (the fixtures in
+//! `tests/frame_files/`), read into the frames they hold; non-square and large grids imported
+//! whole and every descriptor defined on them; malformed inputs named.
+
+use std::path::Path;
+use std::process::Command;
+
+use taction::dataset::{Dataset, FramePlace, RealData, RealImport, import_real};
+use taction::describe::DescriptorKind;
+use taction::tactile::TactileImage;
+
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/frame_files");
+
+/// Writes a grayscale PNG of `rows x cols` pixels, 8 or 16 bit.
+fn write_png(path: &Path, rows: usize, cols: usize, pixels: &[u16], sixteen: bool) {
+    let file = std::fs::File::create(path).expect("creates the image");
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), cols as u32, rows as u32);
+    encoder.set_color(png::ColorType::Grayscale);
+    let data: Vec<u8> = if sixteen {
+        encoder.set_depth(png::BitDepth::Sixteen);
+        pixels.iter().flat_map(|p| p.to_be_bytes()).collect()
+    } else {
+        encoder.set_depth(png::BitDepth::Eight);
+        pixels.iter().map(|&p| p as u8).collect()
+    };
+    let mut writer = encoder.write_header().expect("a header");
+    writer.write_image_data(&data).expect("the pixels");
+}
+
+fn import(path: &Path) -> Result<RealData, String> {
+    import_real(path, &RealImport::default()).map_err(|e| e.to_string())
+}
+
+/// A pixel value of frame `f` at taxel `k`, below 2^16.
+fn pixel(f: usize, k: usize) -> u16 {
+    ((f * 7919 + k * 104_729) % 60_000) as u16
+}
+
+#[test]
+fn a_folder_of_class_folders_imports_every_image_whole() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let root = dir.path().join("frames");
+    // A 28 x 50 array (rows x cols), 16 bit, two labels of two frames; a README at the top and a
+    // hidden file are skipped.
+    let (rows, cols) = (28, 50);
+    for (label, frames) in [("pawn", [0, 1]), ("mug", [2, 3])] {
+        std::fs::create_dir_all(root.join(label)).expect("a class folder");
+        for f in frames {
+            let pixels: Vec<u16> = (0..rows * cols).map(|k| pixel(f, k)).collect();
+            write_png(
+                &root.join(label).join(format!("{f:04}.png")),
+                rows,
+                cols,
+                &pixels,
+                true,
+            );
+        }
+    }
+    std::fs::write(root.join("README.txt"), "how the frames were taken").expect("writes");
+    std::fs::write(root.join("mug").join(".DS_Store"), "").expect("writes");
+    let data = import(&root).expect("imports");
+    assert_eq!(
+        (data.rows, data.cols),
+        (rows, cols),
+        "not cropped, not transposed"
+    );
+    let labels: Vec<&str> = data.readings.iter().map(|r| r.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        ["mug", "mug", "pawn", "pawn"],
+        "labels then files in name order"
+    );
+    assert_eq!(data.readings[0].place, FramePlace::Image("mug/0002.png".into()));
+    let max = (0..4)
+        .flat_map(|f| (0..rows * cols).map(move |k| pixel(f, k)))
+        .max()
+        .map_or(1.0, f64::from);
+    for (reading, f) in data.readings.iter().zip([2, 3, 0, 1]) {
+        for k in [0, cols - 1, cols, rows * cols - 1] {
+            let expected = f64::from(pixel(f, k)) / max;
+            assert_eq!(
+                reading.image.get(k / cols, k % cols),
+                expected,
+                "frame {f} taxel {k}"
+            );
+        }
+    }
+    // 8-bit PNGs and an 8-bit JPEG (Pillow's, the fixture) read as their pixels.
+    let small = dir.path().join("small");
+    std::fs::create_dir_all(small.join("a")).expect("a class folder");
+    std::fs::create_dir_all(small.join("b")).expect("a class folder");
+    let ramp: Vec<u16> = (0..8 * 16).map(|k| (k % 16 * 10) as u16).collect();
+    write_png(&small.join("a/ramp.png"), 8, 16, &ramp, false);
+    std::fs::copy(
+        Path::new(FIXTURES).join("two_tone_8x16.jpg"),
+        small.join("b/two_tone.JPG"),
+    )
+    .expect("copies");
+    let data = import(&small).expect("imports");
+    assert_eq!((data.rows, data.cols), (8, 16));
+    let (ramp, jpeg) = (&data.readings[0].image, &data.readings[1].image);
+    assert_eq!(
+        ramp.get(3, 15),
+        150.0 / 200.0,
+        "the largest value is the JPEG's 200"
+    );
+    assert_eq!((jpeg.get(0, 0), jpeg.get(7, 7)), (50.0 / 200.0, 50.0 / 200.0));
+    assert_eq!((jpeg.get(0, 8), jpeg.get(7, 15)), (1.0, 1.0));
+}
+
+#[test]
+fn an_npz_from_numpy_imports_as_its_frames() {
+    // numpy.savez(frames=arange(30, dtype=int16).reshape(2, 3, 5), labels=['mug', 'pawn']), and
+    // savez_compressed of the same values as big-endian float64 in Fortran order with the labels
+    // 7 and 11.
+    let plain = import(&Path::new(FIXTURES).join("numpy_2x3x5.npz")).expect("imports");
+    let fortran = import(&Path::new(FIXTURES).join("numpy_fortran_2x3x5.npz")).expect("imports");
+    for (data, labels) in [(&plain, ["mug", "pawn"]), (&fortran, ["7", "11"])] {
+        assert_eq!((data.rows, data.cols), (3, 5));
+        let got: Vec<&str> = data.readings.iter().map(|r| r.label.as_str()).collect();
+        assert_eq!(got, labels);
+        assert_eq!(data.readings[1].place, FramePlace::Frame(1));
+        for (f, reading) in data.readings.iter().enumerate() {
+            for k in 0..15 {
+                let expected = (15 * f + k) as f64 / 29.0;
+                assert_eq!(reading.image.get(k / 5, k % 5), expected, "frame {f} taxel {k}");
+            }
+        }
+    }
+    let pickled = import(&Path::new(FIXTURES).join("numpy_pickled_labels.npz")).unwrap_err();
+    assert!(
+        pickled.contains("numpy_pickled_labels.npz") && pickled.contains("pickle"),
+        "{pickled}"
+    );
+}
+
+/// Runs `taction args`, which must succeed.
+fn taction(args: &[&str]) {
+    let output = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args(args)
+        .output()
+        .expect("the taction binary runs");
+    assert!(
+        output.status.success(),
+        "taction {args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+#[test]
+fn a_44x44_recording_round_trips_through_export_and_import() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let side = 44;
+    let names: Vec<String> = (0..side * side)
+        .map(|k| format!("r{}c{}", k / side, k % side))
+        .collect();
+    let mut csv = format!("label,{}\n", names.join(","));
+    for f in 0..6 {
+        let label = if f % 2 == 0 { "cup" } else { "key" };
+        let values: Vec<String> = (0..side * side)
+            .map(|k| {
+                // A pressed blob, so that the frames count as contacts.
+                let (r, c) = ((k / side) as f64 - 20.0, (k % side) as f64 - 22.0 + f as f64);
+                format!("{:.0}", 1000.0 * (-(r * r + c * c) / 50.0).exp())
+            })
+            .collect();
+        csv.push_str(&format!("{label},{}\n", values.join(",")));
+    }
+    let frames = dir.path().join("frames.csv");
+    std::fs::write(&frames, csv).expect("writes");
+    let (first, npz, second) = (
+        dir.path().join("first.csv"),
+        dir.path().join("first.npz"),
+        dir.path().join("second.csv"),
+    );
+    let path = |p: &Path| p.to_str().expect("a UTF-8 path").to_string();
+    taction(&["dataset", "import", &path(&frames), "--out", &path(&first)]);
+    taction(&[
+        "dataset",
+        "export",
+        &path(&first),
+        "--format",
+        "npz",
+        "--out",
+        &path(&npz),
+    ]);
+    taction(&["dataset", "import", &path(&npz), "--out", &path(&second)]);
+    let (a, b) = (
+        Dataset::read(&first).expect("reads"),
+        Dataset::read(&second).expect("reads"),
+    );
+    assert_eq!((a.header().sensor.rows, a.header().sensor.cols), (side, side));
+    assert_eq!(a.readings().len(), 6);
+    for (x, y) in a.readings().iter().zip(b.readings()) {
+        assert_eq!((&x.object, x.status), (&y.object, y.status));
+        // The export keeps float32 images; the largest of them is 1 again, so they come back.
+        for (u, v) in x.image.values().iter().zip(y.image.values()) {
+            assert!((u - v).abs() <= 1e-7, "{u} against {v}");
+        }
+    }
+}
+
+#[test]
+fn malformed_frames_are_named_not_imported() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let folder = |name: &str, files: &[(&str, usize, usize)]| {
+        let root = dir.path().join(name);
+        for (file, rows, cols) in files {
+            let path = root.join(file);
+            std::fs::create_dir_all(path.parent().expect("a class folder")).expect("creates");
+            if file.ends_with(".png") {
+                write_png(&path, *rows, *cols, &vec![9; rows * cols], false);
+            } else {
+                std::fs::write(&path, "not an image").expect("writes");
+            }
+        }
+        root
+    };
+    let mixed = folder("mixed", &[("a/1.png", 4, 6), ("b/1.png", 6, 4)]);
+    let e = import(&mixed).unwrap_err();
+    assert!(e.contains("b/1.png") && e.contains("but a/1.png is 4x6"), "{e}");
+    let text = folder("text", &[("a/1.png", 4, 6), ("a/notes.txt", 0, 0)]);
+    let e = import(&text).unwrap_err();
+    assert!(e.contains("a/notes.txt") && e.contains("not an image"), "{e}");
+    let fake = folder("fake", &[("a/1.png", 4, 6)]);
+    std::fs::write(fake.join("a/2.png"), "no png").expect("writes");
+    let e = import(&fake).unwrap_err();
+    assert!(e.contains("a/2.png") && e.contains("not a readable PNG"), "{e}");
+    let empty = folder("empty", &[("a/1.png", 4, 6)]);
+    std::fs::create_dir_all(empty.join("b")).expect("creates");
+    let e = import(&empty).unwrap_err();
+    assert!(e.contains("class folder 'b' holds no image"), "{e}");
+    let colour = folder("colour", &[("a/1.png", 8, 8)]);
+    std::fs::copy(Path::new(FIXTURES).join("colour_8x8.jpg"), colour.join("a/2.jpg")).expect("copies");
+    let e = import(&colour).unwrap_err();
+    assert!(e.contains("a/2.jpg") && e.contains("grayscale"), "{e}");
+    let thin = folder("thin", &[("a/1.png", 1, 6)]);
+    let e = import(&thin).unwrap_err();
+    assert!(e.contains("a 1x6 sensor; accepted are 2 to 128"), "{e}");
+    let none = dir.path().join("none");
+    std::fs::create_dir_all(&none).expect("creates");
+    assert!(import(&none).unwrap_err().contains("no class folders"));
+    let npy = dir.path().join("frames.npy");
+    std::fs::write(&npy, "x").expect("writes");
+    assert!(import(&npy).unwrap_err().contains("numpy.savez"));
+}
+
+#[test]
+fn every_descriptor_describes_any_grid_it_imports() {
+    for (rows, cols) in [(2, 2), (2, 7), (28, 50), (50, 28), (44, 44), (128, 128)] {
+        let values: Vec<f64> = (0..rows * cols)
+            .map(|k| {
+                let (r, c) = (
+                    (k / cols) as f64 / rows as f64 - 0.5,
+                    (k % cols) as f64 / cols as f64 - 0.4,
+                );
+                (-(r * r + c * c) * 8.0).exp()
+            })
+            .collect();
+        let image = TactileImage::new(rows, cols, values).expect("an image");
+        for kind in DescriptorKind::ALL {
+            let features = kind.build().describe(&image);
+            assert!(!features.is_empty(), "{kind:?} on {rows}x{cols}: no feature");
+            let length = features[0].len();
+            assert!(length > 0, "{kind:?} on {rows}x{cols}: an empty feature");
+            for feature in &features {
+                assert_eq!(feature.len(), length, "{kind:?} on {rows}x{cols}");
+                assert!(
+                    feature.iter().all(|v| v.is_finite()),
+                    "{kind:?} on {rows}x{cols}: {feature:?}"
+                );
+            }
+        }
+    }
+}
