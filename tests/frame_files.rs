@@ -274,3 +274,65 @@ fn every_descriptor_describes_any_grid_it_imports() {
         }
     }
 }
+
+/// Runs `experiment real-frames --real <frames> --trials 1` and returns its accuracy CSV.
+fn real_frames_csv(frames: &Path, out: &Path) -> Vec<u8> {
+    let path = |p: &Path| p.to_str().expect("a UTF-8 path").to_string();
+    taction(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        &path(frames),
+        "--trials",
+        "1",
+        "--out",
+        &path(out),
+    ]);
+    std::fs::read(out.join("real-frames/real-frames.csv")).expect("the experiment's CSV")
+}
+
+#[test]
+fn the_real_frames_experiment_reads_a_folder_of_images_as_the_same_frames_in_a_csv() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let (rows, cols) = (6, 6);
+    let names: Vec<String> = (0..rows * cols)
+        .map(|k| format!("r{}c{}", k / cols, k % cols))
+        .collect();
+    let mut csv = format!("label,{}\n", names.join(","));
+    let images = dir.path().join("images");
+    for (label, shape) in [("bar", 0usize), ("cross", 1)] {
+        std::fs::create_dir_all(images.join(label)).expect("a class folder");
+        for f in 0..14 {
+            let pixels: Vec<u16> = (0..rows * cols)
+                .map(|k| {
+                    let (r, c) = (k / cols, k % cols);
+                    let pressed = if shape == 0 {
+                        r == 2 || r == 3
+                    } else {
+                        r == 2 || c == 3
+                    };
+                    if pressed {
+                        900 + (f * 13 + k) as u16 % 50
+                    } else {
+                        (f + k) as u16 % 30
+                    }
+                })
+                .collect();
+            write_png(
+                &images.join(label).join(format!("{f:02}.png")),
+                rows,
+                cols,
+                &pixels,
+                true,
+            );
+            let values: Vec<String> = pixels.iter().map(u16::to_string).collect();
+            csv.push_str(&format!("{label},{}\n", values.join(",")));
+        }
+    }
+    let text = dir.path().join("frames.csv");
+    std::fs::write(&text, csv).expect("writes");
+    let from_csv = real_frames_csv(&text, &dir.path().join("from-csv"));
+    let from_images = real_frames_csv(&images, &dir.path().join("from-images"));
+    assert!(!from_csv.is_empty());
+    assert_eq!(from_csv, from_images, "the same frames, the same results");
+}

@@ -43,11 +43,13 @@ pub struct PaperArgs {
     #[arg(long, num_args = 1.., default_value = "letters", value_name = "SET")]
     pub letters: Vec<PathBuf>,
     /// Recorded real frames for the sim-to-real and real-frames experiments [default: the shipped
-    /// synthetic example]. CSV: a header `label,r0c0,r0c1,...` naming every taxel of a rows x cols
-    /// grid (2x2 to 128x128), then one frame per line: its label, then one non-negative raw value
-    /// per taxel; `#` lines are comments. Frames of the wrong size or with non-finite values are
-    /// rejected with their line number. Values are divided by the file's largest value.
-    #[arg(long, value_name = "CSV")]
+    /// synthetic example], of a rows x cols grid (2x2 to 128x128). CSV: a header
+    /// `label,r0c0,r0c1,...` naming every taxel, then one frame per line: its label, then one
+    /// non-negative raw value per taxel; `#` lines are comments. Or a folder of class folders of
+    /// grayscale PNG/JPEG images, or an .npz of `frames` and `labels` (as `dataset import` takes
+    /// them). Frames of the wrong size or with non-finite values are rejected with their line,
+    /// frame or file. Values are divided by the largest value.
+    #[arg(long, value_name = "FRAMES")]
     pub real: Option<PathBuf>,
     /// Per-taxel calibration of `--real`, applied on import as gain * (raw - offset), clamped at 0.
     /// CSV: a header `taxel,gain,offset`, then one line per taxel (`r0c0,1.02,13`), every taxel of

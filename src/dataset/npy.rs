@@ -263,9 +263,12 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
     };
     let (descr, fortran_order, shape) = parse_header(header)?;
     let dtype = Dtype::parse(&descr)?;
-    let count: usize = shape.iter().product();
+    // A corrupt header can name a shape no memory holds: its size is checked, not wrapped.
+    let expected = shape
+        .iter()
+        .try_fold(dtype.size(), |n, &d| n.checked_mul(d))
+        .ok_or_else(|| NpyError::Header(format!("shape {shape:?} is larger than any memory")))?;
     let data = &bytes[start + header_len..];
-    let expected = count * dtype.size();
     if data.len() != expected {
         return Err(NpyError::Length {
             shape,
@@ -495,6 +498,11 @@ mod tests {
                 got: 16
             })
         );
+        let huge = npy(
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (4294967296, 4294967296), }",
+            &[0; 8],
+        );
+        assert!(matches!(parse_npy(&huge), Err(NpyError::Header(_))));
         let half = npy(
             "{'descr': '<f2', 'fortran_order': False, 'shape': (1,), }",
             &[0; 2],

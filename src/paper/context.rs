@@ -10,6 +10,7 @@ use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
 use serde::Serialize;
 
+use crate::dataset::import_real;
 use crate::dataset::recorded::{Calibration, RealData, RealImport, parse_real_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
@@ -22,13 +23,22 @@ use crate::recognize::{CodebookKind, PosteriorRule};
 /// the sim-to-real experiment's default input, so that its whole path runs without a recording.
 pub const EXAMPLE_REAL_CSV: &str = include_str!("../../data/real_letters_example.csv");
 
-/// A recording of real sensor frames: its CSV text and where it came from.
+/// A recording of real sensor frames: its frames and where they came from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RealRecording {
     pub origin: String,
-    pub text: String,
+    pub frames: RealFrames,
     /// Per-taxel gain and offset applied on import.
     pub calibration: Option<Calibration>,
+}
+
+/// How a recording's frames are kept.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RealFrames {
+    /// A frames CSV's text (`dataset::recorded`).
+    Csv(String),
+    /// A folder of class folders of images or an `.npz` (`dataset::import_real`), read when needed.
+    Kept(std::path::PathBuf),
 }
 
 impl RealRecording {
@@ -36,16 +46,22 @@ impl RealRecording {
     pub fn example() -> Self {
         Self {
             origin: "data/real_letters_example.csv (built in)".into(),
-            text: EXAMPLE_REAL_CSV.into(),
+            frames: RealFrames::Csv(EXAMPLE_REAL_CSV.into()),
             calibration: None,
         }
     }
 
+    /// The recording at `path`: a frames CSV, a folder of class folders of images, or an `.npz`.
     pub fn read(path: &std::path::Path) -> Result<Self, BoxError> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let kept = path.is_dir() || path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"));
+        let frames = if kept {
+            RealFrames::Kept(path.to_path_buf())
+        } else {
+            RealFrames::Csv(std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
+        };
         Ok(Self {
             origin: path.display().to_string(),
-            text,
+            frames,
             calibration: None,
         })
     }
@@ -158,14 +174,14 @@ impl PaperContext {
     /// The real recording, calibrated when it has a calibration, normalised to the sensing range by
     /// its largest value.
     pub fn real_data(&self) -> Result<Arc<RealData>, BoxError> {
-        Ok(Arc::new(parse_real_csv(
-            &self.real.text,
-            &self.real.origin,
-            &RealImport {
-                calibration: self.real.calibration.clone(),
-                ..RealImport::default()
-            },
-        )?))
+        let options = RealImport {
+            calibration: self.real.calibration.clone(),
+            ..RealImport::default()
+        };
+        Ok(Arc::new(match &self.real.frames {
+            RealFrames::Csv(text) => parse_real_csv(text, &self.real.origin, &options)?,
+            RealFrames::Kept(path) => import_real(path, &options)?,
+        }))
     }
 
     /// The letters the recording's labels name, each named by its label: a label is a single

@@ -46,7 +46,7 @@ use std::path::PathBuf;
 
 // A run of the paper's experiments: its context (objects, recordings, scale) and the shared data
 // under `<out>/data`; the time it will take; the headline table `reproduce` prints.
-pub use context::{EXAMPLE_REAL_CSV, Family, PaperContext, RealRecording};
+pub use context::{EXAMPLE_REAL_CSV, Family, PaperContext, RealFrames, RealRecording};
 pub use data::{SHORTFALLS_FILE, read_shortfalls};
 pub use estimate::{PACE_AFTER_S, REFERENCE_THREADS, RunEstimate, human_duration};
 pub use headline::{HEADLINE_READINGS, headline_table};
