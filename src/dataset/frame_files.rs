@@ -39,22 +39,32 @@ use crate::dataset::recorded::{
 /// The image files a class folder may hold, by extension (any case).
 const IMAGE_EXTENSIONS: [&str; 3] = ["png", "jpg", "jpeg"];
 
+/// Whether `path` holds a frames CSV (`recorded.rs`) rather than frames kept as [`import_real`]
+/// otherwise reads them: a folder, or a file named `.npz` (or `.npy`, refused with the way round).
+pub fn is_frames_csv(path: &Path) -> bool {
+    !path.is_dir() && numpy_extension(path).is_none()
+}
+
+/// `npz` or `npy` when `path` is named so (any case).
+fn numpy_extension(path: &Path) -> Option<&'static str> {
+    let extension = path.extension()?.to_string_lossy().to_ascii_lowercase();
+    ["npz", "npy"].into_iter().find(|e| *e == extension)
+}
+
 /// Reads recorded frames from `path`: a folder of class folders of images, an `.npz`, or else a
 /// frames CSV (`recorded.rs`).
 pub fn import_real(path: &Path, options: &RealImport) -> Result<RealData, RealDataError> {
-    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
     if path.is_dir() {
-        import_real_images(path, options)
-    } else if extension.as_deref() == Some("npz") {
-        import_real_npz(path, options)
-    } else if extension.as_deref() == Some("npy") {
-        Err(invalid(
+        return import_real_images(path, options);
+    }
+    match numpy_extension(path) {
+        Some("npz") => import_real_npz(path, options),
+        Some(_) => Err(invalid(
             path,
             "an .npy holds one array, the frames without their labels: save both in an .npz, \
              numpy.savez(\"frames.npz\", frames=frames, labels=labels)",
-        ))
-    } else {
-        crate::dataset::recorded::import_real_csv(path, options)
+        )),
+        None => crate::dataset::recorded::import_real_csv(path, options),
     }
 }
 

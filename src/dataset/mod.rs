@@ -37,7 +37,7 @@ pub use export::{ColumnType, ExportFormat, ExportFormatError, column_types};
 pub use summary::DatasetSummary;
 
 // A real sensor's recorded frames, and their import as a dataset.
-pub use frame_files::{import_real, import_real_images, import_real_npz};
+pub use frame_files::{import_real, import_real_images, import_real_npz, is_frames_csv};
 pub use recorded::{
     Calibration, FramePlace, Normalisation, RealData, RealDataError, RealImport, RealReading, SYNTHETIC_MARK,
     import_real_csv, parse_real_csv,

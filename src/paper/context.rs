@@ -10,8 +10,8 @@ use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
 use serde::Serialize;
 
-use crate::dataset::import_real;
 use crate::dataset::recorded::{Calibration, RealData, RealImport, parse_real_csv};
+use crate::dataset::{import_real, is_frames_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
 use crate::mesh::letters::LetterStyle;
@@ -37,7 +37,8 @@ pub struct RealRecording {
 pub enum RealFrames {
     /// A frames CSV's text (`dataset::recorded`).
     Csv(String),
-    /// A folder of class folders of images or an `.npz` (`dataset::import_real`), read when needed.
+    /// Frames kept otherwise (`dataset::import_real`: a folder of class folders of images, an
+    /// `.npz`), read when needed.
     Kept(std::path::PathBuf),
 }
 
@@ -53,11 +54,10 @@ impl RealRecording {
 
     /// The recording at `path`: a frames CSV, a folder of class folders of images, or an `.npz`.
     pub fn read(path: &std::path::Path) -> Result<Self, BoxError> {
-        let kept = path.is_dir() || path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npz"));
-        let frames = if kept {
-            RealFrames::Kept(path.to_path_buf())
-        } else {
+        let frames = if is_frames_csv(path) {
             RealFrames::Csv(std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?)
+        } else {
+            RealFrames::Kept(path.to_path_buf())
         };
         Ok(Self {
             origin: path.display().to_string(),
