@@ -190,6 +190,7 @@ fn rotation_about_the_pad_normal_barely_moves_the_invariant_descriptors_but_move
         DescriptorKind::Sift => 0.15,
         DescriptorKind::Mr8 | DescriptorKind::Mnti => 0.3,
         DescriptorKind::MomentNormalized => 0.4,
+        DescriptorKind::ShapeIndex => 0.3,
     };
     let mut failures = Vec::new();
     for n in [14, 26] {
@@ -340,6 +341,15 @@ fn extremes_give_finite_documented_outputs_at_every_size() {
                     // DC is the largest magnitude of a non-negative image.
                     let dc = full_out[0][0];
                     assert!(dc > 0.0 && full_out[0].iter().all(|&v| v <= dc + 1e-9));
+                }
+                // A flat press: every taxel at the top value, no slope, every curvature 0 (the
+                // shape index of a flat is atan2(0, 0) = 0, the saddle's bin, curvedness bin 0).
+                DescriptorKind::ShapeIndex => {
+                    let f = &full_out[0];
+                    assert_eq!((f[9], f[10], f[11]), (1.0, 1.0, 1.0), "{f:?}");
+                    let scale = &f[12..12 + 46];
+                    assert!((scale[4 * 4] - 1.0).abs() < 1e-12, "{scale:?}");
+                    assert!((scale[32] - 1.0).abs() < 1e-12 && (scale[45] - 1.0).abs() < 1e-12);
                 }
             }
         }

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use taction::dataset::{Dataset, FramePlace, RealData, RealImport, import_real};
+use taction::dataset::{Dataset, FramePlace, PadSize, RealData, RealImport, import_real};
 use taction::describe::DescriptorKind;
 use taction::tactile::TactileImage;
 
@@ -135,8 +135,8 @@ fn an_npz_from_numpy_imports_as_its_frames() {
     );
 }
 
-/// Runs `taction args`, which must succeed.
-fn taction(args: &[&str]) {
+/// Runs `taction args`, which must succeed; its standard output.
+fn taction(args: &[&str]) -> String {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
         .args(args)
         .output()
@@ -146,6 +146,7 @@ fn taction(args: &[&str]) {
         "taction {args:?}: {}",
         String::from_utf8_lossy(&output.stderr)
     );
+    String::from_utf8_lossy(&output.stdout).into_owned()
 }
 
 #[test]
@@ -175,7 +176,19 @@ fn a_44x44_recording_round_trips_through_export_and_import() {
         dir.path().join("second.csv"),
     );
     let path = |p: &Path| p.to_str().expect("a UTF-8 path").to_string();
-    taction(&["dataset", "import", &path(&frames), "--out", &path(&first)]);
+    let with_pitch = taction(&[
+        "dataset",
+        "import",
+        &path(&frames),
+        "--taxel-pitch-m",
+        "0.0015",
+        "--out",
+        &path(&first),
+    ]);
+    assert!(
+        with_pitch.contains("44x44 taxels, pad 66 mm x 66 mm"),
+        "{with_pitch}"
+    );
     taction(&[
         "dataset",
         "export",
@@ -185,12 +198,52 @@ fn a_44x44_recording_round_trips_through_export_and_import() {
         "--out",
         &path(&npz),
     ]);
-    taction(&["dataset", "import", &path(&npz), "--out", &path(&second)]);
+    // Without its pitch the pad's size is recorded as unknown, never made up.
+    let without = taction(&["dataset", "import", &path(&npz), "--out", &path(&second)]);
+    assert!(
+        without.contains("44x44 taxels, pad size unknown") && !without.contains("mm x"),
+        "{without}"
+    );
     let (a, b) = (
         Dataset::read(&first).expect("reads"),
         Dataset::read(&second).expect("reads"),
     );
     assert_eq!((a.header().sensor.rows, a.header().sensor.cols), (side, side));
+    assert_eq!(
+        (a.header().pad_size, b.header().pad_size),
+        (PadSize::Known, PadSize::Unknown)
+    );
+    assert!((a.header().sensor.pad_width_m - 0.066).abs() < 1e-12);
+    let header_line = |p: &Path| {
+        std::fs::read_to_string(p)
+            .expect("reads")
+            .lines()
+            .nth(1)
+            .map(str::to_string)
+    };
+    assert!(!header_line(&first).unwrap_or_default().contains("pad_size"));
+    assert!(
+        header_line(&second)
+            .unwrap_or_default()
+            .contains(r#""pad_size":"unknown""#)
+    );
+    let refused = Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "dataset",
+            "import",
+            &path(&frames),
+            "--taxel-pitch-m",
+            "0.02",
+            "--out",
+        ])
+        .arg(dir.path().join("third.csv"))
+        .output()
+        .expect("the taction binary runs");
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && stderr.contains("--taxel-pitch-m") && stderr.contains("0.0078125"),
+        "{stderr}"
+    );
     assert_eq!(a.readings().len(), 6);
     for (x, y) in a.readings().iter().zip(b.readings()) {
         assert_eq!((&x.object, x.status), (&y.object, y.status));

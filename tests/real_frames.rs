@@ -287,7 +287,7 @@ fn too_few_frames_after_pruning_is_an_error_naming_the_label() {
 }
 
 #[test]
-fn imports_reject_bad_frames_with_their_line_and_accept_4_to_32_taxels() {
+fn imports_reject_bad_frames_with_their_line_and_accept_2_to_128_taxels() {
     let frame = vec!["1"; 36].join(",");
     let header = recording(&[]);
     let short = format!("{header}A,{frame}\nA,1,2,3\n");

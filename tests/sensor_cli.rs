@@ -69,6 +69,54 @@ fn sense_writes_the_reading_as_csv_and_png() {
     assert_eq!(&bytes[1..4], b"PNG");
 }
 
+/// A rectangular pad 16 mm wide and 4 mm high, its centre over the slab's edge at x = 0.03: the
+/// half of its 8 columns (2 mm apart) over the slab read the covering's 0.6, the other half 0,
+/// and both of its rows alike. A square pad of either side would read another image.
+#[test]
+fn a_rectangular_pad_reads_its_width_along_a_row_and_its_height_along_a_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = box_file(dir.path());
+    let csv = dir.path().join("r.csv");
+    let out = sense(&[
+        "--mesh",
+        &mesh,
+        "--pad-center",
+        "0.03,0,0.0004",
+        "--pad-normal",
+        "0,0,-1",
+        "--pad-up",
+        "0,1,0",
+        "--rows",
+        "2",
+        "--cols",
+        "8",
+        "--pad-width-m",
+        "0.016",
+        "--pad-height-m",
+        "0.004",
+        "--thickness-m",
+        "0.001",
+        "--psf-sigma-m",
+        "0",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let image = TactileImage::read_csv(&csv).unwrap();
+    assert_eq!((image.rows(), image.cols()), (2, 8));
+    for row in 0..2 {
+        let values: Vec<f64> = (0..8).map(|col| image.get(row, col)).collect();
+        let on_slab = values.iter().filter(|v| (**v - 0.6).abs() < 1e-6).count();
+        let off_slab = values.iter().filter(|v| v.abs() < 1e-12).count();
+        assert_eq!((on_slab, off_slab), (4, 4), "row {row}: {values:?}");
+        assert_eq!(
+            values[0] == 0.0,
+            values[7] != 0.0,
+            "row {row}: one side each: {values:?}"
+        );
+    }
+}
+
 #[test]
 fn bad_flags_give_one_line_naming_the_flag() {
     let dir = tempfile::tempdir().unwrap();
@@ -92,6 +140,19 @@ fn bad_flags_give_one_line_naming_the_flag() {
         (vec!["--thickness-m", "-0.001", "--out", out_csv], "--thickness-m"),
         (vec!["--noise", "5", "--out", out_csv], "--noise"),
         (vec!["--pad-m", "0", "--out", out_csv], "--pad-m"),
+        (vec!["--pad-width-m", "0", "--out", out_csv], "--pad-width-m"),
+        (vec!["--pad-height-m", "-1", "--out", out_csv], "--pad-height-m"),
+        (
+            vec![
+                "--pad-height-m",
+                "0.002",
+                "--thickness-m",
+                "0.0015",
+                "--out",
+                out_csv,
+            ],
+            "--thickness-m",
+        ),
         (vec!["--pad-up", "0,0,3", "--out", out_csv], "--pad-up"),
         (vec!["--out", "reading.txt"], "--out"),
         (vec!["--pad-center", "1,2", "--out", out_csv], "--pad-center"),

@@ -15,8 +15,9 @@ use crate::array;
 use crate::error::{bad_argument, refused};
 use crate::object::Object;
 
-/// The tactile sensor: `rows x cols` taxels over a square pad `pad_m` wide under a covering
-/// `thickness_m` thick (default 10% of the pad), blurred by a Gaussian point-spread (default
+/// The tactile sensor: `rows x cols` taxels over a square pad `pad_m` wide (or a rectangular
+/// one, `pad_width_m` along a row by `pad_height_m` along a column) under a covering
+/// `thickness_m` thick (default 10% of the pad's shorter side), blurred by a Gaussian point-spread (default
 /// sigma 0.48 t), each taxel averaging `rays_per_taxel` rays, with additive noise `noise` (a
 /// fraction of the range) drawn from `seed`. The defaults are `taction sense`'s (the paper's
 /// 6x6 sensor).
@@ -93,7 +94,7 @@ fn image_dtype(dtype: &Bound<'_, PyAny>) -> PyResult<&'static str> {
 #[pymethods]
 impl Sensor {
     #[new]
-    #[pyo3(signature = (rows=Whole(6), cols=Whole(6), pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=Whole(4), noise=0.0, seed=Whole(1)), text_signature = "(rows=6, cols=6, pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=4, noise=0.0, seed=1)")]
+    #[pyo3(signature = (rows=Whole(6), cols=Whole(6), pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=Whole(4), noise=0.0, seed=Whole(1), pad_width_m=None, pad_height_m=None), text_signature = "(rows=6, cols=6, pad_m=0.012, thickness_m=None, psf_sigma_m=None, rays_per_taxel=4, noise=0.0, seed=1, pad_width_m=None, pad_height_m=None)")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a sensor parameter
     fn new(
         rows: Whole<usize>,
@@ -104,6 +105,8 @@ impl Sensor {
         rays_per_taxel: Whole<usize>,
         noise: f64,
         seed: Whole<u64>,
+        pad_width_m: Option<f64>,
+        pad_height_m: Option<f64>,
     ) -> PyResult<Self> {
         let (Whole(rows), Whole(cols), Whole(rays_per_taxel), Whole(seed)) =
             (rows, cols, rays_per_taxel, seed);
@@ -111,7 +114,14 @@ impl Sensor {
             rays_per_taxel,
             noise_fraction: noise,
             noise_seed: seed,
-            ..SensorConfig::of_square_pad(rows, cols, pad_m, thickness_m, psf_sigma_m)
+            ..SensorConfig::of_pad(
+                rows,
+                cols,
+                pad_width_m.unwrap_or(pad_m),
+                pad_height_m.unwrap_or(pad_m),
+                thickness_m,
+                psf_sigma_m,
+            )
         };
         Ok(Self {
             config: Valid::new(config).map_err(refused)?,
@@ -169,16 +179,14 @@ impl Sensor {
 
     fn __repr__(&self) -> String {
         let c = &*self.config;
+        let pad = if c.is_square_pad() {
+            format!("pad_m={}", c.pad_width_m)
+        } else {
+            format!("pad_width_m={}, pad_height_m={}", c.pad_width_m, c.pad_height_m)
+        };
         format!(
-            "Sensor(rows={}, cols={}, pad_m={}, thickness_m={}, psf_sigma_m={}, rays_per_taxel={}, noise={}, seed={})",
-            c.rows,
-            c.cols,
-            c.pad_width_m,
-            c.thickness_m,
-            c.psf_sigma_m,
-            c.rays_per_taxel,
-            c.noise_fraction,
-            c.noise_seed
+            "Sensor(rows={}, cols={}, {pad}, thickness_m={}, psf_sigma_m={}, rays_per_taxel={}, noise={}, seed={})",
+            c.rows, c.cols, c.thickness_m, c.psf_sigma_m, c.rays_per_taxel, c.noise_fraction, c.noise_seed
         )
     }
 }

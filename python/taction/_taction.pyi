@@ -66,6 +66,8 @@ class Sensor:
         rays_per_taxel: int = 4,
         noise: float = 0.0,
         seed: int = 1,
+        pad_width_m: float | None = None,
+        pad_height_m: float | None = None,
     ) -> Sensor: ...
     @staticmethod
     def _from_config(json: str) -> Sensor: ...

@@ -45,6 +45,25 @@ def test_the_sensor_parameters_shape_the_image(sphere_path):
     assert taction.Sensor().read(sphere, lifted).max() == 0.0
 
 
+def test_a_rectangular_pad_reads_what_the_cli_reads(sphere_path, tmp_path):
+    out = tmp_path / "sense.csv"
+    taction_cli(
+        "sense",
+        "--mesh", str(sphere_path),
+        "--pad-center", "0.001,-0.002,0.0606",
+        "--pad-normal", "0,0,-1",
+        "--pad-up", "0,1,0",
+        "--rows", "5", "--cols", "9", "--pad-width-m", "0.018", "--pad-height-m", "0.01",
+        "--out", str(out),
+    )
+    cli = np.loadtxt(out, delimiter=",", ndmin=2)
+    sensor = taction.Sensor(rows=5, cols=9, pad_width_m=0.018, pad_height_m=0.01)
+    assert repr(sensor).startswith("Sensor(rows=5, cols=9, pad_width_m=0.018, pad_height_m=0.01, thickness_m=0.001,")
+    image = sensor.read(taction.Object.from_file(sphere_path), TOUCH, dtype="float64")
+    assert image.shape == (5, 9) and image.max() > 0.3
+    assert np.array_equal(image, cli)
+
+
 # Sensors out of range, as Python keywords (each also given to the CLI as its flags, `--thickness-m`
 # for `thickness_m`), with the key the refusal names. The covering at most half the pad is the
 # sensor's own rule, which both edges meet through the library.
@@ -56,6 +75,8 @@ REFUSED_SENSORS = [
     ({"thickness_m": 0.0}, "thickness_m"),
     ({"thickness_m": 0.007}, "thickness_m"),
     ({"pad_m": 0.004, "thickness_m": 0.0025}, "thickness_m"),
+    ({"pad_height_m": 0.0}, "pad_height_m"),
+    ({"pad_width_m": 0.004, "thickness_m": 0.0025}, "thickness_m"),
     ({"psf_sigma_m": -0.001}, "psf_sigma_m"),
     ({"rays_per_taxel": 5}, "rays_per_taxel"),
     ({"noise": 2.5}, "noise_fraction"),
@@ -65,6 +86,7 @@ FLAG_OF_KEY = {
     "rows": "--rows",
     "cols": "--cols",
     "pad_width_m": "--pad-m",
+    "pad_height_m": "--pad-height-m",
     "thickness_m": "--thickness-m",
     "psf_sigma_m": "--psf-sigma-m",
     "rays_per_taxel": "--rays-per-taxel",

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
-use taction::dataset::{Calibration, RealImport, import_real, import_real_csv};
+use taction::dataset::{Calibration, RealImport, TaxelPitch, import_real, import_real_csv};
 use taction::dataset::{Dataset, DatasetError, ExportFormat};
 use taction::paper::RealFramesOptions;
 use taction::paper::recorded_dataset;
@@ -72,6 +72,11 @@ pub struct ImportArgs {
     /// grid exactly once.
     #[arg(long, value_name = "CSV")]
     pub calibration: Option<PathBuf>,
+    /// The distance between neighbouring taxel centres of the recorded array, metres (e.g. 0.002):
+    /// the pad is then cols x pitch wide and rows x pitch high. Without it the dataset records the
+    /// pad's size as unknown, since frames alone do not tell it.
+    #[arg(long, value_name = "M")]
+    pub taxel_pitch_m: Option<TaxelPitch>,
     #[command(flatten)]
     pub preprocess: PreprocessArgs,
 }
@@ -137,7 +142,8 @@ fn run_import(args: &ImportArgs) -> Result<(), Box<dyn std::error::Error>> {
         .frames
         .file_stem()
         .map_or_else(|| "recorded".to_string(), |s| s.to_string_lossy().into_owned());
-    let dataset = recorded_dataset(&real, &options, &object_set).map_err(|e| e.to_string())?;
+    let dataset =
+        recorded_dataset(&real, &options, &object_set, args.taxel_pitch_m).map_err(|e| e.to_string())?;
     dataset.write(&args.out)?;
     println!("wrote {}", args.out.display());
     println!("{}", dataset.summary());

@@ -10,7 +10,7 @@ use taction::tactile::{ImageError, TactileImage};
 
 #[derive(Debug, Args)]
 pub struct DescribeArgs {
-    /// vectorize | sift | mr8 | moment-normalized | polar-fourier | mnti
+    /// vectorize | sift | mr8 | moment-normalized | polar-fourier | mnti | shape-index
     #[arg(long, value_name = "NAME", value_parser = parse_kind)]
     pub descriptor: DescriptorKind,
     /// The tactile image: rows of comma-separated values in [0, 1].

@@ -25,7 +25,15 @@ pub struct SensorArgs {
     /// Side of the square pad, metres.
     #[arg(long, default_value_t = 0.012, allow_hyphen_values = true)]
     pub pad_m: f64,
-    /// Covering thickness t, metres [default: 10% of the pad side].
+    /// Width of a rectangular pad (along an image row, the `--cols` taxels), metres [default:
+    /// --pad-m].
+    #[arg(long, allow_hyphen_values = true)]
+    pub pad_width_m: Option<f64>,
+    /// Height of a rectangular pad (along an image column, the `--rows` taxels), metres
+    /// [default: --pad-m].
+    #[arg(long, allow_hyphen_values = true)]
+    pub pad_height_m: Option<f64>,
+    /// Covering thickness t, metres [default: 10% of the pad's (shorter) side].
     #[arg(long, allow_hyphen_values = true)]
     pub thickness_m: Option<f64>,
     /// Point-spread sigma, metres; 0 disables it [default: 0.48 t, the half-space law].
@@ -48,37 +56,40 @@ pub struct SensorFlagError {
     pub allowed: String,
 }
 
-/// The flag that sets a config key.
-pub fn flag_of(key: ConfigKey) -> &'static str {
-    match key {
-        ConfigKey::Rows => "rows",
-        ConfigKey::Cols => "cols",
-        ConfigKey::PadWidth | ConfigKey::PadHeight => "pad-m",
-        ConfigKey::Thickness => "thickness-m",
-        ConfigKey::PsfSigma => "psf-sigma-m",
-        ConfigKey::RaysPerTaxel => "rays-per-taxel",
-        ConfigKey::NoiseFraction => "noise",
-        ConfigKey::NoiseSeed => "seed",
-    }
-}
-
 impl SensorArgs {
+    /// The flag that sets a config key: a pad side's own flag when given, else `--pad-m`.
+    pub fn flag_of(&self, key: ConfigKey) -> &'static str {
+        match key {
+            ConfigKey::Rows => "rows",
+            ConfigKey::Cols => "cols",
+            ConfigKey::PadWidth if self.pad_width_m.is_some() => "pad-width-m",
+            ConfigKey::PadHeight if self.pad_height_m.is_some() => "pad-height-m",
+            ConfigKey::PadWidth | ConfigKey::PadHeight => "pad-m",
+            ConfigKey::Thickness => "thickness-m",
+            ConfigKey::PsfSigma => "psf-sigma-m",
+            ConfigKey::RaysPerTaxel => "rays-per-taxel",
+            ConfigKey::NoiseFraction => "noise",
+            ConfigKey::NoiseSeed => "seed",
+        }
+    }
+
     /// The sensor configuration the flags describe, with noise seed `noise_seed`, validated.
     pub fn config(&self, noise_seed: u64) -> Result<Valid<SensorConfig>, SensorFlagError> {
         let config = SensorConfig {
             rays_per_taxel: self.rays_per_taxel,
             noise_fraction: self.noise,
             noise_seed,
-            ..SensorConfig::of_square_pad(
+            ..SensorConfig::of_pad(
                 self.rows,
                 self.cols,
-                self.pad_m,
+                self.pad_width_m.unwrap_or(self.pad_m),
+                self.pad_height_m.unwrap_or(self.pad_m),
                 self.thickness_m,
                 self.psf_sigma_m,
             )
         };
         Valid::new(config).map_err(|e| SensorFlagError {
-            flag: flag_of(e.key),
+            flag: self.flag_of(e.key),
             value: e.value,
             allowed: e.allowed,
         })

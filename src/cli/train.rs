@@ -31,7 +31,8 @@ pub struct TrainArgs {
     #[arg(long, value_name = "FILE")]
     pub validation: Option<PathBuf>,
     /// vectorize | sift | mr8 | moment-normalized (mn) | polar-fourier (pf) | mnti (default
-    /// parameters); several joined by '+' (e.g. mnti+sift) train one model per descriptor on the
+    /// parameters), or beyond the paper shape-index (the local shapes of a large array's frame,
+    /// pooled over it: the measured best on 28x50 frames, docs/measurements.md); several joined by '+' (e.g. mnti+sift) train one model per descriptor on the
     /// same data, written as one fused model whose posterior multiplies their likelihoods.
     #[arg(long, value_name = "NAME[+NAME]", value_parser = DescriptorChoice::parse)]
     pub descriptor: DescriptorChoice,

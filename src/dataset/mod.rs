@@ -39,8 +39,9 @@ pub use summary::DatasetSummary;
 // A real sensor's recorded frames, and their import as a dataset.
 pub use frame_files::{import_real, import_real_images, import_real_npz, is_frames_csv};
 pub use recorded::{
-    Calibration, FramePlace, Normalisation, RealData, RealDataError, RealImport, RealReading, SYNTHETIC_MARK,
-    import_real_csv, parse_real_csv,
+    Calibration, FramePlace, MAX_TAXEL_PITCH_M, Normalisation, RealData, RealDataError, RealImport,
+    RealReading, SYNTHETIC_MARK, TaxelPitch, TaxelPitchError, import_real_csv, parse_real_csv,
+    recorded_sensor,
 };
 
 use std::fmt;
@@ -157,6 +158,31 @@ pub struct DatasetHeader {
     /// object is what it was, and a file without it reads as fixed.
     #[serde(default, skip_serializing_if = "Perturbed::is_fixed")]
     pub perturbation: Perturbed,
+    /// Whether [`sensor`](Self::sensor)'s pad size is the sensor's: a recording imported without
+    /// its taxel pitch tells only its grid, and its pad fields are then placeholders
+    /// ([`recorded_sensor`]). Written only when unknown, so every other file is what it was, and
+    /// a file without it (every simulated one) reads as known.
+    #[serde(default, skip_serializing_if = "PadSize::is_known")]
+    pub pad_size: PadSize,
+}
+
+/// Whether a dataset's pad size was measured or is unknown (a recording imported without its
+/// taxel pitch).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PadSize {
+    /// The sensor's own: every simulated dataset's, and a recording's given its pitch.
+    #[default]
+    Known,
+    /// Never given: the grid is the recording's, the size is not.
+    Unknown,
+}
+
+impl PadSize {
+    /// Whether the size is the sensor's own.
+    pub fn is_known(&self) -> bool {
+        *self == Self::Known
+    }
 }
 
 impl DatasetHeader {
@@ -177,6 +203,7 @@ impl DatasetHeader {
             seed,
             start_pose: StartPose::Canonical,
             perturbation: Perturbed::FIXED,
+            pad_size: PadSize::Known,
         }
     }
 
@@ -238,6 +265,8 @@ impl Check for DatasetHeader {
             // Its heading was checked where it was made (serde included).
             start_pose: _,
             perturbation,
+            // Either value is a dataset's: the sensor's fields are checked the same way.
+            pad_size: _,
         } = self;
         if !perturbation.is_valid() {
             return Err(HeaderError::Perturbation(*perturbation));

@@ -57,9 +57,10 @@ use std::fmt;
 use std::ops::RangeInclusive;
 use std::path::Path;
 
-use crate::dataset::{ContactStatus, Dataset, DatasetError, DatasetHeader, Reading, Strategy};
+use crate::dataset::{ContactStatus, Dataset, DatasetError, DatasetHeader, PadSize, Reading, Strategy};
 use crate::pose::Pose;
 use crate::tactile::{SensorConfig, TactileImage};
+use crate::valid::checked_f64;
 
 /// The comment that marks a file of made-up frames (module docs).
 pub const SYNTHETIC_MARK: &str = "# SYNTHETIC";
@@ -309,18 +310,49 @@ pub struct RealData {
     pub synthetic: bool,
 }
 
-/// The sensor recorded frames are filed under in a dataset: the recording's `rows x cols` at the
-/// pitch of the paper's letters sensor (2 mm), the default covering and point-spread, no simulated
-/// noise. A recording tells nothing of its pad's geometry, so these fields only describe; a 6x6
-/// recording gets exactly [`SensorConfig::default`].
-pub fn recorded_sensor(rows: usize, cols: usize) -> SensorConfig {
+checked_f64! {
+    /// The distance between neighbouring taxel centres of a recorded array, metres: what a
+    /// recording's pad size follows from, and only its maker knows (`dataset import
+    /// --taxel-pitch-m`). At most [`MAX_TAXEL_PITCH_M`], so that the largest grid's pad stays
+    /// within the sensor's 1 m.
+    pub struct TaxelPitch(pitch_m) where pitch_m > 0.0 && pitch_m <= MAX_TAXEL_PITCH_M;
+    /// A taxel pitch out of range, or no number.
+    pub enum TaxelPitchError {
+        OutOfRange = "taxel pitch {0} m is out of range: want metres in (0, 0.0078125] (1 m over 128 taxels)",
+        NotANumber = "'{0}' is not a taxel pitch in metres",
+    }
+}
+
+/// The largest [`TaxelPitch`]: 1 m (the sensor's largest pad side) over 128 taxels.
+pub const MAX_TAXEL_PITCH_M: f64 = crate::tactile::config::MAX_LENGTH_M / MAX_TAXELS_PER_SIDE as f64;
+
+/// The sensor recorded frames are filed under in a dataset: the recording's `rows x cols`, at
+/// `pitch` when its maker gave it (the pad `cols x pitch` wide and `rows x pitch` high), the
+/// default covering for that pad and its point-spread, no simulated noise. A recording without
+/// its pitch tells nothing of its pad's size: the pad is then the paper's letters sensor's 2 mm
+/// pitch as a placeholder, and [`PadSize::Unknown`] says so (a 6x6 recording gets exactly
+/// [`SensorConfig::default`]).
+pub fn recorded_sensor(rows: usize, cols: usize, pitch: Option<TaxelPitch>) -> (SensorConfig, PadSize) {
     let default = SensorConfig::default();
-    SensorConfig {
-        rows,
-        cols,
-        pad_width_m: default.pad_width_m * (cols as f64 / default.cols as f64),
-        pad_height_m: default.pad_height_m * (rows as f64 / default.rows as f64),
-        ..default
+    match pitch {
+        Some(pitch) => {
+            let (width_m, height_m) = (pitch.get() * cols as f64, pitch.get() * rows as f64);
+            let sensor = SensorConfig {
+                noise_seed: default.noise_seed,
+                ..SensorConfig::of_pad(rows, cols, width_m, height_m, None, None)
+            };
+            (sensor, PadSize::Known)
+        }
+        None => {
+            let sensor = SensorConfig {
+                rows,
+                cols,
+                pad_width_m: default.pad_width_m * (cols as f64 / default.cols as f64),
+                pad_height_m: default.pad_height_m * (rows as f64 / default.rows as f64),
+                ..default
+            };
+            (sensor, PadSize::Unknown)
+        }
     }
 }
 
@@ -343,15 +375,20 @@ impl RealData {
         &self,
         object_set: &str,
         generator: &str,
+        pitch: Option<TaxelPitch>,
         mut file: impl FnMut(&RealReading) -> (TactileImage, ContactStatus),
     ) -> Result<Dataset, DatasetError> {
-        let header = DatasetHeader::new(
-            recorded_sensor(self.rows, self.cols),
-            object_set,
-            self.labels().into_iter().map(str::to_string).collect(),
-            generator,
-            0,
-        );
+        let (sensor, pad_size) = recorded_sensor(self.rows, self.cols, pitch);
+        let header = DatasetHeader {
+            pad_size,
+            ..DatasetHeader::new(
+                sensor,
+                object_set,
+                self.labels().into_iter().map(str::to_string).collect(),
+                generator,
+                0,
+            )
+        };
         let readings = self
             .readings
             .iter()

@@ -92,18 +92,27 @@ impl fmt::Display for DatasetSummary {
 }
 
 impl DatasetSummary {
-    /// The sensor line: shape, pad, covering, PSF, rays, noise.
+    /// The sensor line: shape, pad, covering, PSF, rays, noise; a recording's unknown pad size
+    /// is said, not its placeholder printed.
     fn write_sensor(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let s = &self.header.sensor;
+        let length = crate::units::length;
+        if !self.header.pad_size.is_known() {
+            return writeln!(
+                f,
+                "sensor: {}x{} taxels, pad size unknown (the taxel pitch was not given on import)",
+                s.rows, s.cols
+            );
+        }
         writeln!(
             f,
             "sensor: {}x{} taxels, pad {} x {}, covering {}, PSF sigma {}, {} rays/taxel ({}), noise {} (seed {})",
             s.rows,
             s.cols,
-            crate::units::length(s.pad_width_m),
-            crate::units::length(s.pad_height_m),
-            crate::units::length(s.thickness_m),
-            crate::units::length(s.psf_sigma_m),
+            length(s.pad_width_m),
+            length(s.pad_height_m),
+            length(s.thickness_m),
+            length(s.psf_sigma_m),
             s.rays_per_taxel,
             match crate::tactile::config::rays_per_side(s.rays_per_taxel) {
                 Some(k) => format!("{k}x{k} grid"),

@@ -2,7 +2,7 @@
 //! vectors, ideally invariant to rotation about the pad normal, which the controllers leave free.
 //!
 //! One file per descriptor (`vectorize`, `sift`, `mr8`, `moment_normalized`, `polar_fourier`,
-//! `mnti`), and the helpers they share: [`Plane`] (centred coordinates, bilinear sampling),
+//! `mnti`, and beyond the paper `shape_index`, for the frames of large arrays), and the helpers they share: [`Plane`] (centred coordinates, bilinear sampling),
 //! [`InscribedDisc`] (the mask), [`CentredMoments`] and [`FftPlans`] (cached FFT plans). Every
 //! descriptor works on images of any size, is deterministic, `Send + Sync`, and returns finite values
 //! for every valid image; each module documents its output for all-zero and saturated images.
@@ -18,6 +18,7 @@ pub(crate) mod mr8;
 pub(crate) mod params;
 pub(crate) mod plane;
 pub(crate) mod polar_fourier;
+pub(crate) mod shape_index;
 pub(crate) mod sift;
 pub(crate) mod vectorize;
 
@@ -34,6 +35,7 @@ pub use mr8::{Mr8, Mr8Params};
 pub use params::{DescriptorParams, ParamsError};
 pub use plane::Plane;
 pub use polar_fourier::{PolarFourier, PolarFourierParams};
+pub use shape_index::{ShapeIndex, ShapeIndexParams};
 pub use sift::{Sift, SiftParams};
 pub use vectorize::Vectorize;
 
@@ -52,7 +54,7 @@ pub trait Descriptor: Send + Sync {
     fn describe(&self, image: &TactileImage) -> Vec<Feature>;
 }
 
-/// The six descriptors of Sec. IV-B, by name.
+/// The six descriptors of Sec. IV-B and the shape index, by name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum DescriptorKind {
@@ -68,19 +70,29 @@ pub enum DescriptorKind {
     PolarFourier,
     /// Sec. IV-B6: Moment-Normalized, then 2-D Fourier magnitudes (translation-invariant).
     Mnti,
+    /// Beyond the paper: the local shapes of a large array's frame, pooled (shape index and
+    /// curvedness at three scales).
+    ShapeIndex,
 }
 
 impl DescriptorKind {
-    pub const ALL: [DescriptorKind; 6] = [
+    /// Every descriptor: the paper's six, then the shape index.
+    pub const ALL: [DescriptorKind; 7] = [
         Self::Vectorize,
         Self::Sift,
         Self::Mr8,
         Self::MomentNormalized,
         Self::PolarFourier,
         Self::Mnti,
+        Self::ShapeIndex,
     ];
 
-    /// The command-line name (`vectorize`, `sift`, `mr8`, `moment-normalized`, `polar-fourier`, `mnti`).
+    /// The six of Sec. IV-B, which the paper's experiments compare: the first six of
+    /// [`ALL`](Self::ALL).
+    pub const PAPER: &'static [DescriptorKind] = Self::ALL.split_at(6).0;
+
+    /// The command-line name (`vectorize`, `sift`, `mr8`, `moment-normalized`, `polar-fourier`,
+    /// `mnti`, `shape-index`).
     pub fn name(self) -> &'static str {
         match self {
             Self::Vectorize => "vectorize",
@@ -89,6 +101,7 @@ impl DescriptorKind {
             Self::MomentNormalized => "moment-normalized",
             Self::PolarFourier => "polar-fourier",
             Self::Mnti => "mnti",
+            Self::ShapeIndex => "shape-index",
         }
     }
 
@@ -123,6 +136,7 @@ impl DescriptorKind {
             Self::MomentNormalized => Box::new(MomentNormalized::default()),
             Self::PolarFourier => Box::new(PolarFourier::default()),
             Self::Mnti => Box::new(Mnti::default()),
+            Self::ShapeIndex => Box::new(ShapeIndex::default()),
         }
     }
 
@@ -149,6 +163,9 @@ mod tests {
             );
         }
         assert_eq!(DescriptorKind::from_name("hog"), None);
+        // The paper's experiments compare the six of Sec. IV-B, never the shape index.
+        assert_eq!(DescriptorKind::PAPER.len(), 6);
+        assert!(!DescriptorKind::PAPER.contains(&DescriptorKind::ShapeIndex));
     }
 
     #[test]

@@ -128,7 +128,8 @@ struct FilterBank {
     log: Vec<f64>,
 }
 
-fn gauss1d(sigma: f64, t: f64, order: u8) -> f64 {
+/// The 1-D Gaussian of `sigma` at `t`, or its first or second derivative (`order` 1, 2 and up).
+pub(super) fn gauss1d(sigma: f64, t: f64, order: u8) -> f64 {
     let variance = sigma * sigma;
     let g = (-t * t / (2.0 * variance)).exp() / (2.0 * PI * variance).sqrt();
     match order {

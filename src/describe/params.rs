@@ -7,6 +7,7 @@ use super::mnti::{Mnti, MntiParams};
 use super::moment_normalized::{MomentNormalized, MomentNormalizedParams};
 use super::mr8::{Mr8, Mr8Params};
 use super::polar_fourier::{PolarFourier, PolarFourierParams};
+use super::shape_index::{ShapeIndex, ShapeIndexParams};
 use super::sift::{Sift, SiftParams};
 use super::vectorize::Vectorize;
 use super::{Descriptor, DescriptorKind};
@@ -23,6 +24,7 @@ pub enum DescriptorParams {
     MomentNormalized(MomentNormalizedParams),
     PolarFourier(PolarFourierParams),
     Mnti(MntiParams),
+    ShapeIndex(ShapeIndexParams),
 }
 
 /// Parameters that cannot describe anything; names the field and what it accepts. The error of the
@@ -47,6 +49,7 @@ impl DescriptorParams {
             DescriptorKind::MomentNormalized => Self::MomentNormalized(MomentNormalizedParams::default()),
             DescriptorKind::PolarFourier => Self::PolarFourier(PolarFourierParams::default()),
             DescriptorKind::Mnti => Self::Mnti(MntiParams::default()),
+            DescriptorKind::ShapeIndex => Self::ShapeIndex(ShapeIndexParams::default()),
         }
     }
 
@@ -58,6 +61,7 @@ impl DescriptorParams {
             Self::MomentNormalized(_) => DescriptorKind::MomentNormalized,
             Self::PolarFourier(_) => DescriptorKind::PolarFourier,
             Self::Mnti(_) => DescriptorKind::Mnti,
+            Self::ShapeIndex(_) => DescriptorKind::ShapeIndex,
         }
     }
 
@@ -70,6 +74,7 @@ impl DescriptorParams {
             Self::MomentNormalized(p) => Box::new(MomentNormalized::new(p)),
             Self::PolarFourier(p) => Box::new(PolarFourier::new(p)),
             Self::Mnti(p) => Box::new(Mnti::new(Valid::new(p)?)),
+            Self::ShapeIndex(p) => Box::new(ShapeIndex::new(Valid::new(p)?)),
         })
     }
 }

@@ -72,7 +72,7 @@ pub fn descriptors() -> RecognitionSweep {
         key_parameter: "",
         legend: None,
         family: Family::Shapes,
-        descriptors: DescriptorKind::ALL.to_vec(),
+        descriptors: DescriptorKind::PAPER.to_vec(),
         settings: vec![Setting {
             calibrated_on: CalibratedOn::ArmExplorations,
             ..Setting::single(

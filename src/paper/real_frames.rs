@@ -27,7 +27,7 @@ use super::real_frames_options::RealFramesOptions;
 use super::recognition::{RecognitionDetail, RecognitionRows, selection_config};
 use super::timing::PhaseClock;
 use crate::dataset::recorded::{RealData, RealReading};
-use crate::dataset::{ContactStatus, Dataset};
+use crate::dataset::{ContactStatus, Dataset, TaxelPitch};
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::AccuracyCurve;
 use crate::experiment::factor::Factors;
@@ -88,11 +88,14 @@ fn touched(reading: &RealReading, contact_threshold: f64) -> bool {
 /// The recording as a taction dataset (`taction dataset import`), so that `train` and `recognize`
 /// take recorded frames: every frame a reading of its label, `converged` when it touched and
 /// `no_contact` when [`prune`] drops it, its image as this experiment describes it (square root and
-/// blur when `options` ask). `object_set` names the recording in the dataset's header.
+/// blur when `options` ask). `object_set` names the recording in the dataset's header, `pitch`
+/// its taxels' spacing when its maker gave it (else the pad's size is filed as unknown,
+/// [`recorded_sensor`](crate::dataset::recorded_sensor)).
 pub fn recorded_dataset(
     real: &RealData,
     options: &RealFramesOptions,
     object_set: &str,
+    pitch: Option<TaxelPitch>,
 ) -> Result<Dataset, BoxError> {
     options.check()?;
     let blur = GaussianBlur::new(options.blur_sigma_taxels)?;
@@ -111,7 +114,7 @@ pub fn recorded_dataset(
             String::new()
         }
     );
-    Ok(real.to_dataset(object_set, &generator, |frame| {
+    Ok(real.to_dataset(object_set, &generator, pitch, |frame| {
         let status = if touched(frame, options.contact_threshold) {
             ContactStatus::Converged
         } else {
@@ -223,7 +226,7 @@ pub fn run_real_frames(context: &PaperContext, codebook: CodebookKind) -> Result
         clock: &context.store.clock,
     });
     let name = SafeName::new(EXPERIMENT_NAME)?;
-    let units = DescriptorKind::ALL
+    let units = DescriptorKind::PAPER
         .iter()
         .map(|&kind| {
             let key = SafeName::builder(kind.name()).build()?;
@@ -321,7 +324,7 @@ impl TrialPlan<'_> {
                 validation: self.sizes.validation,
                 test: self.sizes.test,
             },
-            descriptors: DescriptorKind::ALL.iter().map(|k| k.name()).collect(),
+            descriptors: DescriptorKind::PAPER.iter().map(|k| k.name()).collect(),
             training: &self.training,
         }
     }

@@ -278,22 +278,32 @@ impl SensorConfig {
     }
 
     /// The sensor as a user describes it (the CLI's sensor flags, Python's `Sensor`): `rows x
-    /// cols` taxels on a square pad of side `pad_m`, a covering `thickness_m` thick (default 10%
-    /// of the side, the paper's), its point spread `psf_sigma_m` (default the
-    /// half-space law for that thickness, [`psf_sigma_for_thickness`]), 4 rays per taxel and no
-    /// noise. Unchecked, as every config is until [`Valid::new`].
-    pub fn of_square_pad(
+    /// cols` taxels on a pad `pad_width_m` wide (along a row) and `pad_height_m` high (along a
+    /// column), as real arrays are often not square (a 28x50 array on a gripper's finger), a
+    /// covering `thickness_m` thick (default 10% of the pad's shorter side, the paper's 10% of
+    /// its square pad), its point spread `psf_sigma_m` (default the half-space law for that
+    /// thickness, [`psf_sigma_for_thickness`]), 4 rays per taxel and no noise. Unchecked, as
+    /// every config is until [`Valid::new`].
+    pub fn of_pad(
         rows: usize,
         cols: usize,
-        pad_m: f64,
+        pad_width_m: f64,
+        pad_height_m: f64,
         thickness_m: Option<f64>,
         psf_sigma_m: Option<f64>,
     ) -> Self {
-        let thickness_m = thickness_m.unwrap_or(DEFAULT_THICKNESS_FRACTION * pad_m);
+        let thickness_m = thickness_m.unwrap_or(DEFAULT_THICKNESS_FRACTION * pad_width_m.min(pad_height_m));
         Self {
+            pad_width_m,
+            pad_height_m,
             psf_sigma_m: psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
-            ..Self::square(rows, cols, pad_m, thickness_m)
+            ..Self::square(rows, cols, pad_width_m, thickness_m)
         }
+    }
+
+    /// Whether the pad is square, as the paper's is: a user's description of it needs one side.
+    pub fn is_square_pad(&self) -> bool {
+        self.pad_width_m == self.pad_height_m
     }
 
     /// Where taxel (`row`, `col`)'s centre is on the pad: (right, up) in metres from the pad's
