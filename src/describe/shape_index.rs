@@ -22,8 +22,9 @@
 //! frame is first divided by its largest value, so that how hard it was pressed does not count
 //! either, as for the paper's descriptors but Vectorize.
 //!
-//! Output, one feature per frame of `12 + 46 scales` values (150 by default), every block a
-//! histogram whose bins sum to 1 so that no block outweighs another in the PCA:
+//! Output, one feature per frame of `12 + 46 scales` values (150 by default), each histogram's
+//! bins summing to 1 and the two single values in [0, 1], so that no block outweighs another in
+//! the PCA:
 //! - the frame's values, 10 bins of [0, 1], as shares of the taxels; then its mean and the share
 //!   of taxels above a tenth;
 //! - per scale: the 8 x 4 histogram of `S` (8 bins of [-1, 1]) and `ln(1 + 20 C)` (4 bins of
