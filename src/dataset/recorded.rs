@@ -337,10 +337,7 @@ pub fn recorded_sensor(rows: usize, cols: usize, pitch: Option<TaxelPitch>) -> (
     match pitch {
         Some(pitch) => {
             let (width_m, height_m) = (pitch.get() * cols as f64, pitch.get() * rows as f64);
-            let sensor = SensorConfig {
-                noise_seed: default.noise_seed,
-                ..SensorConfig::of_pad(rows, cols, width_m, height_m, None, None)
-            };
+            let sensor = SensorConfig::of_pad(rows, cols, width_m, height_m, None, None);
             (sensor, PadSize::Known)
         }
         None => {
@@ -826,4 +823,34 @@ fn records(text: &str) -> impl Iterator<Item = (u64, Vec<&str>)> {
         (!trimmed.is_empty() && !trimmed.starts_with('#'))
             .then(|| (i as u64 + 1, trimmed.split(',').map(str::trim).collect()))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The refusal's message spells the bound as a number (the macro's messages are literals):
+    /// it must be the bound the check applies.
+    #[test]
+    fn a_refused_pitch_names_the_bound_the_check_applies() {
+        let refused = TaxelPitch::new(MAX_TAXEL_PITCH_M * 1.5).map(TaxelPitch::get);
+        let message = refused.map_err(|e| e.to_string()).unwrap_err();
+        assert!(
+            message.contains(&format!("(0, {MAX_TAXEL_PITCH_M}]")),
+            "{message}"
+        );
+        assert_eq!(
+            TaxelPitch::new(MAX_TAXEL_PITCH_M).map(TaxelPitch::get),
+            Ok(MAX_TAXEL_PITCH_M)
+        );
+    }
+
+    #[test]
+    fn a_known_pitch_sizes_the_pad_and_keeps_the_default_noise_seed() {
+        let pitch = TaxelPitch::new(0.0015).ok();
+        let (sensor, size) = recorded_sensor(28, 50, pitch);
+        assert_eq!(size, PadSize::Known);
+        assert!((sensor.pad_width_m - 0.075).abs() < 1e-12 && (sensor.pad_height_m - 0.042).abs() < 1e-12);
+        assert_eq!(sensor.noise_seed, SensorConfig::default().noise_seed);
+    }
 }

@@ -266,15 +266,7 @@ impl SensorConfig {
     /// A config with `rows x cols` taxels on a square pad of side `pad_m`, covering `thickness_m`,
     /// the PSF law, 4 rays per taxel and no noise.
     pub fn square(rows: usize, cols: usize, pad_m: f64, thickness_m: f64) -> Self {
-        Self {
-            rows,
-            cols,
-            pad_width_m: pad_m,
-            pad_height_m: pad_m,
-            thickness_m,
-            psf_sigma_m: psf_sigma_for_thickness(thickness_m),
-            ..Self::default()
-        }
+        Self::of_pad(rows, cols, pad_m, pad_m, Some(thickness_m), None)
     }
 
     /// The sensor as a user describes it (the CLI's sensor flags, Python's `Sensor`): `rows x
@@ -294,10 +286,13 @@ impl SensorConfig {
     ) -> Self {
         let thickness_m = thickness_m.unwrap_or(DEFAULT_THICKNESS_FRACTION * pad_width_m.min(pad_height_m));
         Self {
+            rows,
+            cols,
             pad_width_m,
             pad_height_m,
+            thickness_m,
             psf_sigma_m: psf_sigma_m.unwrap_or_else(|| psf_sigma_for_thickness(thickness_m)),
-            ..Self::square(rows, cols, pad_width_m, thickness_m)
+            ..Self::default()
         }
     }
 
