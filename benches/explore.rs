@@ -243,6 +243,7 @@ fn shapes_run(objects: &[ObjectSpec], seed: u64) -> Vec<ExplorationReport> {
         readings_per_object: SHAPES_READINGS,
         seed,
         start_pose: StartPose::Canonical,
+        free_object: None,
     };
     plan.collect(objects, 1).expect("planner runs")
 }

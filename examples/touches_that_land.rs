@@ -46,6 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         readings_per_object: 0,
         seed,
         start_pose: StartPose::random(heading),
+        free_object: None,
     };
     println!("object,touch,touches,converged,converged_per_touch,attempts,last_attempt_by_status");
     let mut totals: BTreeMap<&str, (usize, usize, Duration)> = BTreeMap::new();

@@ -204,6 +204,7 @@ fn an_episode_starts_its_object_where_its_config_says() {
         readings_per_object: 0,
         seed: 5,
         start_pose: random.start_pose,
+        free_object: None,
     };
     let mut scene = SceneBuilder::with_arm_and_table()
         .object(object.clone())
@@ -232,6 +233,7 @@ fn touching_toward_the_planners_own_proposals_is_exploring() {
         readings_per_object: usize::MAX,
         seed: 5,
         start_pose: StartPose::Canonical,
+        free_object: None,
     };
     let object = &objects()[0];
     let (mut scene, mut explorer) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
@@ -303,6 +305,7 @@ fn active_exploration_touches_about_as_often_as_blind_exploration() {
         readings_per_object: TOUCHES,
         seed: 5,
         start_pose: StartPose::Canonical,
+        free_object: None,
     };
     let object = &objects()[1];
     let (mut scene, mut blind) = plan.planner_for(object, 0, planner(ITERATIONS)).unwrap();
@@ -413,6 +416,7 @@ fn a_guarded_touch_says_when_it_meets_nothing() {
         readings_per_object: 0,
         seed: 5,
         start_pose: StartPose::Canonical,
+        free_object: None,
     };
     let (mut scene, mut planner) = plan.planner_for(&objects()[1], 0, beside).unwrap();
     let axis = DVec3::new(0.16, 0.16, 0.08);

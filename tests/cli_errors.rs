@@ -1019,6 +1019,31 @@ fn a_flag_of_the_other_collection_mode_is_refused() {
 }
 
 #[test]
+fn a_free_objects_flags_are_the_planners_and_in_range() {
+    for (flags, says) in [
+        (
+            &["--mode", "sampler", "--free-object"][..],
+            "--free-object: not a flag of --mode sampler",
+        ),
+        (
+            &["--mode", "planner", "--object-friction", "0.3"][..],
+            "--object-friction: only with --free-object",
+        ),
+        (
+            &["--mode", "planner", "--free-object", "--object-density", "-5"][..],
+            "--object-density -5: object density -5 kg/m3 is outside [10, 20000]",
+        ),
+        (
+            &["--mode", "planner", "--free-object", "--object-friction", "NaN"][..],
+            "--object-friction NaN: object friction NaN is outside [0, 2]",
+        ),
+    ] {
+        let line = chess_collect_fails(flags, 2);
+        assert!(line.contains(says), "{line}");
+    }
+}
+
+#[test]
 fn train_with_objects_but_nothing_to_weigh_them_on_is_refused_before_any_dataset_is_read() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.csv").display().to_string();

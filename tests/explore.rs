@@ -36,6 +36,7 @@ fn plan(mode: CollectMode, readings: usize, perturbation: PerturbationBounds) ->
         readings_per_object: readings,
         seed: 17,
         start_pose: StartPose::Canonical,
+        free_object: None,
     }
 }
 

@@ -41,6 +41,7 @@ fn explore(local_probability: f64, perturbation: PerturbationBounds) -> (Vec<Obj
         readings_per_object: READINGS,
         seed: 11,
         start_pose: StartPose::Canonical,
+        free_object: None,
     };
     let dataset = plan
         .collect_dataset(&set.id(), &objects, 0, &|| {})

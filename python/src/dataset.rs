@@ -9,7 +9,7 @@ use pyo3::types::{PyBytes, PyDict};
 use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
 use taction::dataset::{ColumnType, ExportFormat, Reading, Shortfall, describe_shortfalls};
 use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{FreeBody, ObjectSpec, PerturbationBounds};
 use taction::tactile::SensorConfig;
 
 use crate::args::{self, Objects, Whole, max_heading};
@@ -232,9 +232,12 @@ impl Dataset {
 /// `perturb_deg` and `perturb_frac` move the object after every reading (Sec. V-B3);
 /// `start_pose="random"` stands each object at a start drawn from the seed (a heading within
 /// `start_heading_deg`, a tilt and a shift) as `taction collect --start-pose` does, which the
-/// header and `object_pose` record. Same seed, same dataset, bit for bit.
+/// header and `object_pose` record. `free_object=True` (the planner's) stands each object on a
+/// free joint, a solid of `object_density` kg/m3 (1000) with sliding friction `object_friction`
+/// (0.8), pushed by the covering, as `taction collect --free-object` does; the header records it.
+/// Same seed, same dataset, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python", start_pose="canonical", start_heading_deg=180.0), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python', start_pose='canonical', start_heading_deg=180.0)")]
+#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python", start_pose="canonical", start_heading_deg=180.0, free_object=false, object_density=None, object_friction=None), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python', start_pose='canonical', start_heading_deg=180.0, free_object=False, object_density=None, object_friction=None)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
 pub fn collect(
     py: Python<'_>,
@@ -252,8 +255,12 @@ pub fn collect(
     object_set: &str,
     start_pose: &str,
     start_heading_deg: f64,
+    free_object: bool,
+    object_density: Option<f64>,
+    object_friction: Option<f64>,
 ) -> PyResult<Dataset> {
     let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
+    let free_body = FreeBody::requested(free_object, object_density, object_friction).map_err(refused)?;
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let start_pose = args::start_pose(start_pose, start_heading_deg)?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
@@ -276,7 +283,8 @@ pub fn collect(
         .seed(seed)
         .threads(threads)
         .perturbation(perturbation)
-        .start_pose(start_pose);
+        .start_pose(start_pose)
+        .free_object(free_body);
     let dataset = py
         .detach(|| collect.dataset(object_set, &specs))
         .map_err(refused)?;

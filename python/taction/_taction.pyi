@@ -133,6 +133,9 @@ def collect(
     object_set: str = "python",
     start_pose: str = "canonical",
     start_heading_deg: float = 180.0,
+    free_object: bool = False,
+    object_density: float | None = None,
+    object_friction: float | None = None,
 ) -> Dataset: ...
 def collect_arm_calibration(
     objects: _Objects,

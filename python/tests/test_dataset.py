@@ -95,6 +95,20 @@ def test_a_set_name_collects_its_objects_and_counts_are_whole_numbers(chess):
         taction.collect(42)
 
 
+def test_a_free_object_is_the_planners_recorded_and_its_material_checked(chess):
+    pawn = [o for o in chess if o.name == "pawn"]
+    data = taction.collect(pawn, mode="planner", readings=2, seed=4, free_object=True, object_friction=0.5)
+    assert data.header["free_object"] == {"density_kg_m3": 1000.0, "friction": 0.5}
+    fixed = taction.collect(pawn, mode="planner", readings=2, seed=4)
+    assert "free_object" not in fixed.header
+    with pytest.raises(taction.TactionError, match="object_density: only with free_object"):
+        taction.collect(pawn, mode="planner", readings=2, object_density=800.0)
+    with pytest.raises(taction.TactionError, match="object_density 5: object density 5 kg/m3 is outside"):
+        taction.collect(pawn, mode="planner", readings=2, free_object=True, object_density=5.0)
+    with pytest.raises(taction.TactionError, match="free_object"):
+        taction.collect(pawn, mode="sampler", readings=2, free_object=True)
+
+
 def test_an_argument_of_the_other_mode_is_refused(chess):
     with pytest.raises(taction.TactionError, match="local_probability"):
         taction.collect(chess, mode="sampler", readings=2, local_probability=0.9)

@@ -430,5 +430,6 @@ fn plan(config: &EpisodeConfig, seed: u64) -> CollectPlan {
         readings_per_object: 0,
         seed,
         start_pose: config.start_pose,
+        free_object: None,
     }
 }

@@ -83,6 +83,7 @@ impl ArmTrainingRecipe {
             readings_per_object: self.readings_per_object,
             seed: self.seed,
             start_pose: StartPose::Canonical,
+            free_object: None,
         })
     }
 
@@ -151,6 +152,7 @@ impl ArmTrainingRecipe {
                 readings_per_object: readings,
                 seed: crate::rng::substream(stream, exploration),
                 start_pose: StartPose::random(self.start_heading),
+                free_object: None,
             })
             .collect())
     }

@@ -5,11 +5,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
+use taction::bodies::FreeBodyRequestError;
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::explore::{CollectModeName, CollectRequest, ExplorationReport, ModeChoices};
 use taction::mesh::ObjectSet;
-use taction::sim::{PerturbationBounds, StartPose};
+use taction::sim::{FreeBody, MotionOutcome, ObjectMotion, PerturbationBounds, StartPose};
 use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
@@ -57,6 +58,17 @@ pub struct CollectArgs {
     /// away from the arm), with the arm's roll: training data that matches what the arm feels
     #[arg(long)]
     pub reachable: bool,
+    /// Planner: the object on a free joint instead of a mocap body (beyond the paper): it settles
+    /// on the table under gravity, the covering pushes it, every touch runs through MuJoCo's
+    /// dynamics, and how far each touch moved it is printed per object
+    #[arg(long)]
+    pub free_object: bool,
+    /// With --free-object: the object's density, kg/m3, in [10, 20000] [default: 1000]
+    #[arg(long, allow_hyphen_values = true, value_name = "KG_M3")]
+    pub object_density: Option<f64>,
+    /// With --free-object: its sliding friction on the table and the arm, in [0, 2] [default: 0.8]
+    #[arg(long, allow_hyphen_values = true)]
+    pub object_friction: Option<f64>,
     /// Perturb the object after every reading: largest rotation, degrees, in [0, 180].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_deg: f64,
@@ -121,6 +133,7 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         .control(args.control.valid(sensor.noise_fraction)?)
         .perturbation(perturbation)
         .start_pose(start_pose)
+        .free_object(free_body(args)?)
         .seed(args.seed.seed)
         .threads(args.threads.count().get());
     let plan = collect.plan().map_err(named_by_flag)?;
@@ -138,7 +151,10 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
         Mode::Planner => objects
             .iter()
             .zip(&reports)
-            .map(|(object, report)| planner_line(&object.name, report))
+            .flat_map(|(object, report)| {
+                let moved = args.free_object.then(|| free_object_line(&object.name, report));
+                std::iter::once(planner_line(&object.name, report)).chain(moved)
+            })
             .collect(),
         Mode::Sampler => Vec::new(),
     };
@@ -206,6 +222,27 @@ fn request(args: &CollectArgs) -> Result<CollectRequest, UsageError> {
             flags.join(", "),
             e.mode.name()
         ))
+    })
+}
+
+/// The free object's material ([`FreeBody::requested`]), its fields named by their flags; the
+/// sampler refused by name, its pad floating over no table.
+fn free_body(args: &CollectArgs) -> Result<Option<FreeBody>, UsageError> {
+    if let (Mode::Sampler, true) = (args.mode, args.free_object) {
+        return Err(UsageError(
+            "--free-object: not a flag of --mode sampler (its pad floats over no table; the arm's planner touches a free object)".into(),
+        ));
+    }
+    FreeBody::requested(args.free_object, args.object_density, args.object_friction).map_err(|e| {
+        let flag = |field: &str| field.replace('_', "-");
+        match e {
+            FreeBodyRequestError::WithoutFreeObject { field } => {
+                UsageError(format!("--{}: only with --free-object", flag(field)))
+            }
+            FreeBodyRequestError::OutOfRange { field, value, error } => {
+                flag_error(&flag(field), value, error)
+            }
+        }
     })
 }
 
@@ -303,6 +340,26 @@ pub fn write_contact_sheets(
 /// What the planner did on the way to `object`'s readings, beyond them: iterations, expansion steps
 /// stopped short (by the causes' names: who touched whom, or a physics fault) or without an
 /// inverse-kinematics solution.
+/// How the touches moved a free object: the mean and largest shift and turn per touch, and the
+/// touches that tipped it over or pushed it off the table.
+fn free_object_line(object: &str, report: &ExplorationReport) -> String {
+    let motions = &report.object_motions;
+    let touches = motions.len().max(1) as f64;
+    let mean = |f: fn(&ObjectMotion) -> f64| motions.iter().map(f).sum::<f64>() / touches;
+    let largest = |f: fn(&ObjectMotion) -> f64| motions.iter().map(f).fold(0.0, f64::max);
+    let count = |outcome| motions.iter().filter(|m| m.outcome() == outcome).count();
+    format!(
+        "free object {object}: {} touches moved it {:.3} mm and {:.3} deg each on average (at most {:.3} mm, {:.3} deg); {} tipped it over, {} pushed it off the table",
+        motions.len(),
+        mean(|m| m.shift_m) * 1e3,
+        mean(|m| m.turn_rad).to_degrees(),
+        largest(|m| m.shift_m) * 1e3,
+        largest(|m| m.turn_rad).to_degrees(),
+        count(MotionOutcome::Tipped),
+        count(MotionOutcome::OffTable),
+    )
+}
+
 fn planner_line(object: &str, report: &ExplorationReport) -> String {
     let stops: Vec<String> = report
         .expansion_stops

@@ -169,7 +169,22 @@ where
         Ok((self.reader)(self.scene)?.with_pose(pose))
     }
 
+    /// The command, then a free object's answer to it ([`Scene::let_object_answer`]): the reading
+    /// after a motion sees where the covering's push left the object.
     fn move_pad(&mut self, target: &PadPose) -> Result<PadMotion, ControlError> {
+        let motion = self.command_pad(target)?;
+        self.scene.let_object_answer()?;
+        Ok(motion)
+    }
+}
+
+impl<R> ArmPad<'_, R>
+where
+    R: ReadTactile,
+{
+    /// One pose command, the object held as it is: IK and the guarded motion, an Orient turn
+    /// backed off or shortened where the table is in the way, a Press refused twice reported.
+    fn command_pad(&mut self, target: &PadPose) -> Result<PadMotion, ControlError> {
         let start = self.arm.q(self.scene.data());
         let current = self.pad_pose();
         let (motion, contact) = self.try_move(target, &start)?;

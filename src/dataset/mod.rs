@@ -49,6 +49,7 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::FileError;
+use crate::bodies::FreeBody;
 use crate::pose::StartPose;
 use crate::tactile::{ConfigError, SensorConfig};
 use crate::valid::Check;
@@ -164,6 +165,10 @@ pub struct DatasetHeader {
     /// a file without it (every simulated one) reads as known.
     #[serde(default, skip_serializing_if = "PadSize::is_known")]
     pub pad_size: PadSize,
+    /// What the object was made of where it stood on a free joint (issue 74); `None`, left out
+    /// of the file, for a mocap object, the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_object: Option<FreeBody>,
 }
 
 /// Whether a dataset's pad size was measured or is unknown (a recording imported without its
@@ -204,6 +209,7 @@ impl DatasetHeader {
             start_pose: StartPose::Canonical,
             perturbation: Perturbed::FIXED,
             pad_size: PadSize::Known,
+            free_object: None,
         }
     }
 
@@ -215,6 +221,11 @@ impl DatasetHeader {
     /// This header for readings of an object moved by `perturbation` after every reading.
     pub fn with_perturbation(self, perturbation: Perturbed) -> Self {
         Self { perturbation, ..self }
+    }
+
+    /// The header of readings of an object on a free joint made of `free_object` (`None`: mocap).
+    pub fn with_free_object(self, free_object: Option<FreeBody>) -> Self {
+        Self { free_object, ..self }
     }
 
     /// Index of `object` in [`objects`](Self::objects).
@@ -267,6 +278,8 @@ impl Check for DatasetHeader {
             perturbation,
             // Either value is a dataset's: the sensor's fields are checked the same way.
             pad_size: _,
+            // Checked where it was made (serde included).
+            free_object: _,
         } = self;
         if !perturbation.is_valid() {
             return Err(HeaderError::Perturbation(*perturbation));

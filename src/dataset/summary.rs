@@ -65,6 +65,15 @@ impl fmt::Display for DatasetSummary {
         if !h.start_pose.is_canonical() {
             write!(f, ", start pose {}", h.start_pose)?;
         }
+        // Only a free object is said: a mocap one is the paper's and every dataset's before.
+        if let Some(body) = &h.free_object {
+            write!(
+                f,
+                ", free object ({} kg/m3, friction {})",
+                body.density_kg_m3(),
+                body.friction()
+            )?;
+        }
         writeln!(f)?;
         self.write_sensor(f)?;
         let width = h

@@ -24,7 +24,7 @@ use crate::explore::setup::TouchSetup;
 use crate::pose::StartPose;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
-use crate::sim::{ObjectSpec, PerturbationBounds, Scene, SimError};
+use crate::sim::{FreeBody, ObjectMount, ObjectSpec, PerturbationBounds, Scene, SimError};
 use crate::tactile::SensorConfig;
 use crate::tactile::sensor::{CoveringSensor, TactileError, arm_with_sensor};
 use crate::valid::{RangeError, Valid};
@@ -88,6 +88,11 @@ pub struct CollectPlan {
     /// existed (an experiment's `config.json`, its cache keys) is written as it was.
     #[serde(default, skip_serializing_if = "StartPose::is_canonical")]
     pub start_pose: StartPose,
+    /// The object on a free joint, made of this (issue 74), or, `None`, a mocap body, the paper's
+    /// (left out of the JSON, so every plan of a mocap object is written as it was). The arm's
+    /// only: [`Collect::plan`] refuses it for the sampler, whose pad floats over no table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_object: Option<FreeBody>,
 }
 
 /// The reader of a scene's covering sensor (it lives in `control`, beside the carriers).
@@ -172,7 +177,7 @@ impl CollectPlan {
     ) -> Result<(Scene, Planner<SensorReader>), ControlError> {
         let setup = self.setup_for(index);
         let sensor = Valid::new(setup.sensor).map_err(TactileError::from)?;
-        let mut scene = arm_with_sensor(object.clone(), &sensor).build()?;
+        let mut scene = arm_with_sensor(self.mounted(object), &sensor).build()?;
         self.place_at_start(&mut scene, index)?;
         let reader: SensorReader = Box::new(sensor_reader(CoveringSensor::on_site(scene.model(), PAD_SITE)?));
         let planner = Planner::new(
@@ -183,6 +188,19 @@ impl CollectPlan {
             reader,
         )?;
         Ok((scene, planner))
+    }
+
+    /// `object` held as this plan holds objects: on a mocap body as given, or free, made of
+    /// [`free_object`](Self::free_object).
+    pub fn mounted(&self, object: &ObjectSpec) -> ObjectSpec {
+        match self.free_object {
+            None => object.clone(),
+            Some(free_body) => ObjectSpec {
+                mount: ObjectMount::Free,
+                free_body,
+                ..object.clone()
+            },
+        }
     }
 
     /// Collects every object on a pool of `threads` threads (0: all cores), results in object order.
@@ -242,7 +260,8 @@ impl CollectPlan {
             self.seed,
         )
         .with_start_pose(self.start_pose)
-        .with_perturbation(recorded_perturbation(&self.perturbation));
+        .with_perturbation(recorded_perturbation(&self.perturbation))
+        .with_free_object(self.free_object);
         Dataset::new(header, reports.into_iter().flat_map(|r| r.readings).collect())
     }
 }
@@ -391,6 +410,7 @@ pub struct Collect<'p> {
     control: Valid<ControlConfig>,
     perturbation: PerturbationBounds,
     start_pose: StartPose,
+    free_object: Option<FreeBody>,
     per_object: usize,
     seed: u64,
     threads: usize,
@@ -421,6 +441,7 @@ impl Collect<'static> {
             control: plan.control,
             perturbation: plan.perturbation,
             start_pose: plan.start_pose,
+            free_object: plan.free_object,
             per_object: plan.readings_per_object,
             seed: plan.seed,
             ..Self::with(procedure, plan.sensor)
@@ -434,6 +455,7 @@ impl Collect<'static> {
             control: Valid::default(),
             perturbation: PerturbationBounds::NONE,
             start_pose: StartPose::Canonical,
+            free_object: None,
             per_object: 100,
             seed: 0,
             threads: 0,
@@ -477,6 +499,16 @@ impl<'p> Collect<'p> {
         Self { start_pose, ..self }
     }
 
+    /// Planner: every object on a free joint, made of `body` (`None`: a mocap body, the paper's
+    /// and the default): the covering pushes it, gravity and the table hold it, and every touch
+    /// runs through MuJoCo's dynamics (`sim::free_object`).
+    pub fn free_object(self, body: Option<FreeBody>) -> Self {
+        Self {
+            free_object: body,
+            ..self
+        }
+    }
+
     /// Sampler: approach only from above (the raised letters, Sec. V-D).
     pub fn from_above(self) -> Self {
         self.map_sampler(|c| SamplerConfig {
@@ -513,6 +545,7 @@ impl<'p> Collect<'p> {
             control: self.control,
             perturbation: self.perturbation,
             start_pose: self.start_pose,
+            free_object: self.free_object,
             per_object: self.per_object,
             seed: self.seed,
             threads: self.threads,
@@ -522,6 +555,14 @@ impl<'p> Collect<'p> {
     /// The checked plan: everything the readings depend on (what an experiment's cache key hashes).
     pub fn plan(&self) -> Result<CollectPlan, RangeError> {
         let mode = match self.procedure {
+            Procedure::Sampler(_) if self.free_object.is_some() => {
+                return Err(RangeError {
+                    config: "collection",
+                    field: "free_object",
+                    value: "a free object".into(),
+                    allowed: "the planner's only (the sampler's pad floats over no table)",
+                });
+            }
             Procedure::Sampler(c) => CollectMode::Sampler(Valid::new(c)?),
             Procedure::Planner(c) => CollectMode::Planner(Valid::new(c)?),
         };
@@ -533,6 +574,7 @@ impl<'p> Collect<'p> {
             readings_per_object: self.per_object,
             seed: self.seed,
             start_pose: self.start_pose,
+            free_object: self.free_object,
         })
     }
 
@@ -586,6 +628,7 @@ mod tests {
             readings_per_object: 7,
             seed: 3,
             start_pose: StartPose::random(crate::pose::MaxHeading::LETTERS),
+            free_object: None,
         };
         assert_eq!(Collect::from_plan(plan).plan().unwrap(), plan);
         // A random start is in the plan's JSON; a canonical one is not, so that a plan written
@@ -617,5 +660,29 @@ mod tests {
         };
         let error = Collect::planner(SensorConfig::default(), bad).plan().unwrap_err();
         assert_eq!(error.field, "max_iterations");
+
+        // A free object is in the plan's JSON, checked on the way back in, and the arm's only.
+        let free = CollectPlan {
+            mode: CollectMode::Planner(Valid::default()),
+            free_object: Some(FreeBody::new(600.0, 0.3).unwrap()),
+            ..canonical
+        };
+        assert_eq!(Collect::from_plan(free).plan().unwrap(), free);
+        let json = serde_json::to_string(&free).unwrap();
+        assert!(
+            json.ends_with(r#""free_object":{"density_kg_m3":600.0,"friction":0.3}}"#),
+            "{json}"
+        );
+        assert_eq!(serde_json::from_str::<CollectPlan>(&json).unwrap(), free);
+        let heavy = json.replace("600.0", "60000.0");
+        let error = serde_json::from_str::<CollectPlan>(&heavy)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("object density 60000 kg/m3 is outside [10, 20000]"),
+            "{error}"
+        );
+        let sampled = Collect::sampler(SensorConfig::default()).free_object(Some(FreeBody::DEFAULT));
+        assert_eq!(sampled.plan().unwrap_err().field, "free_object");
     }
 }

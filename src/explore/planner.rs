@@ -738,7 +738,11 @@ where
         record: &mut Record<'_>,
     ) -> Result<(), ControlError> {
         let (vertex, pad) = at;
+        let lay = scene.object_pose().filter(|_| scene.object_is_free());
         let mut reading = self.settle_here(scene, arm, expansion)?;
+        if let Some(lay) = lay {
+            record.report.object_motions.push(scene.object_motion_from(&lay)?);
+        }
         relabel_table_contact(&mut reading, &self.setup.sensor);
         let converged = reading.is_converged();
         let pose = reading.image.pose().copied().unwrap_or(pad);

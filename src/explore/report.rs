@@ -6,6 +6,7 @@ use crate::control::ContactOutcome;
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::pose::PadPose;
 use crate::pose::Pose;
+use crate::sim::{MotionOutcome, ObjectMotion};
 use crate::tactile::{SensorConfig, TactileError, TactileImage};
 
 /// The reading of one settling attempt on `object` (at `object_pose`): the controllers' image and
@@ -89,9 +90,21 @@ pub struct ExplorationReport {
     pub expansion_stops: BTreeMap<CauseKind, usize>,
     /// Expansion steps with no inverse-kinematics solution.
     pub unreachable_steps: usize,
+    /// Where the object is free ([`ObjectMount::Free`](crate::sim::ObjectMount)): how each
+    /// reading's touch moved it, from where it lay when the controllers took over to where the
+    /// reading was taken, one per settled reading in order. Empty for a mocap object.
+    pub object_motions: Vec<ObjectMotion>,
 }
 
 impl ExplorationReport {
+    /// The touches of a free object that tipped it over or pushed it off the table.
+    pub fn objects_lost(&self) -> usize {
+        self.object_motions
+            .iter()
+            .filter(|m| m.outcome() != MotionOutcome::Standing)
+            .count()
+    }
+
     /// Number of converged readings.
     pub fn converged(&self) -> usize {
         self.readings.iter().filter(|r| r.is_converged()).count()

@@ -21,12 +21,14 @@ pub struct TouchSetup {
 impl TouchSetup {
     /// Moves the object in `scene` by a random draw within [`perturbation`](Self::perturbation)
     /// (nothing, drawing nothing, when it allows no motion): after every reading, so that the
-    /// next one sees the object where it now lies (Sec. V-B4).
+    /// next one sees the object where it now lies (Sec. V-B4). A free object is put there and
+    /// then comes to rest under gravity ([`Scene::settle_object`]).
     pub(crate) fn perturb(&self, scene: &mut Scene, rng: &mut Rng) -> Result<(), ControlError> {
         if !self.perturbation.is_none() {
             let width = scene.object_width_m().ok_or(SimError::NoObject)?;
             let p = self.perturbation.draw(width, rng);
             scene.perturb_object(&p)?;
+            scene.settle_object()?;
         }
         Ok(())
     }

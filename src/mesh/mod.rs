@@ -19,6 +19,7 @@ pub(crate) mod glyph;
 pub(crate) mod glyph_overlap;
 pub(crate) mod letters;
 pub(crate) mod load;
+pub(crate) mod mass;
 pub(crate) mod normalise;
 pub(crate) mod obj;
 mod object;
@@ -35,6 +36,7 @@ pub(crate) mod validate;
 // One object: a mesh file loaded, validated, and checked for a plausible size.
 pub use error::{Location, MeshError};
 pub use load::{LoadedMesh, MeshFormat, load, parse};
+pub use mass::SolidMoments;
 pub use object::Object;
 pub use plausible::{Implausible, SizeLimit, check_plausible};
 pub use validate::ValidationReport;

@@ -570,6 +570,7 @@ impl<'a> SettingData<'a> {
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
                 start_pose: StartPose::Canonical,
+                free_object: None,
             },
         ))
     }
@@ -607,6 +608,7 @@ impl<'a> SettingData<'a> {
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
                 start_pose,
+                free_object: None,
             },
         ))
     }

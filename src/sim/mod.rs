@@ -4,6 +4,7 @@
 pub(crate) mod arm;
 pub(crate) mod collision_shell;
 pub(crate) mod contact_screen;
+pub(crate) mod free_object;
 pub(crate) mod ik;
 pub(crate) mod mjcf;
 mod motion;
@@ -14,9 +15,20 @@ pub(crate) mod start_pose;
 pub(crate) mod twin;
 
 // The world: built from objects and the arm, stepped, saved and restored.
-pub use object::{DRAWN_MESH_TRIANGLES, LARGE_MESH_TRIANGLES, ObjectMount, ObjectSpec, ObjectSurfaces};
+pub use object::{
+    DRAWN_MESH_TRIANGLES, LARGE_MESH_TRIANGLES, ObjectMount, ObjectSpec, ObjectSurfaces, ROLLING_FRICTION_M,
+    TORSIONAL_FRICTION_M,
+};
 pub use scene::{
     Scene, SceneBuilder, SceneObject, SceneState, give_back_freed_memory, keep_mujoco_log_off_disk,
+};
+
+pub use crate::bodies::{FreeBody, FreeBodyError};
+
+// A free object under the arm: the dynamics stepped while the arm holds, and what they did to it.
+pub use free_object::{
+    DWELL_S, MotionOutcome, ObjectMotion, REST_SPEED_M_PER_S, REST_TURN_RAD_PER_S, SETTLE_MAX_S,
+    TABLE_HALF_SIDE_M, TIPPED_RAD,
 };
 
 // The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.

@@ -46,8 +46,8 @@ impl Arm {
         scene.kinematics_and_collision();
     }
 
-    /// Zero velocity and servo commands equal to `q`, which must be the configuration in `qpos`.
-    fn rest_at(&self, scene: &mut Scene, q: &[f64]) {
+    /// The arm at `q` with zero velocity and servo commands equal to `q`: at rest, held there.
+    pub(super) fn rest_at(&self, scene: &mut Scene, q: &[f64]) {
         let data = scene.data_mut();
         self.set_q(data, q);
         for j in &self.joints {

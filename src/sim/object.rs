@@ -6,13 +6,13 @@
 
 use std::borrow::Cow;
 
-use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, TriMesh, cluster_vertices};
+use crate::mesh::{BuildOptions, MeshError, Object, ObjectSet, SolidMoments, TriMesh, cluster_vertices};
 use crate::pose::Pose;
 use crate::sim::SimError;
 use crate::sim::collision_shell::{ShellOptions, collision_shell};
 use crate::sim::mjcf::{COLLISION_GROUP, Document, Section, comment, escape_attr, numbers, space_separated};
 
-use crate::bodies::OBJECT_BODY;
+use crate::bodies::{FreeBody, OBJECT_BODY};
 
 /// Geom and joint names of the object slot (its body: [`OBJECT_BODY`]).
 pub const OBJECT_GEOM: &str = "object";
@@ -28,9 +28,20 @@ pub enum ObjectMount {
     /// taking a sensor measurement" (Sec. I).
     #[default]
     Mocap,
-    /// A free joint: gravity and contacts act on it; it rests on the table.
+    /// A free joint: gravity, contacts and the covering's push (`tactile::press_back`) act on
+    /// it; it rests on the table. Its mass and inertia are its mesh's as a uniform solid of the
+    /// [`FreeBody`]'s density.
     Free,
 }
+
+/// The torsional friction of a free object's contacts, metres (MuJoCo's `condim="6"` second
+/// coefficient: the torque resisting a spin about the contact normal per newton of normal force,
+/// about the radius of a contact patch): set so that a press off the object's centre does not spin
+/// it in place, which MuJoCo's default `condim="3"` would let it do freely about a single contact.
+pub const TORSIONAL_FRICTION_M: f64 = 0.01;
+/// The rolling friction of a free object's contacts, metres (`condim="6"`'s third coefficient):
+/// a hard object on a wooden table, 1 mm, so a sphere pressed from the side rolls, as one does.
+pub const ROLLING_FRICTION_M: f64 = 0.001;
 
 /// Meshes of more triangles than this reach MuJoCo as a coarse copy of at most
 /// [`DRAWN_MESH_TRIANGLES`] (`mesh::cluster_vertices`), with the exact surface beside it for the
@@ -85,8 +96,10 @@ pub struct ObjectSpec {
     /// Initial pose of the mesh frame in the world.
     pub pose: Pose,
     pub mount: ObjectMount,
-    /// Mass of the object (free mount only), kilograms.
+    /// The mass the mocap mount writes (a mocap body's mass moves nothing), kilograms.
     pub mass_kg: f64,
+    /// What the object is made of, where it is free ([`ObjectMount::Free`]).
+    pub free_body: FreeBody,
     /// Triangles above which MuJoCo is given a coarse copy of the mesh and the sensor the exact
     /// surface beside it ([`ObjectSurfaces`]; [`LARGE_MESH_TRIANGLES`] by default); `usize::MAX`
     /// gives MuJoCo the whole mesh whatever its size.
@@ -109,6 +122,7 @@ impl ObjectSpec {
             pose: Pose::IDENTITY,
             mount: ObjectMount::Mocap,
             mass_kg: 0.2,
+            free_body: FreeBody::DEFAULT,
             large_mesh_triangles: LARGE_MESH_TRIANGLES,
         }
     }
@@ -168,40 +182,89 @@ impl ObjectSpec {
             MeshAsset::Inline | MeshAsset::File(_) => &self.mesh,
         };
         let shell = match with_shell {
-            true => add_collision_shell(doc, shell_of),
+            true => add_collision_shell(doc, shell_of, self.shell_contacts()),
             false => String::new(),
         };
-
-        let center = (lo + hi) * 0.5;
-        let radius = ((hi - lo).length() * 0.5).max(1e-3);
-        let inertia = 0.4 * self.mass_kg * radius * radius;
         let pos = numbers(self.pose.position_m.to_array());
         let quat = numbers(self.pose.mujoco_quat());
-        let (mount_attr, joint) = match self.mount {
-            ObjectMount::Mocap => (" mocap=\"true\"", String::new()),
-            ObjectMount::Free => ("", format!("<freejoint name=\"{OBJECT_JOINT}\"/>")),
+        let (mount_attr, joint, inertial) = match self.mount {
+            ObjectMount::Mocap => (" mocap=\"true\"", String::new(), self.sphere_inertial(lo, hi)),
+            ObjectMount::Free => (
+                "",
+                format!("<freejoint name=\"{OBJECT_JOINT}\"/>"),
+                self.solid_inertial()?,
+            ),
         };
         doc.add(
             Section::Worldbody,
             format!(
                 "<body name=\"{OBJECT_BODY}\" pos=\"{pos}\" quat=\"{quat}\"{mount_attr}>\n\
-                 {}\n{joint}\n\
-                 <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>\n\
+                 {}\n{joint}\n{inertial}\n\
                  <geom name=\"{OBJECT_GEOM}\" type=\"mesh\" mesh=\"{OBJECT_MESH}\" rgba=\"0.8 0.5 0.3 1\" contype=\"0\" conaffinity=\"0\"/>\n\
                  {shell}</body>",
                 comment(&self.name),
-                numbers(center.to_array()),
-                self.mass_kg
             ),
         );
         Ok(())
+    }
+
+    /// The mocap body's `<inertial>`: a solid sphere of the mesh's bounding radius and
+    /// [`mass_kg`](Self::mass_kg), so that open or thin user meshes, whose volume MuJoCo cannot
+    /// compute, still load, and so that the body's frames do not depend on whether it has a shell.
+    fn sphere_inertial(&self, lo: glam::DVec3, hi: glam::DVec3) -> String {
+        let center = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1e-3);
+        let inertia = 0.4 * self.mass_kg * radius * radius;
+        format!(
+            "<inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{inertia} {inertia} {inertia}\"/>",
+            numbers(center.to_array()),
+            self.mass_kg
+        )
+    }
+
+    /// The free body's `<inertial>`: the mesh as a uniform solid of the [`FreeBody`]'s density.
+    /// A mesh that encloses no volume cannot be a free body: a named error.
+    fn solid_inertial(&self) -> Result<String, SimError> {
+        let moments = SolidMoments::of(&self.mesh).ok_or_else(|| SimError::Object {
+            name: self.name.clone(),
+            message: "a free object must be a closed solid, and this mesh encloses no volume".into(),
+        })?;
+        let density = self.free_body.density_kg_m3();
+        let i = moments.inertia_kg_m2(density);
+        Ok(format!(
+            "<inertial pos=\"{}\" mass=\"{}\" fullinertia=\"{}\"/>",
+            numbers(moments.centroid_m.to_array()),
+            density * moments.volume_m3,
+            numbers([
+                i.x_axis.x, i.y_axis.y, i.z_axis.z, i.y_axis.x, i.z_axis.x, i.z_axis.y
+            ])
+        ))
+    }
+
+    /// The contact attributes of the collision shell's pieces: the mocap object's plain friction,
+    /// or the free body's friction, torsional and rolling resistance, ruling its contacts
+    /// (`priority`: MuJoCo otherwise takes the larger of two geoms' frictions, and a slippery
+    /// object on the table would get the table's).
+    fn shell_contacts(&self) -> String {
+        match self.mount {
+            ObjectMount::Mocap => "friction=\"0.6\"".into(),
+            // Frictionless contacts are normal forces alone: MuJoCo's cone of a zero sliding
+            // friction with torsional and rolling terms beside it is degenerate, and blows up.
+            ObjectMount::Free if self.free_body.friction() == 0.0 => {
+                "friction=\"0 0 0\" condim=\"1\" priority=\"1\"".into()
+            }
+            ObjectMount::Free => format!(
+                "friction=\"{} {TORSIONAL_FRICTION_M} {ROLLING_FRICTION_M}\" condim=\"6\" priority=\"1\"",
+                self.free_body.friction()
+            ),
+        }
     }
 }
 
 /// Adds the convex pieces of the collision shell as assets and returns their geoms for the
 /// object's body: contacts go through the shell (see `collision_shell`), the sensor reads the
 /// exact mesh.
-fn add_collision_shell(doc: &mut Document, mesh: &TriMesh) -> String {
+fn add_collision_shell(doc: &mut Document, mesh: &TriMesh, contacts: String) -> String {
     let mut shell = String::new();
     for (i, piece) in collision_shell(mesh, &ShellOptions::default()).iter().enumerate() {
         let vertex = numbers(piece.iter().flat_map(|v| v.to_array()));
@@ -211,7 +274,7 @@ fn add_collision_shell(doc: &mut Document, mesh: &TriMesh) -> String {
         );
         shell.push_str(&format!(
             "<geom name=\"{OBJECT_GEOM}_shell_{i}\" type=\"mesh\" mesh=\"{OBJECT_GEOM}_shell_{i}\" \
-             group=\"{COLLISION_GROUP}\" contype=\"2\" conaffinity=\"2\" rgba=\"0.8 0.5 0.3 0.3\" friction=\"0.6\"/>\n"
+             group=\"{COLLISION_GROUP}\" contype=\"2\" conaffinity=\"2\" rgba=\"0.8 0.5 0.3 0.3\" {contacts}/>\n"
         ));
     }
     shell

@@ -55,6 +55,11 @@ impl SceneBuilder {
         self
     }
 
+    /// How the scene's object is held, when it has one.
+    pub fn object_mount(&self) -> Option<ObjectMount> {
+        self.object.as_ref().map(|o| o.mount)
+    }
+
     /// Leaves out the object's collision shell (`collision_shell.rs`): for a world where nothing
     /// can collide with the object (the free-floating pad's: its plate takes part in no contact,
     /// and there is neither arm nor table), where the shell's 40-200 convex pieces would only be
@@ -115,6 +120,9 @@ impl SceneBuilder {
         if self.table {
             doc.include(TABLE_XML, "mjcf/table.xml")?;
         }
+        if self.object_mount() == Some(ObjectMount::Free) {
+            doc.include(FREE_OBJECT_OPTIONS, "free object options")?;
+        }
         if let Some(object) = &self.object {
             object.add_to(&mut doc, asset, !self.without_collision_shell)?;
         }
@@ -137,6 +145,16 @@ impl SceneBuilder {
         Scene::new(model, self.object.as_ref())
     }
 }
+
+/// The solver options of a world with a free object: MuJoCo's contacts are soft, and a sustained
+/// sideways force, however far inside the friction cone, makes an object creep (0.2 mm a touch on
+/// four-legged shapes under no press at all, 3-6 mm under a 1 kPa covering's); elliptic friction
+/// cones with `impratio` 10 make friction as hard as the normal force, and the no-slip pass
+/// removes what slip is left, as MuJoCo's documentation advises for objects that must stay put
+/// under a finger. With them the shapes move a few micrometres a touch under the default covering
+/// (docs/measurements.md). The paper's mocap worlds keep MuJoCo's defaults.
+const FREE_OBJECT_OPTIONS: &str =
+    "<mujoco><option cone=\"elliptic\" impratio=\"10\" noslip_iterations=\"10\"/></mujoco>";
 
 /// The start of the message MuJoCo gives when `errno` is set after it parsed a numeric array
 /// attribute without finding a fault (`ReadAttrVec` in `xml_util.cc`).

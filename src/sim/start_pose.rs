@@ -37,7 +37,19 @@ impl Scene {
     ///
     /// [`StartPose::Turned`] is the same draw at one fixed heading: its tilt and shift, nothing
     /// drawn for the heading.
+    ///
+    /// A free object then comes to rest under gravity ([`Scene::settle_object`]): it starts where
+    /// it settled, which the pose returned is.
     pub fn place_at_start(&mut self, start: &StartPose, rng: &mut Rng) -> Result<Pose, SimError> {
+        let put = self.put_at_start(start, rng)?;
+        match self.settle_object()? {
+            Some(_) => self.object_pose().ok_or(SimError::NoObject),
+            None => Ok(put),
+        }
+    }
+
+    /// [`place_at_start`](Self::place_at_start) but for the settling.
+    fn put_at_start(&mut self, start: &StartPose, rng: &mut Rng) -> Result<Pose, SimError> {
         let angle_rad = match start {
             StartPose::Canonical => return self.object_pose().ok_or(SimError::NoObject),
             StartPose::Turned { heading } => heading.rad(),

@@ -36,6 +36,7 @@ use crate::tactile::formation::ImageFormation;
 use crate::tactile::grid::SampleGrid;
 use crate::tactile::mesh_bvh::{CheckedMesh, Leaf, MeshBvh, MeshBvhError, OrientedBox};
 use crate::tactile::model_view::{ModelView, PoseView};
+use crate::tactile::press_back::{BodyPress, CoveringModulus, column_pressure_pa};
 use crate::tactile::primitive::{GeomShape, Solid};
 use crate::tactile::raster::DepthBuffer;
 use crate::tactile::shared_bvh::SHARED_BVHS;
@@ -74,6 +75,8 @@ enum Shape {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SensedGeom {
     geom: usize,
+    /// The body the geom is on: the one the covering pushes ([`Covering::press`]).
+    body: usize,
     shape: Shape,
     /// Bounding-sphere radius about the geom origin; 0 for unbounded (planes).
     rbound_m: f64,
@@ -84,6 +87,8 @@ struct SensedGeom {
 struct PadSensor {
     adr: usize,
     site: usize,
+    /// The body carrying the pad: it feels the covering's push reversed.
+    pad_body: usize,
     /// Noise stream seed of this sensor.
     noise_seed: u64,
     sensed: Vec<SensedGeom>,
@@ -130,7 +135,15 @@ pub struct Covering {
     depth: DepthBuffer,
     leaves: Vec<Leaf>,
     stack: Vec<usize>,
+    /// Per sample, which sensed geom (index into the sensor's list) is nearest, and the depths
+    /// before a geom was drawn: kept only while [`press`](Covering::press) works.
+    owner: Vec<usize>,
+    before_m: Vec<f64>,
     stats: CoveringStats,
+    /// How hard the covering pushes back; [`CoveringModulus::NONE`] unless the scene asked.
+    modulus: CoveringModulus,
+    /// What the last [`press`](Covering::press) applied, per pressed body.
+    last_press: Vec<BodyPress>,
 }
 
 /// The box, in a mesh's geom frame, that holds every face that can change a reading's depths:
@@ -365,6 +378,7 @@ fn sensed_geom(model: &ModelView, geom: usize, cache: &mut MeshCache) -> Result<
     };
     Ok(SensedGeom {
         geom,
+        body: model.geom_bodyid[geom] as usize,
         shape,
         rbound_m,
     })
@@ -396,6 +410,7 @@ impl Covering {
             sensors.push(PadSensor {
                 adr: model.sensor_adr[sensor] as usize,
                 site,
+                pad_body: model.site_bodyid[site] as usize,
                 noise_seed,
                 sensed,
             });
@@ -410,8 +425,28 @@ impl Covering {
             depth,
             leaves: Vec::new(),
             stack: Vec::new(),
+            owner: Vec::new(),
+            before_m: Vec::new(),
             stats: cache.stats,
+            modulus: CoveringModulus::NONE,
+            last_press: Vec::new(),
         })
+    }
+
+    /// The instance with a covering of Young's modulus `modulus` pushing back (`press_back.rs`).
+    pub fn with_modulus(mut self, modulus: CoveringModulus) -> Self {
+        self.modulus = modulus;
+        self
+    }
+
+    pub fn modulus(&self) -> CoveringModulus {
+        self.modulus
+    }
+
+    /// What the last [`press`](Self::press) applied: per pressed body, the force on it and its
+    /// moment about the pad's origin (world frame); the pad felt the opposite.
+    pub fn last_press(&self) -> &[BodyPress] {
+        &self.last_press
     }
 
     pub fn config(&self) -> &SensorConfig {
@@ -442,14 +477,25 @@ impl Covering {
     /// Fills `nearest_m` with the per-sample penetration (metres) seen by sensor `k`; returns how
     /// many samples are fully penetrated.
     fn penetration(&mut self, k: usize, poses: &PoseView) -> usize {
+        self.depths(k, poses, false);
+        penetration_from_depths(&mut self.depth.nearest_m, self.grid.cols, self.config.thickness_m)
+    }
+
+    /// Fills `nearest_m` with the pad-frame depth of the nearest sensed surface per sample, in the
+    /// grid's own order (not yet mirrored, see the module docs), as sensor `k` sees it; with
+    /// `track_owner`, `owner` says per sample which sensed geom is the nearest.
+    fn depths(&mut self, k: usize, poses: &PoseView, track_owner: bool) {
         let sensor = &self.sensors[k];
         let t = self.config.thickness_m;
-        let pad_origin = DVec3::from_slice(&poses.site_xpos[3 * sensor.site..3 * sensor.site + 3]);
-        let pad_rotation = rotation_from_xmat(&poses.site_xmat[9 * sensor.site..9 * sensor.site + 9]);
+        let (pad_origin, pad_rotation) = site_frame(poses, sensor.site);
         let to_pad = pad_rotation.transpose();
         let (hw, hh) = (self.grid.half_width_m, self.grid.half_height_m);
         self.depth.nearest_m.fill(f64::INFINITY);
-        for g in &sensor.sensed {
+        if track_owner {
+            self.owner.clear();
+            self.owner.resize(self.grid.len(), usize::MAX);
+        }
+        for (index, g) in sensor.sensed.iter().enumerate() {
             let geom_origin = DVec3::from_slice(&poses.geom_xpos[3 * g.geom..3 * g.geom + 3]);
             let geom_rotation = rotation_from_xmat(&poses.geom_xmat[9 * g.geom..9 * g.geom + 9]);
             // Geom frame -> pad frame: p_pad = m p_geom + o.
@@ -458,6 +504,9 @@ impl Covering {
             let r = g.rbound_m;
             if r > 0.0 && (o.z - r > t || o.z + r < 0.0 || o.x.abs() - r > hw || o.y.abs() - r > hh) {
                 continue;
+            }
+            if track_owner {
+                self.before_m.clone_from(&self.depth.nearest_m);
             }
             match g.shape {
                 Shape::Mesh(slot) => {
@@ -477,9 +526,93 @@ impl Covering {
                     draw_solid(&self.grid, &mut self.depth.nearest_m, solid, (&m, o), r);
                 }
             }
+            if track_owner {
+                let nearer = self.depth.nearest_m.iter().zip(&self.before_m);
+                for (owner, _) in self
+                    .owner
+                    .iter_mut()
+                    .zip(nearer)
+                    .filter(|(_, (now, was))| now < was)
+                {
+                    *owner = index;
+                }
+            }
         }
-        penetration_from_depths(&mut self.depth.nearest_m, self.grid.cols, t)
     }
+
+    /// The covering's push on every body it touches, from the poses in `poses` and the velocity
+    /// `velocity(body, point)` of a body's point (world frame), per sensor: each sample's column
+    /// pressed by the nearest sensed surface ([`column_pressure_pa`]), acting at that surface
+    /// along the pad normal. Fills [`last_press`](Self::last_press) (empty when the modulus is
+    /// zero) and returns each press with the body carrying its pad, which feels it reversed.
+    pub fn press(
+        &mut self,
+        poses: &PoseView,
+        velocity: &dyn Fn(usize, DVec3) -> DVec3,
+    ) -> Vec<(usize, BodyPress)> {
+        self.last_press.clear();
+        let mut applied = Vec::new();
+        if self.modulus.is_none() {
+            return applied;
+        }
+        for k in 0..self.sensors.len() {
+            self.depths(k, poses, true);
+            let pad_body = self.sensors[k].pad_body;
+            for press in self.columns_pushing(k, poses, velocity) {
+                applied.push((pad_body, press));
+                self.last_press.push(press);
+            }
+        }
+        applied
+    }
+
+    /// Sensor `k`'s columns summed per pressed body, after [`depths`](Self::depths) tracked
+    /// which geom each sample meets.
+    fn columns_pushing(
+        &self,
+        k: usize,
+        poses: &PoseView,
+        velocity: &dyn Fn(usize, DVec3) -> DVec3,
+    ) -> Vec<BodyPress> {
+        let sensor = &self.sensors[k];
+        let t = self.config.thickness_m;
+        let (pad_origin, pad_rotation) = site_frame(poses, sensor.site);
+        let normal = pad_rotation.z_axis;
+        let area_m2 = self.grid.dx_m() * self.grid.dy_m();
+        let pad_body = sensor.pad_body;
+        let mut presses: Vec<BodyPress> = Vec::new();
+        for i in 0..self.grid.rows {
+            for j in 0..self.grid.cols {
+                let s = i * self.grid.cols + j;
+                let penetration_m = (t - self.depth.nearest_m[s]).clamp(0.0, t);
+                let Some(g) = sensor.sensed.get(self.owner[s]).filter(|_| penetration_m > 0.0) else {
+                    continue;
+                };
+                let point =
+                    pad_origin + pad_rotation * DVec3::new(self.grid.x(j), self.grid.y(i), t - penetration_m);
+                let approach = (velocity(pad_body, point) - velocity(g.body, point)).dot(normal);
+                let pressure = column_pressure_pa(self.modulus, t, penetration_m, approach);
+                let force = normal * (pressure * area_m2);
+                let at = match presses.iter().position(|p| p.body == g.body) {
+                    Some(at) => at,
+                    None => {
+                        presses.push(BodyPress::none(g.body, pad_origin));
+                        presses.len() - 1
+                    }
+                };
+                presses[at].add(force, point);
+            }
+        }
+        presses
+    }
+}
+
+/// The origin and rotation of site `site` in the world.
+fn site_frame(poses: &PoseView, site: usize) -> (DVec3, DMat3) {
+    (
+        DVec3::from_slice(&poses.site_xpos[3 * site..3 * site + 3]),
+        rotation_from_xmat(&poses.site_xmat[9 * site..9 * site + 9]),
+    )
 }
 
 /// Lowers `nearest_m` (pad-frame depths, sample order) to the depth of `solid` placed by

@@ -12,6 +12,7 @@
 //! primitive   planes, spheres, capsules, ellipsoids, cylinders, boxes cut analytically
 //! grid        where the (supersampled) rays pierce the pad
 //! formation   penetration -> PSF -> taxels -> [0, 1] -> noise
+//! press_back  the same penetration as a force on the object and the pad (a free object's scene)
 //! sensor      the Rust handle (read an image from sensordata) and the MJCF helpers
 //! free_floating  the scene of the pad on a mocap body, no arm (Sec. V-A3; `control::FreePad`)
 //! image       TactileImage (and PadPose, from `pose`)
@@ -27,6 +28,7 @@ pub(crate) mod image;
 pub(crate) mod mesh_bvh;
 pub(crate) mod model_view;
 pub(crate) mod plugin;
+pub(crate) mod press_back;
 pub(crate) mod primitive;
 pub(crate) mod raster;
 pub(crate) mod sensor;
@@ -44,6 +46,11 @@ pub use free_floating::{free_floating_builder, free_pad_body_xml};
 
 // The MuJoCo plugin: registration, and the taxel colours of the viewer.
 pub use plugin::{PLUGIN_NAME, ensure_registered, register, taxel_rgba, taxel_tiles};
+
+// The covering's force on what it touches, where the object is free to move.
+pub use press_back::{
+    BodyPress, CoveringModulus, CoveringModulusError, RELAXATION_S, column_pressure_pa, total_force_n,
+};
 
 // One instance's state and the model it reads.
 pub use covering::{Covering, CoveringError, CoveringStats, query_region};

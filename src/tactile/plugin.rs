@@ -31,15 +31,16 @@ use std::sync::Once;
 
 use glam::{DMat3, DVec3};
 use mujoco_rs::mujoco_c::{
-    mj_getPluginConfig, mjData, mjModel, mjp_defaultPlugin, mjp_getPlugin, mjp_getPluginAtSlot,
-    mjp_registerPlugin, mjpPlugin, mjtCatBit, mjtGeom, mjtNum, mjtObj, mjtPluginCapabilityBit, mjtSensor,
-    mjtStage, mju_error, mju_warning, mjv_initGeom, mjvOption, mjvScene,
+    mj_applyFT, mj_getPluginConfig, mj_objectVelocity, mjData, mjModel, mjp_defaultPlugin, mjp_getPlugin,
+    mjp_getPluginAtSlot, mjp_registerPlugin, mjpPlugin, mjtCatBit, mjtGeom, mjtNum, mjtObj,
+    mjtPluginCapabilityBit, mjtSensor, mjtStage, mju_error, mju_warning, mjv_initGeom, mjvOption, mjvScene,
 };
 
 use crate::pose::rotation_from_xmat;
 use crate::tactile::config::{ConfigKey, SensorConfig};
 use crate::tactile::covering::Covering;
 use crate::tactile::model_view::{ModelView, PoseView};
+use crate::tactile::press_back::{CoveringModulus, CoveringModulusError};
 use crate::valid::Valid;
 
 /// The plugin's registered name.
@@ -47,7 +48,7 @@ pub const PLUGIN_NAME: &str = "taction.covering";
 const PLUGIN_NAME_C: &CStr = c"taction.covering";
 
 /// The config keys as C strings, in [`ConfigKey::ALL`] order.
-struct Attributes([*const c_char; 9]);
+struct Attributes([*const c_char; 10]);
 // SAFETY: the pointers refer to 'static string literals, never written.
 unsafe impl Sync for Attributes {}
 
@@ -61,7 +62,15 @@ static ATTRIBUTES: Attributes = Attributes([
     c"rays_per_taxel".as_ptr(),
     c"noise_fraction".as_ptr(),
     c"noise_seed".as_ptr(),
+    MODULUS_KEY.as_ptr(),
 ]);
+
+/// The config key of the covering's Young's modulus, pascals (`press_back.rs`): absent or 0, the
+/// covering pushes nothing, as the paper's. Not a [`ConfigKey`]: it changes no image, only what
+/// the covering does to the world.
+const MODULUS_KEY: &CStr = c"modulus_pa";
+/// [`MODULUS_KEY`] as MJCF writes it.
+pub const MODULUS_CONFIG_KEY: &str = "modulus_pa";
 
 static REGISTER: Once = Once::new();
 
@@ -87,7 +96,8 @@ pub fn register() {
             plugin.name = PLUGIN_NAME_C.as_ptr();
             plugin.nattribute = ATTRIBUTES.0.len() as c_int;
             plugin.attributes = ATTRIBUTES.0.as_ptr();
-            plugin.capabilityflags = mjtPluginCapabilityBit::mjPLUGIN_SENSOR as c_int;
+            plugin.capabilityflags = mjtPluginCapabilityBit::mjPLUGIN_SENSOR as c_int
+                | mjtPluginCapabilityBit::mjPLUGIN_PASSIVE as c_int;
             plugin.needstage = mjtStage::mjSTAGE_POS as c_int;
             plugin.nstate = Some(nstate);
             plugin.nsensordata = Some(nsensordata);
@@ -203,7 +213,9 @@ fn set_up(m: &mjModel, d: &mut mjData, instance: c_int) -> Result<(), String> {
     // SAFETY: m is the model being compiled or used, with all arrays allocated.
     let model = unsafe { ModelView::new(m) };
     let sensors = instance_sensors(&model, instance as usize);
-    let covering = Covering::new(&model, config, &sensors).map_err(|e| e.to_string())?;
+    let covering = Covering::new(&model, config, &sensors)
+        .map_err(|e| e.to_string())?
+        .with_modulus(instance_modulus(m, instance as usize)?);
     // SAFETY: plugin_data has nplugin entries; the pointer is reclaimed in `destroy`.
     unsafe { *d.plugin_data.add(instance as usize) = Box::into_raw(Box::new(covering)) as usize };
     Ok(())
@@ -256,15 +268,44 @@ unsafe extern "C" fn reset(
     unsafe { *plugin_state = 0.0 };
 }
 
-unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int, _capability: c_int) {
-    // SAFETY: MuJoCo passes valid pointers; plugin_data[instance] is our Covering (set in init);
-    // the state address comes from the model; sensordata has nsensordata entries.
+/// The covering modulus of instance `instance` ([`MODULUS_KEY`]); absent or empty, none.
+fn instance_modulus(m: &mjModel, instance: usize) -> Result<CoveringModulus, String> {
+    // SAFETY: as in `instance_config`.
+    let text = unsafe {
+        let value = mj_getPluginConfig(m, instance as c_int, MODULUS_KEY.as_ptr());
+        (!value.is_null()).then(|| CStr::from_ptr(value).to_string_lossy().into_owned())
+    };
+    match text.as_deref().map(str::trim).filter(|t| !t.is_empty()) {
+        None => Ok(CoveringModulus::NONE),
+        Some(text) => text
+            .parse()
+            .map_err(|e: CoveringModulusError| format!("taction.covering: {MODULUS_CONFIG_KEY}: {e}")),
+    }
+}
+
+unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int, capability: c_int) {
+    // SAFETY: MuJoCo passes valid pointers; plugin_data[instance] is our Covering (set in init).
     unsafe {
         let (m, d) = (&*m, &mut *d);
         let covering = *d.plugin_data.add(instance as usize) as *mut Covering;
         if covering.is_null() {
             return;
         }
+        if capability == mjtPluginCapabilityBit::mjPLUGIN_PASSIVE as c_int {
+            press_back(m, d, &mut *covering);
+        } else {
+            read_covering(m, d, instance, &mut *covering);
+        }
+    }
+}
+
+/// The sensor stage: the image into `sensordata`, the reading counter advanced.
+///
+/// # Safety
+/// As [`compute`]'s arguments: `covering` is instance `instance`'s.
+unsafe fn read_covering(m: &mjModel, d: &mut mjData, instance: c_int, covering: &mut Covering) {
+    // SAFETY: the state address comes from the model; sensordata has nsensordata entries.
+    unsafe {
         let state = d
             .plugin_state
             .add(*m.plugin_stateadr.add(instance as usize) as usize);
@@ -272,7 +313,7 @@ unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int,
         let poses = PoseView::new(m, d);
         let sensordata = std::slice::from_raw_parts_mut(d.sensordata, m.nsensordata as usize);
         let computed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            (*covering).compute(&poses, reading, sensordata)
+            covering.compute(&poses, reading, sensordata)
         }));
         if computed.is_err() {
             mju_warning(
@@ -282,6 +323,56 @@ unsafe extern "C" fn compute(m: *const mjModel, d: *mut mjData, instance: c_int,
         }
         *state = (reading + 1) as mjtNum;
     }
+}
+
+/// The passive stage: the covering's push (`press_back.rs`) added to `qfrc_passive`, on each body
+/// it touches at the pad's origin and, reversed, on the body carrying the pad, so MuJoCo's step
+/// integrates it. Nothing when the covering has no modulus.
+///
+/// # Safety
+/// As [`compute`]'s arguments.
+unsafe fn press_back(m: &mjModel, d: &mut mjData, covering: &mut Covering) {
+    if covering.modulus().is_none() {
+        return;
+    }
+    // SAFETY: positions and velocities are current in the passive stage; mj_objectVelocity reads
+    // them; mj_applyFT adds to qfrc_passive, nv long.
+    unsafe {
+        let velocity = |body: usize, point: DVec3| point_velocity(m, d, body, point);
+        let poses = PoseView::new(m, d);
+        let pressed =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| covering.press(&poses, &velocity)));
+        let Ok(pressed) = pressed else {
+            mju_warning(
+                c"%s".as_ptr(),
+                c"taction.covering: internal error while pressing back".as_ptr(),
+            );
+            return;
+        };
+        for (pad_body, press) in pressed {
+            let origin = press.about_m.to_array();
+            for (body, sign) in [(press.body, 1.0), (pad_body, -1.0)] {
+                let force = (press.force_n * sign).to_array();
+                let torque = (press.torque_nm * sign).to_array();
+                mj_applyFT(m, d, &force, &torque, &origin, body as c_int, d.qfrc_passive);
+            }
+        }
+    }
+}
+
+/// The world velocity of `body`'s point `point`.
+///
+/// # Safety
+/// `d` holds current positions and velocities of `m`.
+unsafe fn point_velocity(m: &mjModel, d: &mjData, body: usize, point: DVec3) -> DVec3 {
+    let mut spatial = [0.0; 6];
+    // SAFETY: `body` is a body of `m`; the result has 6 values (rotation, then translation of the
+    // body frame's origin, world axes).
+    unsafe { mj_objectVelocity(m, d, mjtObj::mjOBJ_BODY as c_int, body as c_int, &mut spatial, 0) };
+    let angular = DVec3::from_slice(&spatial[..3]);
+    let linear = DVec3::from_slice(&spatial[3..]);
+    let origin = unsafe { DVec3::from_slice(std::slice::from_raw_parts(d.xpos.add(3 * body), 3)) };
+    linear + angular.cross(point - origin)
 }
 
 /// The instance state behind plugin instance `instance` of `d`, when it is a covering instance

@@ -8,14 +8,16 @@ use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use crate::pose::PadPose;
 use crate::sim::arm::PAD_SITE;
 use crate::sim::mjcf::{Section, escape_attr};
-use crate::sim::{ObjectSpec, SceneBuilder};
+use crate::sim::{ObjectMount, ObjectSpec, SceneBuilder};
 use crate::tactile::config::{ConfigError, ConfigKey, SensorConfig};
 use crate::tactile::covering::CoveringStats;
 use crate::tactile::image::{ImageError, TactileImage};
 use crate::tactile::model_view::ModelView;
 use crate::tactile::plugin::{
-    PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state, is_covering_instance,
+    MODULUS_CONFIG_KEY, PLUGIN_NAME, ensure_registered, instance_config, instance_sensors, instance_state,
+    is_covering_instance,
 };
+use crate::tactile::press_back::{BodyPress, CoveringModulus};
 use crate::valid::Valid;
 
 /// Errors of the tactile module; each names the sensor, site or key concerned.
@@ -142,6 +144,14 @@ impl CoveringSensor {
             .is_some_and(|s| s.last_full_samples > 0 || s.last_back_touched)
     }
 
+    /// What the covering pushed in `data`'s last passive stage (`press_back.rs`): per body it
+    /// touched, the force on it and the moment about the pad's origin; empty when the covering
+    /// has no modulus. `None` when this copy of the plugin's code does not own the instance.
+    pub fn last_press<M: ModelType>(&self, model: &MjModel, data: &MjData<M>) -> Option<Vec<BodyPress>> {
+        // SAFETY: `data` was made by MuJoCo for `model` (mujoco-rs ties them together).
+        unsafe { instance_state(model.ffi(), data.ffi(), self.instance).map(|c| c.last_press().to_vec()) }
+    }
+
     /// The instance's counters (BVHs built, readings computed) in `data`.
     pub fn stats<M: ModelType>(&self, model: &MjModel, data: &MjData<M>) -> Option<CoveringStats> {
         // SAFETY: `data` was made by MuJoCo for `model` (mujoco-rs ties them together).
@@ -154,8 +164,10 @@ pub fn extension_xml() -> String {
     format!("<plugin plugin=\"{PLUGIN_NAME}\"/>")
 }
 
-/// The `<sensor>` content of a covering sensor named `name` on site `site` with every config key.
-pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str) -> String {
+/// The `<sensor>` content of a covering sensor named `name` on site `site` with every config key,
+/// and the covering's `modulus` when it pushes back (`press_back.rs`; none writes no key, so the
+/// paper's scenes are unchanged).
+pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str, modulus: CoveringModulus) -> String {
     let mut xml = format!(
         "<plugin name=\"{}\" plugin=\"{PLUGIN_NAME}\" objtype=\"site\" objname=\"{}\">\n",
         escape_attr(name),
@@ -167,6 +179,11 @@ pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str) -> Strin
             config.value_text(key)
         ));
     }
+    if !modulus.is_none() {
+        xml.push_str(&format!(
+            "  <config key=\"{MODULUS_CONFIG_KEY}\" value=\"{modulus}\"/>\n"
+        ));
+    }
     xml.push_str("</plugin>");
     xml
 }
@@ -176,12 +193,18 @@ pub fn sensor_xml(config: &Valid<SensorConfig>, name: &str, site: &str) -> Strin
 pub const SENSOR_NAME: &str = "tactile";
 
 /// Adds the plugin declaration and the covering sensor ([`SENSOR_NAME`]) on site `site` to a
-/// scene, and registers the plugin so the scene compiles.
+/// scene, and registers the plugin so the scene compiles. Where the scene's object is free
+/// ([`ObjectMount::Free`]) the covering pushes it back, a [`CoveringModulus::SOFT_GEL`]: a free
+/// object would otherwise feel no press at all, the pad's rigid back not touching it.
 pub fn add_sensor(builder: SceneBuilder, config: &Valid<SensorConfig>, site: &str) -> SceneBuilder {
+    let modulus = match builder.object_mount() {
+        Some(ObjectMount::Free) => CoveringModulus::SOFT_GEL,
+        Some(ObjectMount::Mocap) | None => CoveringModulus::NONE,
+    };
     ensure_registered();
     builder
         .add(Section::Extension, extension_xml())
-        .add(Section::Sensor, sensor_xml(config, SENSOR_NAME, site))
+        .add(Section::Sensor, sensor_xml(config, SENSOR_NAME, site, modulus))
 }
 
 /// The arm on its table with `object` and the covering sensor on the pad site: the world of every

@@ -109,6 +109,7 @@ fn figure_plan(object: &ObjectSpec, seed: u64) -> Result<CollectPlan, BoxError> 
         readings_per_object: READINGS,
         seed: rng::substream(seed, STREAM),
         start_pose: StartPose::Canonical,
+        free_object: None,
     })
 }
 

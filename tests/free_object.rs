@@ -1,0 +1,260 @@
+//! The object as a body MuJoCo moves (issue 74): the covering's push as a force, equal and
+//! opposite on the object and the pad and as the stiffness model says at a known penetration;
+//! a free object at rest stays at rest, a push changes its velocity by the impulse over its mass,
+//! a toppled object is reported as tipped.
+
+mod common;
+
+use glam::{DQuat, DVec3};
+use mujoco_rs::prelude::*;
+use taction::pose::Pose;
+use taction::sim::{FreeBody, MotionOutcome, ObjectMount, ObjectSpec, Scene, SceneBuilder};
+use taction::tactile::{CoveringModulus, CoveringSensor, SensorConfig, sensor_xml, total_force_n};
+use taction::valid::Valid;
+
+/// A 10 cm cube of 0.4 kg on a free joint, its top face at z = 0.05, and a 0.1 kg pad on a free
+/// joint looking down at it from `pad_height_m`, gravity off, nothing in contact: only the
+/// covering of modulus `modulus` acts between them.
+fn cube_under_a_free_pad(
+    config: &Valid<SensorConfig>,
+    modulus: CoveringModulus,
+    pad_height_m: f64,
+) -> (MjModel, CoveringSensor) {
+    taction::tactile::ensure_registered();
+    let xml = format!(
+        "<mujoco><option gravity=\"0 0 0\" timestep=\"0.001\"/>\
+         <extension><plugin plugin=\"taction.covering\"/></extension>\
+         <worldbody>\
+         <body name=\"object\"><freejoint/><geom type=\"box\" size=\"0.05 0.05 0.05\" mass=\"0.4\"/></body>\
+         <body name=\"pad_body\" pos=\"0.01 -0.02 {pad_height_m}\"><freejoint/>\
+         <geom type=\"box\" size=\"0.006 0.006 0.002\" pos=\"0 0 0.003\" mass=\"0.1\" contype=\"0\" conaffinity=\"0\"/>\
+         <site name=\"pad\" zaxis=\"0 0 -1\"/></body>\
+         </worldbody><sensor>{}</sensor></mujoco>",
+        sensor_xml(config, "tactile", "pad", modulus)
+    );
+    let model = MjModel::from_xml_string(&xml).unwrap();
+    let sensor = CoveringSensor::first(&model).unwrap();
+    (model, sensor)
+}
+
+#[test]
+fn the_covering_pushes_by_its_stiffness_and_the_pad_feels_the_opposite() {
+    let config = Valid::new(SensorConfig::paper()).unwrap();
+    let t = config.thickness_m;
+    let depth_m = 0.4 * t;
+    let modulus = CoveringModulus::new(20_000.0).unwrap();
+    let (model, sensor) = cube_under_a_free_pad(&config, modulus, 0.05 + t - depth_m);
+    let mut data = MjData::new(&model);
+    data.forward();
+
+    // The whole pad over the cube's top face, pressed `depth_m` in: E/t d A, straight down.
+    let area_m2 = config.pad_width_m * config.pad_height_m;
+    let expected_n = modulus.get() / t * depth_m * area_m2;
+    let presses = sensor.last_press(&model, &data).unwrap();
+    assert_eq!(presses.len(), 1, "{presses:?}");
+    let force = total_force_n(&presses);
+    assert!(
+        (force.z + expected_n).abs() < 0.01 * expected_n,
+        "{force} against {expected_n} N down"
+    );
+    assert!(force.truncate().length() < 1e-9 * expected_n);
+
+    // MuJoCo's generalised forces: the object's free joint feels the force, the pad's its opposite.
+    let qfrc = data.qfrc_passive();
+    let (on_object, on_pad) = (DVec3::from_slice(&qfrc[0..3]), DVec3::from_slice(&qfrc[6..9]));
+    assert!(
+        (on_object - force).length() < 0.01 * expected_n,
+        "{on_object} {force}"
+    );
+    assert!(
+        (on_object + on_pad).length() < 0.01 * expected_n,
+        "{on_object} {on_pad}"
+    );
+
+    // Stepped, the two bodies' momenta change by equal and opposite amounts.
+    data.step();
+    let v = data.qvel();
+    let (object_momentum, pad_momentum) = (
+        DVec3::from_slice(&v[0..3]) * 0.4,
+        DVec3::from_slice(&v[6..9]) * 0.1,
+    );
+    assert!(object_momentum.z < 0.0 && pad_momentum.z > 0.0);
+    assert!(
+        (object_momentum + pad_momentum).length() < 0.01 * object_momentum.length(),
+        "{object_momentum} {pad_momentum}"
+    );
+}
+
+#[test]
+fn a_covering_without_modulus_pushes_nothing_and_a_bad_modulus_fails_the_model() {
+    let config = Valid::new(SensorConfig::paper()).unwrap();
+    let t = config.thickness_m;
+    let (model, sensor) = cube_under_a_free_pad(&config, CoveringModulus::NONE, 0.05 + 0.5 * t);
+    let mut data = MjData::new(&model);
+    data.forward();
+    assert_eq!(sensor.last_press(&model, &data), Some(vec![]));
+    assert!(data.qfrc_passive().iter().all(|&f| f == 0.0));
+    // The image is the same whatever the covering's modulus.
+    let (pressing_model, pressing) =
+        cube_under_a_free_pad(&config, CoveringModulus::SOFT_GEL, 0.05 + 0.5 * t);
+    let mut pressing_data = MjData::new(&pressing_model);
+    pressing_data.forward();
+    assert_eq!(
+        sensor.read(&data).unwrap().values(),
+        pressing.read(&pressing_data).unwrap().values()
+    );
+
+    let xml = "<mujoco><extension><plugin plugin=\"taction.covering\"/></extension>\
+         <worldbody><body mocap=\"true\"><site name=\"pad\"/></body></worldbody><sensor>\
+         <plugin plugin=\"taction.covering\" objtype=\"site\" objname=\"pad\"><config key=\"modulus_pa\" value=\"-3\"/></plugin>\
+         </sensor></mujoco>";
+    let e = format!("{:?}", MjModel::from_xml_string(xml).err().unwrap());
+    assert!(e.contains("modulus_pa") && e.contains("out of range"), "{e}");
+}
+
+/// The arm's world with `mesh` on a free joint of `body`, its start `pose`.
+fn free_object_scene(mesh: taction::mesh::TriMesh, body: FreeBody, pose: Pose) -> Scene {
+    let spec = ObjectSpec {
+        mount: ObjectMount::Free,
+        free_body: body,
+        pose,
+        ..ObjectSpec::new("free", mesh)
+    };
+    let config = Valid::new(SensorConfig::paper()).unwrap();
+    taction::tactile::arm_with_sensor(spec, &config).build().unwrap()
+}
+
+#[test]
+fn a_free_object_on_the_table_stays_at_rest_and_has_its_solid_mass() {
+    let size = DVec3::new(0.08, 0.06, 0.1);
+    let mut scene = free_object_scene(common::box_mesh(size), FreeBody::DEFAULT, Pose::IDENTITY);
+    let mass = scene.object_mass_kg().unwrap();
+    assert!((mass - 1000.0 * size.x * size.y * size.z).abs() < 1e-9, "{mass}");
+    let settled = scene.settle_object().unwrap().unwrap();
+    assert!(settled.shift_m < 1e-3, "{settled:?}");
+    let start = scene.object_pose().unwrap();
+    scene.step_holding_the_arm(10.0).unwrap();
+    let motion = scene.object_motion_from(&start).unwrap();
+    assert!(motion.shift_m < 1e-4 && motion.turn_rad < 1e-3, "{motion:?}");
+    assert_eq!(motion.outcome(), MotionOutcome::Standing);
+}
+
+#[test]
+fn a_push_changes_the_velocity_by_the_impulse_over_the_mass() {
+    // A frictionless object on the table: the push alone changes its horizontal velocity.
+    let slippery = FreeBody::new(800.0, 0.0).unwrap();
+    let mut scene = free_object_scene(
+        common::box_mesh(DVec3::new(0.06, 0.06, 0.04)),
+        slippery,
+        Pose::IDENTITY,
+    );
+    scene.settle_object().unwrap();
+    let mass = scene.object_mass_kg().unwrap();
+    let body = scene.object().unwrap().body;
+    let dt = scene.model().opt().timestep;
+    let (force_n, steps) = (2.0, 5);
+    let impulse = force_n * dt * steps as f64;
+    let before = scene.data().qvel()[..2].to_vec();
+    scene.data_mut().xfrc_applied_mut()[body][0] = force_n;
+    for _ in 0..steps {
+        scene.step().unwrap();
+    }
+    scene.data_mut().xfrc_applied_mut()[body][0] = 0.0;
+    let dv = scene.object_speed().unwrap().0 - DVec3::new(before[0], before[1], 0.0).length();
+    assert!(
+        (dv - impulse / mass).abs() < 0.02 * impulse / mass,
+        "{dv} against {}",
+        impulse / mass
+    );
+}
+
+#[test]
+fn a_toppled_object_is_reported_as_tipped() {
+    // A tall thin post put on the table leaning 40 degrees falls over.
+    let post = common::box_mesh(DVec3::new(0.02, 0.02, 0.12));
+    let lean = Pose::new(
+        DVec3::new(0.0, 0.0, 0.02),
+        DQuat::from_rotation_x(40f64.to_radians()),
+    );
+    let mut scene = free_object_scene(post, FreeBody::DEFAULT, lean);
+    let upright = Pose::IDENTITY;
+    scene.settle_object().unwrap();
+    let motion = scene.object_motion_from(&upright).unwrap();
+    assert_eq!(motion.outcome(), MotionOutcome::Tipped, "{motion:?}");
+    assert!(
+        motion.tilt_rad > 80f64.to_radians(),
+        "it lies on its side: {motion:?}"
+    );
+}
+
+#[test]
+fn a_free_object_must_enclose_a_volume() {
+    let mut sheet = common::box_mesh(DVec3::splat(0.05));
+    sheet.triangles.truncate(2);
+    let spec = ObjectSpec {
+        mount: ObjectMount::Free,
+        ..ObjectSpec::new("sheet", sheet)
+    };
+    let e = SceneBuilder::with_arm_and_table()
+        .object(spec)
+        .build()
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("object 'sheet'") && e.contains("encloses no volume"),
+        "{e}"
+    );
+}
+
+#[test]
+fn collect_touches_a_free_object_records_it_and_says_how_far_each_touch_moved_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("block.obj");
+    taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.06, 0.05, 0.07)), &mesh, "a block").unwrap();
+    let out = dir.path().join("d.csv");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "collect",
+            "--mode",
+            "planner",
+            "--free-object",
+            "--readings",
+            "3",
+            "--contact-sheet",
+            "0",
+        ])
+        .arg("--objects")
+        .arg(&mesh)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("free object block: "))
+        .unwrap();
+    // "free object block: N touches moved it X mm and Y deg each on average ..."
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let (touches, shift_mm): (usize, f64) = (words[3].parse().unwrap(), words[7].parse().unwrap());
+    assert!(touches >= 3 && shift_mm < 1.0, "{line}");
+    assert!(
+        line.ends_with("0 tipped it over, 0 pushed it off the table"),
+        "{line}"
+    );
+
+    let dataset = taction::dataset::Dataset::read(&out).unwrap();
+    assert_eq!(dataset.header().free_object, Some(FreeBody::DEFAULT));
+    assert!(
+        dataset
+            .summary()
+            .to_string()
+            .contains("free object (1000 kg/m3, friction 0.8)")
+    );
+}
