@@ -258,3 +258,121 @@ fn collect_touches_a_free_object_records_it_and_says_how_far_each_touch_moved_it
             .contains("free object (1000 kg/m3, friction 0.8)")
     );
 }
+
+#[test]
+fn an_exported_free_object_scene_opens_pressed_and_the_object_stays_under_the_servos() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "scene",
+            "export",
+            "--object",
+            "pawn",
+            "--free-object",
+            "--object-density",
+            "1200",
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let xml = std::fs::read_to_string(dir.path().join("scene.xml")).unwrap();
+    assert!(
+        xml.contains("<freejoint") && xml.contains("key=\"modulus_pa\" value=\"300\""),
+        "{xml}"
+    );
+    assert!(
+        xml.contains("a solid of 1200 kg/m3, friction 0.8"),
+        "the header says the material"
+    );
+
+    taction::tactile::ensure_registered();
+    let model = MjModel::from_xml(dir.path().join("scene.xml")).expect("the exported scene compiles");
+    let key = model
+        .name_to_id(MjtObjBase::mjOBJ_KEY, "touch")
+        .expect("a keyframe 'touch'");
+    let mut scene = Scene::new(model, None).unwrap();
+    scene.data_mut().reset_keyframe(key).unwrap();
+    scene.forward();
+    let body = scene
+        .model()
+        .name_to_id(MjtObjBase::mjOBJ_BODY, "object")
+        .unwrap();
+    let sensor = CoveringSensor::first(scene.model()).unwrap();
+    let presses = sensor.last_press(scene.model(), scene.data()).unwrap();
+    let press = presses
+        .iter()
+        .find(|p| p.body == body)
+        .expect("the pad presses the object");
+    assert!(press.force_n.z < 0.0, "the pad presses down: {press:?}");
+    // The mass is the pawn's as a solid of 1200 kg/m3.
+    let pawn = taction::mesh::ObjectSet::builtin("chess", None)
+        .unwrap()
+        .build_object("pawn", &taction::mesh::BuildOptions::default())
+        .unwrap();
+    let volume = taction::mesh::SolidMoments::of(&pawn.mesh).unwrap().volume_m3;
+    assert!((scene.model().body_mass()[body] - 1200.0 * volume).abs() < 1e-9);
+    // MuJoCo's own stepping, the servos holding the arm: the object stays where it stood.
+    let start = DVec3::from_array(scene.data().xpos()[body]);
+    for _ in 0..500 {
+        scene.step().unwrap();
+    }
+    let moved = (DVec3::from_array(scene.data().xpos()[body]) - start).length();
+    assert!(
+        moved < 2e-4,
+        "the object moved {moved} m in 1 s under the pressing pad"
+    );
+}
+
+#[test]
+fn a_sliding_free_objects_dataset_is_the_same_on_one_thread_and_on_two() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut meshes = Vec::new();
+    for (name, size) in [
+        ("block", DVec3::new(0.06, 0.05, 0.07)),
+        ("post", DVec3::new(0.03, 0.03, 0.1)),
+    ] {
+        let path = dir.path().join(format!("{name}.obj"));
+        taction::mesh::write_obj(&common::box_mesh(size), &path, name).unwrap();
+        meshes.push(path);
+    }
+    let collect = |threads: &str| {
+        let out = dir.path().join(format!("d{threads}.csv"));
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+            .args([
+                "collect",
+                "--mode",
+                "planner",
+                "--free-object",
+                "--object-density",
+                "500",
+            ])
+            .args([
+                "--object-friction",
+                "0.05",
+                "--readings",
+                "3",
+                "--seed",
+                "5",
+                "--start-pose",
+                "random",
+            ])
+            .args([
+                "--contact-sheet",
+                "0",
+                "--allow-short",
+                "--threads",
+                threads,
+                "--objects",
+            ])
+            .args(&meshes)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        std::fs::read(out).unwrap()
+    };
+    assert_eq!(collect("1"), collect("2"));
+}

@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use taction::bodies::FreeBodyRequestError;
 use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::explore::{CollectModeName, CollectRequest, ExplorationReport, ModeChoices};
@@ -15,7 +14,7 @@ use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
 use crate::cli::common::{
-    ControlArg, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, check_output_file, flag_error,
+    ControlArg, FreeObjectArgs, ObjectSizeArg, SeedArg, ThreadsArg, UsageError, check_output_file, flag_error,
 };
 use crate::cli::plausible::{Carrier, build_objects};
 use crate::cli::sensor_args::SensorArgs;
@@ -58,17 +57,10 @@ pub struct CollectArgs {
     /// away from the arm), with the arm's roll: training data that matches what the arm feels
     #[arg(long)]
     pub reachable: bool,
-    /// Planner: the object on a free joint instead of a mocap body (beyond the paper): it settles
-    /// on the table under gravity, the covering pushes it, every touch runs through MuJoCo's
-    /// dynamics, and how far each touch moved it is printed per object
-    #[arg(long)]
-    pub free_object: bool,
-    /// With --free-object: the object's density, kg/m3, in [10, 20000] [default: 1000]
-    #[arg(long, allow_hyphen_values = true, value_name = "KG_M3")]
-    pub object_density: Option<f64>,
-    /// With --free-object: its sliding friction on the table and the arm, in [0, 2] [default: 0.8]
-    #[arg(long, allow_hyphen_values = true)]
-    pub object_friction: Option<f64>,
+    /// Planner: the object on a free joint (`--free-object`, with `--object-density` and
+    /// `--object-friction`); how far each touch moved it is printed per object.
+    #[command(flatten)]
+    pub free: FreeObjectArgs,
     /// Perturb the object after every reading: largest rotation, degrees, in [0, 180].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_deg: f64,
@@ -152,7 +144,10 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .zip(&reports)
             .flat_map(|(object, report)| {
-                let moved = args.free_object.then(|| free_object_line(&object.name, report));
+                let moved = args
+                    .free
+                    .free_object
+                    .then(|| free_object_line(&object.name, report));
                 std::iter::once(planner_line(&object.name, report)).chain(moved)
             })
             .collect(),
@@ -225,25 +220,15 @@ fn request(args: &CollectArgs) -> Result<CollectRequest, UsageError> {
     })
 }
 
-/// The free object's material ([`FreeBody::requested`]), its fields named by their flags; the
-/// sampler refused by name, its pad floating over no table.
+/// The free object's material ([`FreeObjectArgs::body`]); the sampler refused by name, its pad
+/// floating over no table.
 fn free_body(args: &CollectArgs) -> Result<Option<FreeBody>, UsageError> {
-    if let (Mode::Sampler, true) = (args.mode, args.free_object) {
+    if let (Mode::Sampler, true) = (args.mode, args.free.free_object) {
         return Err(UsageError(
             "--free-object: not a flag of --mode sampler (its pad floats over no table; the arm's planner touches a free object)".into(),
         ));
     }
-    FreeBody::requested(args.free_object, args.object_density, args.object_friction).map_err(|e| {
-        let flag = |field: &str| field.replace('_', "-");
-        match e {
-            FreeBodyRequestError::WithoutFreeObject { field } => {
-                UsageError(format!("--{}: only with --free-object", flag(field)))
-            }
-            FreeBodyRequestError::OutOfRange { field, value, error } => {
-                flag_error(&flag(field), value, error)
-            }
-        }
-    })
+    args.free.body()
 }
 
 /// The flag (without its dashes) that sets a field of [`ModeChoices`] and of the planner's

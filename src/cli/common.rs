@@ -8,6 +8,7 @@ use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use taction::bodies::{FreeBody, FreeBodyRequestError};
 use taction::control::ControlConfig;
 use taction::paper::{DEFAULT_CONTACT_THRESHOLD, RealFramesOptions};
 use taction::recognize::{CodebookKind, PosteriorRule};
@@ -23,6 +24,39 @@ pub struct SeedArg {
     /// seed gives the same output bit for bit, whatever --threads.
     #[arg(long, default_value_t = DEFAULT_SEED, value_name = "N")]
     pub seed: u64,
+}
+
+/// `--free-object` and its material: the object on a free joint instead of a mocap body (beyond
+/// the paper), for every command that puts it under the arm.
+#[derive(Debug, Clone, Copy, Default, Args)]
+pub struct FreeObjectArgs {
+    /// The object on a free joint instead of a mocap body (beyond the paper): it settles on the
+    /// table under gravity and the covering pushes it (docs/guide.md, "A free object")
+    #[arg(long)]
+    pub free_object: bool,
+    /// With --free-object: the object's density, kg/m3, in [10, 20000] [default: 1000]
+    #[arg(long, allow_hyphen_values = true, value_name = "KG_M3")]
+    pub object_density: Option<f64>,
+    /// With --free-object: its sliding friction on the table and the arm, in [0, 2] [default: 0.8]
+    #[arg(long, allow_hyphen_values = true)]
+    pub object_friction: Option<f64>,
+}
+
+impl FreeObjectArgs {
+    /// The material asked for ([`FreeBody::requested`]), its fields named by their flags.
+    pub fn body(&self) -> Result<Option<FreeBody>, UsageError> {
+        FreeBody::requested(self.free_object, self.object_density, self.object_friction).map_err(|e| {
+            let flag = |field: &str| field.replace('_', "-");
+            match e {
+                FreeBodyRequestError::WithoutFreeObject { field } => {
+                    UsageError(format!("--{}: only with --free-object", flag(field)))
+                }
+                FreeBodyRequestError::OutOfRange { field, value, error } => {
+                    flag_error(&flag(field), value, error)
+                }
+            }
+        })
+    }
 }
 
 /// `--object-size-m`: the one rescale flag of every command that builds objects from the user's

@@ -3,7 +3,8 @@
 //! The scene is the one the arm explores (`SceneBuilder`: the arm of Sec. V-A1, the table, the object
 //! with its collision shell in geom group 3) with the `taction.covering` sensor on the pad site,
 //! configured by the sensor flags. The object's mesh goes beside the MJCF as an OBJ file the mesh
-//! asset refers to. The object is a mocap body at the world origin, resting on the table.
+//! asset refers to. The object is a mocap body at the world origin, resting on the table, or with
+//! `--free-object` a body on a free joint there, its mass its mesh's, the covering pushing it.
 //!
 //! Like `mjcf/scene.xml`, the scene carries a keyframe `touch`: the arm where `taction touch --arm`
 //! leaves it after pressing the pad onto the object from above, so that MuJoCo's own tools open it
@@ -16,14 +17,14 @@ use glam::DVec3;
 use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::mesh::BUILTIN_SETS;
-use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
+use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, SolidMoments, write_obj};
 use taction::pose::PadPose;
-use taction::sim::{ObjectSpec, SceneBuilder};
+use taction::sim::{ObjectMount, ObjectSpec, SceneBuilder};
 use taction::sim::{Section, comment, numbers};
 use taction::tactile::{SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, SeedArg, check_output_folder};
+use crate::cli::common::{FreeObjectArgs, ObjectSizeArg, SeedArg, check_output_folder};
 use crate::cli::plausible::{Carrier, check_mesh};
 use crate::cli::plugin_path::PLUGIN_LIBRARY;
 use crate::cli::sensor_args::SensorArgs;
@@ -58,6 +59,10 @@ pub struct ExportArgs {
     pub sensor: SensorArgs,
     #[command(flatten)]
     pub seed: SeedArg,
+    /// The object on a free joint (`--free-object`, with `--object-density` and
+    /// `--object-friction`): its mass and inertia its mesh's, the covering pushing it.
+    #[command(flatten)]
+    pub free: FreeObjectArgs,
 }
 
 /// What can go wrong; each names the flag or file at fault.
@@ -148,21 +153,48 @@ fn touch_from_above(
     Ok(in_contact)
 }
 
+/// What the header says of a free object: its mass, material and the covering's push; nothing
+/// for a mocap one.
+fn free_sentence(object: &ObjectSpec) -> String {
+    if object.mount != ObjectMount::Free {
+        return String::new();
+    }
+    let body = object.free_body;
+    let mass_kg = SolidMoments::of(&object.mesh).map_or(0.0, |m| m.volume_m3 * body.density_kg_m3());
+    format!(
+        "\n  The object stands on a free joint: {} g, a solid of {} kg/m3, friction {}; the covering pushes it\n  \
+         (the sensor's modulus_pa), so stepping the scene presses it as taction collect --free-object does.",
+        taction::units::significant(mass_kg * 1e3),
+        body.density_kg_m3(),
+        body.friction()
+    )
+}
+
 /// `builder` with the keyframe "touch" where the arm, pressing from above, settled on `spec`
-/// (none, with a warning, when it could not), and the sentence the scene's header gives it.
+/// (none, with a warning, when it could not), and the sentence the scene's header gives it. A free
+/// object's joint stands in the keyframe where the object was built, at rest.
 fn with_touch_keyframe(
     mut builder: SceneBuilder,
     spec: &ObjectSpec,
     config: &Valid<SensorConfig>,
     object: &str,
+    mount: ObjectMount,
 ) -> Result<(SceneBuilder, String), Box<dyn std::error::Error>> {
     let keyframe = match touch_from_above(spec, config)? {
         Some(touch) => {
+            let object_qpos = match mount {
+                ObjectMount::Free => {
+                    let [w, x, y, z] = spec.pose.mujoco_quat();
+                    let p = spec.pose.position_m;
+                    vec![p.x, p.y, p.z, w, x, y, z]
+                }
+                ObjectMount::Mocap => Vec::new(),
+            };
             builder = builder.add(
                 Section::Keyframe,
                 format!(
                     "<key name=\"touch\" qpos=\"{}\" ctrl=\"{}\"/>",
-                    numbers(touch.qpos.iter().copied()),
+                    numbers(touch.qpos.iter().copied().chain(object_qpos)),
                     numbers(touch.q_rad.iter().copied())
                 ),
             );
@@ -189,6 +221,7 @@ fn with_touch_keyframe(
 pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> {
     check_output_folder(&args.out, "out")?;
     let config = args.sensor.config(args.seed.seed)?;
+    let free_body = args.free.body()?;
     let built = resolve_object(&args.object, args.object_size.m)?;
     check_mesh(&format!("--object: {}", args.object), &built.mesh, Carrier::Arm)?;
     if !built.warnings.is_clean() {
@@ -200,15 +233,24 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     // Named as `taction objects export` names its files.
     let mesh_file = format!("{}.obj", built.name);
     let spec = ObjectSpec::from(built);
-    let builder = arm_with_sensor(spec.clone(), &config).object_mesh_file(mesh_file.clone());
-    let (builder, keyframe) = with_touch_keyframe(builder, &spec, &config, &args.object)?;
+    let mounted = match free_body {
+        Some(body) => ObjectSpec {
+            mount: ObjectMount::Free,
+            free_body: body,
+            ..spec.clone()
+        },
+        None => spec.clone(),
+    };
+    let builder = arm_with_sensor(mounted.clone(), &config).object_mesh_file(mesh_file.clone());
+    let (builder, keyframe) = with_touch_keyframe(builder, &spec, &config, &args.object, mounted.mount)?;
     let xml = builder.to_xml()?;
     let header = comment(&format!(
         "  Written by taction scene export for the object {}: the arm, the table, the object (mesh in {mesh_file},\n  \
          metres) and the taction.covering sensor on the pad site. Load the plugin library first:\n  \
          mujoco.mj_loadPluginLibrary(path) with the path `taction plugin-path` prints ({PLUGIN_LIBRARY}),\n  \
-         or copy the library into the plugin/ folder of the mujoco Python package.\n  {keyframe}",
-        args.object
+         or copy the library into the plugin/ folder of the mujoco Python package.\n  {keyframe}{}",
+        args.object,
+        free_sentence(&mounted)
     )) + "\n";
     let write = |path: PathBuf, text: &str| {
         taction::atomic::write_atomic(&path, text.as_bytes()).map_err(|e| SceneExportError::Write {
