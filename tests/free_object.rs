@@ -207,29 +207,38 @@ fn a_free_object_must_enclose_a_volume() {
     );
 }
 
+/// `taction collect --mode planner --free-object --contact-sheet 0` of `meshes` into `out`, with
+/// `flags` besides.
+fn collect_planner_free(
+    meshes: &[std::path::PathBuf],
+    out: &std::path::Path,
+    flags: &[&str],
+) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
+        .args([
+            "collect",
+            "--mode",
+            "planner",
+            "--free-object",
+            "--contact-sheet",
+            "0",
+        ])
+        .args(flags)
+        .arg("--objects")
+        .args(meshes)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 #[test]
 fn collect_touches_a_free_object_records_it_and_says_how_far_each_touch_moved_it() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("block.obj");
     taction::mesh::write_obj(&common::box_mesh(DVec3::new(0.06, 0.05, 0.07)), &mesh, "a block").unwrap();
     let out = dir.path().join("d.csv");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
-        .args([
-            "collect",
-            "--mode",
-            "planner",
-            "--free-object",
-            "--readings",
-            "3",
-            "--contact-sheet",
-            "0",
-        ])
-        .arg("--objects")
-        .arg(&mesh)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = collect_planner_free(&[mesh], &out, &["--readings", "3"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(
         run.status.success(),
@@ -339,38 +348,22 @@ fn a_sliding_free_objects_dataset_is_the_same_on_one_thread_and_on_two() {
     }
     let collect = |threads: &str| {
         let out = dir.path().join(format!("d{threads}.csv"));
-        let run = std::process::Command::new(env!("CARGO_BIN_EXE_taction"))
-            .args([
-                "collect",
-                "--mode",
-                "planner",
-                "--free-object",
-                "--object-density",
-                "500",
-            ])
-            .args([
-                "--object-friction",
-                "0.05",
-                "--readings",
-                "3",
-                "--seed",
-                "5",
-                "--start-pose",
-                "random",
-            ])
-            .args([
-                "--contact-sheet",
-                "0",
-                "--allow-short",
-                "--threads",
-                threads,
-                "--objects",
-            ])
-            .args(&meshes)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
+        let flags = [
+            "--object-density",
+            "500",
+            "--object-friction",
+            "0.05",
+            "--readings",
+            "3",
+            "--seed",
+            "5",
+            "--start-pose",
+            "random",
+            "--allow-short",
+            "--threads",
+            threads,
+        ];
+        let run = collect_planner_free(&meshes, &out, &flags);
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
         std::fs::read(out).unwrap()
     };

@@ -17,7 +17,7 @@ use glam::DVec3;
 use taction::control::ControlConfig;
 use taction::dataset::ContactStatus;
 use taction::mesh::BUILTIN_SETS;
-use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, SolidMoments, write_obj};
+use taction::mesh::{BuildOptions, MeshError, Object, ObjectSet, write_obj};
 use taction::pose::PadPose;
 use taction::sim::{ObjectMount, ObjectSpec, SceneBuilder};
 use taction::sim::{Section, comment, numbers};
@@ -160,7 +160,7 @@ fn free_sentence(object: &ObjectSpec) -> String {
         return String::new();
     }
     let body = object.free_body;
-    let mass_kg = SolidMoments::of(&object.mesh).map_or(0.0, |m| m.volume_m3 * body.density_kg_m3());
+    let mass_kg = object.solid_mass_kg().unwrap_or(0.0);
     format!(
         "\n  The object stands on a free joint: {} g, a solid of {} kg/m3, friction {}; the covering pushes it\n  \
          (the sensor's modulus_pa), so stepping the scene presses it as taction collect --free-object does.",
@@ -233,14 +233,7 @@ pub fn export(args: &ExportArgs) -> Result<PathBuf, Box<dyn std::error::Error>> 
     // Named as `taction objects export` names its files.
     let mesh_file = format!("{}.obj", built.name);
     let spec = ObjectSpec::from(built);
-    let mounted = match free_body {
-        Some(body) => ObjectSpec {
-            mount: ObjectMount::Free,
-            free_body: body,
-            ..spec.clone()
-        },
-        None => spec.clone(),
-    };
+    let mounted = spec.mounted(free_body);
     let builder = arm_with_sensor(mounted.clone(), &config).object_mesh_file(mesh_file.clone());
     let (builder, keyframe) = with_touch_keyframe(builder, &spec, &config, &args.object, mounted.mount)?;
     let xml = builder.to_xml()?;

@@ -24,7 +24,7 @@ use crate::explore::setup::TouchSetup;
 use crate::pose::StartPose;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
-use crate::sim::{FreeBody, ObjectMount, ObjectSpec, PerturbationBounds, Scene, SimError};
+use crate::sim::{FreeBody, ObjectSpec, PerturbationBounds, Scene, SimError};
 use crate::tactile::SensorConfig;
 use crate::tactile::sensor::{CoveringSensor, TactileError, arm_with_sensor};
 use crate::valid::{RangeError, Valid};
@@ -193,14 +193,7 @@ impl CollectPlan {
     /// `object` held as this plan holds objects: on a mocap body as given, or free, made of
     /// [`free_object`](Self::free_object).
     pub fn mounted(&self, object: &ObjectSpec) -> ObjectSpec {
-        match self.free_object {
-            None => object.clone(),
-            Some(free_body) => ObjectSpec {
-                mount: ObjectMount::Free,
-                free_body,
-                ..object.clone()
-            },
-        }
+        object.mounted(self.free_object)
     }
 
     /// Collects every object on a pool of `threads` threads (0: all cores), results in object order.

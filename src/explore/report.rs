@@ -6,7 +6,7 @@ use crate::control::ContactOutcome;
 use crate::dataset::{AttemptCause, CauseKind, ContactStatus, Reading, Strategy};
 use crate::pose::PadPose;
 use crate::pose::Pose;
-use crate::sim::{MotionOutcome, ObjectMotion};
+use crate::sim::ObjectMotion;
 use crate::tactile::{SensorConfig, TactileError, TactileImage};
 
 /// The reading of one settling attempt on `object` (at `object_pose`): the controllers' image and
@@ -97,14 +97,6 @@ pub struct ExplorationReport {
 }
 
 impl ExplorationReport {
-    /// The touches of a free object that tipped it over or pushed it off the table.
-    pub fn objects_lost(&self) -> usize {
-        self.object_motions
-            .iter()
-            .filter(|m| m.outcome() != MotionOutcome::Standing)
-            .count()
-    }
-
     /// Number of converged readings.
     pub fn converged(&self) -> usize {
         self.readings.iter().filter(|r| r.is_converged()).count()

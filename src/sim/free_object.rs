@@ -64,16 +64,6 @@ pub enum MotionOutcome {
     OffTable,
 }
 
-impl MotionOutcome {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Standing => "standing",
-            Self::Tipped => "tipped",
-            Self::OffTable => "off_table",
-        }
-    }
-}
-
 impl ObjectMotion {
     /// The motion from `before` to `after`, the object's centre `centre_m` at `after`.
     pub fn between(before: &Pose, after: &Pose, centre_m: DVec3) -> Self {

@@ -137,6 +137,24 @@ impl ObjectSpec {
         Ok(built.into_iter().map(Self::from).collect())
     }
 
+    /// This object held free and made of `body`, or, `None`, as it is.
+    pub fn mounted(&self, body: Option<FreeBody>) -> ObjectSpec {
+        match body {
+            None => self.clone(),
+            Some(free_body) => ObjectSpec {
+                mount: ObjectMount::Free,
+                free_body,
+                ..self.clone()
+            },
+        }
+    }
+
+    /// The mass a free mount gives it: its mesh as a uniform solid of the [`FreeBody`]'s density;
+    /// `None` when the mesh encloses no volume.
+    pub fn solid_mass_kg(&self) -> Option<f64> {
+        SolidMoments::of(&self.mesh).map(|m| m.volume_m3 * self.free_body.density_kg_m3())
+    }
+
     /// How a scene holds this object's surface: as it is, or, for a mesh of more than
     /// [`large_mesh_triangles`](Self::large_mesh_triangles), a coarse copy for MuJoCo and the exact
     /// surface beside it.
