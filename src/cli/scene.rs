@@ -163,7 +163,7 @@ fn free_sentence(object: &ObjectSpec) -> String {
     let mass_kg = object.solid_mass_kg().unwrap_or(0.0);
     format!(
         "\n  The object stands on a free joint: {} g, a solid of {} kg/m3, friction {}; the covering pushes it\n  \
-         (the sensor's modulus_pa), so stepping the scene presses it as taction collect --free-object does.",
+         (the sensor's modulus_pa), so stepping the scene presses it as taction collect does with its free-object flag.",
         taction::units::significant(mass_kg * 1e3),
         body.density_kg_m3(),
         body.friction()
