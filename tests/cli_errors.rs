@@ -384,6 +384,7 @@ fn flat_dataset(sensor: SensorConfig, objects: &[&str], per_object: usize) -> Da
             image: image.clone(),
             object: object.to_string(),
             object_pose: Pose::IDENTITY,
+            object_pose_after: None,
             status: ContactStatus::Converged,
             iterations: 3,
             strategy: Strategy::Sampler,
@@ -939,7 +940,7 @@ fn recognize_warns_of_a_sampler_calibration_on_the_arms_touches() {
     let shown = taction(&["dataset", "show", &v2]);
     let text = String::from_utf8_lossy(&shown.stdout);
     assert!(
-        text.contains("written in format version 2; read as version 3"),
+        text.contains("written in format version 2; read as version 4"),
         "{text}"
     );
 }

@@ -39,6 +39,11 @@ fn dataset() -> Dataset {
                 position_m: DVec3::new(k, 2.0 / 3.0, -1e20),
                 rotation: DQuat::from_rotation_z(k),
             },
+            // A free object's pose after the touch: shifted and turned, or none (fixed).
+            object_pose_after: with_pad.then(|| Pose {
+                position_m: DVec3::new(k + 0.1, 1.0 / 3.0, 1e-300),
+                rotation: DQuat::from_rotation_x(k / 7.0),
+            }),
             status,
             iterations: k as u32,
             strategy: if with_pad {
@@ -174,6 +179,7 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
         "iterations",
         "object",
         "object_pose",
+        "object_pose_after",
         "pad_pose",
         "status",
         "strategy",
@@ -213,6 +219,17 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
     let (t, q) = (o.position_m, o.rotation);
     let second: Vec<u64> = [t.x, t.y, t.z, q.w, q.x, q.y, q.z].map(f64::to_bits).to_vec();
     assert_eq!(object_pose.f8()[7..14], second);
+
+    let after = &arrays["object_pose_after"];
+    assert_eq!(after.shape, [3, 7]);
+    let o = readings[0].object_pose_after.expect("a free object's reading");
+    let (t, q) = (o.position_m, o.rotation);
+    let first: Vec<u64> = [t.x, t.y, t.z, q.w, q.x, q.y, q.z].map(f64::to_bits).to_vec();
+    assert_eq!(after.f8()[..7], first);
+    assert!(
+        after.f8()[7..14].iter().all(|&b| f64::from_bits(b).is_nan()),
+        "a fixed object: NaN"
+    );
 
     assert_eq!(arrays["iterations"].shape, [3]);
     assert_eq!(arrays["iterations"].i8(), [1, 2, 3]);
@@ -311,6 +328,8 @@ fn parquet_reads_back_with_the_parquet_reader() {
     assert_eq!(field(1, "pad_x_m"), Field::Null, "no pose: null");
     assert_eq!(field(0, "pad_x_m"), Field::Double(0.1));
     assert_eq!(field(1, "object_y_m"), Field::Double(2.0 / 3.0));
+    assert_eq!(field(1, "object_after_y_m"), Field::Null, "a fixed object: null");
+    assert_eq!(field(0, "object_after_y_m"), Field::Double(1.0 / 3.0));
     for (row, reading) in data.readings().iter().enumerate() {
         let want = (reading.image.get(1, 1) as f32).to_bits();
         assert!(matches!(field(row, "t_1_1"), Field::Float(v) if v.to_bits() == want));

@@ -9,13 +9,15 @@
 //! | `images` | `<f4` | `[N, rows, cols]` | the tactile images, row 0 the pad's `+up` edge as [`TactileImage`](crate::tactile::TactileImage) stores it |
 //! | `pad_pose` | `<f8` | `[N, 9]` | centre xyz (m), normal xyz, up xyz: the CSV's `pad_x_m` ... `pad_up_z`; NaN where a reading has no pose |
 //! | `object_pose` | `<f8` | `[N, 7]` | x, y, z (m), qw, qx, qy, qz: the CSV's `object_x_m` ... `object_qz` |
+//! | `object_pose_after` | `<f8` | `[N, 7]` | a free object's pose when the reading was taken, the CSV's `object_after_x_m` ... `object_after_qz`; NaN where the object is fixed |
 //! | `iterations` | `<i8` | `[N]` | the contact controller's iterations |
 //! | `object`, `status`, `strategy`, `cause`, `touched_bodies` | `<U..` | `[N]` | the CSV's names; `cause` and `touched_bodies` empty when none |
 //! | `header` | `<U..` | `[]` | the header JSON of the CSV's line 2 (`json.loads(str(z["header"]))`) |
 //!
 //! **Parquet** (`pandas.read_parquet(path)`): the CSV's columns under the CSV's names and in its
 //! order, one row group: the names as UTF-8 strings, `iterations` int64, the poses float64 (the
-//! nine pad pose columns null where a reading has no pose), then one float32 column per taxel,
+//! nine pad pose columns null where a reading has no pose, the seven of the object's pose after
+//! the touch null where the object is fixed), then one float32 column per taxel,
 //! `t_{row}_{col}` row-major, so `df.filter(regex="^t_").to_numpy().reshape(-1, rows, cols)` gives
 //! the images. Snappy-compressed; the header JSON is the file's key-value metadata
 //! `taction_header` (`pyarrow.parquet.read_schema(path).metadata[b"taction_header"]`).
@@ -147,6 +149,10 @@ fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::Zip
             Npy::f8(vec![n, 7], pose_values(readings, Meta::object_pose())),
         ),
         (
+            "object_pose_after",
+            Npy::f8(vec![n, 7], pose_values(readings, Meta::object_pose_after())),
+        ),
+        (
             "iterations",
             Npy::i8(vec![n], readings.iter().map(|r| i64::from(r.iterations))),
         ),
@@ -212,7 +218,7 @@ impl ParquetColumn {
         match self {
             Self::Taxel(_) => ColumnType::Float32,
             Self::Meta(Meta::Iterations) => ColumnType::Int64,
-            Self::Meta(m) if Meta::pad().contains(&m) || Meta::object_pose().contains(&m) => {
+            Self::Meta(m) if m.is_optional_pose() || Meta::object_pose().contains(&m) => {
                 ColumnType::Float64
             }
             Self::Meta(_) => ColumnType::Text,
@@ -220,7 +226,7 @@ impl ParquetColumn {
     }
 
     /// How the column is stored: its [`ColumnType`], the pad pose optional (for images without
-    /// one).
+    /// one) and the object's pose after the touch (for a fixed object).
     fn storage(self) -> (PhysicalType, Repetition) {
         let physical = match self.column_type() {
             ColumnType::Text => PhysicalType::BYTE_ARRAY,
@@ -228,7 +234,7 @@ impl ParquetColumn {
             ColumnType::Float64 => PhysicalType::DOUBLE,
             ColumnType::Float32 => PhysicalType::FLOAT,
         };
-        let optional = matches!(self, Self::Meta(m) if Meta::pad().contains(&m));
+        let optional = matches!(self, Self::Meta(m) if m.is_optional_pose());
         let repetition = if optional {
             Repetition::OPTIONAL
         } else {

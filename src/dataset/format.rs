@@ -1,4 +1,4 @@
-//! A dataset on disk (version 3).
+//! A dataset on disk (version 4).
 //!
 //! One UTF-8 text file, so a dataset is a single atomic unit (written to a temporary file in the
 //! same folder, then renamed over the target) and any CSV reader can open it after skipping the
@@ -6,11 +6,11 @@
 //!
 //! ```text
 //! # taction dataset
-//! # {"format_version":3,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
+//! # {"format_version":4,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
 //! #   "generator":"sampler","seed":7,"readings":11000}          <- one line of JSON
-//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,touched_bodies,t_0_0,...,t_{rows-1}_{cols-1}
-//! bunny,converged,sampler,4,0.1,...,,,0,0.25,...
-//! bunny,collision,sampler,3,0.1,...,pad_on_object,sensor/object,0,0.31,...
+//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,touched_bodies,object_after_x_m,...,object_after_qz,t_0_0,...
+//! bunny,converged,sampler,4,0.1,...,,,,,,,,,,0,0.25,...
+//! bunny,collision,sampler,3,0.1,...,pad_on_object,sensor/object,,,,,,,,0,0.31,...
 //! ...
 //! # end 11000
 //! ```
@@ -27,9 +27,12 @@
 //!   for a `no_contact` after pressing, `physics_fault` for an `aborted` attempt; empty when the
 //!   status says it all), `touched_bodies` (for the four touches, the two bodies as
 //!   `arm_body/other_body`, e.g. `sensor/object`, `link4/world`, the table being `world`; empty
-//!   otherwise), then the `rows x cols` taxels row-major as `t_{row}_{col}`, row 0 being the pad's
-//!   `+up` edge.
-//! - Older versions are read and brought up to this one: version 2 had no `touched_bodies`, its
+//!   otherwise), a free object's pose when the reading was taken `object_after_x_m, ...,
+//!   object_after_qz` (the touch may have moved it from `object_x_m, ...`; all seven empty where the
+//!   object is fixed, as the paper's is, so no touch moves it), then the `rows x cols` taxels
+//!   row-major as `t_{row}_{col}`, row 0 being the pad's `+up` edge.
+//! - Older versions are read and brought up to this one: version 3 had no pose after the touch
+//!   (its objects were all fixed); version 2 had no `touched_bodies`, its
 //!   `cause` held the bodies themselves (`sensor/object`, now `pad_on_object` with those bodies) or
 //!   `covering_meets_table` (now `covering_on_table`); version 1 had no `cause`. Neither wrote
 //!   `lost_contact`, which is given to their `no_contact` rows with iterations.
@@ -60,7 +63,7 @@ use crate::tactile::TactileImage;
 use crate::valid::Check;
 
 /// The file format version this build writes; it reads this one and every earlier one.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 const MAGIC: &str = "# taction dataset";
 const END_PREFIX: &str = "# end ";
@@ -90,10 +93,17 @@ pub(super) enum Meta {
     PadUpZ,
     Cause,
     TouchedBodies,
+    ObjectAfterX,
+    ObjectAfterY,
+    ObjectAfterZ,
+    ObjectAfterQw,
+    ObjectAfterQx,
+    ObjectAfterQy,
+    ObjectAfterQz,
 }
 
 impl Meta {
-    pub(super) const ALL: [Meta; 22] = [
+    pub(super) const ALL: [Meta; 29] = [
         Self::Object,
         Self::Status,
         Self::Strategy,
@@ -116,6 +126,13 @@ impl Meta {
         Self::PadUpZ,
         Self::Cause,
         Self::TouchedBodies,
+        Self::ObjectAfterX,
+        Self::ObjectAfterY,
+        Self::ObjectAfterZ,
+        Self::ObjectAfterQw,
+        Self::ObjectAfterQx,
+        Self::ObjectAfterQy,
+        Self::ObjectAfterQz,
     ];
 
     /// The columns before the taxels in a file of format `version` (a prefix of [`ALL`](Self::ALL):
@@ -124,6 +141,7 @@ impl Meta {
         match version {
             1 => &Self::ALL[..=Self::PadUpZ.index()],
             2 => &Self::ALL[..=Self::Cause.index()],
+            3 => &Self::ALL[..=Self::TouchedBodies.index()],
             _ => &Self::ALL,
         }
     }
@@ -163,12 +181,31 @@ impl Meta {
             Self::PadUpZ => "pad_up_z",
             Self::Cause => "cause",
             Self::TouchedBodies => "touched_bodies",
+            Self::ObjectAfterX => "object_after_x_m",
+            Self::ObjectAfterY => "object_after_y_m",
+            Self::ObjectAfterZ => "object_after_z_m",
+            Self::ObjectAfterQw => "object_after_qw",
+            Self::ObjectAfterQx => "object_after_qx",
+            Self::ObjectAfterQy => "object_after_qy",
+            Self::ObjectAfterQz => "object_after_qz",
         }
     }
 
     /// The object pose's seven columns, `object_x_m` to `object_qz`.
     pub(super) fn object_pose() -> &'static [Meta] {
         &Self::ALL[Self::ObjectX.index()..=Self::ObjectQz.index()]
+    }
+
+    /// A free object's pose after the touch, seven columns `object_after_x_m` to
+    /// `object_after_qz`: all set, or all empty (a fixed object).
+    pub(super) fn object_pose_after() -> &'static [Meta] {
+        &Self::ALL[Self::ObjectAfterX.index()..=Self::ObjectAfterQz.index()]
+    }
+
+    /// The columns that may be empty together: the pad's pose (an image without one) and the
+    /// object's pose after the touch (a fixed object).
+    pub(super) fn is_optional_pose(self) -> bool {
+        Self::pad().contains(&self) || Self::object_pose_after().contains(&self)
     }
 
     /// This column of `r`, as written.
@@ -194,11 +231,13 @@ impl Meta {
     }
 
     /// This pose column of `r` as a number: `None` for a pad pose column of an image without a
-    /// pose, and for the columns that are not poses.
+    /// pose, for the pose after the touch of a fixed object, and for the columns that are not
+    /// poses.
     pub(super) fn number(self, r: &Reading) -> Option<f64> {
         let position = r.object_pose.position_m;
         let rotation = r.object_pose.rotation;
         let pad = |value: fn(&PadPose) -> f64| r.image.pose().map(value);
+        let after = |value: fn(&Pose) -> f64| r.object_pose_after.as_ref().map(value);
         match self {
             Self::ObjectX => Some(position.x),
             Self::ObjectY => Some(position.y),
@@ -216,6 +255,13 @@ impl Meta {
             Self::PadUpX => pad(|p| p.up.x),
             Self::PadUpY => pad(|p| p.up.y),
             Self::PadUpZ => pad(|p| p.up.z),
+            Self::ObjectAfterX => after(|p| p.position_m.x),
+            Self::ObjectAfterY => after(|p| p.position_m.y),
+            Self::ObjectAfterZ => after(|p| p.position_m.z),
+            Self::ObjectAfterQw => after(|p| p.rotation.w),
+            Self::ObjectAfterQx => after(|p| p.rotation.x),
+            Self::ObjectAfterQy => after(|p| p.rotation.y),
+            Self::ObjectAfterQz => after(|p| p.rotation.z),
             Self::Object
             | Self::Status
             | Self::Strategy
@@ -594,6 +640,15 @@ impl Row<'_> {
         Ok(DVec3::new(self.number(x)?, self.number(y)?, self.number(z)?))
     }
 
+    /// An object pose from its seven `columns`: x, y, z (metres), qw, qx, qy, qz.
+    fn pose(&self, columns: &[Meta]) -> Result<Pose, (String, String)> {
+        let n = |i: usize| self.number(columns[i]);
+        Ok(Pose {
+            position_m: DVec3::new(n(0)?, n(1)?, n(2)?),
+            rotation: DQuat::from_xyzw(n(4)?, n(5)?, n(6)?, n(3)?),
+        })
+    }
+
     /// The column's text as `parse` reads it, or an error listing the `name`s of `all` (built only
     /// then: this runs for every row of a dataset).
     fn named<T: Copy>(
@@ -644,14 +699,11 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
             format!("'{}' is not a non-negative integer", row.text(Meta::Iterations)),
         )
     })?;
-    let object_pose = Pose {
-        position_m: row.vector([Meta::ObjectX, Meta::ObjectY, Meta::ObjectZ])?,
-        rotation: DQuat::from_xyzw(
-            row.number(Meta::ObjectQx)?,
-            row.number(Meta::ObjectQy)?,
-            row.number(Meta::ObjectQz)?,
-            row.number(Meta::ObjectQw)?,
-        ),
+    let object_pose = row.pose(Meta::object_pose())?;
+    let object_pose_after = match row.version {
+        ..=3 => None,
+        _ if all_empty(row, Meta::object_pose_after())? => None,
+        _ => Some(row.pose(Meta::object_pose_after())?),
     };
     let pad = parse_pad_pose(row)?;
     let cause = parse_cause(row, status, iterations)?;
@@ -664,6 +716,7 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
         image,
         object,
         object_pose,
+        object_pose_after,
         status,
         iterations,
         strategy,
@@ -671,14 +724,23 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
     })
 }
 
+/// Whether the row's `columns` are all empty; an error names the first empty one when only some
+/// are (a pose is whole, or absent).
+fn all_empty(row: &Row, columns: &[Meta]) -> Result<bool, (String, String)> {
+    let is_empty = |column: &&Meta| row.text(**column).trim().is_empty();
+    if columns.iter().all(|column| is_empty(&column)) {
+        return Ok(true);
+    }
+    match columns.iter().find(is_empty) {
+        Some(column) => Err(row.error(column.index(), "empty, but other fields of its pose are set".into())),
+        None => Ok(false),
+    }
+}
+
 /// The row's pad pose: its nine columns all set, or all empty (`None`: an image without a pose).
 fn parse_pad_pose(row: &Row) -> Result<Option<PadPose>, (String, String)> {
-    let is_empty = |column: &&Meta| row.text(**column).trim().is_empty();
-    if Meta::pad().iter().all(|column| is_empty(&column)) {
+    if all_empty(row, Meta::pad())? {
         return Ok(None);
-    }
-    if let Some(column) = Meta::pad().iter().find(is_empty) {
-        return Err(row.error(column.index(), "empty, but other pad pose fields are set".into()));
     }
     Ok(Some(PadPose {
         center_m: row.vector([Meta::PadX, Meta::PadY, Meta::PadZ])?,

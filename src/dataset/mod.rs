@@ -482,6 +482,11 @@ mod tests {
                 position_m: DVec3::new(k, 2.0 / 3.0, -1e20),
                 rotation: DQuat::from_rotation_z(k),
             },
+            // A free object's pose after the touch: shifted and turned, or none (fixed).
+            object_pose_after: with_pad.then(|| Pose {
+                position_m: DVec3::new(k + 0.1, 1.0 / 3.0, 1e-300),
+                rotation: DQuat::from_rotation_x(k / 7.0),
+            }),
             status,
             iterations: k as u32,
             strategy: if with_pad {
@@ -677,7 +682,66 @@ mod tests {
 
     /// `text` (a format 3 file) as format 2 wrote it: no `touched_bodies`, the bodies themselves in
     /// `cause`, `covering_meets_table`, and no `lost_contact`.
+    /// `text` (this version's file) as format 3 wrote it: no pose after the touch.
+    fn as_format_3(text: &str) -> String {
+        let after = format::Meta::ObjectAfterX.index();
+        let lines: Vec<String> = text
+            .lines()
+            .map(|line| match line.starts_with('#') {
+                true => line.replace("\"format_version\":4", "\"format_version\":3"),
+                false => {
+                    // Rows without a quoted comma in the object name split at commas into columns.
+                    let offset = usize::from(line.starts_with('"'));
+                    let mut fields: Vec<&str> = line.split(',').collect();
+                    fields.drain(after + offset..after + offset + 7);
+                    fields.join(",")
+                }
+            })
+            .collect();
+        lines.join("\n") + "\n"
+    }
+
+    /// `d` as a file of format 3 or older holds it: every object fixed.
+    fn without_poses_after(mut d: Dataset) -> Dataset {
+        for r in &mut d.readings {
+            r.object_pose_after = None;
+        }
+        d
+    }
+
+    #[test]
+    fn a_format_3_file_is_read_with_every_object_fixed() {
+        let d = dataset_with_causes();
+        assert!(d.readings.iter().any(|r| r.object_pose_after.is_some()));
+        let old = as_format_3(&String::from_utf8(d.to_file_bytes("d.csv").unwrap()).unwrap());
+        assert!(!old.contains("object_after"), "{old}");
+        let read = Dataset::parse(&old, "v3.csv").unwrap();
+        assert_eq!(read.header().format_version, FORMAT_VERSION);
+        assert_eq!(read, without_poses_after(d));
+    }
+
+    #[test]
+    fn a_pose_after_the_touch_is_whole_or_absent() {
+        let t = text();
+        let lines: Vec<&str> = t.lines().collect();
+        let after_qz = format::Meta::ObjectAfterQz.index();
+        let row = (3..lines.len())
+            .find(|&i| !lines[i].starts_with('"') && lines[i].split(',').nth(after_qz).is_some_and(|v| !v.is_empty()))
+            .expect("a free object's reading");
+        let mut fields: Vec<&str> = lines[row].split(',').collect();
+        fields[after_qz] = "";
+        let broken = t.replace(lines[row], &fields.join(","));
+        let e = parse_err(&broken);
+        assert!(
+            e.contains(&format!("line {}", row + 1))
+                && e.contains("'object_after_qz'")
+                && e.contains("empty, but other fields of its pose are set"),
+            "{e}"
+        );
+    }
+
     fn as_format_2(text: &str) -> String {
+        let text = as_format_3(text);
         let mut lines: Vec<String> = Vec::new();
         for line in text.lines() {
             let mut fields: Vec<String> = line.split(',').map(str::to_string).collect();
@@ -714,6 +778,7 @@ mod tests {
         let path = dir.path().join("d.csv");
         d.write(&path).unwrap();
         let old = as_format_2(&std::fs::read_to_string(&path).unwrap());
+        let mut d = without_poses_after(d);
         assert!(
             old.contains(",link4/world,") && !old.contains("touched_bodies") && !old.contains("lost_contact"),
             "{old}"
@@ -734,12 +799,12 @@ mod tests {
             read.readings()[2].cause.as_ref().map(AttemptCause::name),
             Some("pad_on_object")
         );
-        // Written again, it is format 3.
+        // Written again, it is this version.
         read.write(&path).unwrap();
         assert!(
             std::fs::read_to_string(&path)
                 .unwrap()
-                .contains("\"format_version\":3")
+                .contains(&format!("\"format_version\":{FORMAT_VERSION}"))
         );
         let e = parse_err(&old.replace(",sensor/object,", ",sensor,"));
         assert!(e.contains("'cause'") && e.contains("format 2"), "{e}");
@@ -748,7 +813,7 @@ mod tests {
     #[test]
     fn a_format_1_file_without_causes_is_read() {
         let d = dataset();
-        let t = text();
+        let t = as_format_3(&text());
         let cause = format::Meta::Cause.index();
         let old: Vec<String> = t
             .lines()
@@ -777,7 +842,7 @@ mod tests {
         let broken = t.replace(lines[4], short);
         let e = parse_err(&broken);
         assert!(
-            e.contains("d.csv: line 5") && e.contains("27 columns, expected 28 (22 + 2x3 taxels)"),
+            e.contains("d.csv: line 5") && e.contains("34 columns, expected 35 (29 + 2x3 taxels)"),
             "{e}"
         );
     }
@@ -831,7 +896,7 @@ mod tests {
         assert!(
             e.contains(&format!("line {}", row + 1))
                 && e.contains("'pad_up_y'")
-                && e.contains("empty, but other pad pose fields are set"),
+                && e.contains("empty, but other fields of its pose are set"),
             "{e}"
         );
     }
@@ -862,7 +927,7 @@ mod tests {
     fn wrong_version_and_wrong_magic_are_named() {
         let t = text();
         let e = Dataset::parse(
-            &t.replace("\"format_version\":3", "\"format_version\":7"),
+            &t.replace("\"format_version\":4", "\"format_version\":7"),
             "d.csv",
         )
         .unwrap_err();
@@ -871,7 +936,7 @@ mod tests {
                 e,
                 DatasetError::Version {
                     found: 7,
-                    expected: 3,
+                    expected: 4,
                     ..
                 }
             ),

@@ -14,8 +14,13 @@ pub struct Reading {
     pub image: TactileImage,
     /// Name of the object touched.
     pub object: String,
-    /// The object's pose when the reading was taken (it may have been perturbed since the last one).
+    /// The object's pose when the attempt began (it may have been perturbed since the last one).
     pub object_pose: Pose,
+    /// A free object's pose when the reading was taken: the touch may have moved it from
+    /// `object_pose` (issue 74). `None` where the object is fixed (the paper's mocap mount), which
+    /// no touch moves. Left out of the JSON when `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object_pose_after: Option<Pose>,
     pub status: ContactStatus,
     /// Press/Orient alternations the controllers ran.
     pub iterations: u32,

@@ -395,6 +395,7 @@ impl RealData {
                     image,
                     object: frame.label.clone(),
                     object_pose: Pose::IDENTITY,
+                    object_pose_after: None,
                     status,
                     iterations: 0,
                     strategy: Strategy::Recorded,

@@ -310,7 +310,12 @@ struct Record<'r> {
 }
 
 impl Record<'_> {
-    fn push(&mut self, reading: Reading) {
+    /// Records `reading`, taken in `scene`: a free object's pose there is the reading's pose after
+    /// its touch.
+    fn push(&mut self, mut reading: Reading, scene: &Scene) {
+        if scene.object_is_free() {
+            reading.object_pose_after = scene.object_pose();
+        }
         let converged = reading.is_converged();
         self.report.readings.push(reading);
         if converged {
@@ -746,7 +751,7 @@ where
         relabel_table_contact(&mut reading, &self.setup.sensor);
         let converged = reading.is_converged();
         let pose = reading.image.pose().copied().unwrap_or(pad);
-        record.push(reading);
+        record.push(reading, scene);
         if converged {
             self.grid.add(pose.center_m);
             self.lift_off(scene, arm, vertex, &pose)?;

@@ -107,6 +107,7 @@ impl TrainedModel {
     ///                 image: image(j, i)?,
     ///                 object: object.clone(),
     ///                 object_pose: Pose::IDENTITY,
+    ///                 object_pose_after: None,
     ///                 status: ContactStatus::Converged,
     ///                 iterations: 1,
     ///                 strategy: Strategy::Sampler,

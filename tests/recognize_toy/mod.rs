@@ -69,6 +69,7 @@ pub fn dataset(per_object: usize, seed: u64) -> Dataset {
                 image: image(j, &mut rng),
                 object: name.to_string(),
                 object_pose: Pose::IDENTITY,
+                object_pose_after: None,
                 status: ContactStatus::Converged,
                 iterations: 3,
                 strategy: Strategy::Sampler,

@@ -246,7 +246,7 @@ where
                 let object_pose = scene.object_pose().unwrap_or_default();
                 let reading =
                     unsettled_reading(&self.setup.sensor, at, (object, object_pose), candidate.0, end);
-                record.push(reading?);
+                record.push(reading?, scene);
             }
             let attempts = &record.report.readings;
             if let Some(last) = attempts.last().filter(|_| attempts.len() < MAX_ATTEMPTS) {
@@ -363,6 +363,7 @@ mod tests {
             image: crate::tactile::TactileImage::zeros(6, 6).unwrap(),
             object: "box".into(),
             object_pose: crate::pose::Pose::default(),
+            object_pose_after: None,
             status,
             iterations: 0,
             strategy: Strategy::Global,
