@@ -23,6 +23,7 @@ pub mod pose;
 pub mod queue;
 pub mod rng;
 pub(crate) mod simd;
+pub mod stats;
 pub mod units;
 pub mod valid;
 

@@ -250,6 +250,7 @@ fn touching_toward_the_planners_own_proposals_is_exploring() {
         assert!(one.readings.len() <= 1, "one iteration, one reading at most");
         touched.iterations += one.iterations;
         touched.readings.extend(one.readings);
+        touched.perturbation_motions.extend(one.perturbation_motions);
         touched.unreachable_steps += one.unreachable_steps;
         for (cause, n) in one.expansion_stops {
             *touched.expansion_stops.entry(cause).or_insert(0) += n;

@@ -8,8 +8,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Modules every module may use: no domain, no MuJoCo.
-const LEAVES: [&str; 8] = [
-    "atomic", "bodies", "pose", "queue", "rng", "simd", "units", "valid",
+const LEAVES: [&str; 9] = [
+    "atomic", "bodies", "pose", "queue", "rng", "simd", "stats", "units", "valid",
 ];
 
 /// The paper's modules in the order of the flow: world -> sensor -> hand-off -> control/explore ->
@@ -35,6 +35,7 @@ fn allowed() -> BTreeMap<&'static str, Vec<&'static str>> {
         ("queue", vec![]),
         ("rng", vec![]),
         ("simd", vec![]),
+        ("stats", vec![]),
         ("units", vec![]),
         ("valid", vec![]),
         ("mesh", vec![]),

@@ -1038,6 +1038,28 @@ fn a_free_objects_flags_are_the_planners_and_in_range() {
             &["--mode", "planner", "--free-object", "--object-friction", "NaN"][..],
             "--object-friction NaN: object friction NaN is outside [0, 2]",
         ),
+        (
+            &["--mode", "planner", "--perturb-deg", "5", "--perturb-by", "push"][..],
+            "--perturb-by push: want teleport for a mocap object (a push needs --free-object's dynamics)",
+        ),
+        (
+            &[
+                "--mode",
+                "planner",
+                "--free-object",
+                "--object-friction",
+                "0",
+                "--perturb-deg",
+                "5",
+                "--perturb-by",
+                "push",
+            ][..],
+            "--perturb-by push: want teleport for a frictionless object",
+        ),
+        (
+            &["--mode", "planner", "--perturb-by", "shove"][..],
+            "--perturb-by shove: want one of teleport, push",
+        ),
     ] {
         let line = chess_collect_fails(flags, 2);
         assert!(line.contains(says), "{line}");

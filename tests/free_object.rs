@@ -266,7 +266,9 @@ fn collect_touches_a_free_object_records_it_and_says_how_far_each_touch_moved_it
         .iter()
         .filter(|r| r.is_converged())
         .map(|r| {
-            let after = r.object_pose_after.expect("a free object's reading records its pose after");
+            let after = r
+                .object_pose_after
+                .expect("a free object's reading records its pose after");
             (after.position_m - r.object_pose.position_m).length() * 1e3
         })
         .collect();
@@ -390,4 +392,55 @@ fn a_sliding_free_objects_dataset_is_the_same_on_one_thread_and_on_two() {
         .filter_map(|r| Some((r.object_pose_after?.position_m - r.object_pose.position_m).length() * 1e3))
         .fold(0.0, f64::max);
     assert!(largest_mm > 0.5, "the largest slide is {largest_mm} mm");
+}
+
+/// The same draws of Sec. V-B4's bounds (10 deg, 10% of the width), teleporting a fixed object
+/// and pushing a free one (each from where it stands): the push's mean shift of the centre along
+/// the table and mean turn are the teleport's within 10%, and nothing tips.
+#[test]
+fn a_push_moves_a_free_object_as_far_as_the_teleport_of_the_same_draw() {
+    use taction::sim::{MotionSummary, PerturbationBounds};
+    for size in [DVec3::new(0.08, 0.06, 0.05), DVec3::new(0.03, 0.03, 0.1)] {
+        let mesh = common::box_mesh(size);
+        let mut rng = taction::rng::stream(17, 0);
+        let mut pushed = free_object_scene(mesh.clone(), FreeBody::DEFAULT, Pose::IDENTITY);
+        pushed.settle_object().unwrap();
+        let config = Valid::new(SensorConfig::paper()).unwrap();
+        let mut teleported = taction::tactile::arm_with_sensor(ObjectSpec::new("fixed", mesh), &config)
+            .build()
+            .unwrap();
+        let width = teleported.object_width_m().unwrap();
+        let (mut by_push, mut by_teleport) = (Vec::new(), Vec::new());
+        for _ in 0..12 {
+            let draw = PerturbationBounds::PAPER.draw(width, &mut rng);
+            by_push.push(pushed.push_object(&draw).unwrap());
+            let before = teleported.object_pose().unwrap();
+            teleported.perturb_object(&draw).unwrap();
+            by_teleport.push(teleported.object_motion_from(&before).unwrap());
+            teleported.set_object_pose(before).unwrap();
+        }
+        let (push, teleport) = (MotionSummary::of(&by_push), MotionSummary::of(&by_teleport));
+        let close = |a: f64, b: f64| (a - b).abs() <= 0.1 * b;
+        assert!(
+            close(push.centre_shift_m.mean, teleport.centre_shift_m.mean)
+                && close(push.turn_rad.mean, teleport.turn_rad.mean),
+            "{size}: pushed {push:?}, teleported {teleport:?}"
+        );
+        assert_eq!((push.tipped, push.off_table), (0, 0), "{push:?}");
+    }
+}
+
+/// A push is a free object's: a mocap object has no dynamics to push.
+#[test]
+fn a_mocap_object_cannot_be_pushed() {
+    let config = Valid::new(SensorConfig::paper()).unwrap();
+    let mut scene = taction::tactile::arm_with_sensor(
+        ObjectSpec::new("fixed", common::box_mesh(DVec3::splat(0.05))),
+        &config,
+    )
+    .build()
+    .unwrap();
+    let draw = taction::sim::PerturbationBounds::PAPER.draw(0.05, &mut taction::rng::stream(1, 0));
+    let e = scene.push_object(&draw).unwrap_err().to_string();
+    assert!(e.contains("a push needs a free object"), "{e}");
 }

@@ -285,6 +285,7 @@ fn an_attempt_without_a_reading_counts_as_a_move_of_a_perturbed_object() {
     let perturbed = Perturbed {
         max_rotation_deg: 10.0,
         max_translation_fraction: 0.1,
+        ..Perturbed::FIXED
     };
     let online = |motion: Perturbed, missed: usize| {
         let mut posterior = model.posterior_for(motion).expect("a posterior");

@@ -9,7 +9,7 @@ use pyo3::types::{PyBytes, PyDict};
 use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
 use taction::dataset::{ColumnType, ExportFormat, Reading, Shortfall, describe_shortfalls};
 use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
-use taction::sim::{FreeBody, ObjectSpec, PerturbationBounds};
+use taction::sim::{FreeBody, ObjectSpec, PerturbationAct, PerturbationBounds};
 use taction::tactile::SensorConfig;
 
 use crate::args::{self, Objects, Whole, max_heading};
@@ -235,9 +235,11 @@ impl Dataset {
 /// header and `object_pose` record. `free_object=True` (the planner's) stands each object on a
 /// free joint, a solid of `object_density` kg/m3 (1000) with sliding friction `object_friction`
 /// (0.8), pushed by the covering, as `taction collect --free-object` does; the header records it.
+/// `perturb_by="push"` (a free object's only) pushes it toward each perturbation's draw rather
+/// than putting it there, as `taction collect --perturb-by push` does.
 /// Same seed, same dataset, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python", start_pose="canonical", start_heading_deg=180.0, free_object=false, object_density=None, object_friction=None), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python', start_pose='canonical', start_heading_deg=180.0, free_object=False, object_density=None, object_friction=None)")]
+#[pyo3(signature = (objects, mode="sampler", readings=Whole(100), seed=Whole(1), sensor=None, threads=Whole(0), local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=false, reachable_by_arm=false, object_set="python", start_pose="canonical", start_heading_deg=180.0, free_object=false, object_density=None, object_friction=None, perturb_by="teleport"), text_signature = "(objects, mode='sampler', readings=100, seed=1, sensor=None, threads=0, local_probability=None, perturb_deg=0.0, perturb_frac=0.0, from_above=False, reachable_by_arm=False, object_set='python', start_pose='canonical', start_heading_deg=180.0, free_object=False, object_density=None, object_friction=None, perturb_by='teleport')")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a collection parameter
 pub fn collect(
     py: Python<'_>,
@@ -258,12 +260,22 @@ pub fn collect(
     free_object: bool,
     object_density: Option<f64>,
     object_friction: Option<f64>,
+    perturb_by: &str,
 ) -> PyResult<Dataset> {
     let (Whole(readings), Whole(seed), Whole(threads)) = (readings, seed, threads);
     let free_body = FreeBody::requested(free_object, object_density, object_friction).map_err(refused)?;
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let start_pose = args::start_pose(start_pose, start_heading_deg)?;
-    let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac).map_err(refused)?;
+    let act = PerturbationAct::from_name(perturb_by).ok_or_else(|| {
+        let names: Vec<&str> = PerturbationAct::ALL.iter().map(|a| a.name()).collect();
+        bad_argument(
+            "perturb_by",
+            format!("'{perturb_by}' is not one of {}", names.join(", ")),
+        )
+    })?;
+    let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac)
+        .map_err(refused)?
+        .by(act);
     let mode = CollectModeName::parse(mode).ok_or_else(|| {
         bad_argument(
             "mode",

@@ -136,6 +136,7 @@ def collect(
     free_object: bool = False,
     object_density: float | None = None,
     object_friction: float | None = None,
+    perturb_by: str = "teleport",
 ) -> Dataset: ...
 def collect_arm_calibration(
     objects: _Objects,

@@ -107,6 +107,21 @@ def test_a_free_object_is_the_planners_recorded_and_its_material_checked(chess):
         taction.collect(pawn, mode="planner", readings=2, free_object=True, object_density=5.0)
     with pytest.raises(taction.TactionError, match="free_object"):
         taction.collect(pawn, mode="sampler", readings=2, free_object=True)
+    # Every touch records where a free object lay after it; a fixed object's columns are empty.
+    assert data.to_pandas()["object_after_x_m"].notna().all()
+    assert fixed.to_pandas()["object_after_x_m"].isna().all()
+
+
+def test_a_push_perturbs_a_free_object_and_only_a_free_one(chess):
+    pawn = [o for o in chess if o.name == "pawn"]
+    pushed = taction.collect(
+        pawn, mode="planner", readings=2, seed=4, free_object=True, perturb_deg=10.0, perturb_frac=0.1, perturb_by="push"
+    )
+    assert pushed.header["perturbation"]["pushed"] is True
+    with pytest.raises(taction.TactionError, match="push"):
+        taction.collect(pawn, mode="planner", readings=2, perturb_deg=10.0, perturb_by="push")
+    with pytest.raises(taction.TactionError, match="perturb_by: 'shove' is not one of teleport, push"):
+        taction.collect(pawn, mode="planner", readings=2, perturb_by="shove")
 
 
 def test_an_argument_of_the_other_mode_is_refused(chess):

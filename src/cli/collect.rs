@@ -9,7 +9,7 @@ use taction::dataset::{Dataset, describe_shortfalls};
 use taction::experiment::Progress;
 use taction::explore::{CollectModeName, CollectRequest, ExplorationReport, ModeChoices};
 use taction::mesh::ObjectSet;
-use taction::sim::{FreeBody, MotionOutcome, ObjectMotion, PerturbationBounds, StartPose};
+use taction::sim::{FreeBody, MotionSummary, PerturbationAct, PerturbationBounds, StartPose};
 use taction::tactile::write_contact_sheet;
 use taction::valid::RangeError;
 
@@ -67,6 +67,10 @@ pub struct CollectArgs {
     /// Perturb the object after every reading: largest translation, fraction of its width, in [0, 1].
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturb_frac: f64,
+    /// How a perturbation moves the object: teleport (the paper's: put at the drawn pose) or push
+    /// (beyond the paper, with --free-object: pushed toward it, friction stopping it)
+    #[arg(long, value_name = "ACT", default_value = "teleport")]
+    pub perturb_by: String,
     /// Where each object starts: canonical (as it was built) or random (a pose drawn per object
     /// from the seed, not told to the explorer: any heading about the vertical, within 10 degrees
     /// for the raised letters, whose heading is part of their identity, then a tilt of up to 10
@@ -100,7 +104,8 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     check_flags(args)?;
     let request = request(args)?;
     check_output_file(&args.out, "out")?;
-    let perturbation = PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?;
+    let perturbation =
+        PerturbationBounds::new(args.perturb_deg, args.perturb_frac)?.by(perturbation_act(args)?);
     let sensor = args.sensor.config(args.seed.seed)?.into_inner();
     let set = ObjectSet::resolve(&args.objects, None, args.object_size.m)?;
     let carrier = match args.mode {
@@ -139,20 +144,20 @@ pub fn run(args: &CollectArgs) -> Result<(), Box<dyn std::error::Error>> {
     let progress = Progress::collection(&format!("collect {}", set.name), objects.len(), args.readings);
     let reports = collect.progress(&|| progress.inc()).run(&objects)?;
     progress.finish(reports.iter().map(ExplorationReport::converged).sum());
-    let planner_lines: Vec<String> = match args.mode {
-        Mode::Planner => objects
-            .iter()
-            .zip(&reports)
-            .flat_map(|(object, report)| {
-                let moved = args
-                    .free
-                    .free_object
-                    .then(|| free_object_line(&object.name, report));
-                std::iter::once(planner_line(&object.name, report)).chain(moved)
-            })
-            .collect(),
-        Mode::Sampler => Vec::new(),
-    };
+    let planner_lines: Vec<String> = objects
+        .iter()
+        .zip(&reports)
+        .flat_map(|(object, report)| {
+            let planner = matches!(args.mode, Mode::Planner).then(|| planner_line(&object.name, report));
+            let moved = args
+                .free
+                .free_object
+                .then(|| free_object_line(&object.name, report));
+            let perturbed = (!perturbation.is_none())
+                .then(|| perturbation_line(&object.name, perturbation.act(), report));
+            planner.into_iter().chain(moved).chain(perturbed)
+        })
+        .collect();
     let dataset = plan.dataset_of(&set.id(), &objects, reports)?;
     dataset.write(&args.out)?;
     println!("{}: {}", args.out.display(), dataset.summary());
@@ -239,6 +244,7 @@ fn flag_of(field: &str) -> Option<&'static str> {
         "reachable_by_arm" => Some("reachable"),
         "local_probability" => Some("local-prob"),
         "max_iterations" => Some("max-iterations"),
+        "perturbation" => Some("perturb-by"),
         _ => None,
     }
 }
@@ -322,29 +328,55 @@ pub fn write_contact_sheets(
     Ok(written)
 }
 
-/// What the planner did on the way to `object`'s readings, beyond them: iterations, expansion steps
-/// stopped short (by the causes' names: who touched whom, or a physics fault) or without an
-/// inverse-kinematics solution.
 /// How the touches moved a free object: the mean and largest shift and turn per touch, and the
 /// touches that tipped it over or pushed it off the table.
 fn free_object_line(object: &str, report: &ExplorationReport) -> String {
-    let motions = &report.object_motions;
-    let touches = motions.len().max(1) as f64;
-    let mean = |f: fn(&ObjectMotion) -> f64| motions.iter().map(f).sum::<f64>() / touches;
-    let largest = |f: fn(&ObjectMotion) -> f64| motions.iter().map(f).fold(0.0, f64::max);
-    let count = |outcome| motions.iter().filter(|m| m.outcome() == outcome).count();
+    let s = MotionSummary::of(&report.object_motions);
     format!(
         "free object {object}: {} touches moved it {:.3} mm and {:.3} deg each on average (at most {:.3} mm, {:.3} deg); {} tipped it over, {} pushed it off the table",
-        motions.len(),
-        mean(|m| m.shift_m) * 1e3,
-        mean(|m| m.turn_rad).to_degrees(),
-        largest(|m| m.shift_m) * 1e3,
-        largest(|m| m.turn_rad).to_degrees(),
-        count(MotionOutcome::Tipped),
-        count(MotionOutcome::OffTable),
+        s.motions,
+        s.shift_m.mean * 1e3,
+        s.turn_rad.mean.to_degrees(),
+        s.shift_m.max * 1e3,
+        s.turn_rad.max.to_degrees(),
+        s.tipped,
+        s.off_table,
     )
 }
 
+/// How the perturbations moved the object (`act`: teleported or pushed): the mean and 95th
+/// percentile of its centre's shift along the table and of its turn, and those that tipped it or
+/// left it off the table. The same numbers for either act, so a push is compared with a teleport.
+fn perturbation_line(object: &str, act: PerturbationAct, report: &ExplorationReport) -> String {
+    let s = MotionSummary::of(&report.perturbation_motions);
+    format!(
+        "perturbed {object} ({}): {} moves, centre shifted {:.3} mm on average (95th percentile {:.3} mm), turned {:.3} deg (95th percentile {:.3} deg); {} tipped it over, {} left it off the table",
+        act.name(),
+        s.motions,
+        s.centre_shift_m.mean * 1e3,
+        s.centre_shift_m.p95 * 1e3,
+        s.turn_rad.mean.to_degrees(),
+        s.turn_rad.p95.to_degrees(),
+        s.tipped,
+        s.off_table,
+    )
+}
+
+/// The `--perturb-by` act, named by the flag when unknown.
+fn perturbation_act(args: &CollectArgs) -> Result<PerturbationAct, UsageError> {
+    PerturbationAct::from_name(&args.perturb_by).ok_or_else(|| {
+        let names: Vec<&str> = PerturbationAct::ALL.iter().map(|a| a.name()).collect();
+        flag_error(
+            "perturb-by",
+            &args.perturb_by,
+            format!("want one of {}", names.join(", ")),
+        )
+    })
+}
+
+/// What the planner did on the way to `object`'s readings, beyond them: iterations, expansion steps
+/// stopped short (by the causes' names: who touched whom, or a physics fault) or without an
+/// inverse-kinematics solution.
 fn planner_line(object: &str, report: &ExplorationReport) -> String {
     let stops: Vec<String> = report
         .expansion_stops

@@ -218,9 +218,7 @@ impl ParquetColumn {
         match self {
             Self::Taxel(_) => ColumnType::Float32,
             Self::Meta(Meta::Iterations) => ColumnType::Int64,
-            Self::Meta(m) if m.is_optional_pose() || Meta::object_pose().contains(&m) => {
-                ColumnType::Float64
-            }
+            Self::Meta(m) if m.is_optional_pose() || Meta::object_pose().contains(&m) => ColumnType::Float64,
             Self::Meta(_) => ColumnType::Text,
         }
     }

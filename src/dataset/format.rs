@@ -732,7 +732,10 @@ fn all_empty(row: &Row, columns: &[Meta]) -> Result<bool, (String, String)> {
         return Ok(true);
     }
     match columns.iter().find(is_empty) {
-        Some(column) => Err(row.error(column.index(), "empty, but other fields of its pose are set".into())),
+        Some(column) => Err(row.error(
+            column.index(),
+            "empty, but other fields of its pose are set".into(),
+        )),
         None => Ok(false),
     }
 }

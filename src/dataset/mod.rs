@@ -115,6 +115,10 @@ impl From<FileError> for DatasetError {
 pub struct Perturbed {
     pub max_rotation_deg: f64,
     pub max_translation_fraction: f64,
+    /// A free object pushed toward each draw rather than put there (beyond the paper; the turn
+    /// then about the vertical). Left out of the header when false, as every file before it.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub pushed: bool,
 }
 
 impl Perturbed {
@@ -122,6 +126,7 @@ impl Perturbed {
     pub const FIXED: Self = Self {
         max_rotation_deg: 0.0,
         max_translation_fraction: 0.0,
+        pushed: false,
     };
 
     pub fn is_fixed(&self) -> bool {
@@ -682,23 +687,31 @@ mod tests {
 
     /// `text` (a format 3 file) as format 2 wrote it: no `touched_bodies`, the bodies themselves in
     /// `cause`, `covering_meets_table`, and no `lost_contact`.
-    /// `text` (this version's file) as format 3 wrote it: no pose after the touch.
-    fn as_format_3(text: &str) -> String {
-        let after = format::Meta::ObjectAfterX.index();
+    /// `text`, a file of format `from`, as format `to` wrote it: without the `columns` it added.
+    fn older(text: &str, (from, to): (u32, u32), columns: std::ops::Range<usize>) -> String {
         let lines: Vec<String> = text
             .lines()
             .map(|line| match line.starts_with('#') {
-                true => line.replace("\"format_version\":4", "\"format_version\":3"),
+                true => line.replace(
+                    &format!("\"format_version\":{from}"),
+                    &format!("\"format_version\":{to}"),
+                ),
                 false => {
                     // Rows without a quoted comma in the object name split at commas into columns.
                     let offset = usize::from(line.starts_with('"'));
                     let mut fields: Vec<&str> = line.split(',').collect();
-                    fields.drain(after + offset..after + offset + 7);
+                    fields.drain(columns.start + offset..columns.end + offset);
                     fields.join(",")
                 }
             })
             .collect();
         lines.join("\n") + "\n"
+    }
+
+    /// `text` (this version's file) as format 3 wrote it: no pose after the touch.
+    fn as_format_3(text: &str) -> String {
+        let after = format::Meta::ObjectAfterX.index();
+        older(text, (4, 3), after..after + 7)
     }
 
     /// `d` as a file of format 3 or older holds it: every object fixed.
@@ -726,7 +739,9 @@ mod tests {
         let lines: Vec<&str> = t.lines().collect();
         let after_qz = format::Meta::ObjectAfterQz.index();
         let row = (3..lines.len())
-            .find(|&i| !lines[i].starts_with('"') && lines[i].split(',').nth(after_qz).is_some_and(|v| !v.is_empty()))
+            .find(|&i| {
+                !lines[i].starts_with('"') && lines[i].split(',').nth(after_qz).is_some_and(|v| !v.is_empty())
+            })
             .expect("a free object's reading");
         let mut fields: Vec<&str> = lines[row].split(',').collect();
         fields[after_qz] = "";
@@ -813,21 +828,9 @@ mod tests {
     #[test]
     fn a_format_1_file_without_causes_is_read() {
         let d = dataset();
-        let t = as_format_3(&text());
         let cause = format::Meta::Cause.index();
-        let old: Vec<String> = t
-            .lines()
-            .map(|line| match line.starts_with('#') {
-                true => line.replace("\"format_version\":3", "\"format_version\":1"),
-                false => {
-                    let offset = usize::from(line.starts_with('"'));
-                    let mut fields: Vec<&str> = line.split(',').collect();
-                    fields.drain(cause + offset..cause + offset + 2);
-                    fields.join(",")
-                }
-            })
-            .collect();
-        let read = Dataset::parse(&(old.join("\n") + "\n"), "v1.csv").unwrap();
+        let old = older(&as_format_3(&text()), (3, 1), cause..cause + 2);
+        let read = Dataset::parse(&old, "v1.csv").unwrap();
         assert_eq!(read.readings().len(), d.len());
         // "c" lost contact after 2 iterations, which version 1 did not say.
         assert_eq!(read.readings()[1].cause, Some(AttemptCause::LostContact));

@@ -9,6 +9,8 @@ use std::collections::BTreeMap;
 
 use rand::RngExt;
 
+use crate::stats::percentile;
+
 use super::factor::Factors;
 
 /// Resamples of the seeds behind each interval: enough that the 5th and 95th percentiles move by
@@ -101,16 +103,6 @@ fn percentile_interval(mut values: Vec<f64>) -> (f64, f64) {
     values.sort_by(f64::total_cmp);
     let tail = (1.0 - INTERVAL_LEVEL) / 2.0;
     (percentile(&values, tail), percentile(&values, 1.0 - tail))
-}
-
-/// The `q` quantile of `sorted` (non-empty), interpolating linearly between order statistics.
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    let h = q * (sorted.len() - 1) as f64;
-    let (below, fraction) = (h.floor() as usize, h - h.floor());
-    match sorted.get(below + 1) {
-        Some(&above) => sorted[below] + fraction * (above - sorted[below]),
-        None => sorted[below],
-    }
 }
 
 #[cfg(test)]

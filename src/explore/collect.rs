@@ -24,7 +24,7 @@ use crate::explore::setup::TouchSetup;
 use crate::pose::StartPose;
 use crate::rng;
 use crate::sim::arm::PAD_SITE;
-use crate::sim::{FreeBody, ObjectSpec, PerturbationBounds, Scene, SimError};
+use crate::sim::{FreeBody, ObjectSpec, PerturbationAct, PerturbationBounds, Scene, SimError};
 use crate::tactile::SensorConfig;
 use crate::tactile::sensor::{CoveringSensor, TactileError, arm_with_sensor};
 use crate::valid::{RangeError, Valid};
@@ -265,6 +265,7 @@ pub fn recorded_perturbation(bounds: &PerturbationBounds) -> Perturbed {
         // Degrees as given: the bound was made from degrees, and the file should say 10, not 10.000000000000002.
         max_rotation_deg: (bounds.max_rotation_rad().to_degrees() * 1e9).round() / 1e9,
         max_translation_fraction: bounds.max_translation_fraction(),
+        pushed: bounds.act() == PerturbationAct::Push,
     }
 }
 
@@ -545,6 +546,27 @@ impl<'p> Collect<'p> {
         }
     }
 
+    /// A push (beyond the paper) moves a free object that friction stops: a mocap object has no
+    /// dynamics, and a frictionless one would slide on.
+    fn check_push(&self) -> Result<(), RangeError> {
+        if self.perturbation.act() != PerturbationAct::Push || self.perturbation.is_none() {
+            return Ok(());
+        }
+        let allowed = match self.free_object {
+            None => "teleport for a mocap object (a push needs --free-object's dynamics)",
+            Some(body) if body.friction() <= 0.0 => {
+                "teleport for a frictionless object (nothing would stop a pushed one)"
+            }
+            Some(_) => return Ok(()),
+        };
+        Err(RangeError {
+            config: "collection",
+            field: "perturbation",
+            value: PerturbationAct::Push.name().into(),
+            allowed,
+        })
+    }
+
     /// The checked plan: everything the readings depend on (what an experiment's cache key hashes).
     pub fn plan(&self) -> Result<CollectPlan, RangeError> {
         let mode = match self.procedure {
@@ -559,6 +581,7 @@ impl<'p> Collect<'p> {
             Procedure::Sampler(c) => CollectMode::Sampler(Valid::new(c)?),
             Procedure::Planner(c) => CollectMode::Planner(Valid::new(c)?),
         };
+        self.check_push()?;
         Ok(CollectPlan {
             mode,
             sensor: self.sensor,

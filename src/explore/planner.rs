@@ -756,7 +756,10 @@ where
             self.grid.add(pose.center_m);
             self.lift_off(scene, arm, vertex, &pose)?;
         }
-        self.setup.perturb(scene, &mut self.rng)
+        if let Some(motion) = self.setup.perturb(scene, &mut self.rng)? {
+            record.report.perturbation_motions.push(motion);
+        }
+        Ok(())
     }
 
     /// Lifts the pad off the surface it read at `pose` along its normal by `lift_off_m`, and adds

@@ -96,6 +96,9 @@ pub struct ExplorationReport {
     /// reading's touch moved it, from where it lay when the controllers took over to where the
     /// reading was taken, one per settled reading in order. Empty for a mocap object.
     pub object_motions: Vec<ObjectMotion>,
+    /// How each perturbation between readings (Sec. V-B4) moved the object, teleported or
+    /// pushed, in order. Empty when the object is not perturbed.
+    pub perturbation_motions: Vec<ObjectMotion>,
 }
 
 impl ExplorationReport {

@@ -154,7 +154,9 @@ impl TrainingSampler {
             if converged {
                 on_converged();
             }
-            setup.perturb(pad.scene_mut(), &mut rng)?;
+            if let Some(motion) = setup.perturb(pad.scene_mut(), &mut rng)? {
+                report.perturbation_motions.push(motion);
+            }
         }
         Ok(report)
     }

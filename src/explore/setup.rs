@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::control::{ControlConfig, ControlError};
 use crate::rng::Rng;
-use crate::sim::{PerturbationBounds, Scene, SimError};
+use crate::sim::{ObjectMotion, PerturbationAct, PerturbationBounds, Scene, SimError};
 use crate::tactile::SensorConfig;
 use crate::valid::Valid;
 
@@ -21,15 +21,30 @@ pub struct TouchSetup {
 impl TouchSetup {
     /// Moves the object in `scene` by a random draw within [`perturbation`](Self::perturbation)
     /// (nothing, drawing nothing, when it allows no motion): after every reading, so that the
-    /// next one sees the object where it now lies (Sec. V-B4). A free object is put there and
-    /// then comes to rest under gravity ([`Scene::settle_object`]).
-    pub(crate) fn perturb(&self, scene: &mut Scene, rng: &mut Rng) -> Result<(), ControlError> {
-        if !self.perturbation.is_none() {
-            let width = scene.object_width_m().ok_or(SimError::NoObject)?;
-            let p = self.perturbation.draw(width, rng);
-            scene.perturb_object(&p)?;
-            scene.settle_object()?;
+    /// next one sees the object where it now lies (Sec. V-B4). Teleported, a free object is put
+    /// there and then comes to rest under gravity ([`Scene::settle_object`]); pushed, it is
+    /// pushed toward there ([`Scene::push_object`]). The same draws either way. Returns how the
+    /// object moved; `None` when nothing was drawn.
+    pub(crate) fn perturb(
+        &self,
+        scene: &mut Scene,
+        rng: &mut Rng,
+    ) -> Result<Option<ObjectMotion>, ControlError> {
+        if self.perturbation.is_none() {
+            return Ok(None);
         }
-        Ok(())
+        let width = scene.object_width_m().ok_or(SimError::NoObject)?;
+        let start = scene.object_pose().ok_or(SimError::NoObject)?;
+        let p = self.perturbation.draw(width, rng);
+        match self.perturbation.act() {
+            PerturbationAct::Teleport => {
+                scene.perturb_object(&p)?;
+                scene.settle_object()?;
+            }
+            PerturbationAct::Push => {
+                scene.push_object(&p)?;
+            }
+        }
+        Ok(Some(scene.object_motion_from(&start)?))
     }
 }

@@ -464,6 +464,7 @@ mod tests {
         let moving = Perturbed {
             max_rotation_deg: 10.0,
             max_translation_fraction: 0.1,
+            ..Perturbed::FIXED
         };
         // The slab is touched on four of its faces at each of three poses, moved between them by
         // a perturbation's size (8 deg about a tilted axis, 9 mm).

@@ -45,6 +45,9 @@ pub const TABLE_HALF_SIDE_M: f64 = 0.6;
 pub struct ObjectMotion {
     /// How far its frame's origin moved, metres.
     pub shift_m: f64,
+    /// How far its centre (its bounding box's) moved along the table, metres: what a
+    /// perturbation's translation draws (Sec. V-B4), whatever the turn about the centre.
+    pub centre_shift_m: f64,
     /// The angle of the rotation between the two poses, radians.
     pub turn_rad: f64,
     /// How far its up axis (the world's z at `before`) turned from upright, radians.
@@ -65,13 +68,17 @@ pub enum MotionOutcome {
 }
 
 impl ObjectMotion {
-    /// The motion from `before` to `after`, the object's centre `centre_m` at `after`.
-    pub fn between(before: &Pose, after: &Pose, centre_m: DVec3) -> Self {
+    /// The motion from `before` to `after` of an object whose centre is `centre_local` in its
+    /// own frame.
+    pub fn between(before: &Pose, after: &Pose, centre_local: DVec3) -> Self {
         let turn = after.rotation * before.rotation.inverse();
         let up_before = DVec3::Z;
         let up_after = turn * up_before;
+        let centre_m = after.transform_point(centre_local);
+        let centre_shift = centre_m - before.transform_point(centre_local);
         Self {
             shift_m: (after.position_m - before.position_m).length(),
+            centre_shift_m: centre_shift.truncate().length(),
             turn_rad: turn.normalize().angle_between(glam::DQuat::IDENTITY),
             tilt_rad: up_before.angle_between(up_after),
             centre_m,
@@ -87,6 +94,58 @@ impl ObjectMotion {
             MotionOutcome::Tipped
         } else {
             MotionOutcome::Standing
+        }
+    }
+}
+
+/// What a run of motions did to an object: each measure's mean, 95th percentile and largest,
+/// and the outcomes counted. How `collect` reports touches and perturbations alike, so a push is
+/// measured as a teleport is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionSummary {
+    pub motions: usize,
+    /// The origin's shift, metres.
+    pub shift_m: Spread,
+    /// The centre's shift along the table, metres.
+    pub centre_shift_m: Spread,
+    pub turn_rad: Spread,
+    pub tipped: usize,
+    pub off_table: usize,
+}
+
+/// One measure over a run of motions.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Spread {
+    pub mean: f64,
+    pub p95: f64,
+    pub max: f64,
+}
+
+impl Spread {
+    fn of(values: impl Iterator<Item = f64>) -> Self {
+        let mut sorted: Vec<f64> = values.collect();
+        sorted.sort_by(f64::total_cmp);
+        match sorted.last() {
+            None => Self::default(),
+            Some(&max) => Self {
+                mean: crate::stats::mean(&sorted),
+                p95: crate::stats::percentile(&sorted, 0.95),
+                max,
+            },
+        }
+    }
+}
+
+impl MotionSummary {
+    pub fn of(motions: &[ObjectMotion]) -> Self {
+        let count = |outcome| motions.iter().filter(|m| m.outcome() == outcome).count();
+        Self {
+            motions: motions.len(),
+            shift_m: Spread::of(motions.iter().map(|m| m.shift_m)),
+            centre_shift_m: Spread::of(motions.iter().map(|m| m.centre_shift_m)),
+            turn_rad: Spread::of(motions.iter().map(|m| m.turn_rad)),
+            tipped: count(MotionOutcome::Tipped),
+            off_table: count(MotionOutcome::OffTable),
         }
     }
 }
@@ -169,8 +228,11 @@ impl Scene {
     /// How the object moved from `before` to where it is now.
     pub fn object_motion_from(&self, before: &Pose) -> Result<ObjectMotion, SimError> {
         let after = self.object_pose().ok_or(SimError::NoObject)?;
-        let centre = self.object_center().ok_or(SimError::NoObject)?;
-        Ok(ObjectMotion::between(before, &after, centre))
+        let (lo, hi) = self
+            .object()
+            .and_then(|o| o.mesh.bounds())
+            .ok_or(SimError::NoObject)?;
+        Ok(ObjectMotion::between(before, &after, (lo + hi) * 0.5))
     }
 
     /// The free object's linear speed (metres per second) and turning rate (radians per second).
@@ -210,6 +272,13 @@ mod tests {
         };
         let motion = ObjectMotion::between(&before, &slid, centre);
         assert!((motion.shift_m - 0.01).abs() < 1e-15 && (motion.turn_rad - 0.3).abs() < 1e-12);
+        assert!(
+            (motion.centre_shift_m - 0.01).abs() < 1e-15,
+            "the centre on the axis of the turn"
+        );
+        let off_axis = ObjectMotion::between(&before, &slid, DVec3::new(0.02, 0.0, 0.05));
+        let swept = 2.0 * 0.02 * (0.3f64 / 2.0).sin();
+        assert!(off_axis.centre_shift_m > 0.01 && off_axis.centre_shift_m < 0.01 + swept + 1e-12);
         assert!(motion.tilt_rad < 1e-12, "a turn about the vertical tips nothing");
         assert_eq!(motion.outcome(), MotionOutcome::Standing);
         let tipped = Pose {
@@ -228,9 +297,12 @@ mod tests {
             ObjectMotion::between(&before, &leaning, centre).outcome(),
             MotionOutcome::Standing
         );
-        let fallen = DVec3::new(0.7, 0.0, 0.05);
+        let fallen = Pose {
+            position_m: DVec3::new(0.7, 0.0, 0.0),
+            ..slid
+        };
         assert_eq!(
-            ObjectMotion::between(&before, &slid, fallen).outcome(),
+            ObjectMotion::between(&before, &fallen, centre).outcome(),
             MotionOutcome::OffTable
         );
     }

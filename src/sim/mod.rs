@@ -10,6 +10,7 @@ pub(crate) mod mjcf;
 mod motion;
 pub(crate) mod object;
 pub(crate) mod perturb;
+pub(crate) mod push;
 pub(crate) mod scene;
 pub(crate) mod start_pose;
 pub(crate) mod twin;
@@ -27,8 +28,8 @@ pub use crate::bodies::{FreeBody, FreeBodyError};
 
 // A free object under the arm: the dynamics stepped while the arm holds, and what they did to it.
 pub use free_object::{
-    DWELL_S, MotionOutcome, ObjectMotion, REST_SPEED_M_PER_S, REST_TURN_RAD_PER_S, SETTLE_MAX_S,
-    TABLE_HALF_SIDE_M, TIPPED_RAD,
+    DWELL_S, MotionOutcome, MotionSummary, ObjectMotion, REST_SPEED_M_PER_S, REST_TURN_RAD_PER_S,
+    SETTLE_MAX_S, Spread, TABLE_HALF_SIDE_M, TIPPED_RAD,
 };
 
 // The arm carrying the pad (its joints, the pad's site), moved by inverse kinematics.
@@ -44,7 +45,8 @@ pub use contact_screen::{CLEARANCE_M, Screened};
 // The object perturbed between readings (Sec. V-B4), and placed at its start
 // (`Scene::place_at_start`; the start itself is plain data of the `pose` leaf).
 pub use crate::pose::{MaxHeading, StartPose};
-pub use perturb::{Perturbation, PerturbationBounds};
+pub use perturb::{Perturbation, PerturbationAct, PerturbationBounds};
+pub use push::{PUSH_MAX_S, SHOVE_M_PER_S, TWIST_RAD_PER_S};
 
 // MJCF text for code that adds bodies to the world: its sections, the collision group, numbers.
 pub use mjcf::{COLLISION_GROUP, Section, comment, numbers, sensed_surface_names};

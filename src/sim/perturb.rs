@@ -16,11 +16,50 @@ use crate::rng::Rng;
 use crate::sim::SimError;
 use crate::sim::scene::Scene;
 
-/// Bounds of a perturbation; construct with [`PerturbationBounds::new`], which checks them.
+/// How a perturbation moves the object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PerturbationAct {
+    /// The paper's (Sec. V-B4): the object is put at the drawn pose, resting on the table (a free
+    /// object then settles under gravity).
+    #[default]
+    Teleport,
+    /// Beyond the paper: a free object is pushed, and friction stops it about where the draw
+    /// would have put it ([`Scene::push_object`](crate::sim::Scene::push_object)).
+    Push,
+}
+
+impl PerturbationAct {
+    pub const ALL: [PerturbationAct; 2] = [Self::Teleport, Self::Push];
+
+    /// The name `--perturb-by` takes and a dataset's header records.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Teleport => "teleport",
+            Self::Push => "push",
+        }
+    }
+
+    /// Parses [`name`](Self::name).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// The paper's act, which plans and headers leave unsaid.
+    pub fn is_teleport(&self) -> bool {
+        *self == Self::Teleport
+    }
+}
+
+/// Bounds of a perturbation, and its act; construct with [`PerturbationBounds::new`], which checks
+/// them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PerturbationBounds {
     max_rotation_rad: f64,
     max_translation_fraction: f64,
+    /// Left out of the JSON when the paper's, so every plan made before pushes keeps its key.
+    #[serde(default, skip_serializing_if = "PerturbationAct::is_teleport")]
+    act: PerturbationAct,
 }
 
 impl PerturbationBounds {
@@ -28,6 +67,7 @@ impl PerturbationBounds {
     pub const NONE: Self = Self {
         max_rotation_rad: 0.0,
         max_translation_fraction: 0.0,
+        act: PerturbationAct::Teleport,
     };
 
     /// The paper's bounds (Sec. V-B4): up to 10 degrees of rotation and 10% of the object's width
@@ -35,6 +75,7 @@ impl PerturbationBounds {
     pub const PAPER: Self = Self {
         max_rotation_rad: 10.0_f64.to_radians(),
         max_translation_fraction: 0.1,
+        act: PerturbationAct::Teleport,
     };
 
     /// Rotation at most `max_rotation_deg` (0..=180) and translation at most
@@ -55,7 +96,17 @@ impl PerturbationBounds {
         Ok(Self {
             max_rotation_rad: max_rotation_deg.to_radians(),
             max_translation_fraction,
+            act: PerturbationAct::Teleport,
         })
+    }
+
+    /// The same bounds, the object moved by `act`.
+    pub fn by(self, act: PerturbationAct) -> Self {
+        Self { act, ..self }
+    }
+
+    pub fn act(&self) -> PerturbationAct {
+        self.act
     }
 
     pub fn max_rotation_rad(&self) -> f64 {
