@@ -267,10 +267,12 @@ pub fn collect(
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let start_pose = args::start_pose(start_pose, start_heading_deg)?;
     let act = PerturbationAct::from_name(perturb_by).ok_or_else(|| {
-        let names: Vec<&str> = PerturbationAct::ALL.iter().map(|a| a.name()).collect();
         bad_argument(
             "perturb_by",
-            format!("'{perturb_by}' is not one of {}", names.join(", ")),
+            format!(
+                "'{perturb_by}' is not one of {}",
+                PerturbationAct::NAMES.join(", ")
+            ),
         )
     })?;
     let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac)

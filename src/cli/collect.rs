@@ -365,11 +365,10 @@ fn perturbation_line(object: &str, act: PerturbationAct, report: &ExplorationRep
 /// The `--perturb-by` act, named by the flag when unknown.
 fn perturbation_act(args: &CollectArgs) -> Result<PerturbationAct, UsageError> {
     PerturbationAct::from_name(&args.perturb_by).ok_or_else(|| {
-        let names: Vec<&str> = PerturbationAct::ALL.iter().map(|a| a.name()).collect();
         flag_error(
             "perturb-by",
             &args.perturb_by,
-            format!("want one of {}", names.join(", ")),
+            format!("want one of {}", PerturbationAct::NAMES.join(", ")),
         )
     })
 }

@@ -36,15 +36,14 @@ impl TouchSetup {
         let width = scene.object_width_m().ok_or(SimError::NoObject)?;
         let start = scene.object_pose().ok_or(SimError::NoObject)?;
         let p = self.perturbation.draw(width, rng);
-        match self.perturbation.act() {
+        let motion = match self.perturbation.act() {
             PerturbationAct::Teleport => {
                 scene.perturb_object(&p)?;
                 scene.settle_object()?;
+                scene.object_motion_from(&start)?
             }
-            PerturbationAct::Push => {
-                scene.push_object(&p)?;
-            }
-        }
-        Ok(Some(scene.object_motion_from(&start)?))
+            PerturbationAct::Push => scene.push_object(&p)?,
+        };
+        Ok(Some(motion))
     }
 }

@@ -228,11 +228,8 @@ impl Scene {
     /// How the object moved from `before` to where it is now.
     pub fn object_motion_from(&self, before: &Pose) -> Result<ObjectMotion, SimError> {
         let after = self.object_pose().ok_or(SimError::NoObject)?;
-        let (lo, hi) = self
-            .object()
-            .and_then(|o| o.mesh.bounds())
-            .ok_or(SimError::NoObject)?;
-        Ok(ObjectMotion::between(before, &after, (lo + hi) * 0.5))
+        let centre = self.object_center_local().ok_or(SimError::NoObject)?;
+        Ok(ObjectMotion::between(before, &after, centre))
     }
 
     /// The free object's linear speed (metres per second) and turning rate (radians per second).

@@ -32,12 +32,12 @@ pub enum PerturbationAct {
 impl PerturbationAct {
     pub const ALL: [PerturbationAct; 2] = [Self::Teleport, Self::Push];
 
-    /// The name `--perturb-by` takes and a dataset's header records.
+    /// Every act's name, as the edges spell them, in [`ALL`](Self::ALL)'s order.
+    pub const NAMES: [&'static str; 2] = ["teleport", "push"];
+
+    /// The name `--perturb-by` and Python's `perturb_by` take.
     pub fn name(self) -> &'static str {
-        match self {
-            Self::Teleport => "teleport",
-            Self::Push => "push",
-        }
+        Self::NAMES[self as usize]
     }
 
     /// Parses [`name`](Self::name).

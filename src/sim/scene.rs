@@ -709,9 +709,13 @@ impl Scene {
 
     /// Centre of the object's bounding box in the world, at its current pose.
     pub fn object_center(&self) -> Option<DVec3> {
-        let object = self.object.as_ref()?;
-        let (lo, hi) = object.mesh.bounds()?;
-        Some(self.object_pose()?.transform_point((lo + hi) * 0.5))
+        Some(self.object_pose()?.transform_point(self.object_center_local()?))
+    }
+
+    /// Centre of the object's bounding box in its own frame.
+    pub fn object_center_local(&self) -> Option<DVec3> {
+        let (lo, hi) = self.object.as_ref()?.mesh.bounds()?;
+        Some((lo + hi) * 0.5)
     }
 }
 
