@@ -11,6 +11,7 @@ use taction::active_touch::{
     ArmData, ArmTrainingObserver, ArmTrainingRecipe, EpisodeConfig, Touch, TouchAction, TouchEpisode,
     TouchError,
 };
+use taction::bodies::FreeBody;
 use taction::dataset::{ContactStatus, Dataset, Shortfall, Strategy};
 use taction::describe::DescriptorKind;
 use taction::explore::{
@@ -19,7 +20,7 @@ use taction::explore::{
 };
 use taction::pose::Pose;
 use taction::recognize::{Recognizer, TrainConfig, TrainedModel};
-use taction::sim::{MaxHeading, ObjectSpec, PerturbationBounds, SceneBuilder, StartPose};
+use taction::sim::{MaxHeading, ObjectSpec, PerturbationAct, PerturbationBounds, SceneBuilder, StartPose};
 use taction::tactile::SensorConfig;
 use taction::valid::Valid;
 
@@ -551,4 +552,57 @@ fn the_demos_recipe_is_its_two_collections_then_its_fit_told_step_by_step() {
         format!("fitting k {ks:?}"),
     ];
     assert_eq!(told.events, expected);
+}
+
+/// An episode takes the object's mount as a collection does: on a free joint its every reading
+/// records where the object lay after it, and a push between readings moves it; a push of the
+/// paper's mocap object, which has no dynamics, is refused by name.
+#[test]
+fn an_episode_takes_a_free_object_and_refuses_to_push_a_mocap_one() {
+    let pushed = PerturbationBounds::new(10.0, 0.1)
+        .unwrap()
+        .by(PerturbationAct::Push);
+    let refused = Valid::new(EpisodeConfig {
+        perturbation: pushed,
+        ..*config()
+    })
+    .err()
+    .map(|e| e.to_string());
+    assert!(
+        refused
+            .as_deref()
+            .is_some_and(|e| e.contains("perturbation") && e.contains("mocap")),
+        "{refused:?}"
+    );
+    let free = Valid::new(EpisodeConfig {
+        perturbation: pushed,
+        free_object: Some(FreeBody::DEFAULT),
+        ..*config()
+    })
+    .unwrap();
+    let boxed = &objects()[0];
+    let mut episode = TouchEpisode::new(model(), boxed, &free, 3).unwrap();
+    for _ in 0..60 {
+        if episode.touch(0).unwrap().is_some() {
+            break;
+        }
+    }
+    let reading = episode.last_attempt().expect("an attempt").clone();
+    assert!(reading.is_converged(), "a touch of the box converged in 60");
+    let after = reading
+        .object_pose_after
+        .expect("a free object's pose after its reading");
+    let now = episode.scene().object_pose().expect("an object");
+    let shift_m = (now.position_m - after.position_m).truncate().length();
+    assert!(
+        shift_m > 1e-3,
+        "the push after the reading moved the box {shift_m} m"
+    );
+    let mut fixed = TouchEpisode::new(model(), boxed, &config(), 3).unwrap();
+    fixed.touch(0).unwrap();
+    assert_eq!(
+        fixed.last_attempt().map(|r| r.object_pose_after),
+        Some(None),
+        "a mocap object has no pose after"
+    );
 }

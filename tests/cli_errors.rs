@@ -1040,7 +1040,7 @@ fn a_free_objects_flags_are_the_planners_and_in_range() {
         ),
         (
             &["--mode", "planner", "--perturb-deg", "5", "--perturb-by", "push"][..],
-            "--perturb-by push: want teleport for a mocap object (a push needs --free-object's dynamics)",
+            "--perturb-by push: want teleport for a mocap object (a push needs a free object's dynamics)",
         ),
         (
             &[

@@ -95,11 +95,12 @@ fn the_readme_demo_command_succeeds_and_every_object_can_be_explored() {
     }
 }
 
-fn demo(out: &Path) -> (bool, String, String) {
+fn demo(out: &Path, extra: &[&str]) -> (bool, String, String) {
     let output = Command::new(env!("CARGO_BIN_EXE_taction"))
         .args(["demo", "--objects", "chess", "--training-readings", "12"])
         .args(["--touches", &TOUCHES.to_string(), "--seed", "3", "--out"])
         .arg(out)
+        .args(extra)
         .output()
         .expect("the taction binary runs");
     (
@@ -168,7 +169,7 @@ fn demo_on_the_chess_pieces_writes_its_outputs_and_reuses_its_model() {
     let dir = tempfile::tempdir().expect("a temporary folder");
     let out = dir.path().join("demo");
 
-    let (ok, stdout, stderr) = demo(&out);
+    let (ok, stdout, stderr) = demo(&out, &[]);
     assert!(ok, "demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
     assert!(stdout.contains("training:"), "{stdout}");
     assert!(!stdout.contains("using the model trained before"), "{stdout}");
@@ -181,13 +182,51 @@ fn demo_on_the_chess_pieces_writes_its_outputs_and_reuses_its_model() {
         .collect();
     assert_eq!(models.len(), 1, "one cached model");
 
-    let (ok, stdout, stderr) = demo(&out);
+    let (ok, stdout, stderr) = demo(&out, &[]);
     assert!(ok, "second demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
     assert!(
         stdout.contains("using the model trained before") && !stdout.contains("training:"),
         "the second run should reuse the cached model:\n{stdout}"
     );
     assert_eq!(check_touches(&out), first, "same arguments, same touches");
+}
+
+/// `--free-object` stands the unknown object on a free joint, made of the material asked for:
+/// `run.json` records it and how far the arm's touches moved the object from where it settled;
+/// for the paper's mocap object it records none.
+#[test]
+fn the_demo_records_a_free_objects_material_and_how_far_it_moved() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let out = dir.path().join("demo");
+    let record = |out: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).expect("run.json")).expect("JSON")
+    };
+    let (ok, stdout, stderr) = demo(&out, &[]);
+    assert!(ok, "demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
+    assert!(record(&out)["free_object"].is_null(), "{}", record(&out));
+    let free = [
+        "--free-object",
+        "--object-density",
+        "300",
+        "--object-friction",
+        "0.3",
+    ];
+    let (ok, stdout, stderr) = demo(&out, &free);
+    assert!(ok, "free demo failed\nstdout:\n{stdout}\nstderr:\n{stderr}");
+    let free = &record(&out)["free_object"];
+    assert_eq!(free["density_kg_m3"], 300.0, "{free}");
+    assert_eq!(free["friction"], 0.3, "{free}");
+    let shift_mm = free["centre_shift_mm"].as_f64().expect("a shift");
+    let turn_deg = free["turn_deg"].as_f64().expect("a turn");
+    assert!(shift_mm >= 0.0 && turn_deg >= 0.0, "{free}");
+    assert!(
+        ["standing", "tipped", "off_table"].contains(&free["outcome"].as_str().unwrap_or("")),
+        "{free}"
+    );
+    assert!(
+        stdout.contains(&format!("the free object's centre moved {shift_mm:.2} mm")),
+        "the motion is printed as recorded:\n{stdout}"
+    );
 }
 
 /// `demo --strategy active` on the chess pieces in `out` with `extra` flags: its stdout and the

@@ -98,3 +98,24 @@ pub fn max_heading(start_heading_deg: f64) -> PyResult<taction::sim::MaxHeading>
         )
     })
 }
+
+/// `perturb_deg` / `perturb_frac` (Sec. V-B4's bounds) moved by `perturb_by`
+/// (`PerturbationAct::NAMES`: the paper's teleport, or a push).
+pub fn perturbation(
+    perturb_deg: f64,
+    perturb_frac: f64,
+    perturb_by: &str,
+) -> PyResult<taction::sim::PerturbationBounds> {
+    let act = taction::sim::PerturbationAct::from_name(perturb_by).ok_or_else(|| {
+        crate::error::bad_argument(
+            "perturb_by",
+            format!(
+                "'{perturb_by}' is not one of {}",
+                taction::sim::PerturbationAct::NAMES.join(", ")
+            ),
+        )
+    })?;
+    Ok(taction::sim::PerturbationBounds::new(perturb_deg, perturb_frac)
+        .map_err(refused)?
+        .by(act))
+}

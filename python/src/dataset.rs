@@ -9,7 +9,7 @@ use pyo3::types::{PyBytes, PyDict};
 use taction::active_touch::{ArmData, ArmTrainingObserver, ArmTrainingRecipe};
 use taction::dataset::{ColumnType, ExportFormat, Reading, Shortfall, describe_shortfalls};
 use taction::explore::{CollectModeName, CollectRequest, ModeChoices};
-use taction::sim::{FreeBody, ObjectSpec, PerturbationAct, PerturbationBounds};
+use taction::sim::{FreeBody, ObjectSpec};
 use taction::tactile::SensorConfig;
 
 use crate::args::{self, Objects, Whole, max_heading};
@@ -266,18 +266,7 @@ pub fn collect(
     let free_body = FreeBody::requested(free_object, object_density, object_friction).map_err(refused)?;
     let (sensor, specs) = touch_inputs(&objects, sensor)?;
     let start_pose = args::start_pose(start_pose, start_heading_deg)?;
-    let act = PerturbationAct::from_name(perturb_by).ok_or_else(|| {
-        bad_argument(
-            "perturb_by",
-            format!(
-                "'{perturb_by}' is not one of {}",
-                PerturbationAct::NAMES.join(", ")
-            ),
-        )
-    })?;
-    let perturbation = PerturbationBounds::new(perturb_deg, perturb_frac)
-        .map_err(refused)?
-        .by(act);
+    let perturbation = args::perturbation(perturb_deg, perturb_frac, perturb_by)?;
     let mode = CollectModeName::parse(mode).ok_or_else(|| {
         bad_argument(
             "mode",

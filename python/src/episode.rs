@@ -6,12 +6,13 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyTuple};
 use taction::active_touch::{EpisodeConfig, TouchAction};
 use taction::explore::PlannerConfig;
-use taction::sim::{ObjectSpec, PerturbationBounds};
+use taction::sim::{FreeBody, ObjectSpec};
 use taction::valid::Valid;
 
-use crate::args::{Whole, start_pose};
+use crate::args::{self, Whole, start_pose};
 use crate::array;
 use crate::error::{bad_argument, refused};
 use crate::model::Model;
@@ -24,7 +25,10 @@ use crate::object::Object;
 /// starting at `start_pose` (`"canonical"`, where it was built, or `"random"`, a pose drawn from
 /// the seed that the planner is not told, turned at most `start_heading_deg` about the vertical:
 /// 180 for any heading, 10 for the raised letters, whose heading is part of their identity) and
-/// perturbed after every reading within `perturb_deg` / `perturb_frac`. A touch is `touch`:
+/// perturbed after every reading within `perturb_deg` / `perturb_frac` (put there, or with
+/// `perturb_by="push"` pushed there, a free object's only). `free_object=True` stands the object on
+/// a free joint, a solid of `object_density` kg/m3 (1000) with sliding friction `object_friction`
+/// (0.8), so the arm's presses can move it, as `taction.collect`'s does. A touch is `touch`:
 /// `"guarded"` (the pad moved along a ray through the candidate until it meets a surface, then
 /// settled: a reading attempt every touch, two when the first met the object and failed) or
 /// `"iteration"` (one planner iteration toward it).
@@ -53,40 +57,38 @@ struct Made {
     start_pose: String,
     start_heading_deg: f64,
     touch: String,
+    free_object: bool,
+    object_density: Option<f64>,
+    object_friction: Option<f64>,
+    perturb_by: String,
 }
 
-/// [`Made`] as the constructor's positional arguments.
-type MadeArgs = (
-    Py<Model>,
-    Py<Object>,
-    u64,
-    usize,
-    f64,
-    f64,
-    f64,
-    Option<Vec<Py<Object>>>,
-    String,
-    f64,
-    String,
-);
-
 impl Made {
-    fn args(&self, py: Python<'_>) -> MadeArgs {
-        (
-            self.model.clone_ref(py),
-            self.object.clone_ref(py),
-            self.seed,
-            self.candidates,
-            self.local_probability,
-            self.perturb_deg,
-            self.perturb_frac,
-            self.workspace
-                .as_ref()
-                .map(|w| w.iter().map(|o| o.clone_ref(py)).collect()),
-            self.start_pose.clone(),
-            self.start_heading_deg,
-            self.touch.clone(),
-        )
+    /// The constructor's positional arguments, in its signature's order: a tuple built item by
+    /// item, since they are more than a Rust tuple converts.
+    fn args<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let workspace: Option<Vec<Py<Object>>> = self
+            .workspace
+            .as_ref()
+            .map(|w| w.iter().map(|o| o.clone_ref(py)).collect());
+        let items = [
+            self.model.clone_ref(py).into_bound(py).into_any(),
+            self.object.clone_ref(py).into_bound(py).into_any(),
+            self.seed.into_pyobject(py)?.into_any(),
+            self.candidates.into_pyobject(py)?.into_any(),
+            self.local_probability.into_pyobject(py)?.into_any(),
+            self.perturb_deg.into_pyobject(py)?.into_any(),
+            self.perturb_frac.into_pyobject(py)?.into_any(),
+            workspace.into_pyobject(py)?.into_any(),
+            self.start_pose.as_str().into_pyobject(py)?.into_any(),
+            self.start_heading_deg.into_pyobject(py)?.into_any(),
+            self.touch.as_str().into_pyobject(py)?.into_any(),
+            PyBool::new(py, self.free_object).to_owned().into_any(),
+            self.object_density.into_pyobject(py)?.into_any(),
+            self.object_friction.into_pyobject(py)?.into_any(),
+            self.perturb_by.as_str().into_pyobject(py)?.into_any(),
+        ];
+        PyTuple::new(py, items)
     }
 
     /// The episode's configuration, its arguments checked.
@@ -99,12 +101,15 @@ impl Made {
             )
         })?;
         let planner = PlannerConfig::exploring(&self.fitted_to()?, self.local_probability);
+        let free_object = FreeBody::requested(self.free_object, self.object_density, self.object_friction)
+            .map_err(refused)?;
         let config = EpisodeConfig {
             planner: Valid::new(planner).map_err(refused)?,
-            perturbation: PerturbationBounds::new(self.perturb_deg, self.perturb_frac).map_err(refused)?,
+            perturbation: args::perturbation(self.perturb_deg, self.perturb_frac, &self.perturb_by)?,
             start_pose,
             candidates: self.candidates,
             touch,
+            free_object,
             ..EpisodeConfig::new(*self.model.get().inner.sensor())
         };
         Valid::new(config).map_err(refused)
@@ -158,7 +163,7 @@ impl TouchEpisode {
 #[pymethods]
 impl TouchEpisode {
     #[new]
-    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose="canonical", start_heading_deg=180.0, touch="guarded"), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose='canonical', start_heading_deg=180.0, touch='guarded')")]
+    #[pyo3(signature = (model, object, seed=Whole(1), candidates=Whole(12), local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose="canonical", start_heading_deg=180.0, touch="guarded", free_object=false, object_density=None, object_friction=None, perturb_by="teleport"), text_signature = "(model, object, seed=1, candidates=12, local_probability=0.5, perturb_deg=0.0, perturb_frac=0.0, workspace=None, start_pose='canonical', start_heading_deg=180.0, touch='guarded', free_object=False, object_density=None, object_friction=None, perturb_by='teleport')")]
     #[allow(clippy::too_many_arguments)] // Python keyword arguments, each an episode parameter
     fn new(
         py: Python<'_>,
@@ -173,6 +178,10 @@ impl TouchEpisode {
         start_pose: &str,
         start_heading_deg: f64,
         touch: &str,
+        free_object: bool,
+        object_density: Option<f64>,
+        object_friction: Option<f64>,
+        perturb_by: &str,
     ) -> PyResult<Self> {
         let made = Made {
             model,
@@ -186,6 +195,10 @@ impl TouchEpisode {
             start_pose: start_pose.to_string(),
             start_heading_deg,
             touch: touch.to_string(),
+            free_object,
+            object_density,
+            object_friction,
+            perturb_by: perturb_by.to_string(),
         };
         let inner = made.start(py)?;
         Ok(Self {
@@ -196,10 +209,14 @@ impl TouchEpisode {
     }
 
     /// Pickled as its arguments, and as its state the touches made so far (`__setstate__`).
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, MadeArgs, Vec<usize>)> {
+    #[allow(clippy::type_complexity)] // pickle's (callable, arguments, state)
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>, Vec<usize>)> {
         let _episode = self.episode()?;
         let touched = self.touched()?.clone();
-        Ok((py.get_type::<Self>().into_any(), self.made.args(py), touched))
+        Ok((py.get_type::<Self>().into_any(), self.made.args(py)?, touched))
     }
 
     /// Makes the touches `touched` (candidate indices, in order) of a pickled episode again; only
@@ -342,6 +359,21 @@ impl TouchEpisode {
     #[getter]
     fn object(&self) -> PyResult<String> {
         Ok(self.episode()?.object_name().to_string())
+    }
+
+    /// Where the explored object lies now (the truth, as `object` is): `(7,)` float64, its
+    /// position (m) and orientation quaternion (w, x, y, z); a free object's moves as the arm
+    /// presses it.
+    #[getter]
+    fn object_pose<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pose = self
+            .episode()?
+            .scene()
+            .object_pose()
+            .ok_or_else(|| refused("the episode's scene has no object"))?;
+        let q = pose.rotation;
+        let values = [pose.position_m.to_array().to_vec(), vec![q.w, q.x, q.y, q.z]].concat();
+        array::from_f64(py, &values, &[7], "float64")
     }
 
     /// The explored object's index in the model's objects.

@@ -101,7 +101,14 @@ class ActiveTouchEnv(gymnasium.Env):
     ``"collision"``, ...; ``None`` for a declaration, or a planner iteration that made no attempt),
     ``cause`` (what ended it short, ``"arm_on_table"``, ...; else ``None``), ``attempts``,
     ``readings`` (the converged ones, which the belief includes) and, when the episode ends,
-    ``object`` (the truth) and ``declared``.
+    ``object`` (the truth), ``object_pose`` (where it lies then: position, m, and quaternion w, x,
+    y, z) and ``declared``.
+
+    ``free_object=True`` stands the object on a free joint (a solid of ``object_density`` kg/m3,
+    1000 by default, with sliding friction ``object_friction``, 0.8), so the arm's presses can
+    slide, turn or tip it; ``perturb_by="push"`` (a free object's only) pushes it toward each
+    perturbation's draw instead of putting it there. The default is the paper's object, which
+    stays where it is put.
     """
 
     metadata = {"render_modes": []}
@@ -125,6 +132,10 @@ class ActiveTouchEnv(gymnasium.Env):
         training_readings: int = 1000,
         training_seed: int = 1,
         touch: str = "iteration",
+        free_object: bool = False,
+        object_density: Optional[float] = None,
+        object_friction: Optional[float] = None,
+        perturb_by: str = "teleport",
     ) -> None:
         if budget < 1:
             raise taction.TactionError(f"budget: {budget} is not 1 or more")
@@ -170,6 +181,10 @@ class ActiveTouchEnv(gymnasium.Env):
             start_pose=start_pose,
             start_heading_deg=start_heading_deg,
             touch=touch,
+            free_object=free_object,
+            object_density=object_density,
+            object_friction=object_friction,
+            perturb_by=perturb_by,
         )
         self.touch_cost = touch_cost
         self.right_reward = right_reward
@@ -294,6 +309,7 @@ class ActiveTouchEnv(gymnasium.Env):
         info["readings"] = e.readings
         if terminated or truncated:
             info["object"] = e.object
+            info["object_pose"] = e.object_pose
             self._over = True
         return self._observation(), float(reward), terminated, truncated, info
 

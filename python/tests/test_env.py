@@ -256,3 +256,21 @@ def test_v1_starts_every_episode_at_a_pose_its_seed_draws(small_model):
     env.close()
     with pytest.raises(taction.TactionError, match="touch: 'poke' is none of guarded, iteration"):
         taction.TouchEpisode(small_model, taction.objects("chess")[0], touch="poke")
+
+
+def test_v1_takes_a_free_object_and_refuses_to_push_a_mocap_one(small_model, chess):
+    pushed = dict(perturb_deg=10.0, perturb_frac=0.1, perturb_by="push")
+    env = gymnasium.make(V1, objects="chess", model=small_model, budget=2, free_object=True, **pushed)
+    env.reset(seed=5)
+    for action in (0, 1):
+        _, _, terminated, truncated, info = env.step(action)
+    assert truncated and not terminated
+    pose = info["object_pose"]
+    assert pose.shape == (7,) and abs(np.linalg.norm(pose[3:]) - 1.0) < 1e-9
+    env.close()
+    env = gymnasium.make(V1, objects="chess", model=small_model, budget=2, **pushed)
+    with pytest.raises(taction.TactionError, match="perturbation.*mocap"):
+        env.reset(seed=5)
+    env.close()
+    with pytest.raises(taction.TactionError, match="object_density"):
+        taction.TouchEpisode(small_model, chess[0], object_density=500.0)

@@ -105,6 +105,7 @@ def episode_state(episode):
         "last_cause": episode.last_cause,
         "object": episode.object,
         "object_index": episode.object_index,
+        "object_pose": episode.object_pose,
     }
 
 
@@ -137,6 +138,23 @@ def test_a_touch_episode_copies_its_touches_and_goes_on_identically(small_model,
     for index in (2, 4, 0, 1):
         assert again.touch(index) == episode.touch(index)
         assert_same_state(again, episode)
+
+
+def test_a_pushed_free_object_episode_copies_where_its_object_went(small_model, chess, copied):
+    pawn, rook = chess
+    episode = taction.TouchEpisode(
+        small_model, rook, seed=4, candidates=6, workspace=chess, free_object=True,
+        object_density=800.0, object_friction=0.6, perturb_deg=10.0, perturb_frac=0.1, perturb_by="push",
+    )
+    start = episode.object_pose.copy()
+    converged = sum(episode.touch(index) for index in (0, 3, 1))
+    assert converged > 0
+    # Pushed toward a new draw after every converged reading.
+    assert np.linalg.norm(episode.object_pose[:2] - start[:2]) > 1e-3
+    again = copied(episode)
+    assert_same_state(again, episode)
+    assert again.touch(2) == episode.touch(2)
+    assert_same_state(again, episode)
 
 
 def test_a_touch_episode_replays_only_on_a_fresh_episode(small_model, chess):

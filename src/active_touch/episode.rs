@@ -21,6 +21,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::{ActiveRecognition, Touch, TouchError};
+use crate::bodies::FreeBody;
 use crate::control::ControlError;
 use crate::dataset::{Reading, Strategy};
 use crate::explore::{
@@ -99,6 +100,11 @@ pub struct EpisodeConfig {
     /// Readings within this distance of a candidate predict what a touch there shows, metres
     /// ([`InformationGain::neighbourhood_m`](super::InformationGain)).
     pub neighbourhood_m: f64,
+    /// The object on a free joint, made of this (beyond the paper: it settles on the table, the
+    /// arm's presses and a pushing perturbation move it); `None`, the paper's mocap object, which
+    /// stays where it is put. Left out of the JSON when `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_object: Option<FreeBody>,
 }
 
 impl EpisodeConfig {
@@ -115,6 +121,7 @@ impl EpisodeConfig {
             start_pose: StartPose::Canonical,
             candidates: DEFAULT_CANDIDATES,
             touch: TouchAction::Guarded,
+            free_object: None,
         }
     }
 }
@@ -130,14 +137,23 @@ impl Check for EpisodeConfig {
         let Self {
             // Checked against the model's at `TouchEpisode::new`, and by the scene's sensor.
             sensor: _,
-            // Checked where they were built.
+            // Checked where they were built; the perturbation's act against the mount here.
             planner: _,
-            perturbation: _,
+            perturbation,
             start_pose: _,
             touch: _,
             candidates,
             neighbourhood_m,
+            free_object,
         } = *self;
+        if let Some(allowed) = perturbation.refusal_for(free_object) {
+            return Err(RangeError {
+                config: "episode config",
+                field: "perturbation",
+                value: perturbation.act().name().into(),
+                allowed,
+            });
+        }
         FieldChecks::of("episode config")
             .count(
                 "candidates",
@@ -430,6 +446,6 @@ fn plan(config: &EpisodeConfig, seed: u64) -> CollectPlan {
         readings_per_object: 0,
         seed,
         start_pose: config.start_pose,
-        free_object: None,
+        free_object: config.free_object,
     }
 }

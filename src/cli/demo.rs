@@ -35,16 +35,19 @@ use taction::explore::{Planner, PlannerConfig};
 use taction::locate::GainOf;
 use taction::mesh::ObjectSet;
 use taction::paper::{Placement, write_exploration_png};
+use taction::pose::Pose;
 use taction::recognize::Belief;
 use taction::recognize::{Recognizer, TrainConfig};
 use taction::rng;
 use taction::sim::PAD_SITE;
-use taction::sim::{ObjectSpec, PerturbationBounds, Scene, StartPose};
+use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
 use taction::tactile::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
 
-use crate::cli::common::{ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error, parse_at_least_one};
+use crate::cli::common::{
+    FreeObjectArgs, ObjectSizeArg, OutputLock, PosteriorArg, SeedArg, flag_error, parse_at_least_one,
+};
 use crate::cli::plausible::{Carrier, build_objects};
 
 /// The random stream that draws the unknown object and its pose, and the planner's own stream
@@ -109,6 +112,10 @@ pub struct DemoArgs {
     pub no_stop: bool,
     #[command(flatten)]
     pub posterior: PosteriorArg,
+    /// The unknown object on a free joint (`--free-object`, `--object-density`,
+    /// `--object-friction`): the arm's presses can move it; `run.json` says how far they did.
+    #[command(flatten)]
+    pub free: FreeObjectArgs,
 }
 
 /// What the active strategy's gain is about (`locate::GainOf`, or appearance alone).
@@ -155,6 +162,15 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut unknown = place_unknown(args, &objects, model.objects(), sensor, &start)?;
     // 3. The exploration, recognising after every converged touch.
     let explored = explore_unknown(args, &objects, &model, &mut unknown, sensor)?;
+    if unknown.scene.object_is_free() {
+        let moved = unknown.scene.object_motion_from(&unknown.start)?;
+        println!(
+            "the free object's centre moved {:.2} mm and it turned {:.2} deg while the arm explored it ({})",
+            moved.centre_shift_m * 1e3,
+            moved.turn_rad.to_degrees(),
+            moved.outcome().name()
+        );
+    }
     // 4. Outputs.
     write_outputs(args, &model, &unknown, &explored, sensor)
 }
@@ -298,6 +314,8 @@ struct Unknown {
     index: usize,
     spec: ObjectSpec,
     scene: Scene,
+    /// Where it stood before the first touch (a free object: after it settled).
+    start: Pose,
 }
 
 /// Draws the unknown object (or takes `--object`) and places it on the table at `start`, a random
@@ -322,14 +340,20 @@ fn place_unknown(
             .ok_or_else(|| format!("--object: '{name}' is not in the set ({})", names.join(", ")))?,
         None => r.random_range(0..objects.len()),
     };
-    let spec = objects[index].clone();
+    let spec = objects[index].mounted(args.free.body()?);
     let mut scene = arm_with_sensor(spec.clone(), &Valid::new(sensor)?).build()?;
     scene.place_at_start(start, &mut r)?;
+    let start = scene.object_pose().ok_or(SimError::NoObject)?;
     println!(
         "exploring an unknown object with the arm (it is '{}'; the planner is not told)",
         spec.name
     );
-    Ok(Unknown { index, spec, scene })
+    Ok(Unknown {
+        index,
+        spec,
+        scene,
+        start,
+    })
 }
 
 /// What the exploration felt and believed.
@@ -577,10 +601,29 @@ fn write_run_record(
         "p_guess": belief.probabilities()[guess],
         "p_true": belief.probabilities()[unknown.index],
         "right": guess == unknown.index,
+        "free_object": free_object_record(unknown)?,
     });
     let text = serde_json::to_string_pretty(&record)? + "\n";
     taction::atomic::write_atomic(&args.out.join("run.json"), text.as_bytes())?;
     Ok(())
+}
+
+/// What `run.json` says of a free object: its material and how far the exploration moved it
+/// from where it settled; `null` for the paper's mocap object, which does not move.
+fn free_object_record(unknown: &Unknown) -> Result<serde_json::Value, SimError> {
+    if !unknown.scene.object_is_free() {
+        return Ok(serde_json::Value::Null);
+    }
+    let body = unknown.spec.free_body;
+    let moved = unknown.scene.object_motion_from(&unknown.start)?;
+    Ok(serde_json::json!({
+        "density_kg_m3": body.density_kg_m3(),
+        "friction": body.friction(),
+        "centre_shift_mm": moved.centre_shift_m * 1e3,
+        "turn_deg": moved.turn_rad.to_degrees(),
+        "tilt_deg": moved.tilt_rad.to_degrees(),
+        "outcome": moved.outcome().name(),
+    }))
 }
 
 /// The posterior of the true object over `touches` touches, chance at 1 / `objects`.

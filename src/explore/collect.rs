@@ -546,25 +546,18 @@ impl<'p> Collect<'p> {
         }
     }
 
-    /// A push (beyond the paper) moves a free object that friction stops: a mocap object has no
-    /// dynamics, and a frictionless one would slide on.
+    /// A push (beyond the paper) moves only a free object with friction
+    /// ([`PerturbationBounds::refusal_for`]).
     fn check_push(&self) -> Result<(), RangeError> {
-        if self.perturbation.act() != PerturbationAct::Push || self.perturbation.is_none() {
-            return Ok(());
+        match self.perturbation.refusal_for(self.free_object) {
+            None => Ok(()),
+            Some(allowed) => Err(RangeError {
+                config: "collection",
+                field: "perturbation",
+                value: PerturbationAct::Push.name().into(),
+                allowed,
+            }),
         }
-        let allowed = match self.free_object {
-            None => "teleport for a mocap object (a push needs --free-object's dynamics)",
-            Some(body) if body.friction() <= 0.0 => {
-                "teleport for a frictionless object (nothing would stop a pushed one)"
-            }
-            Some(_) => return Ok(()),
-        };
-        Err(RangeError {
-            config: "collection",
-            field: "perturbation",
-            value: PerturbationAct::Push.name().into(),
-            allowed,
-        })
     }
 
     /// The checked plan: everything the readings depend on (what an experiment's cache key hashes).

@@ -67,6 +67,17 @@ pub enum MotionOutcome {
     OffTable,
 }
 
+impl MotionOutcome {
+    /// The outcome as files name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Standing => "standing",
+            Self::Tipped => "tipped",
+            Self::OffTable => "off_table",
+        }
+    }
+}
+
 impl ObjectMotion {
     /// The motion from `before` to `after` of an object whose centre is `centre_local` in its
     /// own frame.

@@ -11,6 +11,7 @@ use glam::{DQuat, DVec3};
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
+use crate::bodies::FreeBody;
 use crate::pose::Pose;
 use crate::rng::Rng;
 use crate::sim::SimError;
@@ -107,6 +108,23 @@ impl PerturbationBounds {
 
     pub fn act(&self) -> PerturbationAct {
         self.act
+    }
+
+    /// Why this perturbation cannot move an object held as `free_object` says (a mocap object
+    /// when `None`), as a [`RangeError`]'s `allowed`: a push (beyond the paper) moves a free object
+    /// that friction stops, and a mocap object has no dynamics while a frictionless one would
+    /// slide on. `None`: it can.
+    pub fn refusal_for(&self, free_object: Option<FreeBody>) -> Option<&'static str> {
+        if self.act != PerturbationAct::Push || self.is_none() {
+            return None;
+        }
+        match free_object {
+            None => Some("teleport for a mocap object (a push needs a free object's dynamics)"),
+            Some(body) if body.friction() <= 0.0 => {
+                Some("teleport for a frictionless object (nothing would stop a pushed one)")
+            }
+            Some(_) => None,
+        }
     }
 
     pub fn max_rotation_rad(&self) -> f64 {
