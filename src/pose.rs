@@ -47,6 +47,12 @@ impl Pose {
         rotation: DQuat::IDENTITY,
     };
 
+    /// How far the body's up axis (its frame's z) leans from the world's vertical, radians: 0
+    /// for an object standing as it was built, whatever its heading.
+    pub fn tilt_rad(&self) -> f64 {
+        (self.rotation * DVec3::Z).angle_between(DVec3::Z)
+    }
+
     pub fn new(position_m: DVec3, rotation: DQuat) -> Self {
         Self {
             position_m,

@@ -27,6 +27,7 @@ fn factor_columns(experiment: &str) -> &'static [&'static str] {
         "active" => &["strategy", "local_probability", "object_motion"],
         "end-to-end" => &["training", "local_probability", "object_motion"],
         "fusion" => &["evidence", "strategy", "local_probability", "object_motion"],
+        "free-object" => &["evidence", "mount", "object_motion"],
         _ => &[],
     }
 }
@@ -415,6 +416,19 @@ fn reproduce_runs_every_experiment_end_to_end_at_a_tiny_scale() {
         fusion_curves.insert(format!("fused active 0.5 {motion}"));
     }
     assert_eq!(values("fusion"), fusion_curves);
+    let mut free_curves = BTreeSet::new();
+    for evidence in ["appearance", "contacts", "fused"] {
+        free_curves.insert(format!("{evidence} mocap fixed"));
+        free_curves.insert(format!("{evidence} mocap perturbed"));
+        for density in ["250", "1000", "2500"] {
+            for friction in ["0.2", "0.8"] {
+                free_curves.insert(format!("{evidence} free_d{density}_mu{friction} fixed"));
+            }
+        }
+        free_curves.insert(format!("{evidence} free_d1000_mu0.8 pushed"));
+    }
+    assert_eq!(values("free-object"), free_curves);
+    assert_free_object_motion(&out);
     // The active curves explore under the plans of the blind L = 0.5 test explorations (the same
     // starts, streams and perturbations), trial by trial.
     let fusion = rows(&out.join("fusion/fusion.csv"));
@@ -542,6 +556,71 @@ fn assert_attempts_end_at_the_last_reading(out: &Path) {
             (final_reading.accuracy, final_reading.reliability),
             "{curve} {trial}"
         );
+    }
+}
+
+/// `free-object`'s motion table: a row per mount, trial and object (nine mounts, three trials, two
+/// chess pieces); a mocap object's touches measure nothing (no touch moves it), every touch of a
+/// free one is measured, its statistics ordered (mean and 95th percentile at most the largest), a
+/// free object's mass its density's (four times at 1000 kg/m3 what it is at 250), and the
+/// convergence rate the counts'.
+fn assert_free_object_motion(out: &Path) {
+    let path = out.join("free-object/free-object_motion.csv");
+    let rows: Vec<BTreeMap<String, String>> = csv::Reader::from_path(&path)
+        .expect("free-object_motion.csv written")
+        .deserialize()
+        .collect::<Result<_, _>>()
+        .expect("free-object_motion.csv reads");
+    assert_eq!(rows.len(), 9 * 3 * 2, "{}", path.display());
+    let number = |row: &BTreeMap<String, String>, column: &str| -> Option<f64> {
+        let cell = &row[column];
+        (!cell.is_empty()).then(|| cell.parse().unwrap_or_else(|_| panic!("{column}: '{cell}'")))
+    };
+    let mut mass_g = BTreeMap::new();
+    for row in &rows {
+        let attempts = number(row, "attempts").expect("attempts");
+        let converged = number(row, "converged").expect("converged");
+        if attempts > 0.0 {
+            assert_eq!(
+                number(row, "convergence_rate"),
+                Some(converged / attempts),
+                "{row:?}"
+            );
+        }
+        let measured = number(row, "touches_measured").expect("touches_measured");
+        if attempts > 0.0 && row["mount"] == "mocap" {
+            // The start pose's drawn tilt (Sec. V-B4's 10 degrees at most).
+            let tilt = number(row, "start_tilt_deg").expect("a start tilt");
+            assert!((0.0..=10.0 + 1e-9).contains(&tilt), "{row:?}");
+        }
+        if row["mount"] == "mocap" {
+            assert_eq!(measured, 0.0, "{row:?}");
+            assert!(
+                row["shift_mean_mm"].is_empty() && row["mass_g"].is_empty(),
+                "{row:?}"
+            );
+            continue;
+        }
+        assert_eq!(
+            measured, attempts,
+            "every touch of a free object is measured: {row:?}"
+        );
+        mass_g.insert(
+            (row["mount"].clone(), row["object"].clone()),
+            number(row, "mass_g").expect("a free object's mass"),
+        );
+        if measured > 0.0 {
+            for measure in ["shift", "turn"] {
+                let unit = if measure == "shift" { "mm" } else { "deg" };
+                let at = |s: &str| number(row, &format!("{measure}_{s}_{unit}")).expect("measured");
+                assert!(at("mean") <= at("max") && at("p95") <= at("max"), "{row:?}");
+            }
+        }
+    }
+    for object in ["pawn", "rook"] {
+        let of = |mount: &str| mass_g[&(mount.to_string(), object.to_string())];
+        let ratio = of("free_d1000_mu0.8") / of("free_d250_mu0.2");
+        assert!((ratio - 4.0).abs() < 1e-9, "{object}: {ratio}");
     }
 }
 

@@ -332,8 +332,19 @@ pub fn write_contact_sheets(
 /// touches that tipped it over or pushed it off the table.
 fn free_object_line(object: &str, report: &ExplorationReport) -> String {
     let s = MotionSummary::of(&report.object_motions);
+    // Where it stood when the first touch began: a mesh not stable as the set orients it lies
+    // down while it settles, before any touch.
+    let rest = report.readings.first().map_or_else(
+        || "it was never touched".to_string(),
+        |r| {
+            format!(
+                "it came to rest {:.1} deg from upright",
+                r.object_pose.tilt_rad().to_degrees()
+            )
+        },
+    );
     format!(
-        "free object {object}: {} touches moved it {:.3} mm and {:.3} deg each on average (at most {:.3} mm, {:.3} deg); {} tipped it over, {} pushed it off the table",
+        "free object {object}: {} touches moved it {:.3} mm and {:.3} deg each on average (at most {:.3} mm, {:.3} deg); {} tipped it over, {} pushed it off the table; {rest}",
         s.motions,
         s.shift_m.mean * 1e3,
         s.turn_rad.mean.to_degrees(),

@@ -19,7 +19,8 @@ use serde::{Serialize, Serializer};
 /// | `training_readings` | training readings per object at scale 1 (`--scale` scales them) | `training-size` |
 /// | `training` | `paper` (sampler readings from every direction) or `reachable` (ours: three times as many, from the starts the arm can reach) | `end-to-end` |
 /// | `strategy` | `blind` (the planner's random local or global moves) or `active` (its candidates scored by expected information gain) | `active`, `fusion` |
-/// | `evidence` | what the recogniser weighs: `appearance` (the tactile images' bag of features), `contacts` (where each touch landed, against each object's surface at a pose it is not told) or `fused` (both) | `fusion` |
+/// | `evidence` | what the recogniser weighs: `appearance` (the tactile images' bag of features), `contacts` (where each touch landed, against each object's surface at a pose it is not told) or `fused` (both) | `fusion`, `free-object` |
+/// | `mount` | how the object is held: `mocap` (the paper's: where it is put, no touch moves it) or `free_d<kg/m3>_mu<friction>` (on a free joint, a solid of that density and sliding friction, pressed by the covering) | `free-object` |
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Factor {
     Data,
@@ -32,10 +33,11 @@ pub enum Factor {
     Training,
     Strategy,
     Evidence,
+    Mount,
 }
 
 impl Factor {
-    pub const ALL: [Factor; 10] = [
+    pub const ALL: [Factor; 11] = [
         Self::Data,
         Self::Resolution,
         Self::LocalProbability,
@@ -46,6 +48,7 @@ impl Factor {
         Self::Training,
         Self::Strategy,
         Self::Evidence,
+        Self::Mount,
     ];
 
     /// The column's name.
@@ -61,6 +64,7 @@ impl Factor {
             Self::Training => "training",
             Self::Strategy => "strategy",
             Self::Evidence => "evidence",
+            Self::Mount => "mount",
         }
     }
 

@@ -32,7 +32,7 @@ impl DetailRow for NoDetail {
 }
 
 /// The further tables of an experiment: none ([`NoDetail`]), one ([`DetailRow`] `D`, whose rows are
-/// `Vec<D>`), two (`(D, E)`, whose rows are `(Vec<D>, Vec<E>)`) or three (`(D, E, F)`).
+/// `Vec<D>`), two (`(D, E)`, whose rows are `(Vec<D>, Vec<E>)`), three (`(D, E, F)`) or four.
 pub trait DetailTables {
     /// What a unit's work gives besides its main rows.
     type Rows;
@@ -84,6 +84,24 @@ impl<D: DetailRow, E: DetailRow, F: DetailRow> DetailTables for (D, E, F) {
         let next = tables.len();
         tables.extend(E::encode(e, paths.get(next..next + 1).unwrap_or_default())?);
         tables.extend(F::encode(f, paths.get(tables.len()..).unwrap_or_default())?);
+        Ok(tables)
+    }
+}
+
+impl<D: DetailRow, E: DetailRow, F: DetailRow, G: DetailRow> DetailTables for (D, E, F, G) {
+    type Rows = (Vec<D>, Vec<E>, Vec<F>, Vec<G>);
+
+    fn names() -> Vec<&'static str> {
+        <(D, E, F)>::names().into_iter().chain(G::TABLE).collect()
+    }
+
+    fn encode((d, e, f, g): &Self::Rows, paths: &[PathBuf]) -> Result<Vec<Vec<u8>>, String> {
+        let mut tables = D::encode(d, paths.get(..1).unwrap_or_default())?;
+        let next = tables.len();
+        tables.extend(E::encode(e, paths.get(next..next + 1).unwrap_or_default())?);
+        let next = tables.len();
+        tables.extend(F::encode(f, paths.get(next..next + 1).unwrap_or_default())?);
+        tables.extend(G::encode(g, paths.get(tables.len()..).unwrap_or_default())?);
         Ok(tables)
     }
 }

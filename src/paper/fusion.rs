@@ -40,6 +40,7 @@ use super::recognition::{
 };
 use super::scale::DataCounts;
 use crate::active_touch::ActiveRecognition;
+use crate::bodies::FreeBody;
 use crate::dataset::{Dataset, Perturbed};
 use crate::describe::DescriptorKind;
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, AttemptRow, PerObjectRow, ReliabilityRow};
@@ -109,7 +110,7 @@ fn object_states() -> [(&'static str, PerturbationBounds); 2] {
 /// The training data's setting: the end-to-end recipe's (`paper::figures::end_to_end`,
 /// "reachable"). Its appearance models are calibrated on their validation readings only because
 /// the fusion fits its own temperings on the arm's explorations ([`FusionData::calibration`]).
-fn setting() -> Setting {
+pub(super) fn setting() -> Setting {
     Setting {
         label: EXPERIMENT_NAME.into(),
         sensor: default_sensor(),
@@ -187,40 +188,96 @@ struct FusionConfig<'a> {
 type TestExplorations = (f64, &'static str, Vec<DataRequest>);
 
 /// The unit's rows: accuracy, and the per-object, reliability and attempt rows.
-type Rows = (
+pub(super) type Rows = (
     Vec<AccuracyRow>,
     (Vec<PerObjectRow>, Vec<ReliabilityRow>, Vec<AttemptRow>),
 );
 
+/// What the product's fused model is made of in a run: the `fusion` setting on the 3D set, its
+/// data counts and training, the explorations' random start poses (`free-object` shares it).
+pub(super) struct FusionBasis {
+    pub setting: Setting,
+    pub objects: Arc<Objects>,
+    pub counts: DataCounts,
+    pub training: TrainConfig,
+    pub start_pose: StartPose,
+}
+
+impl FusionBasis {
+    pub(super) fn of(context: &PaperContext, codebook: CodebookKind) -> Result<Self, BoxError> {
+        let setting = setting();
+        let objects = context.objects(Family::Shapes)?;
+        let counts = setting.counts(context.scale.counts());
+        let training = training_config(context, codebook, counts, objects.specs.len());
+        let start_pose = StartPose::Random {
+            max_heading: objects.set.start_heading(),
+        };
+        Ok(Self {
+            setting,
+            objects,
+            counts,
+            training,
+            start_pose,
+        })
+    }
+
+    /// The unit of `experiment` that judges explorations with the model in `context`.
+    pub(super) fn unit<'a>(&'a self, context: &'a PaperContext, experiment: &'static str) -> FusionUnit<'a> {
+        FusionUnit {
+            experiment,
+            data: SettingData::new(context, &self.objects, &self.setting, self.counts),
+            objects: Arc::clone(&self.objects),
+            training: self.training.clone(),
+            start_pose: self.start_pose,
+        }
+    }
+}
+
+/// The plot of `experiment`'s accuracy against touch attempts (its `attempts` table), its curves
+/// told apart by the `factors` columns and named by `legend`.
+pub(super) fn attempts_plot(
+    experiment: &str,
+    title: &str,
+    factors: &[&str],
+    legend: &str,
+) -> Result<PlotSpec, BoxError> {
+    let mut plot = PlotSpec::lines(
+        SafeName::new(format!("{experiment}-attempts"))?,
+        title,
+        Axis::new("n_attempts", "touch attempts per object"),
+        vec![Axis::new("accuracy", "accuracy")],
+        factors,
+    )
+    .with_legend(legend);
+    plot.table = AttemptRow::TABLE.map(SafeName::new).transpose()?;
+    Ok(plot)
+}
+
 /// Runs the experiment in `context` (one unit: the model, then every curve).
 pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
-    let setting = setting();
-    let objects = context.objects(Family::Shapes)?;
-    let counts = setting.counts(context.scale.counts());
-    let training = training_config(context, codebook, counts, objects.specs.len());
-    let start_pose = StartPose::Random {
-        max_heading: objects.set.start_heading(),
-    };
+    let basis = FusionBasis::of(context, codebook)?;
+    let FusionBasis {
+        setting,
+        objects,
+        counts,
+        training,
+        start_pose,
+    } = &basis;
     let name = SafeName::new(EXPERIMENT_NAME)?;
     let choice = DescriptorChoice::fused(DESCRIPTORS.to_vec())?;
     let key = SafeName::builder(choice.name()).build()?;
     let dir = ExperimentDir::new(&context.options.out, &name);
-    let work = FusionUnit {
-        data: SettingData::new(context, &objects, &setting, counts),
-        objects: Arc::clone(&objects),
-        training: training.clone(),
-        start_pose,
-    };
+    let work = basis.unit(context, EXPERIMENT_NAME);
     if context.options.shard.contains(0) && !dir.unit_csv(&key).exists() {
         context.store.prepare(&work.requests()?, dir.root())?;
     }
     let config = FusionConfig {
-        setting: &setting,
+        setting,
         descriptor: choice.name(),
         evidence: EVIDENCE.iter().map(Evidence::name).collect(),
         local_probabilities: LOCAL_PROBABILITIES,
         active: FusionActive::new(),
-        start_pose,
+        start_pose: *start_pose,
         geometry: GeometryParams {
             max_heading: objects.set.start_heading(),
             ..GeometryParams::default()
@@ -229,25 +286,22 @@ pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
         calibration: work.calibration_record(),
         posterior: context.posterior(),
         scale: context.scale.fraction(),
-        counts,
+        counts: *counts,
         seed: context.seed,
         object_set_id: objects.set.id(),
         objects: objects.names(),
-        training,
+        training: training.clone(),
     };
     let title = "Appearance, contact geometry and their fusion (random start poses)";
     let plot = PlotSpec::accuracy(name.clone(), title)
         .with_chance(objects.specs.len())
         .with_legend(CURVE_LABEL);
-    let mut attempts = PlotSpec::lines(
-        SafeName::new(format!("{EXPERIMENT_NAME}-attempts"))?,
+    let attempts = attempts_plot(
+        EXPERIMENT_NAME,
         "Accuracy against touch attempts (converged or not)",
-        Axis::new("n_attempts", "touch attempts per object"),
-        vec![Axis::new("accuracy", "accuracy")],
         &["evidence", "strategy", "local_probability", "object_motion"],
-    )
-    .with_legend(CURVE_LABEL);
-    attempts.table = AttemptRow::TABLE.map(SafeName::new).transpose()?;
+        CURVE_LABEL,
+    )?;
     let experiment = Experiment {
         spec: ExperimentSpec {
             name: name.clone(),
@@ -270,27 +324,30 @@ pub fn run_fusion(context: &PaperContext, codebook: CodebookKind) -> Result<RunR
     Ok(run(&experiment, &context.options)?)
 }
 
-/// What the experiment's one unit works from.
-struct FusionUnit<'a> {
-    data: SettingData<'a>,
-    objects: Arc<Objects>,
-    training: TrainConfig,
-    start_pose: StartPose,
+/// What the experiment's one unit works from: the product's fused model and the arm's
+/// explorations it judges (the `free-object` experiment's too).
+pub(super) struct FusionUnit<'a> {
+    /// The experiment whose rows it writes.
+    pub experiment: &'static str,
+    pub data: SettingData<'a>,
+    pub objects: Arc<Objects>,
+    pub training: TrainConfig,
+    pub start_pose: StartPose,
 }
 
 impl FusionUnit<'_> {
-    /// The explorations at `l`, the object `perturbation`-moved, one per trial, `readings` per
-    /// object, from `first_stream`.
-    fn explorations(
+    /// The explorations at `l`, the object held and moved as `object` says (a mocap body when
+    /// its body is `None`), one per trial, `readings` per object, from `first_stream`.
+    pub(super) fn explorations(
         &self,
         l: f64,
-        perturbation: PerturbationBounds,
+        object: (PerturbationBounds, Option<FreeBody>),
         readings: usize,
         first_stream: u64,
     ) -> Result<Vec<DataRequest>, BoxError> {
         Ok(self
             .data
-            .planner_trials(l, perturbation, self.start_pose, readings, first_stream)?)
+            .planner_trials(l, object, self.start_pose, readings, first_stream)?)
     }
 
     /// The arm's explorations the fusion is weighed on: at each L of [`LOCAL_PROBABILITIES`] with
@@ -303,7 +360,7 @@ impl FusionUnit<'_> {
         for (i, l) in LOCAL_PROBABILITIES.into_iter().enumerate() {
             requests.extend(self.explorations(
                 l,
-                PerturbationBounds::NONE,
+                (PerturbationBounds::NONE, None),
                 readings,
                 CALIBRATION_STREAM + 100 * i as u64,
             )?);
@@ -311,7 +368,7 @@ impl FusionUnit<'_> {
         let moving = CALIBRATION_STREAM + 100 * LOCAL_PROBABILITIES.len() as u64;
         requests.extend(self.explorations(
             MOVING_CALIBRATION_L,
-            PerturbationBounds::PAPER,
+            (PerturbationBounds::PAPER, None),
             readings,
             moving,
         )?);
@@ -333,18 +390,28 @@ impl FusionUnit<'_> {
         let mut tests = Vec::new();
         for l in LOCAL_PROBABILITIES {
             for (motion, perturbation) in object_states() {
-                let requests =
-                    self.explorations(l, perturbation, self.data.counts.test_per_object, TEST_STREAM)?;
+                let requests = self.explorations(
+                    l,
+                    (perturbation, None),
+                    self.data.counts.test_per_object,
+                    TEST_STREAM,
+                )?;
                 tests.push((l, motion, requests));
             }
         }
         Ok(tests)
     }
 
-    /// Every dataset the unit reads.
-    fn requests(&self) -> Result<Vec<DataRequest>, BoxError> {
+    /// Every dataset the model is made of: training, validation and calibration.
+    pub(super) fn model_requests(&self) -> Result<Vec<DataRequest>, BoxError> {
         let mut requests = vec![self.data.training_request()?, self.data.validation_request()?];
         requests.extend(self.calibration()?);
+        Ok(requests)
+    }
+
+    /// Every dataset the unit reads.
+    fn requests(&self) -> Result<Vec<DataRequest>, BoxError> {
+        let mut requests = self.model_requests()?;
         for (.., tests) in self.tests()? {
             requests.extend(tests);
         }
@@ -354,7 +421,7 @@ impl FusionUnit<'_> {
     /// The product's model: MNTI and SIFT fused (each trained and chosen as every figure's model,
     /// the fusion's tempering fitted on the validation readings), then fused with the contact
     /// geometry of every object's mesh, weighed on the arm's explorations.
-    fn model(&self) -> Result<GeometricFusion, BoxError> {
+    pub(super) fn model(&self) -> Result<GeometricFusion, BoxError> {
         let store = &self.data.context.store;
         let (training, validation) = (self.data.training_request()?, self.data.validation_request()?);
         let parts = DESCRIPTORS
@@ -392,18 +459,7 @@ impl FusionUnit<'_> {
         let mut rows: Rows = Default::default();
         let mut active_plans = Vec::new();
         for (l, motion, requests) in self.tests()? {
-            let mut tests = Vec::new();
-            for request in &requests {
-                let test = self.data.context.store.dataset(request)?;
-                let trials = model.trials(&test, usize::MAX)?;
-                let attempts = attempt_logs(model.objects(), &test, &trials)?;
-                tests.push(TestRun {
-                    stream_seed: request.plan.seed,
-                    motion: test.header().perturbation,
-                    trials,
-                    attempts,
-                });
-            }
+            let tests = self.test_runs(&model, &requests)?;
             for evidence in EVIDENCE {
                 let judge = model.clone().with_evidence(evidence);
                 extend(
@@ -498,9 +554,31 @@ impl FusionUnit<'_> {
         Ok(curves)
     }
 
+    /// The test explorations of `requests`, each described by `model` (the readings of each
+    /// object one sequence) with every object's attempts.
+    pub(super) fn test_runs(
+        &self,
+        model: &GeometricFusion,
+        requests: &[DataRequest],
+    ) -> Result<Vec<TestRun>, BoxError> {
+        let mut tests = Vec::new();
+        for request in requests {
+            let test = self.data.context.store.dataset(request)?;
+            let trials = model.trials(&test, usize::MAX)?;
+            let attempts = attempt_logs(model.objects(), &test, &trials)?;
+            tests.push(TestRun {
+                stream_seed: request.plan.seed,
+                motion: test.header().perturbation,
+                trials,
+                attempts,
+            });
+        }
+        Ok(tests)
+    }
+
     /// One curve: `model` recognising each test exploration (one repetition per dataset, each
     /// object's readings one sequence) at every reading count and every attempt count.
-    fn curve_rows(
+    pub(super) fn curve_rows(
         &self,
         model: &GeometricFusion,
         factors: &Factors,
@@ -509,7 +587,7 @@ impl FusionUnit<'_> {
         let mut rows: Rows = Default::default();
         let mut table = ReliabilityTable::default();
         let mut meta = AccuracyCurve {
-            experiment: EXPERIMENT_NAME.to_string(),
+            experiment: self.experiment.to_string(),
             descriptor: model.appearance().choice().name(),
             factors: factors.clone(),
             trial: 0,
@@ -545,7 +623,7 @@ impl FusionUnit<'_> {
 }
 
 /// Appends one curve's rows to the unit's.
-fn extend(rows: &mut Rows, (accuracy, (per_object, reliability, attempts)): Rows) {
+pub(super) fn extend(rows: &mut Rows, (accuracy, (per_object, reliability, attempts)): Rows) {
     rows.0.extend(accuracy);
     rows.1.0.extend(per_object);
     rows.1.1.extend(reliability);
@@ -554,7 +632,7 @@ fn extend(rows: &mut Rows, (accuracy, (per_object, reliability, attempts)): Rows
 
 /// One test exploration, described: each object's readings with their touches, and each object's
 /// attempts (whether each converged), in the same order.
-struct TestRun {
+pub(super) struct TestRun {
     stream_seed: u64,
     motion: Perturbed,
     trials: Vec<Trial<TouchReading>>,

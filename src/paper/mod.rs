@@ -20,6 +20,7 @@
 //! | `active` | beyond | active touch by expected information gain vs L = 1, 0.5; touches to confidence (`active.rs`) |
 //! | `end-to-end` | beyond | the arm's blind touches recognised by the paper's training and ours (L, fixed/perturbed) |
 //! | `fusion` | beyond | appearance, contact geometry and their fusion at random start poses (blind L and the fused model's active touch, fixed/perturbed), against readings and touch attempts (`fusion.rs`) |
+//! | `free-object` | beyond | the object mocap, free (three densities, two frictions) or pushed: how far touches move it, Press's convergence, recognition (`free_object.rs`) |
 //!
 //! Datasets and models are shared between the experiments of a run through `<out>/data` and
 //! `<out>/models` (`data.rs`, [`read_shortfalls`]).
@@ -31,6 +32,7 @@ pub(crate) mod data;
 pub(crate) mod estimate;
 pub(crate) mod figure1;
 pub(crate) mod figures;
+pub(crate) mod free_object;
 pub(crate) mod fusion;
 pub(crate) mod headline;
 pub(crate) mod real_frames;
@@ -97,12 +99,13 @@ pub enum PaperExperiment {
     Active,
     EndToEnd,
     Fusion,
+    FreeObject,
 }
 
 impl PaperExperiment {
     /// Every experiment, in the order `reproduce` runs them (the paper's figure order, then the
     /// experiments beyond the paper).
-    pub const ALL: [PaperExperiment; 16] = [
+    pub const ALL: [PaperExperiment; 17] = [
         Self::Exploration,
         Self::Descriptors,
         Self::Strategy,
@@ -119,6 +122,7 @@ impl PaperExperiment {
         Self::Active,
         Self::EndToEnd,
         Self::Fusion,
+        Self::FreeObject,
     ];
 
     /// The recognition figure's sweep; `None` for Fig. 1, a picture, Fig. 14, which is not a
@@ -133,7 +137,12 @@ impl PaperExperiment {
             Self::Thickness => figures::thickness(),
             Self::Resolution => figures::resolution(),
             Self::Noise => figures::noise(),
-            Self::Exploration | Self::Convergence | Self::RealFrames | Self::Active | Self::Fusion => {
+            Self::Exploration
+            | Self::Convergence
+            | Self::RealFrames
+            | Self::Active
+            | Self::Fusion
+            | Self::FreeObject => {
                 return None;
             }
             Self::Letters => figures::letters(),
@@ -152,7 +161,9 @@ impl PaperExperiment {
     /// [`ArmTrainingRecipe::CODEBOOK`]: crate::active_touch::ArmTrainingRecipe::CODEBOOK
     pub fn default_codebook(self) -> CodebookKind {
         match self {
-            Self::Active | Self::EndToEnd | Self::Fusion => crate::active_touch::ArmTrainingRecipe::CODEBOOK,
+            Self::Active | Self::EndToEnd | Self::Fusion | Self::FreeObject => {
+                crate::active_touch::ArmTrainingRecipe::CODEBOOK
+            }
             _ => CodebookKind::Gmm,
         }
     }
@@ -171,6 +182,7 @@ impl PaperExperiment {
             Self::RealFrames => real_frames::EXPERIMENT_NAME,
             Self::Active => active::EXPERIMENT_NAME,
             Self::Fusion => fusion::EXPERIMENT_NAME,
+            Self::FreeObject => free_object::EXPERIMENT_NAME,
             _ => self.sweep().map_or(convergence::EXPERIMENT_NAME, |s| s.name),
         }
     }
@@ -181,6 +193,7 @@ impl PaperExperiment {
             Self::RealFrames => return real_frames::DESCRIPTION,
             Self::Active => return active::DESCRIPTION,
             Self::Fusion => return fusion::DESCRIPTION,
+            Self::FreeObject => return free_object::DESCRIPTION,
             _ => {}
         }
         self.sweep().map_or(
@@ -207,6 +220,9 @@ impl PaperExperiment {
             }
             None if self == Self::Fusion => {
                 PaperOutput::Run(Box::new(fusion::run_fusion(context, codebook)?))
+            }
+            None if self == Self::FreeObject => {
+                PaperOutput::Run(Box::new(free_object::run_free_object(context, codebook)?))
             }
             None => PaperOutput::Run(Box::new(run_convergence(context)?)),
         })

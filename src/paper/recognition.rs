@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::context::{Family, PaperContext};
 use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
+use crate::bodies::FreeBody;
 use crate::control::ControlConfig;
 use crate::dataset::recorded::RealData;
 use crate::describe::{Descriptor, DescriptorKind};
@@ -584,12 +585,12 @@ impl<'a> SettingData<'a> {
     }
 
     /// The planner exploring each object blind with the arm at L = `local_probability`, the object
-    /// starting at `start_pose` and perturbed within `perturbation`, `readings` per object, seeded
-    /// by the run's `stream`.
+    /// held as `held` says, starting at `start_pose` and perturbed within `perturbation`,
+    /// `readings` per object, seeded by the run's `stream`.
     fn planner_request(
         &self,
         local_probability: f64,
-        perturbation: PerturbationBounds,
+        (perturbation, held): (PerturbationBounds, Option<FreeBody>),
         start_pose: StartPose,
         readings: usize,
         stream: u64,
@@ -608,7 +609,7 @@ impl<'a> SettingData<'a> {
                 readings_per_object: readings,
                 seed: rng::substream(self.context.seed, stream),
                 start_pose,
-                free_object: None,
+                free_object: held,
             },
         ))
     }
@@ -631,7 +632,7 @@ impl<'a> SettingData<'a> {
         for (i, local_probability) in CALIBRATION_LOCAL_PROBABILITIES.into_iter().enumerate() {
             requests.extend(self.planner_trials(
                 local_probability,
-                PerturbationBounds::NONE,
+                (PerturbationBounds::NONE, None),
                 StartPose::Canonical,
                 self.counts.validation_per_object,
                 CALIBRATION_STREAM + 100 * i as u64,
@@ -641,11 +642,11 @@ impl<'a> SettingData<'a> {
     }
 
     /// One planner dataset per trial, `readings` per object, trial `t` on stream
-    /// `first_stream + t`.
+    /// `first_stream + t`, the object held as `held` says (a mocap body when `None`).
     pub(super) fn planner_trials(
         &self,
         local_probability: f64,
-        perturbation: PerturbationBounds,
+        (perturbation, held): (PerturbationBounds, Option<FreeBody>),
         start_pose: StartPose,
         readings: usize,
         first_stream: u64,
@@ -654,7 +655,7 @@ impl<'a> SettingData<'a> {
             .map(|t| {
                 self.planner_request(
                     local_probability,
-                    perturbation,
+                    (perturbation, held),
                     start_pose,
                     readings,
                     first_stream + t as u64,
@@ -676,7 +677,7 @@ impl<'a> SettingData<'a> {
                 perturbation,
             } => self.planner_trials(
                 local_probability,
-                perturbation,
+                (perturbation, None),
                 StartPose::Canonical,
                 self.counts.test_per_object,
                 TEST_STREAM,

@@ -111,7 +111,7 @@ impl PerturbationBounds {
     }
 
     /// Why this perturbation cannot move an object held as `free_object` says (a mocap object
-    /// when `None`), as a [`RangeError`]'s `allowed`: a push (beyond the paper) moves a free object
+    /// when `None`), as a [`RangeError`](crate::valid::RangeError)'s `allowed`: a push (beyond the paper) moves a free object
     /// that friction stops, and a mocap object has no dynamics while a frictionless one would
     /// slide on. `None`: it can.
     pub fn refusal_for(&self, free_object: Option<FreeBody>) -> Option<&'static str> {
