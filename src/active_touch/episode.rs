@@ -146,14 +146,7 @@ impl Check for EpisodeConfig {
             neighbourhood_m,
             free_object,
         } = *self;
-        if let Some(allowed) = perturbation.refusal_for(free_object) {
-            return Err(RangeError {
-                config: "episode config",
-                field: "perturbation",
-                value: perturbation.act().name().into(),
-                allowed,
-            });
-        }
+        perturbation.check_act_on(free_object, "episode config")?;
         FieldChecks::of("episode config")
             .count(
                 "candidates",

@@ -40,7 +40,7 @@ use taction::recognize::Belief;
 use taction::recognize::{Recognizer, TrainConfig};
 use taction::rng;
 use taction::sim::PAD_SITE;
-use taction::sim::{ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
+use taction::sim::{ObjectMotion, ObjectSpec, PerturbationBounds, Scene, SimError, StartPose};
 use taction::tactile::write_contact_sheet;
 use taction::tactile::{CoveringSensor, SensorConfig, arm_with_sensor};
 use taction::valid::Valid;
@@ -162,8 +162,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut unknown = place_unknown(args, &objects, model.objects(), sensor, &start)?;
     // 3. The exploration, recognising after every converged touch.
     let explored = explore_unknown(args, &objects, &model, &mut unknown, sensor)?;
-    if unknown.scene.object_is_free() {
-        let moved = unknown.scene.object_motion_from(&unknown.start)?;
+    if let Some(moved) = &explored.moved {
         println!(
             "the free object's centre moved {:.2} mm and it turned {:.2} deg while the arm explored it ({})",
             moved.centre_shift_m * 1e3,
@@ -365,6 +364,9 @@ struct Explored {
     p_true: Vec<(f64, f64)>,
     /// The belief after the last touch.
     belief: Belief,
+    /// How far the exploration moved a free object from where it settled; `None` for the
+    /// paper's mocap object, which does not move.
+    moved: Option<ObjectMotion>,
 }
 
 /// The arm explores `unknown` with the planner (blind or active), the posterior updated and
@@ -420,11 +422,16 @@ fn explore_unknown(
         .into());
     }
     std::io::stdout().flush()?;
+    let moved = match unknown.scene.object_is_free() {
+        true => Some(unknown.scene.object_motion_from(&unknown.start)?),
+        false => None,
+    };
     Ok(Explored {
         run,
         csv: shown.csv,
         p_true: shown.p_true,
         belief: recognition.belief(),
+        moved,
     })
 }
 
@@ -520,7 +527,6 @@ fn write_outputs(
         &placements,
         &sensor,
     )?;
-    let belief = &explored.belief;
     let ending = if run.stopped_confident {
         "stopped: confident".to_string()
     } else if images.len() >= args.touches {
@@ -532,21 +538,21 @@ fn write_outputs(
             args.touches
         )
     };
-    let guess = belief.guess();
+    let guess = explored.belief.guess();
     write_run_record(
         args,
         model,
         unknown,
         &ending,
         (images.len(), run.attempts),
-        belief,
+        explored,
     )?;
     println!(
         "after {} touches ({} attempts; {ending}): '{}' with p = {:.3} (true: '{}'); wrote {}/{{touches.csv, posterior.svg, posterior.png, contact_sheet.png, exploration.png, run.json}}",
         images.len(),
         run.attempts,
         names[guess],
-        belief.probabilities()[guess],
+        explored.belief.probabilities()[guess],
         unknown.spec.name,
         args.out.display()
     );
@@ -573,8 +579,9 @@ fn write_run_record(
     unknown: &Unknown,
     ending: &str,
     (touches, attempts): (usize, usize),
-    belief: &Belief,
+    explored: &Explored,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    let belief = &explored.belief;
     let names = model.objects();
     let pose = unknown.scene.object_pose().unwrap_or(unknown.spec.pose);
     let guess = belief.guess();
@@ -601,29 +608,28 @@ fn write_run_record(
         "p_guess": belief.probabilities()[guess],
         "p_true": belief.probabilities()[unknown.index],
         "right": guess == unknown.index,
-        "free_object": free_object_record(unknown)?,
+        "free_object": free_object_record(unknown, explored.moved.as_ref()),
     });
     let text = serde_json::to_string_pretty(&record)? + "\n";
     taction::atomic::write_atomic(&args.out.join("run.json"), text.as_bytes())?;
     Ok(())
 }
 
-/// What `run.json` says of a free object: its material and how far the exploration moved it
+/// What `run.json` says of a free object: its material and how far the exploration `moved` it
 /// from where it settled; `null` for the paper's mocap object, which does not move.
-fn free_object_record(unknown: &Unknown) -> Result<serde_json::Value, SimError> {
-    if !unknown.scene.object_is_free() {
-        return Ok(serde_json::Value::Null);
-    }
+fn free_object_record(unknown: &Unknown, moved: Option<&ObjectMotion>) -> serde_json::Value {
+    let Some(moved) = moved else {
+        return serde_json::Value::Null;
+    };
     let body = unknown.spec.free_body;
-    let moved = unknown.scene.object_motion_from(&unknown.start)?;
-    Ok(serde_json::json!({
+    serde_json::json!({
         "density_kg_m3": body.density_kg_m3(),
         "friction": body.friction(),
         "centre_shift_mm": moved.centre_shift_m * 1e3,
         "turn_deg": moved.turn_rad.to_degrees(),
         "tilt_deg": moved.tilt_rad.to_degrees(),
         "outcome": moved.outcome().name(),
-    }))
+    })
 }
 
 /// The posterior of the true object over `touches` touches, chance at 1 / `objects`.

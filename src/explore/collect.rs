@@ -546,20 +546,6 @@ impl<'p> Collect<'p> {
         }
     }
 
-    /// A push (beyond the paper) moves only a free object with friction
-    /// ([`PerturbationBounds::refusal_for`]).
-    fn check_push(&self) -> Result<(), RangeError> {
-        match self.perturbation.refusal_for(self.free_object) {
-            None => Ok(()),
-            Some(allowed) => Err(RangeError {
-                config: "collection",
-                field: "perturbation",
-                value: PerturbationAct::Push.name().into(),
-                allowed,
-            }),
-        }
-    }
-
     /// The checked plan: everything the readings depend on (what an experiment's cache key hashes).
     pub fn plan(&self) -> Result<CollectPlan, RangeError> {
         let mode = match self.procedure {
@@ -574,7 +560,7 @@ impl<'p> Collect<'p> {
             Procedure::Sampler(c) => CollectMode::Sampler(Valid::new(c)?),
             Procedure::Planner(c) => CollectMode::Planner(Valid::new(c)?),
         };
-        self.check_push()?;
+        self.perturbation.check_act_on(self.free_object, "collection")?;
         Ok(CollectPlan {
             mode,
             sensor: self.sensor,

@@ -76,6 +76,13 @@ impl TriMesh {
         )
     }
 
+    /// The centre of the bounding box: where an object's shift along the table is measured
+    /// (`sim::ObjectMotion`); `None` for a mesh with no vertices.
+    pub fn bounding_box_centre(&self) -> Option<DVec3> {
+        let (lo, hi) = self.bounds()?;
+        Some((lo + hi) * 0.5)
+    }
+
     /// Length of the bounding-box diagonal, |max - min|; `None` for a mesh with no vertices.
     pub fn bounding_diagonal_m(&self) -> Option<f64> {
         self.bounds().map(|(lo, hi)| (hi - lo).length())

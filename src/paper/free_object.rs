@@ -189,10 +189,7 @@ impl MotionRow {
         attempts: &[&crate::dataset::Reading],
         seed: u64,
     ) -> Self {
-        let centre_local = object
-            .mesh
-            .bounds()
-            .map_or(glam::DVec3::ZERO, |(lo, hi)| (lo + hi) * 0.5);
+        let centre_local = object.mesh.bounding_box_centre().unwrap_or(glam::DVec3::ZERO);
         let motions: Vec<ObjectMotion> = attempts
             .iter()
             .filter_map(|r| {
@@ -201,10 +198,11 @@ impl MotionRow {
             })
             .collect();
         let summary = MotionSummary::of(&motions);
-        let measured = (!motions.is_empty()).then_some(());
+        // Empty cells where no touch was measured (a mocap object), not zeros.
+        let measured = !motions.is_empty();
         let converged = attempts.iter().filter(|r| r.is_converged()).count();
-        let mm = |m: f64| measured.map(|_| m * 1e3);
-        let deg = |r: f64| measured.map(|_| r.to_degrees());
+        let mm = |m: f64| measured.then_some(m * 1e3);
+        let deg = |r: f64| measured.then_some(r.to_degrees());
         Self {
             experiment: EXPERIMENT_NAME.to_string(),
             factors: mount.factors(None),

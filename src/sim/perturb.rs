@@ -16,6 +16,7 @@ use crate::pose::Pose;
 use crate::rng::Rng;
 use crate::sim::SimError;
 use crate::sim::scene::Scene;
+use crate::valid::RangeError;
 
 /// How a perturbation moves the object.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
@@ -110,21 +111,31 @@ impl PerturbationBounds {
         self.act
     }
 
-    /// Why this perturbation cannot move an object held as `free_object` says (a mocap object
-    /// when `None`), as a [`RangeError`](crate::valid::RangeError)'s `allowed`: a push (beyond the paper) moves a free object
-    /// that friction stops, and a mocap object has no dynamics while a frictionless one would
-    /// slide on. `None`: it can.
-    pub fn refusal_for(&self, free_object: Option<FreeBody>) -> Option<&'static str> {
+    /// Whether this perturbation can move an object held as `free_object` says (a mocap object
+    /// when `None`); if not, the error of field `perturbation` of `config`: a push (beyond the
+    /// paper) moves a free object that friction stops, and a mocap object has no dynamics while a
+    /// frictionless one would slide on.
+    pub fn check_act_on(
+        &self,
+        free_object: Option<FreeBody>,
+        config: &'static str,
+    ) -> Result<(), RangeError> {
         if self.act != PerturbationAct::Push || self.is_none() {
-            return None;
+            return Ok(());
         }
-        match free_object {
-            None => Some("teleport for a mocap object (a push needs a free object's dynamics)"),
+        let allowed = match free_object {
+            None => "teleport for a mocap object (a push needs a free object's dynamics)",
             Some(body) if body.friction() <= 0.0 => {
-                Some("teleport for a frictionless object (nothing would stop a pushed one)")
+                "teleport for a frictionless object (nothing would stop a pushed one)"
             }
-            Some(_) => None,
-        }
+            Some(_) => return Ok(()),
+        };
+        Err(RangeError {
+            config,
+            field: "perturbation",
+            value: self.act.name().into(),
+            allowed,
+        })
     }
 
     pub fn max_rotation_rad(&self) -> f64 {

@@ -714,8 +714,7 @@ impl Scene {
 
     /// Centre of the object's bounding box in its own frame.
     pub fn object_center_local(&self) -> Option<DVec3> {
-        let (lo, hi) = self.object.as_ref()?.mesh.bounds()?;
-        Some((lo + hi) * 0.5)
+        self.object.as_ref()?.mesh.bounding_box_centre()
     }
 }
 
