@@ -27,7 +27,11 @@ pub enum PerturbationAct {
     #[default]
     Teleport,
     /// Beyond the paper: a free object is pushed, and friction stops it about where the draw
-    /// would have put it ([`Scene::push_object`](crate::sim::Scene::push_object)).
+    /// would have put it ([`Scene::push_object`](crate::sim::Scene::push_object)). A plan names it
+    /// `steadied_push`, the hand that holds the object upright as it pushes, so that no dataset
+    /// cached under the earlier hand's `push` (which let rounded objects rock and tip) is taken
+    /// for this one's; a plan that says `push` still reads.
+    #[serde(rename = "steadied_push", alias = "push")]
     Push,
 }
 
