@@ -1418,6 +1418,32 @@ fn preprocessing_takes_square_roots_then_blurs() {
         }
     }
 
+    // A frame of another shape than square (a 28x50 array's, smaller) is blurred along each axis
+    // over that axis's length: a delta gives the same outer product, and blurring the transposed
+    // frame gives the transposed blur, borders included.
+    let out = blur.apply(&delta(9, 13, (4, 8), 1.0));
+    for r in 0..9 {
+        for c in 0..13 {
+            let (dr, dc) = (r as i64 - 4, c as i64 - 8);
+            let expected = if dr.abs() <= 2 && dc.abs() <= 2 {
+                k[(dr + 2) as usize] * k[(dc + 2) as usize]
+            } else {
+                0.0
+            };
+            assert!((out.get(r, c) - expected).abs() < 1e-15, "({r}, {c})");
+        }
+    }
+    let values: Vec<f64> = (0..21).map(|i| ((i * 7) % 11) as f64 / 10.0).collect();
+    let wide = TactileImage::new(3, 7, values).unwrap();
+    let transpose = |im: &TactileImage| {
+        let t = (0..im.cols()).flat_map(|c| (0..im.rows()).map(move |r| (r, c)));
+        TactileImage::new(im.cols(), im.rows(), t.map(|(r, c)| im.get(r, c)).collect()).unwrap()
+    };
+    let (blurred, tall) = (blur.apply(&wide), blur.apply(&transpose(&wide)));
+    for (a, b) in transpose(&blurred).values().iter().zip(tall.values()) {
+        assert!((a - b).abs() < 1e-12, "{a} against {b}");
+    }
+
     // Mass is preserved away from the borders; a uniform image stays uniform up to the borders.
     let sum = |im: &TactileImage| im.values().iter().sum::<f64>();
     let mut values = vec![0.0; 144];

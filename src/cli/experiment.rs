@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use taction::dataset::Calibration;
+use taction::dataset::{Calibration, TaxelPitch};
 use taction::experiment::RunOptions;
 use taction::mesh::BUILTIN_SETS;
 use taction::mesh::ObjectSet;
@@ -56,6 +56,12 @@ pub struct PaperArgs {
     /// the grid exactly once.
     #[arg(long, value_name = "CSV", requires = "real")]
     pub calibration: Option<PathBuf>,
+    /// The distance between neighbouring taxel centres of `--real`'s array, metres (e.g. 0.002):
+    /// sim-to-real then simulates a pad of the recording's rows x cols at this pitch (cols x pitch
+    /// wide, rows x pitch high; the figure's 10% covering and 30% noise) instead of the paper's
+    /// 6x6 letters sensor. Needed for a recording of another grid than 6x6.
+    #[arg(long, value_name = "M", requires = "real")]
+    pub taxel_pitch_m: Option<TaxelPitch>,
     #[command(flatten)]
     pub preprocess: PreprocessArgs,
     /// real-frames (Fig. 16b): trials of the whole split-train-test process.
@@ -92,6 +98,7 @@ impl PaperArgs {
         if let Some(path) = &self.calibration {
             real.calibration = Some(Calibration::read(path).map_err(|e| format!("--calibration: {e}"))?);
         }
+        real.taxel_pitch = self.taxel_pitch_m;
         let real_frames = self.preprocess.options(self.trials)?;
         let run = RunOptions {
             threads: Some(self.threads.count()),

@@ -10,7 +10,7 @@ use super::real_frames_options::RealFramesOptions;
 use super::scale::Scale;
 use serde::Serialize;
 
-use crate::dataset::recorded::{Calibration, RealData, RealImport, parse_real_csv};
+use crate::dataset::recorded::{Calibration, RealData, RealImport, TaxelPitch, parse_real_csv};
 use crate::dataset::{import_real, is_frames_csv};
 use crate::experiment::runner::RunOptions;
 use crate::experiment::unit::BoxError;
@@ -30,6 +30,9 @@ pub struct RealRecording {
     pub frames: RealFrames,
     /// Per-taxel gain and offset applied on import.
     pub calibration: Option<Calibration>,
+    /// The recorded array's taxel pitch, when its maker gave it (`--taxel-pitch-m`): `sim-to-real`
+    /// then simulates a pad of the recording's grid at this pitch instead of the paper's 6x6.
+    pub taxel_pitch: Option<TaxelPitch>,
 }
 
 /// How a recording's frames are kept.
@@ -49,6 +52,7 @@ impl RealRecording {
             origin: "data/real_letters_example.csv (built in)".into(),
             frames: RealFrames::Csv(EXAMPLE_REAL_CSV.into()),
             calibration: None,
+            taxel_pitch: None,
         }
     }
 
@@ -63,6 +67,7 @@ impl RealRecording {
             origin: path.display().to_string(),
             frames,
             calibration: None,
+            taxel_pitch: None,
         })
     }
 }

@@ -18,7 +18,7 @@ use super::data::{DataRequest, Objects};
 use super::scale::DataCounts;
 use crate::bodies::FreeBody;
 use crate::control::ControlConfig;
-use crate::dataset::recorded::RealData;
+use crate::dataset::recorded::{RealData, TaxelPitch, recorded_sensor};
 use crate::describe::{Descriptor, DescriptorKind};
 use crate::experiment::accuracy::{AccuracyCurve, AccuracyRow, PerObjectRow, ReliabilityRow};
 use crate::experiment::factor::Factors;
@@ -251,21 +251,31 @@ impl RecognitionSweep {
             .then(|| ArmCalibration::of(counts))
     }
 
-    /// Every setting's simulated sensor has the recorded frames' taxel grid: a model of another
-    /// grid cannot describe them.
-    fn check_real_grid(&self, real: &RealData) -> Result<(), BoxError> {
-        match self
-            .settings
-            .iter()
-            .find(|s| (s.sensor.rows, s.sensor.cols) != (real.rows, real.cols))
-        {
-            Some(s) => Err(format!(
-                "--real: the frames are {}x{} taxels but the simulated sensor is {}x{}",
-                real.rows, real.cols, s.sensor.rows, s.sensor.cols
-            )
-            .into()),
-            None => Ok(()),
+    /// This sweep with every simulated sensor fitted to the recording `real` (Fig. 17 tests on
+    /// it): unchanged without a `taxel_pitch` (the recording's grid must then be the sensor's, the
+    /// paper's 6x6); with one, a pad of the recording's grid at that pitch
+    /// ([`recorded_sensor`]), its covering the same share of the pad's shorter side and its noise
+    /// the same as the figure's, so that the model learns frames the size and shape of those it
+    /// is tested on.
+    fn fitted_to(&self, real: &RealData, taxel_pitch: Option<TaxelPitch>) -> Result<Self, BoxError> {
+        let mut sweep = self.clone();
+        for setting in &mut sweep.settings {
+            setting.sensor = match taxel_pitch {
+                Some(pitch) => sensor_of_recording(&setting.sensor, real, pitch),
+                None if (setting.sensor.rows, setting.sensor.cols) == (real.rows, real.cols) => {
+                    setting.sensor
+                }
+                None => {
+                    return Err(format!(
+                        "--real: the frames are {}x{} taxels but the simulated sensor is {}x{}: give the \
+                         recording's --taxel-pitch-m, and the simulated pad follows its grid",
+                        real.rows, real.cols, setting.sensor.rows, setting.sensor.cols
+                    )
+                    .into());
+                }
+            };
         }
+        Ok(sweep)
     }
 
     /// The plot's title: [`title`](Self::title), followed, when the sweep tests on recorded frames,
@@ -281,6 +291,31 @@ impl RecognitionSweep {
     /// units need, then runs the units on the experiment framework (resumable, sharded, parallel).
     pub fn run(&self, context: &PaperContext, codebook: CodebookKind) -> Result<RunReport, BoxError> {
         let objects = context.objects(self.family)?;
+        // The recorded frames are read, and the simulated sensor fitted to their grid, before any
+        // dataset is collected.
+        match self.family {
+            Family::RealLabels => {
+                let real = context.real_data()?;
+                self.fitted_to(&real, context.real.taxel_pitch)?.run_with(
+                    context,
+                    codebook,
+                    objects,
+                    Some(real),
+                )
+            }
+            _ => self.run_with(context, codebook, objects, None),
+        }
+    }
+
+    /// [`run`](Self::run) on `objects`, and on the recorded frames `real` when the sweep tests on
+    /// them.
+    fn run_with(
+        &self,
+        context: &PaperContext,
+        codebook: CodebookKind,
+        objects: Arc<Objects>,
+        real: Option<Arc<RealData>>,
+    ) -> Result<RunReport, BoxError> {
         let counts = context.scale.counts();
         let plans = self.unit_plans()?;
         let name = SafeName::new(self.name)?;
@@ -298,14 +333,6 @@ impl RecognitionSweep {
             arm_calibration: self.arm_calibration(context, counts),
         };
         check_resumable(&context.options, &name, &config)?;
-        // The recorded frames are read, and their grid checked, before any dataset is collected.
-        let real = match self.family {
-            Family::RealLabels => Some(context.real_data()?),
-            _ => None,
-        };
-        if let Some(real) = &real {
-            self.check_real_grid(real)?;
-        }
         let dir = ExperimentDir::new(&context.options.out, &name);
         prepare_pending(context, &objects, counts, &plans, &dir)?;
         let experiment = Experiment {
@@ -788,6 +815,25 @@ pub(super) fn selection_config(
         ..TrainConfig::default()
     }
     .with_grid_for(objects, training_per_object * objects, true)
+}
+
+/// The simulated counterpart of `sensor` for a recording of `real`'s grid at `pitch`: the
+/// recording's pad ([`recorded_sensor`]) with `sensor`'s covering share of the shorter side, its
+/// point spread for that covering, and `sensor`'s noise.
+fn sensor_of_recording(sensor: &SensorConfig, real: &RealData, pitch: TaxelPitch) -> SensorConfig {
+    let (pad, _) = recorded_sensor(real.rows, real.cols, Some(pitch));
+    let shorter_m = |s: &SensorConfig| s.pad_width_m.min(s.pad_height_m);
+    SensorConfig {
+        noise_fraction: sensor.noise_fraction,
+        ..SensorConfig::of_pad(
+            real.rows,
+            real.cols,
+            pad.pad_width_m,
+            pad.pad_height_m,
+            Some(sensor.thickness_m / shorter_m(sensor) * shorter_m(&pad)),
+            None,
+        )
+    }
 }
 
 /// The recorded frames as trials of the model's objects: each label's frames, preprocessed as in

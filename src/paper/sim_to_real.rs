@@ -77,11 +77,12 @@ impl GaussianBlur {
         self.kernel.len() / 2
     }
 
-    /// The blurred image (same size, same pose).
+    /// The blurred image (same size, same pose): down every column (`cols` lines of `rows`
+    /// values, a row apart), then along every row (`rows` lines of `cols` values, side by side).
     pub fn apply(&self, image: &TactileImage) -> TactileImage {
         let (rows, cols) = (image.rows(), image.cols());
-        let rows_pass = self.pass(image.values(), rows, cols, 1, cols);
-        let both = self.pass(&rows_pass, cols, rows, cols, 1);
+        let down_columns = self.pass(image.values(), cols, rows, 1, cols);
+        let both = self.pass(&down_columns, rows, cols, cols, 1);
         rebuild(image, both)
     }
 
