@@ -1405,34 +1405,30 @@ fn preprocessing_takes_square_roots_then_blurs() {
     for (i, a) in (-2..=2).enumerate() {
         assert!((k[i] - g(a as f64) / norm).abs() < 1e-15);
     }
-    let out = blur.apply(&delta(12, 12, (6, 6), 1.0));
-    for r in 0..12 {
-        for c in 0..12 {
-            let (dr, dc) = (r as i64 - 6, c as i64 - 6);
-            let expected = if dr.abs() <= 2 && dc.abs() <= 2 {
-                k[(dr + 2) as usize] * k[(dc + 2) as usize]
-            } else {
-                0.0
-            };
-            assert!((out.get(r, c) - expected).abs() < 1e-15, "({r}, {c})");
+    // The blur of a delta at `at` on a `rows x cols` frame, away from its borders.
+    let assert_kernel_around = |rows: usize, cols: usize, at: (usize, usize)| {
+        let out = blur.apply(&delta(rows, cols, at, 1.0));
+        for r in 0..rows {
+            for c in 0..cols {
+                let (dr, dc) = (r as i64 - at.0 as i64, c as i64 - at.1 as i64);
+                let expected = if dr.abs() <= 2 && dc.abs() <= 2 {
+                    k[(dr + 2) as usize] * k[(dc + 2) as usize]
+                } else {
+                    0.0
+                };
+                assert!(
+                    (out.get(r, c) - expected).abs() < 1e-15,
+                    "{rows}x{cols}: ({r}, {c})"
+                );
+            }
         }
-    }
+    };
+    assert_kernel_around(12, 12, (6, 6));
 
     // A frame of another shape than square (a 28x50 array's, smaller) is blurred along each axis
     // over that axis's length: a delta gives the same outer product, and blurring the transposed
     // frame gives the transposed blur, borders included.
-    let out = blur.apply(&delta(9, 13, (4, 8), 1.0));
-    for r in 0..9 {
-        for c in 0..13 {
-            let (dr, dc) = (r as i64 - 4, c as i64 - 8);
-            let expected = if dr.abs() <= 2 && dc.abs() <= 2 {
-                k[(dr + 2) as usize] * k[(dc + 2) as usize]
-            } else {
-                0.0
-            };
-            assert!((out.get(r, c) - expected).abs() < 1e-15, "({r}, {c})");
-        }
-    }
+    assert_kernel_around(9, 13, (4, 8));
     let values: Vec<f64> = (0..21).map(|i| ((i * 7) % 11) as f64 / 10.0).collect();
     let wide = TactileImage::new(3, 7, values).unwrap();
     let transpose = |im: &TactileImage| {
