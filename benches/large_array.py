@@ -19,8 +19,9 @@ What it does (every step a `taction` command a user could type):
    frame, drawn once from `--seed`, as real arrays have them (`--dead`, `--saturated`);
 4. the frames as a user with a real array keeps them, an `.npz` of `frames` and `labels`,
    imported with `taction dataset import --taxel-pitch-m`;
-5. the product: `taction train --descriptor shape-index` (the neighbour codebook, its default),
-   `taction recognize --readings 1` (every test frame alone) and `--readings 5` (five frames);
+5. the product: `taction train --descriptor shape-index` (its default codebook, the network,
+   and `--codebook knn` beside it), `taction recognize --readings 1` (every test frame alone)
+   and `--readings 5` (five frames);
 6. the baselines on the same standardised frames: 1-nearest-neighbour, and an RBF SVM whose C and
    gamma are chosen by 5-fold cross-validation on the training split (`--grid` sizes it).
 
@@ -97,17 +98,26 @@ def frames_of(dataset_csv, npz, defects):
     return flat.copy(), labels
 
 
-def product(out, train_npz, test_npz, pitch_m):
-    """The product's accuracy: (frames, right, trials) at 1 and 5 frames, and per object at 1."""
+def imported(out, train_npz, test_npz, pitch_m):
+    """The two .npz files as the datasets `taction dataset import` makes of them."""
     datasets = {}
     for name, npz in (("train", train_npz), ("test", test_npz)):
         datasets[name] = out / f"{name}_dataset.csv"
         taction("dataset", "import", npz, "--taxel-pitch-m", pitch_m, "--out", datasets[name])
-    model = out / "shape_index.model.json"
-    taction("train", "--dataset", datasets["train"], "--descriptor", "shape-index", "--out", model)
+    return datasets
+
+
+def product(out, datasets, codebook):
+    """The product's accuracy with `codebook` (None: `train`'s default): (frames, right, trials)
+    at 1 and 5 frames, and per object at 1."""
+    tag = codebook or "default"
+    model = out / f"shape_index_{tag}.model.json"
+    chosen = ["--codebook", codebook] if codebook else []
+    taction("train", "--dataset", datasets["train"], "--descriptor", "shape-index", *chosen,
+            "--out", model)
     rows, per_object = [], {}
     for frames in (1, 5):
-        folder = out / f"recognize_{frames}"
+        folder = out / f"recognize_{tag}_{frames}"
         taction("recognize", "--model", model, "--dataset", datasets["test"], "--readings", frames,
                 "--out", folder)
         with open(folder / "accuracy.csv") as f:
@@ -184,13 +194,17 @@ def main():
           f"{len(split['test'][1])} test frames of {args.rows}x{args.cols} taxels, "
           f"{len(set(split['train'][1]))} objects; dead taxels {sorted(defects[0].tolist())}, "
           f"saturated {sorted(defects[1].tolist())}", flush=True)
-    rows, per_object = product(args.out, args.out / "train_frames.npz", args.out / "test_frames.npz",
-                               args.pitch_m)
+    datasets = imported(args.out, args.out / "train_frames.npz", args.out / "test_frames.npz",
+                        args.pitch_m)
+    # The product's default for the shape index (the network), and the neighbour codebook beside it.
+    products = {name: product(args.out, datasets, codebook) for name, codebook in
+                (("taction shape-index (default: mlp)", None), ("taction shape-index (knn)", "knn"))}
     grid = {"small": {"C": [10, 100], "gamma_times_d": [1, 3]},
             "full": {"C": [1, 10, 100, 1000], "gamma_times_d": [0.1, 0.3, 1, 3]}}[args.grid]
     guesses = baselines(split["train"], split["test"], grid, args.seed)
     y_test = split["test"][1]
-    table = [("taction shape-index (knn codebook)", frames, right, n) for frames, right, n in rows]
+    table = [(name, frames, right, n) for name, (rows, _) in products.items()
+             for frames, right, n in rows]
     for name, guess in guesses.items():
         table.append((name, 1, int((guess == y_test).sum()), len(y_test)))
     with open(args.out / "large_array.csv", "w", newline="") as f:
@@ -202,11 +216,11 @@ def main():
             print(f"{name:<44} {frames} frame(s): {right:>5}/{n:<5} = {right / n:.3f} [{low:.3f}, {high:.3f}]")
     with open(args.out / "large_array_per_object.csv", "w", newline="") as f:
         w = csv.writer(f)
-        names = ["taction shape-index (knn codebook)", *guesses]
+        names = [*products, *guesses]
         w.writerow(["object", *names])
-        for obj in sorted(per_object):
+        for obj in sorted(set(y_test.tolist())):
             mask = y_test == obj
-            cells = [per_object[obj][0] / per_object[obj][1]]
+            cells = [per[obj][0] / per[obj][1] for _, per in products.values()]
             cells += [float((guess[mask] == obj).mean()) for guess in guesses.values()]
             w.writerow([obj, *[f"{c:.3f}" for c in cells]])
             print(f"  {obj:<18} " + " ".join(f"{c:.2f}" for c in cells))

@@ -200,9 +200,16 @@ fn per_touch(c: &mut Criterion) {
         variance_kept: CodebookKind::Knn.default_variance_kept(),
         ..gmm.clone()
     };
+    // The network: one hidden layer of 128 units, its membership two small products per touch.
+    let mlp = TrainConfig {
+        codebook: CodebookKind::Mlp,
+        ks: vec![128],
+        variance_kept: CodebookKind::Mlp.default_variance_kept(),
+        ..gmm.clone()
+    };
     let touch = training.readings(3)[17].clone();
     let mut group = c.benchmark_group("per_touch");
-    for (name, config) in [("gmm_k50", gmm), ("knn_k20", knn)] {
+    for (name, config) in [("gmm_k50", gmm), ("knn_k20", knn), ("mlp_h128", mlp)] {
         let config = Valid::new(config).expect("a valid configuration");
         let trained = train(&config, &training, None, &mut |_| {}).expect("train");
         group.bench_function(

@@ -711,3 +711,74 @@ fn recognize_replays_the_confidence_stop_as_posterior_long_shows_it() {
     assert!(ok, "{stderr}");
     assert!(!dir.path().join("later/stop.csv").exists());
 }
+
+/// Issue 73: the shape index of a large array trains the network by default (a per-frame
+/// posterior over the objects, frames combined by the product rule), with the same bytes from the
+/// same seed, and recognises single presses of a simulated 20x30 pad on the chess set.
+#[test]
+fn the_shape_index_trains_the_network_by_default_and_recognises_single_presses() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).display().to_string();
+    for (name, readings, seed) in [("train.csv", "100", "1"), ("test.csv", "40", "2")] {
+        let (ok, _, stderr) = taction(&[
+            "collect",
+            "--objects",
+            "chess",
+            "--mode",
+            "sampler",
+            "--readings",
+            readings,
+            "--seed",
+            seed,
+            "--rows",
+            "20",
+            "--cols",
+            "30",
+            "--pad-width-m",
+            "0.045",
+            "--pad-height-m",
+            "0.03",
+            "--noise",
+            "0.1",
+            "--out",
+            &p(name),
+        ]);
+        assert!(ok, "{stderr}");
+    }
+    let train = |out: &str| {
+        taction(&[
+            "train",
+            "--dataset",
+            &p("train.csv"),
+            "--descriptor",
+            "shape-index",
+            "--out",
+            &p(out),
+        ])
+    };
+    let (ok, stdout, stderr) = train("a.json");
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("k=128 ") && stdout.contains("k=256 ") && stdout.contains("explain 100.0%"),
+        "{stdout}"
+    );
+    assert!(train("b.json").0);
+    let text = std::fs::read_to_string(p("a.json")).unwrap();
+    assert_eq!(
+        text,
+        std::fs::read_to_string(p("b.json")).unwrap(),
+        "same seed, same model"
+    );
+    let model: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(model["bag"]["codebook"]["kind"], serde_json::json!("mlp"));
+    assert_eq!(model["bag"]["models"]["rule"], serde_json::json!("per-frame"));
+    let (ok, stdout, stderr) = recognise(&p("a.json"), &p("test.csv"), "1", &p("out"));
+    assert!(ok, "{stderr}");
+    let accuracy: f64 = stdout
+        .split("accuracy at   1 readings: ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|a| a.parse().ok())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(accuracy >= 0.8, "one press of a pawn or a rook: {accuracy}");
+}

@@ -205,6 +205,23 @@ fn inconsistent_or_foreign_content() {
         matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("object 99"),
         "{e}"
     );
+    // A network whose models lost the per-frame rule, or whose output layer lost a weight.
+    let mlp: serde_json::Value = serde_json::from_str(&dir_model_text(CodebookKind::Mlp)).unwrap();
+    assert_eq!(mlp["bag"]["models"]["rule"], serde_json::json!("per-frame"));
+    let mut broken = mlp.clone();
+    broken["bag"]["models"].as_object_mut().unwrap().remove("rule");
+    let e = load_text(&path, &broken.to_string());
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("decides by"),
+        "{e}"
+    );
+    let mut broken = mlp;
+    broken["bag"]["codebook"]["w2"].as_array_mut().unwrap().pop();
+    let e = load_text(&path, &broken.to_string());
+    assert!(
+        matches!(e, RecognizeError::Inconsistent { .. }) && e.to_string().contains("w2 holds"),
+        "{e}"
+    );
     let e = TrainedModel::load(&path.with_file_name("missing.json")).unwrap_err();
     assert!(
         matches!(e, RecognizeError::Io { .. }) && e.to_string().contains("missing.json"),

@@ -329,21 +329,22 @@ impl Posterior {
 }
 
 /// Trains a recogniser on `dataset` as `taction train` does: `descriptor` one of `vectorize`,
-/// `sift`, `mr8`, `mn`, `pf`, `mnti` or several joined by `+` (fused), `codebook` `knn` (the
-/// default, the product's), `gmm` (the paper's) or `kmeans`; the codebook size chosen among `ks`
+/// `sift`, `mr8`, `mn`, `pf`, `mnti`, `shape-index` or several joined by `+` (fused), `codebook`
+/// `knn`, `mlp` (a network over the objects), `gmm` (the paper's) or `kmeans`, by default the
+/// product's for the descriptor (mlp for `shape-index` alone, knn otherwise); the codebook size chosen among `ks`
 /// (default: a grid sized to the data) on `validation` (default: the last 1/11 of each object's
 /// readings). `calibration`, the arm's explorations, calibrates the posterior (in trials of
 /// `calibration_trial_readings`, default each object's readings as one); `objects`, the objects the
 /// dataset was collected on, adds where each touch landed, weighed on `calibration` (else
 /// `validation`).
 #[pyfunction]
-#[pyo3(signature = (dataset, descriptor="mnti", codebook="knn", validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None), text_signature = "(dataset, descriptor='mnti', codebook='knn', validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None)")]
+#[pyo3(signature = (dataset, descriptor="mnti", codebook=None, validation=None, ks=None, restarts=Whole(3), seed=Whole(1), variance_kept=None, pseudo_count=1.0, trial_readings=Whole(10), objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None), text_signature = "(dataset, descriptor='mnti', codebook=None, validation=None, ks=None, restarts=3, seed=1, variance_kept=None, pseudo_count=1.0, trial_readings=10, objects=None, calibration=None, start_heading_deg=180.0, calibration_trial_readings=None)")]
 #[allow(clippy::too_many_arguments)] // Python keyword arguments, each a training parameter
 pub fn train(
     py: Python<'_>,
     dataset: &Dataset,
     descriptor: &str,
-    codebook: &str,
+    codebook: Option<&str>,
     validation: Option<PyRef<'_, Dataset>>,
     ks: Option<Vec<Whole<usize>>>,
     restarts: Whole<usize>,
@@ -356,9 +357,14 @@ pub fn train(
     start_heading_deg: f64,
     calibration_trial_readings: Option<Whole<usize>>,
 ) -> PyResult<Model> {
+    let descriptor = DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?;
+    let codebook = match codebook {
+        Some(name) => CodebookKind::parse(name).map_err(|e| bad_argument("codebook", e))?,
+        None => TrainChoices::default_codebook(&descriptor),
+    };
     let choices = TrainChoices {
-        descriptor: DescriptorChoice::parse(descriptor).map_err(|e| bad_argument("descriptor", e))?,
-        codebook: CodebookKind::parse(codebook).map_err(|e| bad_argument("codebook", e))?,
+        descriptor,
+        codebook,
         ks: ks.map(|ks| ks.into_iter().map(|Whole(k)| k).collect()),
         restarts: restarts.0,
         seed: seed.0,

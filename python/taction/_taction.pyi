@@ -192,7 +192,7 @@ class Posterior:
 def train(
     dataset: Dataset,
     descriptor: str = "mnti",
-    codebook: str = "knn",
+    codebook: str | None = None,
     validation: Dataset | None = None,
     ks: Sequence[int] | None = None,
     restarts: int = 3,

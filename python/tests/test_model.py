@@ -111,6 +111,19 @@ def test_training_is_seeded(small_dataset):
     assert np.array_equal(a.posterior().observe(image), b.posterior().observe(image))
 
 
+def test_the_shape_index_trains_the_network_by_default(small_dataset):
+    """Issue 73: `codebook` left out is the product's choice for the descriptor: the network (its
+    candidate sizes are hidden units, 128 and 256) for the shape index, the neighbour codebook
+    (neighbour counts below half an object's readings) for the others."""
+    network = taction.train(small_dataset, descriptor="shape-index", restarts=1, seed=3)
+    assert network.k[0] in (128, 256)
+    neighbours = taction.train(small_dataset, descriptor="mnti", restarts=1, seed=3)
+    assert neighbours.k[0] < 128
+    image = small_dataset.images[small_dataset.status == "converged"][0]
+    belief = network.posterior().observe(image)
+    assert belief.shape == (len(network.objects),) and abs(belief.sum() - 1.0) < 1e-9
+
+
 def test_bad_training_arguments_name_the_argument(small_dataset, small_model):
     with pytest.raises(taction.TactionError, match="descriptor"):
         taction.train(small_dataset, descriptor="nope")

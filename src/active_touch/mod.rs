@@ -332,7 +332,7 @@ impl<'a> ActiveRecognition<'a> {
     /// Describes one converged reading's image, adds it to the posterior and returns the belief.
     pub fn observe(&mut self, image: &TactileImage) -> Result<Belief, RecognizeError> {
         let features = self.posterior.describe(image);
-        let mut reading = ClusterHistogram::new(self.bag.models().clusters());
+        let mut reading = self.bag.models().empty_histogram();
         self.bag.add_features(&features[0], &mut reading, "the reading")?;
         let belief = self.posterior.observe_described(image, features)?;
         // The gain predicts by Bayes' rule, which the tempered belief follows and its confidence

@@ -36,14 +36,16 @@ pub struct TrainArgs {
     /// same data, written as one fused model whose posterior multiplies their likelihoods.
     #[arg(long, value_name = "NAME[+NAME]", value_parser = DescriptorChoice::parse)]
     pub descriptor: DescriptorChoice,
-    /// knn (the default, beyond the paper: the objects' shares of a feature's k nearest training
-    /// features; the model keeps every training feature) | gmm (the paper's, soft membership) |
-    /// kmeans (hard membership). The neighbour codebook is the product's measured best: the 52
-    /// letters at 94.2% against the GMM's 78.8% at 20 readings (docs/measurements.md, "A
-    /// neighbour codebook").
-    #[arg(long, value_name = "KIND", default_value = "knn", value_parser = parse_codebook)]
-    pub codebook: CodebookKind,
-    /// Cluster counts to try, comma-separated (neighbour counts with `--codebook knn`). Default:
+    /// knn (beyond the paper: the objects' shares of a feature's k nearest training features;
+    /// the model keeps every training feature) | mlp (beyond the paper: a network's posterior
+    /// over the objects, frames combined by the product rule) | gmm (the paper's, soft
+    /// membership) | kmeans (hard membership). Default: mlp for `shape-index` alone (a large
+    /// array's frames: 64.5% from one frame against knn's 49.3%), knn otherwise (the 52 letters
+    /// at 94.2% against the GMM's 78.8% at 20 readings); docs/measurements.md.
+    #[arg(long, value_name = "KIND", value_parser = parse_codebook)]
+    pub codebook: Option<CodebookKind>,
+    /// Cluster counts to try, comma-separated (neighbour counts with `--codebook knn`, hidden
+    /// units with mlp: 128, 256 by default). Default:
     /// four steps of 10, 20, 50, 100, 200, 400, ... starting near one cluster per object ({50,
     /// 100, 200, 400} for 52 objects), without counts that leave fewer than 5 training readings per
     /// cluster; for knn 10, 20, 50, 100 neighbours, below half an object's training readings.
@@ -55,7 +57,7 @@ pub struct TrainArgs {
     #[command(flatten)]
     pub seed: SeedArg,
     /// Fraction of the training variance the kept principal components explain [default: 0.9,
-    /// the paper's; 0.99 with `--codebook knn`].
+    /// the paper's; 0.99 with `--codebook knn`, 0.999 with mlp].
     #[arg(long, value_name = "FRACTION", allow_hyphen_values = true)]
     pub variance_kept: Option<f64>,
     /// Pseudo-count added to every cluster bin of every object histogram.
@@ -122,7 +124,9 @@ fn choices(args: &TrainArgs) -> Result<Valid<TrainChoices>, Box<dyn std::error::
         .map_err(named_by_flag)?;
     let choices = TrainChoices {
         descriptor: args.descriptor.clone(),
-        codebook: args.codebook,
+        codebook: args
+            .codebook
+            .unwrap_or_else(|| TrainChoices::default_codebook(&args.descriptor)),
         ks: args.ks.clone(),
         restarts: args.restarts,
         seed: args.seed.seed,

@@ -53,6 +53,14 @@ impl BagOfFeatures {
                 self.pca.output_dim()
             ));
         }
+        if self.codebook.kind().evidence_rule() != self.models.rule() {
+            return Err(format!(
+                "the {} codebook decides by {:?}, the object models by {:?}",
+                self.codebook.kind().name(),
+                self.codebook.kind().evidence_rule(),
+                self.models.rule()
+            ));
+        }
         if self.codebook.clusters() != self.models.clusters() {
             return Err(format!(
                 "the codebook has {} clusters, the object histograms {}",

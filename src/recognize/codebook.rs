@@ -7,8 +7,10 @@ use crate::recognize::RecognizeError;
 use crate::recognize::features::TrainingFeatures;
 use crate::recognize::gmm::{GaussianMixture, GmmConfig};
 use crate::recognize::kmeans::{KMeans, KMeansConfig};
+use crate::recognize::mlp::{FrameClassifier, MlpConfig};
 use crate::recognize::neighbours::NearestNeighbours;
-use crate::recognize::pca::VarianceFraction;
+use crate::recognize::object_model::EvidenceRule;
+use crate::recognize::pca::{Pca, VarianceFraction};
 use crate::rng::Rng;
 
 /// A clustering function with a membership usable on new features.
@@ -72,6 +74,20 @@ impl Codebook for NearestNeighbours {
     }
 }
 
+impl Codebook for FrameClassifier {
+    fn clusters(&self) -> usize {
+        FrameClassifier::clusters(self)
+    }
+
+    fn dim(&self) -> usize {
+        FrameClassifier::dim(self)
+    }
+
+    fn membership(&self, f: &[f64], out: &mut [f64]) {
+        FrameClassifier::membership(self, f, out)
+    }
+}
+
 /// Which clustering method builds the codebook.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -83,17 +99,22 @@ pub enum CodebookKind {
     /// Beyond the paper: the training objects as clusters, a feature's membership the objects'
     /// shares of its `k` nearest training features ([`NearestNeighbours`]).
     Knn,
+    /// Beyond the paper: the training objects as clusters, a feature's membership a trained
+    /// network's posterior over them ([`FrameClassifier`]); readings combine by the product rule
+    /// ([`EvidenceRule::PerFrame`]).
+    Mlp,
 }
 
 impl CodebookKind {
-    pub const ALL: [CodebookKind; 3] = [Self::Gmm, Self::Kmeans, Self::Knn];
+    pub const ALL: [CodebookKind; 4] = [Self::Gmm, Self::Kmeans, Self::Knn, Self::Mlp];
 
-    /// The command-line name: `gmm`, `kmeans` or `knn`.
+    /// The command-line name: `gmm`, `kmeans`, `knn` or `mlp`.
     pub fn name(self) -> &'static str {
         match self {
             Self::Gmm => "gmm",
             Self::Kmeans => "kmeans",
             Self::Knn => "knn",
+            Self::Mlp => "mlp",
         }
     }
 
@@ -114,11 +135,23 @@ impl CodebookKind {
     /// The fraction of the training variance the PCA keeps by default: the paper's 90% for the
     /// clustering codebooks; 99% for the neighbour codebook, whose neighbourhoods use the detail
     /// the last components keep (docs/measurements.md, "A neighbour codebook", has the
-    /// measurement).
+    /// measurement); all of it for the network, which reads the features back in the
+    /// descriptor's units and learns which of them matter (99% cost it 3 points on the
+    /// large-array benchmark).
     pub fn default_variance_kept(self) -> VarianceFraction {
         match self {
             Self::Gmm | Self::Kmeans => VarianceFraction::PAPER,
             Self::Knn => VarianceFraction::NEIGHBOURS,
+            Self::Mlp => VarianceFraction::NETWORK,
+        }
+    }
+
+    /// How the memberships of several features make the evidence for each object: Eq. 4's
+    /// cross-entropy of their histogram, or, for a classifier's posterior, the product rule.
+    pub fn evidence_rule(self) -> EvidenceRule {
+        match self {
+            Self::Gmm | Self::Kmeans | Self::Knn => EvidenceRule::CrossEntropy,
+            Self::Mlp => EvidenceRule::PerFrame,
         }
     }
 
@@ -135,6 +168,10 @@ pub struct CodebookConfig {
     pub kmeans: KMeansConfig,
     /// EM settings, including the k-means run that initialises it.
     pub gmm: GmmConfig,
+    /// The network's training; left out of a file at its default, so configurations written
+    /// before the network existed read and compare the same.
+    #[serde(default, skip_serializing_if = "MlpConfig::is_default")]
+    pub mlp: MlpConfig,
 }
 
 /// A fitted codebook of any kind (what a saved model holds).
@@ -144,14 +181,17 @@ pub enum CodebookModel {
     Kmeans(KMeans),
     Gmm(GaussianMixture),
     Knn(NearestNeighbours),
+    Mlp(FrameClassifier),
 }
 
 impl CodebookModel {
-    /// Fits a `kind` codebook of `k` clusters (`k` neighbours for [`CodebookKind::Knn`]) on
-    /// `training`, drawing from `rng`.
+    /// Fits a `kind` codebook of `k` clusters (`k` neighbours for [`CodebookKind::Knn`], `k` hidden
+    /// units for [`CodebookKind::Mlp`]) on `training`, the output of `pca` (which the network
+    /// reads back in the descriptor's units), drawing from `rng`.
     pub fn fit(
         kind: CodebookKind,
         training: TrainingFeatures,
+        pca: &Pca,
         k: usize,
         config: &CodebookConfig,
         rng: &mut Rng,
@@ -166,6 +206,7 @@ impl CodebookModel {
                 training.object_count,
                 k,
             )?),
+            CodebookKind::Mlp => Self::Mlp(FrameClassifier::fit(training, pca, k, &config.mlp, rng)?),
         })
     }
 
@@ -174,6 +215,7 @@ impl CodebookModel {
             Self::Kmeans(_) => CodebookKind::Kmeans,
             Self::Gmm(_) => CodebookKind::Gmm,
             Self::Knn(_) => CodebookKind::Knn,
+            Self::Mlp(_) => CodebookKind::Mlp,
         }
     }
 
@@ -182,6 +224,7 @@ impl CodebookModel {
             Self::Kmeans(k) => k,
             Self::Gmm(g) => g,
             Self::Knn(n) => n,
+            Self::Mlp(m) => m,
         }
     }
 
@@ -191,6 +234,7 @@ impl CodebookModel {
             // A GaussianMixture is validated when it is deserialised.
             Self::Gmm(_) => Ok(()),
             Self::Knn(n) => n.check(),
+            Self::Mlp(m) => m.check(),
         }
     }
 }

@@ -2,7 +2,7 @@
 //! (Appendix, Eq. 12-16).
 
 use crate::recognize::calibration::Tempering;
-use crate::recognize::object_model::{ClusterHistogram, ObjectModels, guess_of};
+use crate::recognize::object_model::{ClusterHistogram, EvidenceRule, ObjectModels, guess_of};
 
 /// The cross-entropy of Eq. 4, `H(U, O_j) = -sum_i p(c_i | U) ln p(c_i | O_j)`: the KL divergence
 /// of Eq. 1-2 less the entropy of `p(c_i | U)`, which does not depend on `j`.
@@ -52,9 +52,15 @@ impl ObjectModels {
         Decision::from_log_likelihoods(self.log_likelihoods(u), u.features())
     }
 
-    /// `ln p(U | O_j) = sum_i s_i ln p(c_i | O_j)` for every object `j` (Eq. 15-16).
+    /// `ln p(U | O_j) = sum_i s_i ln p(c_i | O_j)` for every object `j` (Eq. 15-16); by the
+    /// product rule `sum_f ln p(c_j | f)` when the models decide per frame
+    /// ([`EvidenceRule::PerFrame`]) and `u` kept those sums ([`ObjectModels::empty_histogram`]).
     pub fn log_likelihoods(&self, u: &ClusterHistogram) -> Vec<f64> {
         debug_assert_eq!(u.clusters(), self.clusters());
+        debug_assert!(self.rule() == EvidenceRule::CrossEntropy || u.log_sums().is_some());
+        if let (EvidenceRule::PerFrame, Some(log_sums)) = (self.rule(), u.log_sums()) {
+            return log_sums.to_vec();
+        }
         (0..self.objects().len())
             .map(|j| {
                 u.sums()
@@ -178,5 +184,44 @@ mod tests {
         assert_eq!(d.guess, 1);
         let expected: f64 = -(0.1 * m.log_probabilities(1)[0] + 0.9 * m.log_probabilities(1)[1]);
         assert!((d.cross_entropy[1] - expected).abs() < 1e-15);
+    }
+
+    /// The per-frame rule (a classifier's memberships): `ln p(U | O_j)` is the sum of each
+    /// feature's `ln p(c_j | f)`, a zero floored, whatever the object histograms say; a merged
+    /// histogram decides as the features added one by one; clusters that are not the objects
+    /// cannot decide so.
+    #[test]
+    fn the_per_frame_rule_multiplies_the_memberships() {
+        use crate::recognize::object_model::MEMBERSHIP_FLOOR;
+        let per_frame = models().with_rule(EvidenceRule::PerFrame).unwrap();
+        let features = [[0.7, 0.2, 0.1], [0.1, 0.9, 0.0]];
+        let mut u = per_frame.empty_histogram();
+        let mut halves = (per_frame.empty_histogram(), per_frame.empty_histogram());
+        for f in &features {
+            u.add(f);
+        }
+        halves.0.add(&features[0]);
+        halves.1.add(&features[1]);
+        halves.0.merge(&halves.1);
+        let expected = [
+            0.7f64.ln() + 0.1f64.ln(),
+            0.2f64.ln() + 0.9f64.ln(),
+            0.1f64.ln() + MEMBERSHIP_FLOOR.ln(),
+        ];
+        for (got, want) in per_frame.log_likelihoods(&u).iter().zip(expected) {
+            assert!((got - want).abs() < 1e-12, "{got} {want}");
+        }
+        assert_eq!(
+            per_frame.log_likelihoods(&halves.0),
+            per_frame.log_likelihoods(&u)
+        );
+        assert_eq!(per_frame.decide(&u).guess, 1);
+        // Eq. 4 on the same features weighs them against the histograms instead.
+        assert_ne!(models().log_likelihoods(&u), per_frame.log_likelihoods(&u));
+        let mut four = ClusterHistogram::new(4);
+        four.add(&[1.0, 0.0, 0.0, 0.0]);
+        let wide = ObjectModels::fit(vec!["a".into()], &[four], PseudoCount::LAPLACE).unwrap();
+        let e = wide.with_rule(EvidenceRule::PerFrame).unwrap_err();
+        assert!(e.to_string().contains("one cluster per object"), "{e}");
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! Training: descriptor features of every training image -> [`Pca`](pipeline::Pca) keeping 90% of the variance ->
 //! a [`Codebook`](pipeline::Codebook) (k-means, hard membership, or a Gaussian mixture, soft membership; beyond the
-//! paper, [`NearestNeighbours`](pipeline::NearestNeighbours), the objects' shares of a feature's nearest training features) -> per object
+//! paper, [`NearestNeighbours`](pipeline::NearestNeighbours), the objects' shares of a feature's nearest training features, and [`FrameClassifier`](pipeline::FrameClassifier), a
+//! network's posterior over the objects that several frames combine by the product rule) -> per object
 //! the smoothed histogram `p(c_i | O_j)` ([`ObjectModels`](pipeline::ObjectModels)); [`train`] repeats the codebook step
 //! over a grid of `k` and seeded restarts and keeps the best on validation data.
 //!
@@ -32,6 +33,7 @@ pub(crate) mod gmm;
 pub(crate) mod gmm_products;
 pub(crate) mod kmeans;
 pub(crate) mod labelled;
+pub(crate) mod mlp;
 pub(crate) mod model;
 pub(crate) mod neighbours;
 pub(crate) mod object_model;
@@ -59,7 +61,7 @@ pub use request::{TrainChoices, TrainData, TrainObserver, check_contacts_weighab
 
 // Its parameters, checked (`Valid<TrainConfig>`) before anything is fitted, and model selection.
 pub use codebook::{CodebookConfig, CodebookKind};
-pub use object_model::PseudoCount;
+pub use object_model::{EvidenceRule, PseudoCount};
 pub use pca::VarianceFraction;
 pub use selection::{
     CandidateScore, MIN_FEATURES_PER_CLUSTER, SelectionReport, TrainConfig, TrainProgress, Trained,
@@ -89,6 +91,7 @@ pub mod pipeline {
     pub use super::features::{FeatureMatrix, TrainingFeatures};
     pub use super::gmm::{GaussianMixture, GmmConfig, GmmFit, GmmParameters};
     pub use super::kmeans::{KMeans, KMeansConfig, KMeansFit, kmeans_plus_plus};
+    pub use super::mlp::{FrameClassifier, MlpConfig};
     pub use super::neighbours::{LeaveOneReadingOut, NearestNeighbours};
     pub use super::object_model::{ClusterHistogram, ObjectModelParameters, ObjectModels};
     pub use super::pca::Pca;

@@ -37,11 +37,20 @@ impl Default for PseudoCount {
 /// Cluster memberships summed over a set of features: `s_i = sum_f p(c_i | f)`, and the number
 /// of features `n`. Its normalised form is the empirical `p(c_i | U) = s_i / n` of Sec. IV-A; with
 /// a hard codebook `s_i` is the count `k_i` of the Appendix, with a soft one its expectation.
+///
+/// For [`EvidenceRule::PerFrame`] it also keeps `sum_f ln max(p(c_i | f), floor)`, the product
+/// rule's evidence ([`ObjectModels::empty_histogram`] makes one that does).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClusterHistogram {
     sums: Vec<f64>,
     features: usize,
+    log_sums: Option<Vec<f64>>,
 }
+
+/// The least membership the product rule takes from one feature: one frame that a network is
+/// sure of can cost an object at most `ln 1e-6 = -13.8` nats, so a later frame can still outvote
+/// it (the clip scikit-learn's comparison used).
+pub const MEMBERSHIP_FLOOR: f64 = 1e-6;
 
 impl ClusterHistogram {
     /// An empty histogram over `clusters` bins.
@@ -49,6 +58,15 @@ impl ClusterHistogram {
         Self {
             sums: vec![0.0; clusters],
             features: 0,
+            log_sums: None,
+        }
+    }
+
+    /// An empty histogram that also sums the memberships' logarithms (the product rule's).
+    pub fn with_log_sums(clusters: usize) -> Self {
+        Self {
+            log_sums: Some(vec![0.0; clusters]),
+            ..Self::new(clusters)
         }
     }
 
@@ -56,14 +74,32 @@ impl ClusterHistogram {
     pub fn add(&mut self, membership: &[f64]) {
         debug_assert_eq!(membership.len(), self.sums.len());
         self.sums.iter_mut().zip(membership).for_each(|(s, m)| *s += m);
+        if let Some(logs) = &mut self.log_sums {
+            logs.iter_mut()
+                .zip(membership)
+                .for_each(|(l, m)| *l += m.max(MEMBERSHIP_FLOOR).ln());
+        }
         self.features += 1;
     }
 
-    /// Adds every bin of `other` (over the same clusters).
+    /// Adds every bin of `other` (over the same clusters); the logarithms' sums are kept only
+    /// when both kept them.
     pub fn merge(&mut self, other: &ClusterHistogram) {
         debug_assert_eq!(other.sums.len(), self.sums.len());
         self.sums.iter_mut().zip(&other.sums).for_each(|(s, o)| *s += o);
+        self.log_sums = match (self.log_sums.take(), &other.log_sums) {
+            (Some(mut mine), Some(theirs)) => {
+                mine.iter_mut().zip(theirs).for_each(|(s, o)| *s += o);
+                Some(mine)
+            }
+            _ => None,
+        };
         self.features += other.features;
+    }
+
+    /// `sum_f ln max(p(c_i | f), floor)`, when this histogram keeps it.
+    pub fn log_sums(&self) -> Option<&[f64]> {
+        self.log_sums.as_deref()
     }
 
     /// `s_i`, the summed memberships.
@@ -111,6 +147,30 @@ pub struct ObjectModelParameters {
     /// `p(c_i | O_j)`, one row per object, each summing to 1.
     pub probabilities: Vec<Vec<f64>>,
     pub pseudo_count: PseudoCount,
+    /// How features make the evidence; absent (Eq. 4) in every file of the paper's codebooks.
+    #[serde(default, skip_serializing_if = "EvidenceRule::is_cross_entropy")]
+    pub rule: EvidenceRule,
+}
+
+/// How the memberships of an unknown object's features make `ln p(U | O_j)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EvidenceRule {
+    /// Eq. 4 and 15: `sum_i s_i ln p(c_i | O_j)`, the summed memberships against each object's
+    /// histogram (the paper's, for a codebook of clusters).
+    #[default]
+    CrossEntropy,
+    /// The product rule over features, `sum_f ln p(c_j | f)`, for a codebook whose clusters are
+    /// the objects and whose membership is a posterior over them under a uniform prior (the
+    /// network, `recognize::mlp`): each feature an independent draw, so its `p(f | O_j)` is
+    /// proportional to `p(c_j | f)`.
+    PerFrame,
+}
+
+impl EvidenceRule {
+    fn is_cross_entropy(&self) -> bool {
+        *self == Self::CrossEntropy
+    }
 }
 
 impl From<ObjectModels> for ObjectModelParameters {
@@ -125,6 +185,12 @@ impl TryFrom<ObjectModelParameters> for ObjectModels {
         let k = params.probabilities.first().map_or(0, Vec::len);
         if params.objects.is_empty() || k == 0 {
             return Err("object models need at least one object and one cluster".into());
+        }
+        if params.rule == EvidenceRule::PerFrame && k != params.objects.len() {
+            return Err(format!(
+                "the per-frame rule needs one cluster per object: {k} clusters, {} objects",
+                params.objects.len()
+            ));
         }
         if params.probabilities.len() != params.objects.len() {
             return Err(format!(
@@ -182,7 +248,38 @@ impl ObjectModels {
             objects,
             probabilities,
             pseudo_count,
+            rule: EvidenceRule::CrossEntropy,
         }))
+    }
+
+    /// The same models deciding by `rule`; the per-frame rule needs the clusters to be the
+    /// objects.
+    pub fn with_rule(mut self, rule: EvidenceRule) -> Result<Self, RecognizeError> {
+        if rule == EvidenceRule::PerFrame && self.clusters() != self.objects().len() {
+            return Err(RecognizeError::InvalidParameter {
+                name: "evidence rule",
+                what: format!(
+                    "the per-frame rule needs one cluster per object: {} clusters, {} objects",
+                    self.clusters(),
+                    self.objects().len()
+                ),
+            });
+        }
+        self.params.rule = rule;
+        Ok(self)
+    }
+
+    pub fn rule(&self) -> EvidenceRule {
+        self.params.rule
+    }
+
+    /// An empty histogram of the unknown object's features, keeping what [`rule`](Self::rule)
+    /// decides by.
+    pub fn empty_histogram(&self) -> ClusterHistogram {
+        match self.params.rule {
+            EvidenceRule::CrossEntropy => ClusterHistogram::new(self.clusters()),
+            EvidenceRule::PerFrame => ClusterHistogram::with_log_sums(self.clusters()),
+        }
     }
 
     fn from_trusted(params: ObjectModelParameters) -> Self {

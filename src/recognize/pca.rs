@@ -27,6 +27,9 @@ impl VarianceFraction {
     pub const PAPER: Self = Self(0.9);
     /// The neighbour codebook's default (`CodebookKind::default_variance_kept`): 99%.
     pub const NEIGHBOURS: Self = Self(0.99);
+    /// The network's default (`CodebookKind::default_variance_kept`): all of it, so that it
+    /// reads the features back exactly (`recognize::mlp`).
+    pub const NETWORK: Self = Self(1.0);
 }
 
 impl Default for VarianceFraction {

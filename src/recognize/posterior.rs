@@ -61,7 +61,7 @@ impl<'a> OnlinePosterior<'a> {
     pub fn new(bag: &'a BagOfFeatures) -> Self {
         Self {
             bag,
-            histogram: ClusterHistogram::new(bag.models().clusters()),
+            histogram: bag.models().empty_histogram(),
             readings: 0,
         }
     }

@@ -126,6 +126,10 @@ const CODEBOOK_LADDER: [usize; 9] = [10, 20, 50, 100, 200, 400, 800, 1600, 3200]
 /// The neighbour counts the neighbour codebook tries.
 const NEIGHBOUR_COUNTS: [usize; 4] = [10, 20, 50, 100];
 
+/// The hidden units the network tries ([`CodebookKind::Mlp`]): on the large-array benchmark 128
+/// to 512 units were within a point of each other with the L2 penalty of `MlpConfig`.
+const HIDDEN_UNITS: [usize; 2] = [128, 256];
+
 /// Candidate cluster counts per problem: [`CODEBOOK_LADDER`] steps tried.
 const CODEBOOK_STEPS: usize = 4;
 
@@ -140,10 +144,14 @@ const CODEBOOK_STEPS: usize = 4;
 ///
 /// For the neighbour codebook ([`CodebookKind::Knn`]) the candidates are neighbour counts, {10, 20,
 /// 50, 100}, kept below half an object's share of the training features (so an object's own
-/// neighbourhood can outvote the rest); when none is, that half (at least 1).
+/// neighbourhood can outvote the rest); when none is, that half (at least 1). For the network
+/// ([`CodebookKind::Mlp`]) they are hidden units, 128 and 256 whatever the problem: its
+/// weights' penalty, not their number, keeps it from fitting the training features by heart.
 pub fn codebook_sizes(kind: CodebookKind, objects: usize, training_features: usize) -> Vec<usize> {
-    if kind == CodebookKind::Knn {
-        return sizes_up_to(&NEIGHBOUR_COUNTS, training_features / objects.max(1) / 2);
+    match kind {
+        CodebookKind::Knn => return sizes_up_to(&NEIGHBOUR_COUNTS, training_features / objects.max(1) / 2),
+        CodebookKind::Mlp => return HIDDEN_UNITS.to_vec(),
+        CodebookKind::Gmm | CodebookKind::Kmeans => {}
     }
     let first = CODEBOOK_LADDER.iter().rposition(|&k| k <= objects).unwrap_or(0);
     let last = (first + CODEBOOK_STEPS).min(CODEBOOK_LADDER.len());
@@ -488,6 +496,7 @@ fn fit_candidates(
         .then(|| LeaveOneReadingOut::scan(features, config.ks.iter().copied().max().unwrap_or(1)));
     let candidate_training = CandidateTraining {
         features,
+        pca: &reduced.pca,
         blocks: &reduced.blocks,
         neighbours: neighbours.as_ref(),
     };
@@ -566,6 +575,8 @@ struct Candidate {
 /// object, and for the neighbour codebook every feature's nearest other-reading features.
 struct CandidateTraining<'a> {
     features: TrainingFeatures<'a>,
+    /// The PCA the features went through.
+    pca: &'a Pca,
     blocks: &'a [FeatureMatrix],
     /// Present exactly when the codebook is [`CodebookKind::Knn`] (`train` scans for it).
     neighbours: Option<&'a LeaveOneReadingOut>,
@@ -582,21 +593,29 @@ fn fit_candidate(
     restart: usize,
 ) -> Candidate {
     let mut rng = stream(substream(config.seed, k as u64), restart as u64);
-    let fitted = CodebookModel::fit(config.codebook, training.features, k, &config.fitting, &mut rng)
-        .and_then(|cb| {
-            debug_assert_eq!(matches!(cb, CodebookModel::Knn(_)), training.neighbours.is_some());
-            let histograms: Vec<ClusterHistogram> = match training.neighbours {
-                // A training feature must not count itself, nor its reading's other features.
-                Some(neighbours) => neighbours.histograms(k),
-                None => training
-                    .blocks
-                    .iter()
-                    .map(|b| reduced_histogram(&cb, b))
-                    .collect(),
-            };
-            let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?;
-            Ok((cb, models))
-        });
+    let fitted = CodebookModel::fit(
+        config.codebook,
+        training.features,
+        training.pca,
+        k,
+        &config.fitting,
+        &mut rng,
+    )
+    .and_then(|cb| {
+        debug_assert_eq!(matches!(cb, CodebookModel::Knn(_)), training.neighbours.is_some());
+        let histograms: Vec<ClusterHistogram> = match training.neighbours {
+            // A training feature must not count itself, nor its reading's other features.
+            Some(neighbours) => neighbours.histograms(k),
+            None => training
+                .blocks
+                .iter()
+                .map(|b| reduced_histogram(&cb, b))
+                .collect(),
+        };
+        let models = ObjectModels::fit(objects.to_vec(), &histograms, config.pseudo_count)?
+            .with_rule(config.codebook.evidence_rule())?;
+        Ok((cb, models))
+    });
     let score = match &fitted {
         Ok((cb, models)) => score_candidate(cb, models, trials, k, restart),
         Err(e) => CandidateScore {
@@ -658,7 +677,7 @@ fn score_candidate(
     let mut reliability = 0.0;
     let mut membership = vec![0.0; codebook.clusters()];
     for t in trials {
-        let mut histogram = ClusterHistogram::new(codebook.clusters());
+        let mut histogram = models.empty_histogram();
         for m in &t.features {
             add_reading(codebook, m, &mut histogram, &mut membership);
         }
@@ -695,7 +714,7 @@ fn add_reading(
 /// A validation trial's Eq. 15 log-likelihoods after each of its readings: what the posterior's
 /// tempering is fitted on (`recognize::calibration`).
 fn evidence_path(codebook: &CodebookModel, models: &ObjectModels, trial: &ReducedTrial) -> EvidencePath {
-    let mut histogram = ClusterHistogram::new(codebook.clusters());
+    let mut histogram = models.empty_histogram();
     let mut membership = vec![0.0; codebook.clusters()];
     let log_likelihoods = trial
         .features
