@@ -57,7 +57,7 @@ pub struct TrainArgs {
     #[command(flatten)]
     pub seed: SeedArg,
     /// Fraction of the training variance the kept principal components explain [default: 0.9,
-    /// the paper's; 0.99 with `--codebook knn`, 0.999 with mlp].
+    /// the paper's; 0.99 with `--codebook knn`, 1 (all of it) with mlp].
     #[arg(long, value_name = "FRACTION", allow_hyphen_values = true)]
     pub variance_kept: Option<f64>,
     /// Pseudo-count added to every cluster bin of every object histogram.

@@ -189,11 +189,6 @@ impl FrameClassifier {
         self.dim
     }
 
-    /// Hidden units.
-    pub fn hidden(&self) -> usize {
-        self.hidden
-    }
-
     /// Writes `p(c_i | f)` under a uniform prior over the objects into `out`.
     pub fn membership(&self, f: &[f64], out: &mut [f64]) {
         let h: Vec<f64> = self
@@ -368,19 +363,17 @@ impl Network {
             row += self.b1.transpose();
             row.iter_mut().for_each(|v| *v = v.max(0.0));
         }
-        let mut p = &hidden * &self.w2;
+        // Transposed, a feature's outputs are one contiguous column: its softmax is `membership`'s.
+        let mut p = (&hidden * &self.w2).transpose();
         let mut loss = 0.0;
-        for (r, mut row) in p.row_iter_mut().enumerate() {
-            row += self.b2.transpose();
-            let top = row.max();
-            row.iter_mut().for_each(|v| *v = (*v - top).exp());
-            let total = row.sum();
-            row /= total;
-            loss -= row[yb[r]].max(LOG_FLOOR).ln();
-            row[yb[r]] -= 1.0;
+        for (column, &y) in p.as_mut_slice().chunks_exact_mut(self.b2.len()).zip(yb) {
+            column.iter_mut().zip(self.b2.iter()).for_each(|(z, b)| *z += b);
+            softmax_in_place(column);
+            loss -= column[y].max(LOG_FLOOR).ln();
+            column[y] -= 1.0;
         }
         let penalty = 0.5 * l2 * (self.w1.norm_squared() + self.w2.norm_squared()) / b;
-        let g = p / b;
+        let g = p.transpose() / b;
         let gw2 = hidden.transpose() * &g + &self.w2 * (l2 / b);
         let gb2 = DMatrix::from_row_slice(1, g.ncols(), g.row_sum().as_slice());
         let mut gh = &g * self.w2.transpose();
