@@ -389,6 +389,7 @@ fn flat_dataset(sensor: SensorConfig, objects: &[&str], per_object: usize) -> Da
             iterations: 3,
             strategy: Strategy::Sampler,
             cause: None,
+            contact: None,
         })
         .collect();
     Dataset::new(header, readings).unwrap()
@@ -940,7 +941,7 @@ fn recognize_warns_of_a_sampler_calibration_on_the_arms_touches() {
     let shown = taction(&["dataset", "show", &v2]);
     let text = String::from_utf8_lossy(&shown.stdout);
     assert!(
-        text.contains("written in format version 2; read as version 4"),
+        text.contains("written in format version 2; read as version 5"),
         "{text}"
     );
 }

@@ -55,6 +55,8 @@ fn dataset() -> Dataset {
                 body_a: "link4".into(),
                 body_b: "world".into(),
             }),
+            // The two frames of `c` one press; the mug's reading a contact of its own.
+            contact: (object == "c").then_some(0),
         }
     };
     let readings = vec![
@@ -174,6 +176,7 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
     let names: Vec<&str> = arrays.keys().map(String::as_str).collect();
     let expected = [
         "cause",
+        "contact",
         "header",
         "images",
         "iterations",
@@ -233,6 +236,7 @@ fn npz_holds_every_array_bit_exact_in_file_order_and_no_temporary_is_left() {
 
     assert_eq!(arrays["iterations"].shape, [3]);
     assert_eq!(arrays["iterations"].i8(), [1, 2, 3]);
+    assert_eq!(arrays["contact"].i8(), [-1, 0, 0], "-1: a contact of its own");
     let texts = |name: &str| {
         assert_eq!(arrays[name].shape, [3], "{name}");
         arrays[name].texts()
@@ -325,6 +329,10 @@ fn parquet_reads_back_with_the_parquet_reader() {
     assert_eq!(field(2, "cause"), Field::Str("arm_on_table".into()));
     assert_eq!(field(1, "cause"), Field::Str(String::new()));
     assert_eq!(field(2, "iterations"), Field::Long(3));
+    assert_eq!(
+        (field(0, "contact"), field(2, "contact")),
+        (Field::Long(-1), Field::Long(0))
+    );
     assert_eq!(field(1, "pad_x_m"), Field::Null, "no pose: null");
     assert_eq!(field(0, "pad_x_m"), Field::Double(0.1));
     assert_eq!(field(1, "object_y_m"), Field::Double(2.0 / 3.0));

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use taction::dataset::{Dataset, FramePlace, PadSize, RealData, RealImport, import_real};
+use taction::dataset::{Dataset, FramePlace, PadSize, RealData, RealImport, import_real, parse_real_csv};
 use taction::describe::DescriptorKind;
 use taction::tactile::TactileImage;
 
@@ -388,4 +388,157 @@ fn the_real_frames_experiment_reads_a_folder_of_images_as_the_same_frames_in_a_c
     let from_images = real_frames_csv(&images, &dir.path().join("from-images"));
     assert!(!from_csv.is_empty());
     assert_eq!(from_csv, from_images, "the same frames, the same results");
+}
+
+/// The contact each frame of `data` is one of.
+fn contacts(data: &RealData) -> Vec<Option<u32>> {
+    data.readings.iter().map(|r| r.contact).collect()
+}
+
+/// A frames CSV of 2x3 frames with a `contact` column: `(label, contact)` per line.
+fn contact_csv(frames: &[(&str, &str)]) -> String {
+    let mut csv = "label,contact,r0c0,r0c1,r0c2,r1c0,r1c1,r1c2\n".to_string();
+    for (f, (label, contact)) in frames.iter().enumerate() {
+        let values: Vec<String> = (0..6).map(|k| (f * 6 + k).to_string()).collect();
+        csv.push_str(&format!("{label},{contact},{}\n", values.join(",")));
+    }
+    csv
+}
+
+#[test]
+fn frames_of_one_press_import_as_one_contact_from_every_source() {
+    // A CSV: two frames of press p1, a frame of its own, press p2; the other label's p1 is
+    // another contact.
+    let csv = contact_csv(&[
+        ("A", "p1"),
+        ("A", "p1"),
+        ("A", ""),
+        ("A", "p2"),
+        ("B", "p1"),
+        ("B", "p1"),
+    ]);
+    let data = parse_real_csv(&csv, "seq.csv", &RealImport::default()).expect("imports");
+    assert_eq!(
+        contacts(&data),
+        [Some(0), Some(0), None, Some(1), Some(2), Some(2)]
+    );
+    assert!(data.has_contacts());
+    assert_eq!(
+        data.readings[5].image.get(1, 2),
+        1.0,
+        "the taxels start after the contact column"
+    );
+    assert_eq!(data.readings[0].image.get(0, 1), 1.0 / 35.0);
+    // A folder: a folder inside a class folder is one press, an image beside it a contact of its
+    // own.
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let root = dir.path().join("frames");
+    for file in [
+        "A/loose.png",
+        "A/p1/0.png",
+        "A/p1/1.png",
+        "A/p2/0.png",
+        "B/p1/0.png",
+        "B/p1/1.png",
+    ] {
+        let path = root.join(file);
+        std::fs::create_dir_all(path.parent().expect("a folder")).expect("creates");
+        write_png(&path, 2, 3, &[1, 2, 3, 4, 5, 6], false);
+    }
+    let data = import(&root).expect("imports");
+    assert_eq!(
+        contacts(&data),
+        [None, Some(0), Some(0), Some(1), Some(2), Some(2)]
+    );
+    assert_eq!(data.readings[2].place, FramePlace::Image("A/p1/1.png".into()));
+    // An npz from numpy with a `contacts` array of strings, '' a frame of its own.
+    let npz = import(&Path::new(FIXTURES).join("numpy_contacts_5x3x5.npz")).expect("imports");
+    assert_eq!(contacts(&npz), [Some(0), Some(0), None, Some(1), Some(1)]);
+    // Without contacts, every frame is its own.
+    let plain = import(&Path::new(FIXTURES).join("numpy_2x3x5.npz")).expect("imports");
+    assert!(!plain.has_contacts());
+}
+
+#[test]
+fn a_press_that_comes_back_or_an_empty_press_is_named() {
+    let csv = contact_csv(&[("A", "p1"), ("A", "p2"), ("A", "p1")]);
+    let e = parse_real_csv(&csv, "seq.csv", &RealImport::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("seq.csv: line 4") && e.contains("contact 'p1' of label 'A' comes back"),
+        "{e}"
+    );
+    let short = "label,contact,r0c0,r0c1,r1c0,r1c1\nA,p1,1,2,3\n";
+    let e = parse_real_csv(short, "seq.csv", &RealImport::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("5 columns, expected 6 (label, contact + 2x2 taxels)"),
+        "{e}"
+    );
+    let e = import(&Path::new(FIXTURES).join("numpy_contacts_resumed.npz")).unwrap_err();
+    assert!(
+        e.contains("frame 2") && e.contains("contact '3' of label 'mug'"),
+        "{e}"
+    );
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let root = dir.path().join("frames");
+    write_png_at(&root.join("A/0.png"));
+    std::fs::create_dir_all(root.join("A/p1")).expect("creates");
+    let e = import(&root).unwrap_err();
+    assert!(e.contains("contact folder 'A/p1' holds no image"), "{e}");
+    write_png_at(&root.join("A/p1/deeper/0.png"));
+    let e = import(&root).unwrap_err();
+    assert!(
+        e.contains("A/p1/deeper") && e.contains("a folder inside a contact folder"),
+        "{e}"
+    );
+}
+
+/// A 2x3 frame at `path`, its folders made.
+fn write_png_at(path: &Path) {
+    std::fs::create_dir_all(path.parent().expect("a folder")).expect("creates");
+    write_png(path, 2, 3, &[1, 2, 3, 4, 5, 6], false);
+}
+
+#[test]
+fn an_imported_sequence_keeps_its_contacts_through_the_dataset_and_its_export() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let frames = dir.path().join("seq.csv");
+    std::fs::write(
+        &frames,
+        contact_csv(&[
+            ("A", "7"),
+            ("A", "7"),
+            ("A", ""),
+            ("B", "7"),
+            ("B", "7"),
+            ("B", "8"),
+        ]),
+    )
+    .expect("writes");
+    let (dataset, npz, again) = (
+        dir.path().join("dataset.csv"),
+        dir.path().join("dataset.npz"),
+        dir.path().join("again.csv"),
+    );
+    let path = |p: &Path| p.to_str().expect("a UTF-8 path").to_string();
+    taction(&["dataset", "import", &path(&frames), "--out", &path(&dataset)]);
+    let read = Dataset::read(&dataset).expect("reads");
+    let numbers: Vec<Option<u32>> = read.readings().iter().map(|r| r.contact).collect();
+    assert_eq!(numbers, [Some(0), Some(0), None, Some(1), Some(1), Some(2)]);
+    taction(&[
+        "dataset",
+        "export",
+        &path(&dataset),
+        "--format",
+        "npz",
+        "--out",
+        &path(&npz),
+    ]);
+    taction(&["dataset", "import", &path(&npz), "--out", &path(&again)]);
+    let again = Dataset::read(&again).expect("reads");
+    let back: Vec<Option<u32>> = again.readings().iter().map(|r| r.contact).collect();
+    assert_eq!(back, numbers, "the npz's contact array, -1 for none, reads back");
 }

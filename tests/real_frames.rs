@@ -27,19 +27,7 @@ fn taction(args: &[&str]) -> Output {
 /// rows.
 fn two_trials_of(text: &str) -> (Vec<AccuracyRow>, Vec<PerObjectRow>) {
     let dir = tempfile::tempdir().unwrap();
-    let real = dir.path().join("recording.csv");
-    std::fs::write(&real, text).unwrap();
-    let out = dir.path().join("out");
-    run_ok(&[
-        "experiment",
-        "real-frames",
-        "--real",
-        real.to_str().unwrap(),
-        "--trials",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let out = trials_of(text, 2, dir.path());
     assert_reliability_per_descriptor(&out);
     (
         rows(&out),
@@ -48,6 +36,25 @@ fn two_trials_of(text: &str) -> (Vec<AccuracyRow>, Vec<PerObjectRow>) {
             PER_OBJECT_HEADER,
         ),
     )
+}
+
+/// Runs `experiment real-frames --trials N` on the recording `text`, written in `dir`; its output
+/// folder.
+fn trials_of(text: &str, trials: usize, dir: &Path) -> std::path::PathBuf {
+    let real = dir.join("recording.csv");
+    std::fs::write(&real, text).unwrap();
+    let out = dir.join("out");
+    run_ok(&[
+        "experiment",
+        "real-frames",
+        "--real",
+        real.to_str().unwrap(),
+        "--trials",
+        &trials.to_string(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    out
 }
 
 /// The run's reliability table: one curve per descriptor, its ten bins pooling both trials'
@@ -603,4 +610,107 @@ fn sim_to_real_simulates_a_pad_of_the_recordings_grid_at_its_pitch() {
         3,
         "the figure's three descriptors: {described:?}"
     );
+}
+
+/// A 6x6 recording of `presses` presses per label of `frames` frames each (`label,contact,...`):
+/// each press its own blob, its frames nearly the same.
+fn sequence_recording(labels: &[&str], presses: usize, frames: usize) -> String {
+    let mut text = String::from("label,contact");
+    for k in 0..36 {
+        text.push_str(&format!(",r{}c{}", k / 6, k % 6));
+    }
+    text.push('\n');
+    for (l, label) in labels.iter().enumerate() {
+        for press in 0..presses {
+            for frame in 0..frames {
+                let centre = ((press * 7 + l * 3) % 5) as f64;
+                let values: Vec<String> = (0..36)
+                    .map(|k| {
+                        let (r, c) = ((k / 6) as f64 - centre, (k % 6) as f64 - 2.5);
+                        let v = 900.0 * (-(r * r + c * c) / (2.0 + l as f64)).exp() + frame as f64;
+                        format!("{v:.0}")
+                    })
+                    .collect();
+                text.push_str(&format!("{label},press-{press},{}\n", values.join(",")));
+            }
+        }
+    }
+    text
+}
+
+#[test]
+fn a_recording_of_sequences_is_split_by_press_and_single_frames_as_before() {
+    let real = parse_real_csv(
+        &sequence_recording(&["A", "B"], 14, 3),
+        "seq",
+        &RealImport::default(),
+    )
+    .unwrap();
+    let (kept, _) = prune(&real, 0.1);
+    let kept: Vec<_> = kept.into_iter().cloned().collect();
+    assert_eq!(kept.len(), 84);
+    // Sizes count presses: 14 a label, 8 / 2 / 4 of them.
+    let sizes = scaled_split_sizes(14, 1.0).unwrap();
+    assert_eq!((sizes.train, sizes.validation, sizes.test), (8, 2, 4));
+    for trial in 0..5 {
+        let split = trial_split(&kept, sizes, 3, trial).unwrap();
+        let presses = |part: &[&taction::dataset::RealReading]| -> BTreeSet<Option<u32>> {
+            part.iter().map(|r| r.contact).collect()
+        };
+        let (train, validation, test) = (
+            presses(&split.train),
+            presses(&split.validation),
+            presses(&split.test),
+        );
+        assert_eq!(
+            (train.len(), validation.len(), test.len()),
+            (16, 4, 8),
+            "trial {trial}"
+        );
+        assert_eq!(
+            (split.train.len(), split.validation.len(), split.test.len()),
+            (48, 12, 24),
+            "trial {trial}: every press whole"
+        );
+        assert!(
+            train.is_disjoint(&test) && train.is_disjoint(&validation) && validation.is_disjoint(&test),
+            "trial {trial}: a press lends frames to two parts"
+        );
+    }
+    // A recording of single frames: each frame its own contact, the split the frames' own, as
+    // before contacts existed (trial 2's seed: the experiment's split stream 6).
+    let single = parse_real_csv(EXAMPLE_REAL_CSV, "example", &RealImport::default()).unwrap();
+    let (kept, _) = prune(&single, 0.1);
+    let kept: Vec<_> = kept.into_iter().cloned().collect();
+    let sizes = scaled_split_sizes(8, 1.0).unwrap();
+    let seed = taction::rng::substream(taction::rng::substream(1, 6), 2);
+    let by_frame = taction::paper::split_per_label(kept.iter().collect(), |r| r.label.as_str(), sizes, seed);
+    let split = trial_split(&kept, sizes, 1, 2).unwrap();
+    let places = |part: &[&taction::dataset::RealReading]| -> Vec<String> {
+        part.iter().map(|r| r.place.to_string()).collect()
+    };
+    let by_frame = by_frame.unwrap();
+    assert_eq!(places(&split.test), places(&by_frame.test));
+    assert_eq!(places(&split.train), places(&by_frame.train));
+}
+
+#[test]
+fn the_experiment_on_sequences_counts_presses_in_its_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = trials_of(&sequence_recording(&["A", "B"], 8, 2), 1, dir.path());
+    let config: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("real-frames/config.json")).unwrap()).unwrap();
+    assert_eq!(
+        config["contacts"],
+        serde_json::json!({"A": 8, "B": 8}),
+        "{config}"
+    );
+    assert_eq!(
+        config["split"],
+        serde_json::json!({"train": 5, "validation": 1, "test": 2})
+    );
+    assert_eq!(config["pruning"]["A"]["kept"], 16);
+    // The test part is two presses of two frames a label: the curve reaches four readings.
+    let longest = rows(&out).iter().map(|r| r.n_readings).max();
+    assert_eq!(longest, Some(4));
 }

@@ -207,6 +207,20 @@ impl Dataset {
         array::from_i64(py, values)
     }
 
+    /// The press each reading is one frame of (a recording's contact, numbered from 0 in the
+    /// order of their first frames), -1 for a reading that is a contact of its own, as in
+    /// `dataset export`'s npz.
+    #[getter]
+    fn contact<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let values = self
+            .inner
+            .readings()
+            .iter()
+            .map(Reading::contact_number)
+            .collect();
+        array::from_i64(py, values)
+    }
+
     fn __repr__(&self) -> String {
         let h = self.inner.header();
         format!(

@@ -1,6 +1,7 @@
 """One dtype per column wherever a dataset goes: Parquet, npz, pandas (`Dataset.to_pandas`) and the
 `Dataset`'s own arrays. Taxels float32, every pose column float64 (also the object's pose of an
-object that never moved, whose CSV numbers are whole), `iterations` int64, names strings."""
+object that never moved, whose CSV numbers are whole), `iterations` and `contact` int64, names
+strings."""
 
 import numpy as np
 import pytest
@@ -45,6 +46,8 @@ def expect_frame_dtypes(frame, where):
     for column in OBJECT_POSE + PAD_POSE:
         assert frame[column].dtype == np.float64, (where, column, frame[column].dtype)
     assert frame["iterations"].dtype == np.int64, where
+    # Every simulated reading is a press of its own: -1, not a missing value.
+    assert frame["contact"].dtype == np.int64 and (frame["contact"] == -1).all(), where
     for column in NAMES:
         assert pd.api.types.is_string_dtype(frame[column]), (where, column, frame[column].dtype)
         assert not frame[column].isna().any(), (where, column)  # no reading's name is missing
@@ -76,6 +79,7 @@ def test_pandas_and_parquet_give_each_column_one_dtype(dataset, tmp_path):
     for column in OBJECT_POSE + PAD_POSE:
         assert str(schema.field(column).type) == "double", column
     assert str(schema.field("iterations").type) == "int64"
+    assert str(schema.field("contact").type) == "int64"
 
 
 def test_npz_and_the_datasets_arrays_give_each_column_one_dtype(dataset, tmp_path):
@@ -86,6 +90,8 @@ def test_npz_and_the_datasets_arrays_give_each_column_one_dtype(dataset, tmp_pat
         assert npz["pad_pose"].dtype == np.float64
         assert npz["object_pose"].dtype == np.float64
         assert npz["iterations"].dtype == np.int64
+        assert npz["contact"].dtype == np.int64
+        assert np.array_equal(npz["contact"], dataset.contact)
         for column in NAMES:
             assert npz[column].dtype.kind == "U", column
         assert np.array_equal(npz["images"], dataset.images)
@@ -93,5 +99,6 @@ def test_npz_and_the_datasets_arrays_give_each_column_one_dtype(dataset, tmp_pat
     assert dataset.images.dtype == np.float32
     assert dataset.pad_pose.dtype == np.float64
     assert dataset.iterations.dtype == np.int64
+    assert dataset.contact.dtype == np.int64 and (dataset.contact == -1).all()
     for column in NAMES:
         assert getattr(dataset, column).dtype.kind == "U", column

@@ -31,7 +31,8 @@ pub enum DatasetCommand {
     /// prune it, its image as that experiment describes it.
     Import(ImportArgs),
     /// A dataset in the formats the ML toolchain reads: `npz` (numpy.load: arrays `images` [N,
-    /// rows, cols] float32, `pad_pose` [N, 9], `object_pose` [N, 7], `iterations`, and `object`,
+    /// rows, cols] float32, `pad_pose` [N, 9], `object_pose` [N, 7], `iterations`, `contact` (-1
+    /// for a reading that is a contact of its own), and `object`,
     /// `status`, `strategy`, `cause`, `touched_bodies` as strings, `header` the JSON header) or
     /// `parquet` (pandas.read_parquet: the CSV's columns, taxels `t_{row}_{col}` as float32, the
     /// JSON header as the metadata `taction_header`).
@@ -61,7 +62,8 @@ pub struct ImportArgs {
     /// one frame per line: its label, then one non-negative raw value per taxel; `#` lines are
     /// comments. Folder: one folder per label, each image (PNG 8/16-bit or JPEG 8-bit grayscale)
     /// one frame. npz: arrays `frames` (N, rows, cols) and `labels` (N strings or integers).
-    /// Values are divided by the largest one.
+    /// Frames of one press stay one contact: a `contact` column after `label`, a folder inside a
+    /// class folder, or an npz array `contacts`. Values are divided by the largest one.
     #[arg(value_name = "FRAMES")]
     pub frames: PathBuf,
     /// The dataset to write.

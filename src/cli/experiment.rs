@@ -47,8 +47,9 @@ pub struct PaperArgs {
     /// `label,r0c0,r0c1,...` naming every taxel, then one frame per line: its label, then one
     /// non-negative raw value per taxel; `#` lines are comments. Or a folder of class folders of
     /// grayscale PNG/JPEG images, or an .npz of `frames` and `labels` (as `dataset import` takes
-    /// them). Frames of the wrong size or with non-finite values are rejected with their line,
-    /// frame or file. Values are divided by the largest value.
+    /// them). Frames of one press (a `contact` column, a folder inside a class folder, an npz
+    /// array `contacts`) are split by press. Frames of the wrong size or with non-finite values are
+    /// rejected with their line, frame or file. Values are divided by the largest value.
     #[arg(long, value_name = "FRAMES")]
     pub real: Option<PathBuf>,
     /// Per-taxel calibration of `--real`, applied on import as gain * (raw - offset), clamped at 0.

@@ -11,20 +11,22 @@
 //! | `object_pose` | `<f8` | `[N, 7]` | x, y, z (m), qw, qx, qy, qz: the CSV's `object_x_m` ... `object_qz` |
 //! | `object_pose_after` | `<f8` | `[N, 7]` | a free object's pose when the reading was taken, the CSV's `object_after_x_m` ... `object_after_qz`; NaN where the object is fixed |
 //! | `iterations` | `<i8` | `[N]` | the contact controller's iterations |
+//! | `contact` | `<i8` | `[N]` | the press a recorded frame is one frame of (the CSV's `contact`), -1 for a reading that is a contact of its own |
 //! | `object`, `status`, `strategy`, `cause`, `touched_bodies` | `<U..` | `[N]` | the CSV's names; `cause` and `touched_bodies` empty when none |
 //! | `header` | `<U..` | `[]` | the header JSON of the CSV's line 2 (`json.loads(str(z["header"]))`) |
 //!
 //! **Parquet** (`pandas.read_parquet(path)`): the CSV's columns under the CSV's names and in its
 //! order, one row group: the names as UTF-8 strings, `iterations` int64, the poses float64 (the
 //! nine pad pose columns null where a reading has no pose, the seven of the object's pose after
-//! the touch null where the object is fixed), then one float32 column per taxel,
+//! the touch null where the object is fixed), `contact` int64, then one float32 column per taxel,
 //! `t_{row}_{col}` row-major, so `df.filter(regex="^t_").to_numpy().reshape(-1, rows, cols)` gives
 //! the images. Snappy-compressed; the header JSON is the file's key-value metadata
 //! `taction_header` (`pyarrow.parquet.read_schema(path).metadata[b"taction_header"]`).
 //!
 //! Every column has one type wherever the dataset goes ([`column_types`]): the Parquet file's,
 //! the `.npz`'s arrays and the Python package's `Dataset.to_pandas()` all follow it (taxels
-//! float32, every pose column float64 even where the object never moved, `iterations` int64).
+//! float32, every pose column float64 even where the object never moved, `iterations` and
+//! `contact` int64).
 
 use std::fmt;
 use std::path::Path;
@@ -154,7 +156,11 @@ fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::Zip
         ),
         (
             "iterations",
-            Npy::i8(vec![n], readings.iter().map(|r| i64::from(r.iterations))),
+            Npy::i8(vec![n], readings.iter().map(|r| Meta::Iterations.integer(r))),
+        ),
+        (
+            "contact",
+            Npy::i8(vec![n], readings.iter().map(|r| Meta::Contact.integer(r))),
         ),
         ("object", text(Meta::Object)),
         ("status", text(Meta::Status)),
@@ -171,7 +177,7 @@ fn npz(dataset: &Dataset, header_json: &str) -> Result<Vec<u8>, zip::result::Zip
 pub enum ColumnType {
     /// A name (UTF-8; empty where a reading has none, e.g. `cause`).
     Text,
-    /// `iterations`.
+    /// `iterations` and `contact`.
     Int64,
     /// The object's and the pad's pose (the pad's NaN, or null, where a reading has no pose).
     Float64,
@@ -213,11 +219,12 @@ impl ParquetColumn {
         metas.chain((0..taxels).map(Self::Taxel))
     }
 
-    /// The column's type: names text, `iterations` int64, poses float64, taxels float32.
+    /// The column's type: names text, `iterations` and `contact` int64, poses float64, taxels
+    /// float32.
     fn column_type(self) -> ColumnType {
         match self {
             Self::Taxel(_) => ColumnType::Float32,
-            Self::Meta(Meta::Iterations) => ColumnType::Int64,
+            Self::Meta(Meta::Iterations | Meta::Contact) => ColumnType::Int64,
             Self::Meta(m) if m.is_optional_pose() || Meta::object_pose().contains(&m) => ColumnType::Float64,
             Self::Meta(_) => ColumnType::Text,
         }
@@ -267,7 +274,7 @@ impl ParquetColumn {
         };
         match self.storage() {
             (PhysicalType::INT64, _) => {
-                let values: Vec<i64> = readings.iter().map(|r| i64::from(r.iterations)).collect();
+                let values: Vec<i64> = readings.iter().map(|r| meta.integer(r)).collect();
                 column.typed::<Int64Type>().write_batch(&values, None, None)?;
             }
             (PhysicalType::DOUBLE, repetition) => {

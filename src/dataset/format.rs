@@ -1,4 +1,4 @@
-//! A dataset on disk (version 4).
+//! A dataset on disk (version 5).
 //!
 //! One UTF-8 text file, so a dataset is a single atomic unit (written to a temporary file in the
 //! same folder, then renamed over the target) and any CSV reader can open it after skipping the
@@ -6,11 +6,11 @@
 //!
 //! ```text
 //! # taction dataset
-//! # {"format_version":4,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
+//! # {"format_version":5,"sensor":{...},"object_set":"princeton","objects":["bunny",...],
 //! #   "generator":"sampler","seed":7,"readings":11000}          <- one line of JSON
-//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,touched_bodies,object_after_x_m,...,object_after_qz,t_0_0,...
-//! bunny,converged,sampler,4,0.1,...,,,,,,,,,,0,0.25,...
-//! bunny,collision,sampler,3,0.1,...,pad_on_object,sensor/object,,,,,,,,0,0.31,...
+//! object,status,strategy,iterations,object_x_m,...,pad_up_z,cause,touched_bodies,object_after_x_m,...,object_after_qz,contact,t_0_0,...
+//! bunny,converged,sampler,4,0.1,...,,,,,,,,,,-1,0,0.25,...
+//! bunny,collision,sampler,3,0.1,...,pad_on_object,sensor/object,,,,,,,,-1,0,0.31,...
 //! ...
 //! # end 11000
 //! ```
@@ -29,9 +29,13 @@
 //!   `arm_body/other_body`, e.g. `sensor/object`, `link4/world`, the table being `world`; empty
 //!   otherwise), a free object's pose when the reading was taken `object_after_x_m, ...,
 //!   object_after_qz` (the touch may have moved it from `object_x_m, ...`; all seven empty where the
-//!   object is fixed, as the paper's is, so no touch moves it), then the `rows x cols` taxels
-//!   row-major as `t_{row}_{col}`, row 0 being the pad's `+up` edge.
-//! - Older versions are read and brought up to this one: version 3 had no pose after the touch
+//!   object is fixed, as the paper's is, so no touch moves it), `contact` (the press a recorded
+//!   frame is one frame of, a number from 0, shared by the frames of one press: a sequence imported
+//!   as one contact, `dataset import`; -1 for a reading that is a contact of its own, as every
+//!   simulated reading is), then the `rows x cols` taxels row-major as `t_{row}_{col}`, row 0 being
+//!   the pad's `+up` edge.
+//! - Older versions are read and brought up to this one: version 4 had no `contact` (every
+//!   reading its own contact); version 3 had no pose after the touch
 //!   (its objects were all fixed); version 2 had no `touched_bodies`, its
 //!   `cause` held the bodies themselves (`sensor/object`, now `pad_on_object` with those bodies) or
 //!   `covering_meets_table` (now `covering_on_table`); version 1 had no `cause`. Neither wrote
@@ -63,7 +67,7 @@ use crate::tactile::TactileImage;
 use crate::valid::Check;
 
 /// The file format version this build writes; it reads this one and every earlier one.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 const MAGIC: &str = "# taction dataset";
 const END_PREFIX: &str = "# end ";
@@ -100,10 +104,11 @@ pub(super) enum Meta {
     ObjectAfterQx,
     ObjectAfterQy,
     ObjectAfterQz,
+    Contact,
 }
 
 impl Meta {
-    pub(super) const ALL: [Meta; 29] = [
+    pub(super) const ALL: [Meta; 30] = [
         Self::Object,
         Self::Status,
         Self::Strategy,
@@ -133,6 +138,7 @@ impl Meta {
         Self::ObjectAfterQx,
         Self::ObjectAfterQy,
         Self::ObjectAfterQz,
+        Self::Contact,
     ];
 
     /// The columns before the taxels in a file of format `version` (a prefix of [`ALL`](Self::ALL):
@@ -142,6 +148,7 @@ impl Meta {
             1 => &Self::ALL[..=Self::PadUpZ.index()],
             2 => &Self::ALL[..=Self::Cause.index()],
             3 => &Self::ALL[..=Self::TouchedBodies.index()],
+            4 => &Self::ALL[..=Self::ObjectAfterQz.index()],
             _ => &Self::ALL,
         }
     }
@@ -188,6 +195,7 @@ impl Meta {
             Self::ObjectAfterQx => "object_after_qx",
             Self::ObjectAfterQy => "object_after_qy",
             Self::ObjectAfterQz => "object_after_qz",
+            Self::Contact => "contact",
         }
     }
 
@@ -214,7 +222,6 @@ impl Meta {
             Self::Object => r.object.clone(),
             Self::Status => r.status.name().to_string(),
             Self::Strategy => r.strategy.name().to_string(),
-            Self::Iterations => r.iterations.to_string(),
             Self::Cause => r
                 .cause
                 .as_ref()
@@ -226,7 +233,18 @@ impl Meta {
                 .as_ref()
                 .and_then(AttemptCause::touched_bodies)
                 .unwrap_or_default(),
+            Self::Iterations | Self::Contact => self.integer(r).to_string(),
             _ => self.number(r).map(format_f64).unwrap_or_default(),
+        }
+    }
+
+    /// This integer column of `r`: the iterations, or the contact (-1 for a reading that is a
+    /// contact of its own); 0 for the other columns.
+    pub(super) fn integer(self, r: &Reading) -> i64 {
+        match self {
+            Self::Iterations => i64::from(r.iterations),
+            Self::Contact => r.contact_number(),
+            _ => 0,
         }
     }
 
@@ -267,7 +285,8 @@ impl Meta {
             | Self::Strategy
             | Self::Iterations
             | Self::Cause
-            | Self::TouchedBodies => None,
+            | Self::TouchedBodies
+            | Self::Contact => None,
         }
     }
 }
@@ -707,6 +726,7 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
     };
     let pad = parse_pad_pose(row)?;
     let cause = parse_cause(row, status, iterations)?;
+    let contact = parse_contact(row)?;
     let image = parse_image(row, header)?;
     let image = match pad {
         Some(pad) => image.with_pose(pad),
@@ -721,7 +741,23 @@ fn parse_reading(row: &Row, header: &DatasetHeader) -> Result<Reading, (String, 
         iterations,
         strategy,
         cause,
+        contact,
     })
+}
+
+/// The row's contact: a number from 0, or -1 for a reading that is a contact of its own (as is
+/// every row of a file before version 5, which has no such column).
+fn parse_contact(row: &Row) -> Result<Option<u32>, (String, String)> {
+    match row.text(Meta::Contact).trim() {
+        "-1" => Ok(None),
+        "" if row.version < 5 => Ok(None),
+        text => text.parse().map(Some).map_err(|_| {
+            row.error(
+                Meta::Contact.index(),
+                format!("'{text}' is not a contact number (an integer from 0, or -1 for none)"),
+            )
+        }),
+    }
 }
 
 /// Whether the row's `columns` are all empty; an error names the first empty one when only some

@@ -12,19 +12,26 @@
 //! ```
 //!
 //! Each folder directly inside is one label (its name), each image in it one frame; labels and
-//! files are taken in name order, so the frames' order is the files'. Images are PNG (8 or 16 bit
+//! files are taken in name order, so the frames' order is the files'. A folder inside a class
+//! folder is one contact (a press recorded as a sequence of frames, `mug/press-07/0001.png ...`):
+//! its images are that contact's frames, in name order, kept together by every split; an image
+//! directly in the class folder is a contact of its own. Images are PNG (8 or 16 bit
 //! grayscale; a palette or fewer bits are expanded) or JPEG (8 bit grayscale), every one of the
 //! same size, `rows` its height and `cols` its width; a pixel's value is its raw reading. Files
 //! at the top level and hidden files (`.DS_Store`) are skipped; any other file in a class folder
-//! that is not such an image, a colour image, an empty class folder or an image of another size
-//! is an error naming the file.
+//! that is not such an image, a colour image, an empty class or contact folder, a folder inside a
+//! contact folder or an image of another size is an error naming the file.
 //!
 //! # An `.npz`
 //!
 //! Two arrays (`numpy.savez("frames.npz", frames=frames, labels=labels)`): `frames`, numbers of
 //! shape `(N, rows, cols)`, and `labels`, `N` strings or integers (an integer label is named by
-//! its decimal digits). A `.npz` that `taction dataset export` wrote reads too: its `images` and
-//! `object` arrays stand for `frames` and `labels`.
+//! its decimal digits). A third array, `contacts` (optional), groups frames taken across one press:
+//! `N` integers or strings, the frames of one label with the same value one contact's frames,
+//! consecutive (as the CSV's `contact` column, `recorded.rs`); a negative integer or an empty
+//! string is a frame that is a contact of its own. A `.npz` that `taction dataset export` wrote
+//! reads too: its `images`, `object` and `contact` arrays stand for `frames`, `labels` and
+//! `contacts`.
 
 use std::fs;
 use std::io::{BufReader, Cursor};
@@ -103,6 +110,9 @@ pub fn import_real_npz(path: &Path, options: &RealImport) -> Result<RealData, Re
     };
     let frames = find(["frames", "images"])?;
     let labels = find(["labels", "object"])?;
+    let contacts = ["contacts", "contact"]
+        .iter()
+        .find_map(|name| arrays.iter().find(|(n, _)| n == name).map(|(_, a)| a));
     let (n, rows, cols) = match (frames.shape.as_slice(), &frames.values) {
         (&[n, rows, cols], NpyValues::Numbers(_)) => (n, rows, cols),
         _ => {
@@ -119,16 +129,22 @@ pub fn import_real_npz(path: &Path, options: &RealImport) -> Result<RealData, Re
     check_grid(rows, cols).map_err(|what| invalid(path, what))?;
     check_calibration_grid((rows, cols), options).map_err(|what| invalid(path, what))?;
     let labels = label_texts(labels, n).map_err(|what| invalid(path, what))?;
+    let contacts = match contacts {
+        Some(contacts) => contact_names(contacts, n).map_err(|what| invalid(path, what))?,
+        None => vec![None; n],
+    };
     let NpyValues::Numbers(values) = &frames.values else {
         return Err(invalid(path, "the frames array holds no numbers"));
     };
     let taxels = rows * cols;
     let raw = labels
         .into_iter()
+        .zip(contacts)
         .enumerate()
-        .map(|(i, label)| {
+        .map(|(i, (label, contact))| {
             let frame = values[i * taxels..(i + 1) * taxels].to_vec();
             checked_frame(label, FramePlace::Frame(i), frame, cols, options, &origin)
+                .map(|frame| frame.of_contact(contact))
         })
         .collect::<Result<Vec<RawFrame>, _>>()?;
     RealData::recorded(raw, (rows, cols), options, &origin)
@@ -157,6 +173,27 @@ fn label_texts(labels: &NpyArray, n: usize) -> Result<Vec<String>, String> {
     }
 }
 
+/// The `n` names of a contacts array (module docs): strings, or integers named by their digits; a
+/// negative integer or an empty string is a frame that is a contact of its own.
+fn contact_names(contacts: &NpyArray, n: usize) -> Result<Vec<Option<String>>, String> {
+    if contacts.shape != [n] {
+        return Err(format!(
+            "the contacts array has shape {:?}, the frames {n} frames: expected shape ({n},)",
+            contacts.shape
+        ));
+    }
+    match &contacts.values {
+        NpyValues::Texts(texts) => Ok(texts.iter().map(|t| Some(t.clone())).collect()),
+        NpyValues::Numbers(numbers) => numbers
+            .iter()
+            .map(|&x| match x.fract() == 0.0 && x.is_finite() {
+                true => Ok((x >= 0.0).then(|| format!("{x:.0}"))),
+                false => Err(format!("contact {x} is neither a string nor an integer")),
+            })
+            .collect(),
+    }
+}
+
 /// Reads a folder of class folders of images (module docs).
 pub fn import_real_images(root: &Path, options: &RealImport) -> Result<RealData, RealDataError> {
     let origin = root.display().to_string();
@@ -172,48 +209,100 @@ pub fn import_real_images(root: &Path, options: &RealImport) -> Result<RealData,
             "no class folders: one folder per label, each holding that label's images",
         ));
     }
-    let mut raw = Vec::new();
-    let mut size: Option<((usize, usize), String)> = None;
+    let mut frames = ImageFrames {
+        origin: origin.clone(),
+        options,
+        size: None,
+        raw: Vec::new(),
+    };
     for class in &classes {
         let label = file_name(class);
-        let images = sorted_entries(class).map_err(io)?;
-        let images: Vec<_> = images
-            .into_iter()
-            .filter(|p| !file_name(p).starts_with('.'))
-            .collect();
-        if images.is_empty() {
+        let entries = visible_entries(class).map_err(io)?;
+        if entries.is_empty() {
             return Err(invalid(root, format!("class folder '{label}' holds no image")));
         }
-        for image in images {
-            let place = format!("{label}/{}", file_name(&image));
-            let at = FramePlace::Image(place.clone());
-            let frame_error = |what: String| RealDataError::Frame {
-                origin: origin.clone(),
-                at: at.clone(),
-                what,
-            };
-            let ((rows, cols), values) = read_gray_image(&image).map_err(frame_error)?;
-            match &size {
-                None => {
-                    check_grid(rows, cols).map_err(frame_error)?;
-                    check_calibration_grid((rows, cols), options).map_err(frame_error)?;
-                    size = Some(((rows, cols), place));
-                }
-                Some((grid, first)) if *grid != (rows, cols) => {
-                    return Err(frame_error(format!(
-                        "{rows}x{cols} pixels (rows x cols), but {first} is {}x{}: every frame is one size",
-                        grid.0, grid.1
-                    )));
-                }
-                Some(_) => {}
+        for entry in entries {
+            let name = file_name(&entry);
+            if !entry.is_dir() {
+                frames.read(&label, &entry, format!("{label}/{name}"), None)?;
+                continue;
             }
-            raw.push(checked_frame(label.clone(), at, values, cols, options, &origin)?);
+            let images = visible_entries(&entry).map_err(io)?;
+            if images.is_empty() {
+                return Err(invalid(
+                    root,
+                    format!("contact folder '{label}/{name}' holds no image"),
+                ));
+            }
+            for image in images {
+                let place = format!("{label}/{name}/{}", file_name(&image));
+                frames.read(&label, &image, place, Some(&name))?;
+            }
         }
     }
-    let Some(((rows, cols), _)) = size else {
+    let Some(((rows, cols), _)) = frames.size else {
         return Err(invalid(root, "no images"));
     };
-    RealData::recorded(raw, (rows, cols), options, &origin)
+    RealData::recorded(frames.raw, (rows, cols), options, &origin)
+}
+
+/// The frames of a folder of class folders as they are read: each image one frame, every one of
+/// the first one's size.
+struct ImageFrames<'a> {
+    origin: String,
+    options: &'a RealImport,
+    /// The first frame's grid and where it came from.
+    size: Option<((usize, usize), String)>,
+    raw: Vec<RawFrame>,
+}
+
+impl ImageFrames<'_> {
+    /// The image at `path` (`place` below the root) as a frame of `label`, one of the contact
+    /// folder `contact` when it lies in one.
+    fn read(
+        &mut self,
+        label: &str,
+        path: &Path,
+        place: String,
+        contact: Option<&str>,
+    ) -> Result<(), RealDataError> {
+        let at = FramePlace::Image(place.clone());
+        let frame_error = |what: String| RealDataError::Frame {
+            origin: self.origin.clone(),
+            at: at.clone(),
+            what,
+        };
+        if path.is_dir() {
+            return Err(frame_error(
+                "a folder inside a contact folder: a contact folder holds that press's images".to_string(),
+            ));
+        }
+        let ((rows, cols), values) = read_gray_image(path).map_err(frame_error)?;
+        match &self.size {
+            None => {
+                check_grid(rows, cols).map_err(frame_error)?;
+                check_calibration_grid((rows, cols), self.options).map_err(frame_error)?;
+                self.size = Some(((rows, cols), place));
+            }
+            Some((grid, first)) if *grid != (rows, cols) => {
+                return Err(frame_error(format!(
+                    "{rows}x{cols} pixels (rows x cols), but {first} is {}x{}: every frame is one size",
+                    grid.0, grid.1
+                )));
+            }
+            Some(_) => {}
+        }
+        let frame = checked_frame(label.to_string(), at, values, cols, self.options, &self.origin)?;
+        self.raw.push(frame.of_contact(contact.map(str::to_string)));
+        Ok(())
+    }
+}
+
+/// The entries of `dir` in name order, without hidden files (`.DS_Store`).
+fn visible_entries(dir: &Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+    let mut entries = sorted_entries(dir)?;
+    entries.retain(|p| !file_name(p).starts_with('.'));
+    Ok(entries)
 }
 
 /// The entries of `dir`, in name order.

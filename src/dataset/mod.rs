@@ -347,8 +347,33 @@ impl Dataset {
                 reading.image.cols()
             )));
         }
+        if let Some(contact) = reading.contact {
+            self.check_contact(index, contact, &reading.object)?;
+        }
         self.readings.push(reading);
         Ok(())
+    }
+
+    /// A contact's readings (format.rs: `contact`) are consecutive and of one object, and each new
+    /// contact is numbered above every earlier one, so that a contact is one run of readings and
+    /// a split at a contact's edge keeps it whole.
+    fn check_contact(&self, index: usize, contact: u32, object: &str) -> Result<(), DatasetError> {
+        if let Some(previous) = self.readings.last().filter(|r| r.contact == Some(contact)) {
+            return match previous.object == object {
+                true => Ok(()),
+                false => Err(DatasetError::Invalid(format!(
+                    "reading {index}: contact {contact} is of object '{object}', the reading before it of '{}'",
+                    previous.object
+                ))),
+            };
+        }
+        match self.readings.iter().rev().find_map(|r| r.contact) {
+            Some(last) if last >= contact => Err(DatasetError::Invalid(format!(
+                "reading {index}: contact {contact} after contact {last}: a contact's readings are \
+                 consecutive, and a new contact is numbered above every earlier one"
+            ))),
+            _ => Ok(()),
+        }
     }
 
     pub fn header(&self) -> &DatasetHeader {
@@ -503,6 +528,7 @@ mod tests {
                 body_a: "link4".into(),
                 body_b: "world".into(),
             }),
+            contact: None,
         }
     }
 
@@ -708,10 +734,80 @@ mod tests {
         lines.join("\n") + "\n"
     }
 
+    /// `text` (this version's file) as format 4 wrote it: no contact column.
+    fn as_format_4(text: &str) -> String {
+        let contact = format::Meta::Contact.index();
+        older(text, (5, 4), contact..contact + 1)
+    }
+
     /// `text` (this version's file) as format 3 wrote it: no pose after the touch.
     fn as_format_3(text: &str) -> String {
         let after = format::Meta::ObjectAfterX.index();
-        older(text, (4, 3), after..after + 7)
+        older(&as_format_4(text), (4, 3), after..after + 7)
+    }
+
+    /// Readings in two contacts (frames 0 and 1 of object `c`, then frame 3) and one of its own.
+    fn dataset_with_contacts() -> Dataset {
+        let header = DatasetHeader::new(sensor(), "toy", vec!["a,\"b\"".into(), "c".into()], "sampler", 42);
+        let readings = [
+            ("c", Some(0), true),
+            ("c", Some(0), false),
+            ("a,\"b\"", None, true),
+            ("c", Some(1), false),
+        ]
+        .into_iter()
+        .enumerate()
+        .map(|(k, (object, contact, with_pad))| Reading {
+            contact,
+            ..reading(object, ContactStatus::Converged, k as f64, with_pad)
+        })
+        .collect();
+        Dataset::new(header, readings).unwrap()
+    }
+
+    #[test]
+    fn contacts_round_trip_and_a_format_4_file_has_none() {
+        let d = dataset_with_contacts();
+        let text = String::from_utf8(d.to_file_bytes("d.csv").unwrap()).unwrap();
+        assert_eq!(Dataset::parse(&text, "d.csv").unwrap(), d);
+        let old = as_format_4(&text);
+        assert!(!old.contains("contact,"), "{old}");
+        let read = Dataset::parse(&old, "v4.csv").unwrap();
+        assert!(read.readings.iter().all(|r| r.contact.is_none()));
+        let contact = format::Meta::Contact.index();
+        let row: Vec<&str> = text.lines().nth(3).unwrap().split(',').collect();
+        let offset = usize::from(row[0].starts_with('"'));
+        let mut broken = row.clone();
+        broken[contact + offset] = "two";
+        let e = parse_err(&text.replace(&row.join(","), &broken.join(",")));
+        assert!(
+            e.contains("line 4") && e.contains("'contact'") && e.contains("'two'"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_contact_is_one_run_of_readings_of_one_object() {
+        let d = dataset_with_contacts();
+        let header = d.header().clone();
+        let mut readings = d.readings.clone();
+        // Contact 0 again after its run ended: a contact does not come back.
+        readings[3].contact = Some(0);
+        let e = Dataset::new(header.clone(), readings).unwrap_err().to_string();
+        assert!(
+            e.contains("reading 3") && e.contains("contact 0 after contact 0"),
+            "{e}"
+        );
+        // Contact 0's second frame of another object.
+        let mut readings = d.readings.clone();
+        readings[1].object = readings[2].object.clone();
+        let other = readings[2].object.clone();
+        let e = Dataset::new(header.clone(), readings).unwrap_err().to_string();
+        assert!(
+            e.contains("reading 1") && e.contains(&format!("of object '{other}'")),
+            "{e}"
+        );
+        assert!(Dataset::new(header, d.readings.clone()).is_ok());
     }
 
     /// `d` as a file of format 3 or older holds it: every object fixed.
@@ -845,7 +941,7 @@ mod tests {
         let broken = t.replace(lines[4], short);
         let e = parse_err(&broken);
         assert!(
-            e.contains("d.csv: line 5") && e.contains("34 columns, expected 35 (29 + 2x3 taxels)"),
+            e.contains("d.csv: line 5") && e.contains("35 columns, expected 36 (30 + 2x3 taxels)"),
             "{e}"
         );
     }
@@ -930,7 +1026,7 @@ mod tests {
     fn wrong_version_and_wrong_magic_are_named() {
         let t = text();
         let e = Dataset::parse(
-            &t.replace("\"format_version\":4", "\"format_version\":7"),
+            &t.replace("\"format_version\":5", "\"format_version\":7"),
             "d.csv",
         )
         .unwrap_err();
@@ -939,7 +1035,7 @@ mod tests {
                 e,
                 DatasetError::Version {
                     found: 7,
-                    expected: 4,
+                    expected: 5,
                     ..
                 }
             ),

@@ -28,6 +28,13 @@ pub struct Reading {
     /// Why the attempt ended, where its status alone does not say: who touched whom (a
     /// `Collision` reading), the covering on the table, contact lost, a physics fault.
     pub cause: Option<AttemptCause>,
+    /// The press this reading is one frame of, when a recording took several frames across one
+    /// press (issue 73: a sequence imported as one contact's frames, numbered from 0 in the order
+    /// of their first frame). `None`: the reading is a contact of its own, as every simulated
+    /// reading and every single recorded frame is. Readings of one contact are never split
+    /// between training and validation or test. Left out of the JSON when `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<u32>,
 }
 
 /// The names of what ends an attempt short of convergence: one vocabulary for the dataset's
@@ -209,6 +216,12 @@ impl Reading {
     /// Whether the contact controllers converged (Sec. III-B): the readings recognition uses.
     pub fn is_converged(&self) -> bool {
         self.status == ContactStatus::Converged
+    }
+
+    /// The contact as every export writes it (the dataset's `contact` column): its number, or -1
+    /// for a reading that is a contact of its own.
+    pub fn contact_number(&self) -> i64 {
+        self.contact.map_or(-1, i64::from)
     }
 
     /// The cause a reading with no recorded one has by its status alone: `lost_contact` for a

@@ -17,6 +17,13 @@
 //!
 //! - `label`: the object the frame was taken from (e.g. `A`); non-empty. When the importer is given
 //!   a set of allowed labels, any other label is an error.
+//! - `contact` (optional, right after `label`: `label,contact,r0c0,...`): the press a frame was
+//!   taken in, any name (`17`, `press-3`), for recordings that keep several frames across one
+//!   press (a sequence). Frames of one label with the same name are one contact's frames and stay
+//!   together, never split between training and test; they must be consecutive lines (a press is
+//!   recorded in one go), a name coming back after other frames is an error. An empty field: the
+//!   frame is a contact of its own, as every frame of a file without the column is. Contacts are
+//!   numbered from 0 in the order of their first frame ([`RealReading::contact`]).
 //! - taxel values: raw sensor units (any scale), finite and non-negative; row 0 is the pad's `up`
 //!   edge, column 0 its left edge, as in [`TactileImage`].
 //! - lines are frames in collection order (Fig. 17b uses that order); fields are separated by commas
@@ -296,6 +303,10 @@ pub struct RealReading {
     pub label: String,
     /// Where in the source it came from.
     pub place: FramePlace,
+    /// The contact (press) this frame is one of, numbered from 0 in the order of the contacts'
+    /// first frames, when the source groups frames into contacts (module docs); `None`: a contact
+    /// of its own.
+    pub contact: Option<u32>,
     /// Values normalised to [0, 1]; no pad pose (a recording has none).
     pub image: TactileImage,
 }
@@ -400,6 +411,7 @@ impl RealData {
                     iterations: 0,
                     strategy: Strategy::Recorded,
                     cause: None,
+                    contact: frame.contact,
                 }
             })
             .collect();
@@ -427,6 +439,11 @@ impl RealData {
         self.readings.iter().map(|r| r.label.as_str()).collect()
     }
 
+    /// Whether the source grouped frames into contacts of several frames (module docs).
+    pub fn has_contacts(&self) -> bool {
+        self.readings.iter().any(|r| r.contact.is_some())
+    }
+
     /// Where the first frame labelled `label` came from, for messages about the label.
     pub fn first_place_of(&self, label: &str) -> Option<&FramePlace> {
         self.readings.iter().find(|r| r.label == label).map(|r| &r.place)
@@ -452,12 +469,13 @@ pub enum RealDataError {
     Header { origin: String, line: u64, what: String },
     #[error("{origin}: no header line (label,r0c0,...)")]
     NoHeader { origin: String },
-    #[error("{origin}: line {line}: {got} columns, expected {expected} (label + {rows}x{cols} taxels)")]
+    #[error("{origin}: line {line}: {got} columns, expected {expected} ({leading} + {rows}x{cols} taxels)")]
     ColumnCount {
         origin: String,
         line: u64,
         got: usize,
         expected: usize,
+        leading: &'static str,
         rows: usize,
         cols: usize,
     },
@@ -527,15 +545,15 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
             range,
         });
     }
-    let mut header: Option<(usize, usize, Vec<String>)> = None;
+    let mut header: Option<CsvLayout> = None;
     let mut raw: Vec<RawFrame> = Vec::new();
     for (line, record) in records(text) {
         match &header {
             None => header = Some(calibrated_header(&record, line, origin, options)?),
-            Some(grid) => raw.push(parse_frame(&record, line, grid, options, origin)?),
+            Some(layout) => raw.push(parse_frame(&record, line, layout, options, origin)?),
         }
     }
-    let Some((rows, cols, _)) = header else {
+    let Some(CsvLayout { rows, cols, .. }) = header else {
         return Err(RealDataError::NoHeader {
             origin: origin.to_string(),
         });
@@ -549,12 +567,43 @@ pub fn parse_real_csv(text: &str, origin: &str, options: &RealImport) -> Result<
     })
 }
 
-/// One frame as read: its label, where it came from and its calibrated values, not yet
-/// normalised.
+/// One frame as read: its label, where it came from, the name of its contact when the source
+/// gives one, and its calibrated values, not yet normalised.
 pub(crate) struct RawFrame {
     label: String,
     place: FramePlace,
+    contact: Option<String>,
     values: Vec<f64>,
+}
+
+impl RawFrame {
+    /// The frame as one of the contact named `contact` (`None`, or an empty name: a contact of
+    /// its own).
+    pub(crate) fn of_contact(self, contact: Option<String>) -> Self {
+        Self {
+            contact: contact.filter(|name| !name.is_empty()),
+            ..self
+        }
+    }
+}
+
+/// A frames CSV's columns (module docs): the optional `contact` column, then a `rows x cols` grid
+/// of taxel columns `names`.
+struct CsvLayout {
+    rows: usize,
+    cols: usize,
+    names: Vec<String>,
+    contact: bool,
+}
+
+impl CsvLayout {
+    /// The columns before the taxels, as messages name them.
+    fn leading(&self) -> &'static str {
+        match self.contact {
+            true => "label, contact",
+            false => "label",
+        }
+    }
 }
 
 /// The header line ([`parse_header`]), whose grid must be the calibration's when there is one.
@@ -563,9 +612,9 @@ fn calibrated_header(
     line: u64,
     origin: &str,
     options: &RealImport,
-) -> Result<(usize, usize, Vec<String>), RealDataError> {
+) -> Result<CsvLayout, RealDataError> {
     let parsed = parse_header(record, line, origin)?;
-    check_calibration_grid((parsed.0, parsed.1), options).map_err(|what| RealDataError::Header {
+    check_calibration_grid((parsed.rows, parsed.cols), options).map_err(|what| RealDataError::Header {
         origin: origin.to_string(),
         line,
         what,
@@ -584,28 +633,35 @@ pub(crate) fn check_calibration_grid(grid: (usize, usize), options: &RealImport)
     }
 }
 
-/// A frame line of a `rows x cols` grid with taxel columns `names`: a known, non-empty label and
-/// one calibrated value a taxel.
+/// A frame line of a `layout`: a known, non-empty label, its contact's name when the layout has
+/// the column, and one calibrated value a taxel.
 fn parse_frame(
     record: &[&str],
     line: u64,
-    grid: &(usize, usize, Vec<String>),
+    layout: &CsvLayout,
     options: &RealImport,
     origin: &str,
 ) -> Result<RawFrame, RealDataError> {
-    let (rows, cols, names) = grid;
-    let expected = 1 + rows * cols;
+    let CsvLayout {
+        rows,
+        cols,
+        names,
+        contact,
+    } = layout;
+    let first_taxel = 1 + usize::from(*contact);
+    let expected = first_taxel + rows * cols;
     if record.len() != expected {
         return Err(RealDataError::ColumnCount {
             origin: origin.to_string(),
             line,
             got: record.len(),
             expected,
+            leading: layout.leading(),
             rows: *rows,
             cols: *cols,
         });
     }
-    let values = record[1..]
+    let values = record[first_taxel..]
         .iter()
         .zip(names)
         .map(|(text, column)| {
@@ -617,14 +673,15 @@ fn parse_frame(
             })
         })
         .collect::<Result<Vec<f64>, _>>()?;
-    checked_frame(
+    let frame = checked_frame(
         record[0].to_string(),
         FramePlace::Line(line),
         values,
         *cols,
         options,
         origin,
-    )
+    )?;
+    Ok(frame.of_contact(contact.then(|| record[1].to_string())))
 }
 
 /// One frame of raw values (row-major, `cols` a row) as read from any source: a known, non-empty
@@ -681,7 +738,12 @@ pub(crate) fn checked_frame(
             }
         })?;
     }
-    Ok(RawFrame { label, place, values })
+    Ok(RawFrame {
+        label,
+        place,
+        contact: None,
+        values,
+    })
 }
 
 /// The name of taxel `k` of a grid `cols` wide: `r<row>c<col>`, as the CSV header names it.
@@ -741,27 +803,77 @@ fn normalised(
         });
     }
     let (rows, cols) = grid;
+    let contacts = numbered_contacts(&raw, origin)?;
     raw.into_iter()
-        .map(|RawFrame { label, place, values }| {
-            let values = values.into_iter().map(|v| v / scale).collect();
-            match TactileImage::new(rows, cols, values) {
-                Ok(image) => Ok(RealReading { label, place, image }),
-                Err(e) => Err(RealDataError::Frame {
-                    origin: origin.to_string(),
-                    at: place,
-                    what: e.to_string(),
-                }),
-            }
-        })
+        .zip(contacts)
+        .map(
+            |(
+                RawFrame {
+                    label, place, values, ..
+                },
+                contact,
+            )| {
+                let values = values.into_iter().map(|v| v / scale).collect();
+                match TactileImage::new(rows, cols, values) {
+                    Ok(image) => Ok(RealReading {
+                        label,
+                        place,
+                        contact,
+                        image,
+                    }),
+                    Err(e) => Err(RealDataError::Frame {
+                        origin: origin.to_string(),
+                        at: place,
+                        what: e.to_string(),
+                    }),
+                }
+            },
+        )
         .collect()
 }
 
-/// Reads `label,r0c0,...`: the taxel columns must be `r<i>c<j>` in row-major order and fill a grid.
-fn parse_header(
-    record: &[&str],
-    line: u64,
-    origin: &str,
-) -> Result<(usize, usize, Vec<String>), RealDataError> {
+/// Each frame's contact number (module docs): the frames of one label under one contact name are
+/// consecutive and share a number, counted from 0 in the order of the contacts' first frames; a
+/// frame without a name is a contact of its own (`None`). A name coming back after other frames is
+/// an error naming the frame.
+fn numbered_contacts(raw: &[RawFrame], origin: &str) -> Result<Vec<Option<u32>>, RealDataError> {
+    let mut finished: BTreeSet<(&str, &str)> = BTreeSet::new();
+    let mut current: Option<((&str, &str), u32)> = None;
+    let mut next = 0u32;
+    let mut numbers = Vec::with_capacity(raw.len());
+    for frame in raw {
+        let Some(name) = frame.contact.as_deref() else {
+            finished.extend(current.take().map(|(key, _)| key));
+            numbers.push(None);
+            continue;
+        };
+        let key = (frame.label.as_str(), name);
+        match current {
+            Some((open, number)) if open == key => numbers.push(Some(number)),
+            _ => {
+                finished.extend(current.take().map(|(key, _)| key));
+                if finished.contains(&key) {
+                    return Err(RealDataError::Frame {
+                        origin: origin.to_string(),
+                        at: frame.place.clone(),
+                        what: format!(
+                            "contact '{name}' of label '{}' comes back after other frames: a contact's frames are consecutive",
+                            frame.label
+                        ),
+                    });
+                }
+                current = Some((key, next));
+                numbers.push(Some(next));
+                next += 1;
+            }
+        }
+    }
+    Ok(numbers)
+}
+
+/// Reads `label,r0c0,...` or `label,contact,r0c0,...`: the taxel columns must be `r<i>c<j>` in
+/// row-major order and fill a grid.
+fn parse_header(record: &[&str], line: u64, origin: &str) -> Result<CsvLayout, RealDataError> {
     let bad = |what: String| RealDataError::Header {
         origin: origin.to_string(),
         line,
@@ -773,7 +885,9 @@ fn parse_header(
             record[0]
         )));
     }
-    let names: Vec<String> = record[1..].iter().map(|s| s.to_string()).collect();
+    let contact = record.get(1) == Some(&"contact");
+    let first_taxel = 1 + usize::from(contact);
+    let names: Vec<String> = record[first_taxel..].iter().map(|s| s.to_string()).collect();
     if names.is_empty() {
         return Err(bad("no taxel columns".to_string()));
     }
@@ -789,7 +903,7 @@ fn parse_header(
         if cell != (k / cols, k % cols) {
             return Err(bad(format!(
                 "taxel column {} is '{name}', expected r{}c{} (row-major, {rows}x{cols})",
-                k + 2,
+                k + first_taxel + 1,
                 k / cols,
                 k % cols
             )));
@@ -802,7 +916,12 @@ fn parse_header(
         )));
     }
     check_grid(rows, cols).map_err(bad)?;
-    Ok((rows, cols, names))
+    Ok(CsvLayout {
+        rows,
+        cols,
+        names,
+        contact,
+    })
 }
 
 /// A recording's grid is `rows x cols` taxels, each side within [`TAXELS_PER_SIDE`].

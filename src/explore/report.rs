@@ -31,6 +31,7 @@ pub(crate) fn attempt_reading(
         iterations: outcome.iterations,
         strategy,
         cause,
+        contact: None,
     }
 }
 
@@ -77,6 +78,7 @@ pub(crate) fn unsettled_reading(
         iterations: 0,
         strategy,
         cause,
+        contact: None,
     })
 }
 

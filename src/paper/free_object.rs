@@ -443,6 +443,7 @@ mod tests {
             iterations: 1,
             strategy: Strategy::Local,
             cause: None,
+            contact: None,
         }
     }
 

@@ -9,7 +9,10 @@
 //! 1. frames whose peak (largest taxel, in [0, 1] of the sensing range) is below the contact
 //!    threshold are dropped before any split ([`prune`]; the count per label goes to `config.json`);
 //! 2. each label's remaining frames are split with [`split_per_label`] under the seed
-//!    `substream(substream(seed, SPLIT_STREAM), t)` into the sizes of [`scaled_split_sizes`];
+//!    `substream(substream(seed, SPLIT_STREAM), t)` into the sizes of [`scaled_split_sizes`]; a
+//!    recording that keeps several frames of one press (a contact, `dataset::recorded`) is split
+//!    by contact, so no press lends frames to both training and test, and the sizes count
+//!    contacts (a recording of single frames splits exactly as before: each frame its contact);
 //! 3. a model is trained per descriptor on the training part, its codebook size chosen on the
 //!    validation part (Sec. V-B1), and each label's test frames are recognised touch by touch.
 //!
@@ -37,7 +40,7 @@ use crate::experiment::runner::{Experiment, RunReport, run};
 use crate::experiment::spec::ExperimentSpec;
 use crate::experiment::unit::{BoxError, Unit};
 use crate::paper::sim_to_real::{GaussianBlur, square_root};
-use crate::paper::split::{SplitSizes, split_per_label};
+use crate::paper::split::{Split, SplitSizes, split_per_label};
 use crate::recognize::{
     CodebookKind, Evaluation, LabelledFeatures, PosteriorRule, ReadingRange, ReliabilityTable, TrainConfig,
     Trial, evaluate, train,
@@ -182,7 +185,11 @@ struct RealFramesConfig<'a> {
     labels: Vec<String>,
     /// Frames kept and dropped by pruning, per label.
     pruning: &'a BTreeMap<String, PruneCount>,
-    /// Readings per label in each part of every trial's split.
+    /// Contacts that kept frames, per label, when the recording groups frames into contacts: the
+    /// split's sizes count these. Absent for a recording of single frames.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contacts: Option<BTreeMap<String, usize>>,
+    /// Readings (or contacts) per label in each part of every trial's split.
     split: SplitPerLabel,
     descriptors: Vec<&'static str>,
     training: &'a TrainConfig,
@@ -206,7 +213,8 @@ pub fn run_real_frames(context: &PaperContext, codebook: CodebookKind) -> Result
     let real = context.real_data()?;
     let (kept, pruning) = prune(&real, options.contact_threshold);
     let labels: Vec<String> = pruning.keys().cloned().collect();
-    let sizes = split_sizes(context, &pruning)?;
+    let contacts = real.has_contacts().then(|| contacts_per_label(&kept));
+    let sizes = split_sizes(context, &pruning, contacts.as_ref())?;
     let training = selection_config(
         codebook,
         rng::substream(context.seed, MODEL_STREAM),
@@ -252,17 +260,19 @@ pub fn run_real_frames(context: &PaperContext, codebook: CodebookKind) -> Result
                 )?,
             ],
         },
-        config: plan.config(context, &real, &pruning),
+        config: plan.config(context, &real, (&pruning, contacts)),
         units,
     };
     Ok(run(&experiment, &context.options)?)
 }
 
 /// The split's sizes per label (see [`scaled_split_sizes`]), set by the label with the fewest frames
-/// kept; recognition needs at least two labels.
+/// kept, or the fewest `contacts` when the recording groups frames into contacts; recognition
+/// needs at least two labels.
 fn split_sizes(
     context: &PaperContext,
     pruning: &BTreeMap<String, PruneCount>,
+    contacts: Option<&BTreeMap<String, usize>>,
 ) -> Result<SplitSizes, BoxError> {
     if pruning.len() < 2 {
         return Err(format!(
@@ -274,17 +284,48 @@ fn split_sizes(
     }
     let (smallest_label, smallest) = pruning
         .iter()
-        .map(|(label, c)| (label.as_str(), c.kept))
+        .map(|(label, c)| {
+            let kept = contacts.map_or(c.kept, |counts| counts.get(label).copied().unwrap_or(0));
+            (label.as_str(), kept)
+        })
         .min_by_key(|(_, kept)| *kept)
         .ok_or("internal: no labels")?;
     Ok(
         scaled_split_sizes(smallest, context.scale.fraction()).map_err(|e| {
+            let e = match contacts {
+                Some(_) => e.to_string().replacen("frames", "contacts", 1),
+                None => e.to_string(),
+            };
             format!(
                 "{}: label '{smallest_label}': {e} (--contact-threshold {} dropped {} of its frames)",
                 context.real.origin, context.real_frames.contact_threshold, pruning[smallest_label].dropped
             )
         })?,
     )
+}
+
+/// How many contacts of each label kept frames (a contact's frames are consecutive,
+/// [`contacts_of`]).
+fn contacts_per_label(kept: &[&RealReading]) -> BTreeMap<String, usize> {
+    let mut counts = BTreeMap::new();
+    for contact in contacts_of(kept.iter().copied()) {
+        *counts.entry(contact[0].label.clone()).or_insert(0) += 1;
+    }
+    counts
+}
+
+/// The frames grouped into contacts, in order: consecutive frames of one contact number together,
+/// a frame without one alone (the importer keeps a contact's frames consecutive,
+/// `dataset::recorded`).
+fn contacts_of<'a>(frames: impl IntoIterator<Item = &'a RealReading>) -> Vec<Vec<&'a RealReading>> {
+    let mut contacts: Vec<Vec<&RealReading>> = Vec::new();
+    for frame in frames {
+        match contacts.last_mut() {
+            Some(open) if frame.contact.is_some() && open[0].contact == frame.contact => open.push(frame),
+            _ => contacts.push(vec![frame]),
+        }
+    }
+    contacts
 }
 
 /// What every trial of every descriptor shares: the frames kept, their labels, the split's sizes,
@@ -308,7 +349,7 @@ impl TrialPlan<'_> {
         &'c self,
         context: &'c PaperContext,
         real: &RealData,
-        pruning: &'c BTreeMap<String, PruneCount>,
+        (pruning, contacts): (&'c BTreeMap<String, PruneCount>, Option<BTreeMap<String, usize>>),
     ) -> RealFramesConfig<'c> {
         RealFramesConfig {
             recording: &context.real.origin,
@@ -319,6 +360,7 @@ impl TrialPlan<'_> {
             options: self.options,
             labels: self.labels.clone(),
             pruning,
+            contacts,
             split: SplitPerLabel {
                 train: self.sizes.train,
                 validation: self.sizes.validation,
@@ -404,20 +446,21 @@ impl TrialPlan<'_> {
     }
 }
 
-/// The split of trial `trial`: per label, disjoint training, validation and test frames.
+/// The split of trial `trial`: per label, disjoint training, validation and test frames, each
+/// contact's frames in one part (`sizes` count contacts; a frame without a contact is one).
 pub fn trial_split(
     kept: &[RealReading],
     sizes: SplitSizes,
     seed: u64,
     trial: usize,
-) -> Result<crate::paper::split::Split<&RealReading>, BoxError> {
+) -> Result<Split<&RealReading>, BoxError> {
     let trial_seed = trial_seed(seed, trial);
-    Ok(split_per_label(
-        kept.iter().collect(),
-        |r| r.label.as_str(),
-        sizes,
-        trial_seed,
-    )?)
+    let split = split_per_label(contacts_of(kept), |c| c[0].label.as_str(), sizes, trial_seed)?;
+    Ok(Split {
+        train: split.train.concat(),
+        validation: split.validation.concat(),
+        test: split.test.concat(),
+    })
 }
 
 /// The seed of trial `trial`'s split (also the `stream_seed` column of its rows).

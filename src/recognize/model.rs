@@ -112,6 +112,7 @@ impl TrainedModel {
     ///                 iterations: 1,
     ///                 strategy: Strategy::Sampler,
     ///                 cause: None,
+    ///                 contact: None,
     ///             });
     ///         }
     ///     }

@@ -74,6 +74,7 @@ pub fn dataset(per_object: usize, seed: u64) -> Dataset {
                 iterations: 3,
                 strategy: Strategy::Sampler,
                 cause: None,
+                contact: None,
             });
         }
     }

@@ -368,6 +368,7 @@ mod tests {
             iterations: 0,
             strategy: Strategy::Global,
             cause,
+            contact: None,
         }
     }
 
