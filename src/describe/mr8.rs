@@ -45,6 +45,7 @@ use std::sync::{Arc, PoisonError, RwLock};
 use serde::{Deserialize, Serialize};
 
 use super::{Descriptor, DescriptorKind, DescriptorParams, Feature, ParamsError};
+use crate::simd::dot;
 use crate::tactile::TactileImage;
 use crate::valid::{Check, Valid};
 
@@ -235,21 +236,6 @@ impl Mr8 {
         let along = |n: usize| (n - side) / self.params.stride_px + 1;
         along(rows) * along(cols)
     }
-}
-
-/// `sum a_i b_i` over four interleaved partial sums (the order is fixed, so the result is too),
-/// which lets the additions pipeline: the filter responses are most of MR-8's time.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut lanes = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (a_rest, b_rest) = (a4.remainder(), b4.remainder());
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            lanes[k] += x[k] * y[k];
-        }
-    }
-    let rest: f64 = a_rest.iter().zip(b_rest).map(|(x, y)| x * y).sum();
-    (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
 }
 
 /// The image made zero-mean with unit RMS; all zero when it has no contrast.

@@ -32,7 +32,7 @@
 
 use rand::RngExt;
 
-use crate::simd::has_avx2;
+use crate::simd::{dot, has_avx2};
 use crate::tactile::SensorConfig;
 use crate::tactile::grid::SampleGrid;
 
@@ -241,25 +241,6 @@ impl ImageFormation {
     }
 }
 
-/// `sum_i a_i b_i` in four independent partial sums, so the loop vectorises.
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in a4.zip(b4) {
-        for l in 0..4 {
-            acc[l] += x[l] * y[l];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-}
-
 /// The pass along x four lanes wide, each taxel's sum [`dot`]'s bit for bit.
 #[cfg(target_arch = "x86_64")]
 mod four_lanes {
@@ -293,8 +274,8 @@ mod four_lanes {
         }
     }
 
-    /// [`dot`](super::dot) of `N` pairs of bands of one length at once, each pair's four partial
-    /// sums in a register of its own (lane `l` is `dot`'s `acc[l]`).
+    /// [`dot`](crate::simd::dot) of `N` pairs of bands of one length at once, each pair's four partial
+    /// sums in a register of its own (lane `l` is `dot`'s `lanes[l]`).
     ///
     /// # Safety
     /// The processor must have AVX2, and every slice of `pairs` must be as long as the first
@@ -331,7 +312,7 @@ mod four_lanes {
         unsafe { _mm256_add_pd(acc, _mm256_mul_pd(_mm256_loadu_pd(a), _mm256_loadu_pd(b))) }
     }
 
-    /// [`dot`](super::dot)'s last step: its four partial sums, then the terms after the last whole
+    /// [`dot`](crate::simd::dot)'s last step: its four partial sums, then the terms after the last whole
     /// chunk of four.
     #[inline]
     #[target_feature(enable = "avx2")]
