@@ -54,12 +54,23 @@ impl ObjectModels {
 
     /// `ln p(U | O_j) = sum_i s_i ln p(c_i | O_j)` for every object `j` (Eq. 15-16); by the
     /// product rule `sum_f ln p(c_j | f)` when the models decide per frame
-    /// ([`EvidenceRule::PerFrame`]) and `u` kept those sums ([`ObjectModels::empty_histogram`]).
+    /// ([`EvidenceRule::PerFrame`]), from the sums `u` keeps for it.
+    ///
+    /// # Panics
+    ///
+    /// When the models decide per frame and `u` did not keep those sums: a histogram made by
+    /// [`ClusterHistogram::new`] rather than [`ObjectModels::empty_histogram`]. Its counts cannot
+    /// give the product rule's evidence, and Eq. 4 in its place would be a wrong answer given
+    /// silently; every decision path of the library makes its histograms with `empty_histogram`.
     pub fn log_likelihoods(&self, u: &ClusterHistogram) -> Vec<f64> {
         debug_assert_eq!(u.clusters(), self.clusters());
-        debug_assert!(self.rule() == EvidenceRule::CrossEntropy || u.log_sums().is_some());
-        if let (EvidenceRule::PerFrame, Some(log_sums)) = (self.rule(), u.log_sums()) {
-            return log_sums.to_vec();
+        if self.rule() == EvidenceRule::PerFrame {
+            let log_sums = u.log_sums();
+            assert!(
+                log_sums.is_some(),
+                "a per-frame model decides from a histogram made by ObjectModels::empty_histogram"
+            );
+            return log_sums.map(<[f64]>::to_vec).unwrap_or_default();
         }
         (0..self.objects().len())
             .map(|j| {
@@ -223,5 +234,16 @@ mod tests {
         let wide = ObjectModels::fit(vec!["a".into()], &[four], PseudoCount::LAPLACE).unwrap();
         let e = wide.with_rule(EvidenceRule::PerFrame).unwrap_err();
         assert!(e.to_string().contains("one cluster per object"), "{e}");
+    }
+
+    /// A histogram of counts alone cannot give the product rule's evidence: a per-frame model
+    /// refuses it loudly rather than deciding by Eq. 4 in its place.
+    #[test]
+    #[should_panic(expected = "ObjectModels::empty_histogram")]
+    fn a_per_frame_model_refuses_a_histogram_without_its_sums() {
+        let per_frame = models().with_rule(EvidenceRule::PerFrame).unwrap();
+        let mut counts = ClusterHistogram::new(3);
+        counts.add(&[0.7, 0.2, 0.1]);
+        per_frame.decide(&counts);
     }
 }
