@@ -808,6 +808,14 @@ mod tests {
             "{e}"
         );
         assert!(Dataset::new(header, d.readings.clone()).is_ok());
+        // `dataset show` counts the presses and their frames; a dataset without any says nothing.
+        assert_eq!(d.summary().presses, Some((2, 3)));
+        assert!(
+            d.summary()
+                .to_string()
+                .ends_with("\ncontacts: 3 frames in 2 presses, each press kept whole by every split")
+        );
+        assert!(!dataset().summary().to_string().contains("contacts"));
     }
 
     /// `d` as a file of format 3 or older holds it: every object fixed.

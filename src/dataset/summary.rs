@@ -26,11 +26,17 @@ impl Dataset {
                 *causes[i].entry(cause.kind()).or_insert(0) += 1;
             }
         }
+        let grouped: Vec<u32> = self.readings.iter().filter_map(|r| r.contact).collect();
+        let presses = (!grouped.is_empty()).then(|| {
+            let contacts = grouped.iter().collect::<std::collections::BTreeSet<_>>().len();
+            (contacts, grouped.len())
+        });
         DatasetSummary {
             header: self.header.clone(),
             per_object,
             causes,
             by_strategy,
+            presses,
         }
     }
 }
@@ -39,6 +45,9 @@ impl Dataset {
 #[derive(Debug, Clone, PartialEq)]
 pub struct DatasetSummary {
     pub header: DatasetHeader,
+    /// Contacts of several frames (a recording's presses, the `contact` column) and the frames
+    /// they hold; `None` when every reading is a contact of its own.
+    pub presses: Option<(usize, usize)>,
     /// Per object (header order): readings by status.
     pub per_object: Vec<BTreeMap<ContactStatus, usize>>,
     /// Per object (header order): failed attempts by what ended them.
@@ -96,7 +105,14 @@ impl fmt::Display for DatasetSummary {
             } else {
                 strategies.join(", ")
             }
-        )
+        )?;
+        match self.presses {
+            Some((contacts, frames)) => write!(
+                f,
+                "\ncontacts: {frames} frames in {contacts} presses, each press kept whole by every split"
+            ),
+            None => Ok(()),
+        }
     }
 }
 
