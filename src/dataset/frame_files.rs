@@ -91,28 +91,28 @@ pub fn import_real_npz(path: &Path, options: &RealImport) -> Result<RealData, Re
         source,
     })?;
     let arrays = parse_npz(&bytes).map_err(|e| invalid(path, e.to_string()))?;
-    let find = |names: [&str; 2]| {
+    let array = |names: [&str; 2]| {
         names
             .iter()
             .find_map(|name| arrays.iter().find(|(n, _)| n == name).map(|(_, a)| a))
-            .ok_or_else(|| {
-                let held: Vec<&str> = arrays.iter().map(|(n, _)| n.as_str()).collect();
-                invalid(
-                    path,
-                    format!(
-                        "no array '{}' (or '{}'); it holds: {}",
-                        names[0],
-                        names[1],
-                        held.join(", ")
-                    ),
-                )
-            })
+    };
+    let find = |names: [&str; 2]| {
+        array(names).ok_or_else(|| {
+            let held: Vec<&str> = arrays.iter().map(|(n, _)| n.as_str()).collect();
+            invalid(
+                path,
+                format!(
+                    "no array '{}' (or '{}'); it holds: {}",
+                    names[0],
+                    names[1],
+                    held.join(", ")
+                ),
+            )
+        })
     };
     let frames = find(["frames", "images"])?;
     let labels = find(["labels", "object"])?;
-    let contacts = ["contacts", "contact"]
-        .iter()
-        .find_map(|name| arrays.iter().find(|(n, _)| n == name).map(|(_, a)| a));
+    let contacts = array(["contacts", "contact"]);
     let (n, rows, cols) = match (frames.shape.as_slice(), &frames.values) {
         (&[n, rows, cols], NpyValues::Numbers(_)) => (n, rows, cols),
         _ => {
@@ -152,43 +152,45 @@ pub fn import_real_npz(path: &Path, options: &RealImport) -> Result<RealData, Re
 
 /// The `n` labels of a labels array: strings, or integers named by their digits.
 fn label_texts(labels: &NpyArray, n: usize) -> Result<Vec<String>, String> {
-    if labels.shape != [n] {
-        return Err(format!(
-            "the labels array has shape {:?}, the frames {n} frames: expected shape ({n},)",
-            labels.shape
-        ));
-    }
-    match &labels.values {
-        NpyValues::Texts(texts) => Ok(texts.clone()),
-        NpyValues::Numbers(numbers) => numbers
-            .iter()
-            .map(|&x| {
-                if x.fract() == 0.0 && x.is_finite() {
-                    Ok(format!("{x:.0}"))
-                } else {
-                    Err(format!("label {x} is neither a string nor an integer"))
-                }
-            })
-            .collect(),
-    }
+    per_frame(labels, n, ("labels", "label"), str::to_string, |x| {
+        format!("{x:.0}")
+    })
 }
 
 /// The `n` names of a contacts array (module docs): strings, or integers named by their digits; a
 /// negative integer or an empty string is a frame that is a contact of its own.
 fn contact_names(contacts: &NpyArray, n: usize) -> Result<Vec<Option<String>>, String> {
-    if contacts.shape != [n] {
+    per_frame(
+        contacts,
+        n,
+        ("contacts", "contact"),
+        |t| Some(t.to_string()),
+        |x| (x >= 0.0).then(|| format!("{x:.0}")),
+    )
+}
+
+/// One value a frame from an array of `n` strings or integers (`names`: the array's and one
+/// value's, for messages), each string through `text` and each integer through `integer`.
+fn per_frame<T>(
+    array: &NpyArray,
+    n: usize,
+    (array_name, value_name): (&str, &str),
+    text: impl Fn(&str) -> T,
+    integer: impl Fn(f64) -> T,
+) -> Result<Vec<T>, String> {
+    if array.shape != [n] {
         return Err(format!(
-            "the contacts array has shape {:?}, the frames {n} frames: expected shape ({n},)",
-            contacts.shape
+            "the {array_name} array has shape {:?}, the frames {n} frames: expected shape ({n},)",
+            array.shape
         ));
     }
-    match &contacts.values {
-        NpyValues::Texts(texts) => Ok(texts.iter().map(|t| Some(t.clone())).collect()),
+    match &array.values {
+        NpyValues::Texts(texts) => Ok(texts.iter().map(|t| text(t)).collect()),
         NpyValues::Numbers(numbers) => numbers
             .iter()
             .map(|&x| match x.fract() == 0.0 && x.is_finite() {
-                true => Ok((x >= 0.0).then(|| format!("{x:.0}"))),
-                false => Err(format!("contact {x} is neither a string nor an integer")),
+                true => Ok(integer(x)),
+                false => Err(format!("{value_name} {x} is neither a string nor an integer")),
             })
             .collect(),
     }
