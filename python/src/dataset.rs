@@ -32,6 +32,15 @@ impl Dataset {
         let items = self.inner.readings().iter().map(column).collect();
         Ok(array::strings(py, items)?.unbind())
     }
+
+    /// An int64 column of every reading.
+    fn integers<'py>(
+        &self,
+        py: Python<'py>,
+        column: impl Fn(&Reading) -> i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        array::from_i64(py, self.inner.readings().iter().map(column).collect())
+    }
 }
 
 #[pymethods]
@@ -198,13 +207,7 @@ impl Dataset {
 
     #[getter]
     fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let values = self
-            .inner
-            .readings()
-            .iter()
-            .map(|r| i64::from(r.iterations))
-            .collect();
-        array::from_i64(py, values)
+        self.integers(py, |r| i64::from(r.iterations))
     }
 
     /// The press each reading is one frame of (a recording's contact, numbered from 0 in the
@@ -212,13 +215,7 @@ impl Dataset {
     /// `dataset export`'s npz.
     #[getter]
     fn contact<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let values = self
-            .inner
-            .readings()
-            .iter()
-            .map(Reading::contact_number)
-            .collect();
-        array::from_i64(py, values)
+        self.integers(py, Reading::contact_number)
     }
 
     fn __repr__(&self) -> String {
