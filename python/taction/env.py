@@ -218,6 +218,14 @@ class ActiveTouchEnv(gymnasium.Env):
             raise taction.TactionError(f"{what}: call reset() first")
         return self._episode
 
+    @property
+    def episode(self) -> taction.TouchEpisode:
+        """The episode under way. It knows the truth (``object_index``), so a policy that reads it
+        cheats; it is here for tools that measure bounds: ``copy.copy(env.episode)`` replays its
+        touches into an episode of its own, the same to the bit, to try a touch on
+        (``examples/python/active_touch_baselines.py``'s oracle)."""
+        return self._current("episode")
+
     # The episode's candidates, repeated in order when the planner offered fewer than K.
     def _candidates(self) -> NDArray[np.float64]:
         offered = self._current("candidates").candidates

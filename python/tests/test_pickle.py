@@ -1,5 +1,5 @@
-"""Every public class pickles, and `copy.deepcopy` copies it, keeping what matters: the same
-readings, images and probabilities, bit for bit, and the same behaviour after the copy."""
+"""Every public class pickles, and `copy.deepcopy` and `copy.copy` copy it, keeping what matters:
+the same readings, images and probabilities, bit for bit, and the same behaviour after the copy."""
 
 import copy
 import pickle
@@ -12,6 +12,8 @@ import taction
 COPIES = {
     "pickle": lambda value: pickle.loads(pickle.dumps(value)),
     "deepcopy": copy.deepcopy,
+    # A shallow copy shares the arguments (an episode's model) and replays the state.
+    "copy": copy.copy,
 }
 
 
