@@ -65,12 +65,10 @@ impl ObjectModels {
     pub fn log_likelihoods(&self, u: &ClusterHistogram) -> Vec<f64> {
         debug_assert_eq!(u.clusters(), self.clusters());
         if self.rule() == EvidenceRule::PerFrame {
-            let log_sums = u.log_sums();
-            assert!(
-                log_sums.is_some(),
-                "a per-frame model decides from a histogram made by ObjectModels::empty_histogram"
-            );
-            return log_sums.map(<[f64]>::to_vec).unwrap_or_default();
+            return u
+                .log_sums()
+                .expect("a per-frame model decides from a histogram made by ObjectModels::empty_histogram")
+                .to_vec();
         }
         (0..self.objects().len())
             .map(|j| {
