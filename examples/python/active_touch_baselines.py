@@ -168,36 +168,34 @@ def at_budget(truth, trace, budget, declare_at):
     return guess == truth, False, None
 
 
-def by_budget(args, model, settings):
-    """``--by-budget``: every budget from 1 to ``--budget`` from one run per episode."""
+def by_budget(args, model, settings, seeds):
+    """``--by-budget``: every budget from 1 to ``--budget`` from one run per episode of ``seeds``."""
     rows = []
     rates = {}
-    ends_of = {}
-    seeds = episode_seeds(args)
+    traces_of = {}  # per policy, every episode's (truth, trace)
     for policy, local_probability in settings.items():
         env = gymnasium.make(f"taction/ActiveTouch-{args.env}", objects=args.objects, model=model,
                              budget=args.budget, local_probability=local_probability)
         rng = np.random.default_rng(7)
         start = time.perf_counter()
-        traces = [run_trace(env, policy, seed, episode, rng) for seed, episode in seeds]
-        rates[policy] = sum(len(t) for _, t in traces) / (time.perf_counter() - start)
+        traces_of[policy] = [run_trace(env, policy, seed, episode, rng) for seed, episode in seeds]
+        rates[policy] = sum(len(t) for _, t in traces_of[policy]) / (time.perf_counter() - start)
         env.close()
-        ends_of[policy] = [
-            [at_budget(truth, trace, budget, args.declare_at) for truth, trace in traces]
-            for budget in range(1, args.budget + 1)
-        ]
-        ends_of[policy, "truths"] = [truth for truth, _ in traces]
+
+    def ends_at(policy, budget):
+        return [at_budget(truth, trace, budget, args.declare_at) for truth, trace in traces_of[policy]]
+
     baseline = "random" if "random" in settings else None
     for policy in settings:
         for budget in range(1, args.budget + 1):
-            ends = ends_of[policy][budget - 1]
+            ends = ends_at(policy, budget)
             rights = [int(e[0]) for e in ends]
             declared = [e for e in ends if e[1]]
             low, high = wilson(sum(rights), len(rights))
             if baseline is None:
                 diff = (float("nan"),) * 3
             else:
-                diff = paired_difference(rights, [int(e[0]) for e in ends_of[baseline][budget - 1]])
+                diff = paired_difference(rights, [int(e[0]) for e in ends_at(baseline, budget)])
             rows.append({
                 "policy": policy, "budget": budget, "episodes": len(ends),
                 "first_seed": args.first_seed, "balanced": int(args.balanced),
@@ -210,9 +208,9 @@ def by_budget(args, model, settings):
     write_csv(args.out, rows)
     per_object = []
     for policy in settings:
-        truths = ends_of[policy, "truths"]
+        truths = [truth for truth, _ in traces_of[policy]]
         for budget in sorted({min(b, args.budget) for b in (6, 10, args.budget)}):
-            ends = ends_of[policy][budget - 1]
+            ends = ends_at(policy, budget)
             for name in sorted(set(truths)):
                 mine = [int(e[0]) for e, t in zip(ends, truths) if t == name]
                 per_object.append({"policy": policy, "budget": budget, "object": name,
@@ -285,8 +283,9 @@ def main(argv=None):
 
     model = default_model(args.objects, args.training_readings, seed=1)
     settings = dict(POLICIES[n] for n in names)
+    seeds = episode_seeds(args)
     if args.by_budget:
-        by_budget(args, model, settings)
+        by_budget(args, model, settings, seeds)
         return
     rows = []
     table = []
@@ -301,8 +300,7 @@ def main(argv=None):
         rng = np.random.default_rng(7)
         start = time.perf_counter()
         results = [
-            run_episode(env, policy, seed, episode, args.declare_at, rng)
-            for seed, episode in episode_seeds(args)
+            run_episode(env, policy, seed, episode, args.declare_at, rng) for seed, episode in seeds
         ]
         seconds = time.perf_counter() - start
         steps = sum(r["steps"] for r in results)
@@ -320,7 +318,7 @@ def main(argv=None):
             )
         )
         rows += [{"policy": policy, "episode": i, "seed": seed, **r}
-                 for i, ((seed, _), r) in enumerate(zip(episode_seeds(args), results))]
+                 for i, ((seed, _), r) in enumerate(zip(seeds, results))]
         env.close()
 
     write_csv(args.out, rows)
